@@ -1,0 +1,12 @@
+# Generates a C++ source holding every scenes/*.toml as a string (the built-in scenes).
+file(GLOB scenes ${SRC_DIR}/scenes/*.toml)
+list(SORT scenes)
+set(body "// Generated from scenes/*.toml by apps/embed_scenes.cmake; do not edit.\n#include <map>\n#include <string>\nnamespace mlc::apps::detail {\nconst std::map<std::string, std::string>& builtin_scenes() {\n  static const std::map<std::string, std::string> s = {\n")
+foreach(f ${scenes})
+  get_filename_component(name ${f} NAME_WE)
+  file(READ ${f} content)
+  string(APPEND body "    {\"${name}\", R\"mlcscene(${content})mlcscene\"},\n")
+endforeach()
+string(APPEND body "  };\n  return s;\n}\n}\n")
+file(WRITE ${OUT}.tmp "${body}")
+execute_process(COMMAND ${CMAKE_COMMAND} -E copy_if_different ${OUT}.tmp ${OUT})

@@ -1,0 +1,214 @@
+// SPDX-License-Identifier: MIT
+// Report and result files of a run.
+#include "apps/output.hpp"
+
+#include "core/check.hpp"
+#include "mesh/io/vtu.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace mlc::apps {
+
+namespace {
+
+void require_finite(double v, const std::string& what) {
+    if (!std::isfinite(v))
+        throw SolverBreakdown("refusing to write a non-finite value (" + what +
+                              "): the solve produced NaN/Inf");
+}
+
+const char* plane_name(const levels::Problem& p) {
+    return p.bodies.front().material.plane == fem::Plane::strain ? "plane strain" : "plane stress";
+}
+
+} // namespace
+
+void print_header(std::ostream& os, const levels::Problem& p, const levels::RunResult& r) {
+    const auto& L = r.finest();
+    os << "scene      " << p.name << (p.units.empty() ? "" : "  [units: " + p.units + "]") << "\n";
+    if (!p.description.empty()) os << "           " << p.description << "\n";
+    for (const auto& b : p.bodies) os << "body       " << b.name << ": " << b.material << "\n";
+    os << "mesh       level " << r.levels.size() - 1 << ": " << L.mesh.n_vertices() << " vertices, "
+       << L.mesh.n_triangles() << " triangles (" << plane_name(p) << ")\n";
+    os << "unknowns   " << L.n_unknowns() << " (" << L.dofs.n_displacement_dofs()
+       << " displacement, " << L.n_unknowns() - L.dofs.n_displacement_dofs() << " multipliers), "
+       << L.n_contact_nodes() << " contact nodes\n";
+    for (const auto& c : p.contacts)
+        os << "contact    " << c.name << ": nodes on '" << c.contactor << "' against "
+           << *c.obstacle << ", mu = " << c.mu << ", r = " << c.r << "\n";
+    os << "loading    " << p.load_steps << " proportional load step(s); Newton " << p.newton
+       << "\n";
+}
+
+StateChecks check_state(const levels::Problem& p, const levels::RunResult& r) {
+    StateChecks c;
+    const auto& L = r.finest();
+    c.force_balance = levels::force_balance_error(L, 1.0, r.u_full, r.nodes);
+    double lmax = 0.0;
+    for (const auto& n : r.nodes) lmax = std::max(lmax, std::abs(n.lambda_n));
+    const double umax = r.u_full.size() ? r.u_full.cwiseAbs().maxCoeff() : 0.0;
+    for (size_t e = 0; e < r.nodes.size(); ++e) {
+        const auto& n = r.nodes[e];
+        const double mu = p.contacts[static_cast<size_t>(L.contacts[e].pair)].mu;
+        const double excess = std::abs(n.lambda_t) - mu * std::abs(n.lambda_n);
+        c.coulomb_excess = std::max(c.coulomb_excess, std::max(excess, 0.0));
+        if (L.contacts[e].frictional() && (n.status == contact::Status::slip_forward ||
+                                           n.status == contact::Status::slip_backward))
+            c.slip_equality = std::max(c.slip_equality, std::abs(excess));
+        c.complementarity = std::max(c.complementarity, std::abs(n.lambda_n * n.d_n));
+        c.penetration = std::max(c.penetration, std::max(-n.d_n, 0.0));
+        c.tension = std::max(c.tension, std::max(n.lambda_n, 0.0));
+    }
+    if (lmax > 0) {
+        c.coulomb_excess /= lmax;
+        c.slip_equality /= lmax;
+        c.tension /= lmax;
+        if (umax > 0) c.complementarity /= lmax * umax;
+    }
+    if (umax > 0) c.penetration /= umax;
+    return c;
+}
+
+void print_summary(std::ostream& os, const levels::Problem& p, const levels::RunResult& r) {
+    os << "\n step   load  newton  lin.it  residual    gap  stick  slip+  slip-   time[s]\n";
+    for (const auto& s : r.steps)
+        os << std::setw(5) << s.step << std::setw(7) << std::fixed << std::setprecision(3)
+           << s.load_factor << std::setw(8) << s.iterations << std::setw(8)
+           << s.linear_iterations << "  " << std::scientific << std::setprecision(2)
+           << s.residuals.back() << std::setw(7) << s.counts.gap << std::setw(7) << s.counts.stick
+           << std::setw(7) << s.counts.slip_forward << std::setw(7) << s.counts.slip_backward
+           << std::setw(10) << std::fixed << std::setprecision(3) << s.seconds
+           << (s.converged ? "" : "  no conv") << "\n";
+    os << std::defaultfloat;
+    if (r.converged) {
+        const StateChecks c = check_state(p, r);
+        os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1)
+           << c.force_balance << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| "
+           << c.slip_equality << "  complementarity " << c.complementarity << "  penetration "
+           << c.penetration << std::defaultfloat << "\n";
+    }
+    os << "\ntimings\n";
+    r.timings.print(os);
+}
+
+void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
+                   const levels::RunResult& r) {
+    const auto& L = r.finest();
+    std::filesystem::create_directories(dir);
+    // Check everything first so that no partial result set is left behind.
+    for (Index i = 0; i < r.u_full.size(); ++i) require_finite(r.u_full[i], "displacement");
+    for (const auto& n : r.nodes) {
+        require_finite(n.lambda_t, "lambda_t");
+        require_finite(n.lambda_n, "lambda_n");
+    }
+    for (const auto& s : r.steps)
+        for (double v : s.residuals) require_finite(v, "Newton residual");
+    const auto stresses = fem::triangle_stresses(L.mesh, L.materials, r.u_full);
+    for (double v : stresses) require_finite(v, "stress");
+
+    {   // contact.csv: one row per contact node of the final state.
+        std::ofstream f(dir / "contact.csv");
+        f << "x,y,ux,uy,lambda_t,lambda_n,status\n" << std::setprecision(17);
+        for (const auto& n : r.nodes)
+            f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << ","
+              << n.lambda_t << "," << n.lambda_n << "," << contact::to_string(n.status) << "\n";
+        MLC_CHECK(f.good(), "cannot write " << (dir / "contact.csv").string());
+    }
+    {   // summary.json
+        toml::table root;
+        root.insert("scene", p.name);
+        root.insert("units", p.units);
+        root.insert("level", static_cast<int64_t>(r.levels.size() - 1));
+        root.insert("unknowns", static_cast<int64_t>(L.n_unknowns()));
+        root.insert("displacement_unknowns", static_cast<int64_t>(L.dofs.n_displacement_dofs()));
+        root.insert("contact_nodes", static_cast<int64_t>(L.n_contact_nodes()));
+        root.insert("vertices", static_cast<int64_t>(L.mesh.n_vertices()));
+        root.insert("triangles", static_cast<int64_t>(L.mesh.n_triangles()));
+        root.insert("converged", r.converged);
+        toml::array steps;
+        int total_newton = 0;
+        for (const auto& s : r.steps) {
+            toml::table t;
+            t.insert("step", static_cast<int64_t>(s.step));
+            t.insert("load_factor", s.load_factor);
+            t.insert("converged", s.converged);
+            t.insert("newton_iterations", static_cast<int64_t>(s.iterations));
+            t.insert("linear_iterations", static_cast<int64_t>(s.linear_iterations));
+            toml::array res;
+            for (double v : s.residuals) res.push_back(v);
+            t.insert("residuals", res);
+            toml::array ch;
+            for (int v : s.status_changes) ch.push_back(static_cast<int64_t>(v));
+            t.insert("status_changes", ch);
+            toml::table st;
+            st.insert("gap", static_cast<int64_t>(s.counts.gap));
+            st.insert("stick", static_cast<int64_t>(s.counts.stick));
+            st.insert("slip_forward", static_cast<int64_t>(s.counts.slip_forward));
+            st.insert("slip_backward", static_cast<int64_t>(s.counts.slip_backward));
+            t.insert("statuses", st);
+            t.insert("seconds", s.seconds);
+            if (!s.message.empty()) t.insert("message", s.message);
+            steps.push_back(t);
+            total_newton += s.iterations;
+        }
+        root.insert("steps", steps);
+        root.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
+        if (r.converged) {
+            const StateChecks c = check_state(p, r);
+            toml::table ct;
+            ct.insert("force_balance", c.force_balance);
+            ct.insert("coulomb_excess", c.coulomb_excess);
+            ct.insert("slip_equality", c.slip_equality);
+            ct.insert("complementarity", c.complementarity);
+            ct.insert("penetration", c.penetration);
+            root.insert("checks", ct);
+        }
+        toml::table tt;
+        for (const auto& [name, e] : r.timings.table()) tt.insert(name, e.seconds);
+        root.insert("timings_seconds", tt);
+        std::ofstream f(dir / "summary.json");
+        f << toml::json_formatter{root} << "\n";
+        MLC_CHECK(f.good(), "cannot write " << (dir / "summary.json").string());
+    }
+    {   // solution.vtu
+        const int nv = L.mesh.n_vertices();
+        mesh::Field disp{"displacement", 2, std::vector<double>(r.u_full.data(), r.u_full.data() + r.u_full.size())};
+        mesh::Field status{"contact_status", 1, std::vector<double>(static_cast<size_t>(nv), -1.0)};
+        mesh::Field force{"contact_force", 2, std::vector<double>(static_cast<size_t>(2 * nv), 0.0)};
+        mesh::Field lt{"lambda_t", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
+        mesh::Field ln{"lambda_n", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
+        for (size_t e = 0; e < r.nodes.size(); ++e) {
+            const auto& n = r.nodes[e];
+            const auto& el = L.contacts[e];
+            const size_t v = static_cast<size_t>(n.vertex);
+            status.values[v] = static_cast<double>(static_cast<int>(n.status));
+            // Force the obstacle/target exerts on the body: -(lambda_t t + lambda_n n).
+            const Vec2 f = -(n.lambda_t * el.t + n.lambda_n * el.n);
+            force.values[2 * v] = f.x();
+            force.values[2 * v + 1] = f.y();
+            lt.values[v] = n.lambda_t;
+            ln.values[v] = n.lambda_n;
+        }
+        mesh::Field stress{"stress", 3, stresses};
+        mesh::Field vm{"von_mises", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()))};
+        mesh::Field body{"body", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()), 0.0)};
+        for (int t = 0; t < L.mesh.n_triangles(); ++t) {
+            const double sx = stresses[static_cast<size_t>(3 * t)], sy = stresses[static_cast<size_t>(3 * t + 1)],
+                         sxy = stresses[static_cast<size_t>(3 * t + 2)];
+            const auto& m = fem::material_of(L.mesh, L.materials, t);
+            // Plane strain: sigma_zz = nu (sx + sy); plane stress: 0.
+            const double sz = m.plane == fem::Plane::strain ? m.nu * (sx + sy) : 0.0;
+            vm.values[static_cast<size_t>(t)] = std::sqrt(
+                0.5 * ((sx - sy) * (sx - sy) + (sy - sz) * (sy - sz) + (sz - sx) * (sz - sx)) +
+                3.0 * sxy * sxy);
+            if (!L.mesh.attribute.empty()) body.values[static_cast<size_t>(t)] = L.mesh.attribute[static_cast<size_t>(t)];
+        }
+        mesh::write_vtu(dir / "solution.vtu", L.mesh, {disp, status, force, lt, ln}, {stress, vm, body});
+    }
+}
+
+} // namespace mlc::apps

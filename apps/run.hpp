@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: MIT
+/// @file The `mlcontact run` command: load a scene, apply command-line overrides, solve, report,
+/// write the result files.
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+
+namespace mlc::apps {
+
+/// Options of `mlcontact run`.
+struct RunOptions {
+    std::string scene = "square";     ///< file path or built-in scene name
+    std::optional<int> levels;        ///< overrides [scene].levels
+    std::optional<double> mu;         ///< overrides mu of every contact pair
+    std::optional<double> r;          ///< overrides r of every contact pair
+    std::optional<int> load_steps;    ///< overrides [scene].load_steps
+    std::string out;                  ///< output folder; empty: out/<scene name>
+    bool quiet = false;               ///< no per-step progress
+};
+
+/// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not
+/// converge (the report says which and how). Throws InvalidInput for bad input.
+int run_scene(const RunOptions& opt, std::ostream& os);
+
+} // namespace mlc::apps

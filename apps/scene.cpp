@@ -1,0 +1,461 @@
+// SPDX-License-Identifier: MIT
+// Scene parsing with toml++; every key is checked against the schema documented in README.md.
+#include "apps/scene.hpp"
+
+#include "core/check.hpp"
+#include "mesh/mesh.hpp"
+#ifdef MLC_HAVE_CGAL
+#include "mesh/cgal/domain_mesher.hpp"
+#endif
+#include "mesh/io/gmsh.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace mlc::apps {
+
+namespace detail {
+const std::map<std::string, std::string>& builtin_scenes(); // generated
+} // namespace detail
+
+namespace {
+
+using levels::Problem;
+
+/// Parsing context: the origin for messages and typed getters that fail with file:line.
+class Reader {
+public:
+    explicit Reader(std::string origin) : origin_(std::move(origin)) {}
+
+    [[noreturn]] void fail(const toml::node* n, const std::string& msg) const {
+        std::ostringstream os;
+        os << origin_;
+        if (n && n->source().begin.line > 0) os << ":" << n->source().begin.line;
+        os << ": " << msg;
+        throw InvalidInput(os.str());
+    }
+
+    void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
+                    const std::string& where) const {
+        for (auto&& [k, v] : t) {
+            bool ok = false;
+            for (auto a : allowed) ok = ok || k.str() == a;
+            if (!ok) {
+                std::string list;
+                for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+                std::ostringstream os;
+                os << origin_ << ":" << k.source().begin.line << ": unknown key '" << k.str()
+                   << "' in " << where << " (allowed: " << list << ")";
+                throw InvalidInput(os.str());
+            }
+        }
+    }
+
+    const toml::node* need(const toml::table& t, std::string_view key, const std::string& where) const {
+        const toml::node* n = t.get(key);
+        if (!n) fail(&t, "missing key '" + std::string(key) + "' in " + where);
+        return n;
+    }
+
+    double number(const toml::node* n, const std::string& what) const {
+        if (auto d = n->value_exact<double>()) return finite(*d, n, what);
+        if (auto i = n->value_exact<int64_t>()) return static_cast<double>(*i);
+        fail(n, what + " must be a number, found " + type_name(n));
+    }
+    double number(const toml::table& t, std::string_view key, const std::string& where) const {
+        return number(need(t, key, where), where + "." + std::string(key));
+    }
+    double number_or(const toml::table& t, std::string_view key, double dflt,
+                     const std::string& where) const {
+        const toml::node* n = t.get(key);
+        return n ? number(n, where + "." + std::string(key)) : dflt;
+    }
+    std::optional<double> optional_number(const toml::table& t, std::string_view key,
+                                          const std::string& where) const {
+        const toml::node* n = t.get(key);
+        if (!n) return std::nullopt;
+        return number(n, where + "." + std::string(key));
+    }
+    int integer(const toml::node* n, const std::string& what) const {
+        if (auto i = n->value_exact<int64_t>()) {
+            if (*i < -1000000000 || *i > 1000000000) fail(n, what + " is out of range");
+            return static_cast<int>(*i);
+        }
+        fail(n, what + " must be an integer, found " + type_name(n));
+    }
+    int integer_or(const toml::table& t, std::string_view key, int dflt, const std::string& where) const {
+        const toml::node* n = t.get(key);
+        return n ? integer(n, where + "." + std::string(key)) : dflt;
+    }
+    std::string string(const toml::node* n, const std::string& what) const {
+        if (auto s = n->value_exact<std::string>()) return *s;
+        fail(n, what + " must be a string, found " + type_name(n));
+    }
+    std::string string(const toml::table& t, std::string_view key, const std::string& where) const {
+        return string(need(t, key, where), where + "." + std::string(key));
+    }
+    std::string string_or(const toml::table& t, std::string_view key, std::string dflt,
+                          const std::string& where) const {
+        const toml::node* n = t.get(key);
+        return n ? string(n, where + "." + std::string(key)) : dflt;
+    }
+    bool boolean_or(const toml::table& t, std::string_view key, bool dflt, const std::string& where) const {
+        const toml::node* n = t.get(key);
+        if (!n) return dflt;
+        if (auto b = n->value_exact<bool>()) return *b;
+        fail(n, where + "." + std::string(key) + " must be true or false, found " + type_name(n));
+    }
+    Vec2 vec2(const toml::node* n, const std::string& what) const {
+        const toml::array* a = n->as_array();
+        if (!a || a->size() != 2) fail(n, what + " must be an array of two numbers [x, y]");
+        return {number(a->get(0), what + "[0]"), number(a->get(1), what + "[1]")};
+    }
+    Vec2 vec2(const toml::table& t, std::string_view key, const std::string& where) const {
+        return vec2(need(t, key, where), where + "." + std::string(key));
+    }
+    const toml::table& table(const toml::node* n, const std::string& what) const {
+        const toml::table* t = n->as_table();
+        if (!t) fail(n, what + " must be a table, found " + type_name(n));
+        return *t;
+    }
+    /// An array of tables ([[name]]) or a single table; empty when absent.
+    std::vector<const toml::table*> tables(const toml::table& t, std::string_view key,
+                                           const std::string& where) const {
+        std::vector<const toml::table*> out;
+        const toml::node* n = t.get(key);
+        if (!n) return out;
+        if (const toml::array* a = n->as_array()) {
+            for (const auto& e : *a) out.push_back(&table(&e, where + "." + std::string(key)));
+        } else {
+            out.push_back(&table(n, where + "." + std::string(key)));
+        }
+        return out;
+    }
+    const std::string& origin() const { return origin_; }
+
+private:
+    double finite(double d, const toml::node* n, const std::string& what) const {
+        if (!std::isfinite(d)) fail(n, what + " must be finite");
+        return d;
+    }
+    static std::string type_name(const toml::node* n) {
+        switch (n->type()) {
+        case toml::node_type::string: return "a string";
+        case toml::node_type::integer: return "an integer";
+        case toml::node_type::floating_point: return "a number";
+        case toml::node_type::boolean: return "a boolean";
+        case toml::node_type::array: return "an array";
+        case toml::node_type::table: return "a table";
+        default: return "a date/time";
+        }
+    }
+    std::string origin_;
+};
+
+/// Wraps a library InvalidInput with the scene position of the entry that caused it.
+template <class F>
+auto at(const Reader& rd, const toml::node* n, F&& f) {
+    try {
+        return f();
+    } catch (const InvalidInput& e) {
+        rd.fail(n, e.what());
+    }
+}
+
+#ifdef MLC_HAVE_CGAL
+mesh::Segment parse_segment(const Reader& rd, const toml::table& t, const std::string& where) {
+    rd.check_keys(t, {"type", "from", "to", "center", "ccw", "tag"}, where);
+    mesh::Segment s;
+    const std::string type = rd.string(t, "type", where);
+    s.from = rd.vec2(t, "from", where);
+    s.to = rd.vec2(t, "to", where);
+    s.tag = rd.string(t, "tag", where);
+    if (type == "line") {
+        s.kind = mesh::Segment::Kind::line;
+        if (t.get("center") || t.get("ccw")) rd.fail(&t, where + ": a line takes no center or ccw");
+    } else if (type == "arc") {
+        s.kind = mesh::Segment::Kind::arc;
+        s.center = rd.vec2(t, "center", where);
+        s.radius = (s.from - s.center).norm();
+        s.ccw = rd.boolean_or(t, "ccw", true, where);
+    } else {
+        rd.fail(t.get("type"), where + ".type must be \"line\" or \"arc\", found \"" + type + "\"");
+    }
+    return s;
+}
+#endif
+
+mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string& where,
+                      const std::filesystem::path& base_dir) {
+    const std::string type = rd.string(t, "type", where);
+    if (type == "rectangle") {
+        rd.check_keys(t, {"type", "corner", "size", "divisions", "diagonal"}, where);
+        const Vec2 corner = rd.vec2(t, "corner", where);
+        const Vec2 size = rd.vec2(t, "size", where);
+        const toml::node* dn = rd.need(t, "divisions", where);
+        const toml::array* da = dn->as_array();
+        if (!da || da->size() != 2) rd.fail(dn, where + ".divisions must be [nx, ny]");
+        const int nx = rd.integer(da->get(0), where + ".divisions[0]");
+        const int ny = rd.integer(da->get(1), where + ".divisions[1]");
+        const std::string diag = rd.string_or(t, "diagonal", "right", where);
+        mesh::Diagonal d = mesh::Diagonal::right;
+        if (diag == "left")
+            d = mesh::Diagonal::left;
+        else if (diag == "alternate")
+            d = mesh::Diagonal::alternate;
+        else if (diag != "right")
+            rd.fail(t.get("diagonal"), where + ".diagonal must be \"right\", \"left\" or \"alternate\"");
+        if (nx < 1 || ny < 1 || nx > 100000 || ny > 100000)
+            rd.fail(dn, where + ".divisions must be between 1 and 100000");
+        return at(rd, &t, [&] { return mesh::structured_rectangle(corner, size, nx, ny, d); });
+    }
+    if (type == "domain") {
+#ifdef MLC_HAVE_CGAL
+        rd.check_keys(t, {"type", "max_size", "min_size", "focus", "grading", "loop"}, where);
+        mesh::SizeField sf;
+        sf.max_size = rd.number(t, "max_size", where);
+        sf.min_size = rd.number_or(t, "min_size", sf.max_size, where);
+        sf.grading = rd.number_or(t, "grading", sf.grading, where);
+        if (const toml::node* f = t.get("focus")) {
+            const toml::array* fa = f->as_array();
+            if (!fa) rd.fail(f, where + ".focus must be an array of points");
+            for (const auto& p : *fa) sf.focus.push_back(rd.vec2(&p, where + ".focus[]"));
+        }
+        std::vector<std::vector<mesh::Segment>> loops;
+        const auto loop_tables = rd.tables(t, "loop", where);
+        if (loop_tables.empty()) rd.fail(&t, where + " needs at least one [[...loop]]");
+        for (size_t i = 0; i < loop_tables.size(); ++i) {
+            const std::string lw = where + ".loop[" + std::to_string(i) + "]";
+            rd.check_keys(*loop_tables[i], {"segments"}, lw);
+            const toml::node* sn = rd.need(*loop_tables[i], "segments", lw);
+            const toml::array* sa = sn->as_array();
+            if (!sa || sa->empty()) rd.fail(sn, lw + ".segments must be a non-empty array");
+            std::vector<mesh::Segment> loop;
+            for (size_t j = 0; j < sa->size(); ++j) {
+                const std::string sw = lw + ".segments[" + std::to_string(j) + "]";
+                loop.push_back(parse_segment(rd, rd.table(sa->get(j), sw), sw));
+            }
+            loops.push_back(std::move(loop));
+        }
+        return at(rd, &t, [&] { return mesh::mesh_domain(loops, sf); });
+#else
+        rd.fail(&t, where + ": type \"domain\" needs CGAL (this build has MLC_WITH_CGAL=OFF)");
+#endif
+    }
+    if (type == "gmsh") {
+        rd.check_keys(t, {"type", "file", "surface"}, where);
+        std::filesystem::path file = rd.string(t, "file", where);
+        if (file.is_relative() && !base_dir.empty()) file = base_dir / file;
+        const std::string surface = rd.string_or(t, "surface", "", where);
+        return at(rd, &t, [&] { return mesh::read_gmsh(file, surface); });
+    }
+    rd.fail(t.get("type"), where + ".type must be \"rectangle\", \"domain\" or \"gmsh\", found \"" + type + "\"");
+}
+
+/// Appends mesh b (body index `body`) to the merged mesh: vertices renumbered, tags merged by
+/// name, circles appended.
+void merge_into(mesh::Mesh& all, const mesh::Mesh& b, int body) {
+    const int voff = all.n_vertices();
+    const int coff = static_cast<int>(all.circles.size());
+    all.vertices.insert(all.vertices.end(), b.vertices.begin(), b.vertices.end());
+    all.circles.insert(all.circles.end(), b.circles.begin(), b.circles.end());
+    for (const auto& t : b.triangles) all.triangles.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
+    all.attribute.resize(all.triangles.size(), body);
+    for (const auto& e : b.boundary)
+        all.boundary.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)),
+                                e.curve >= 0 ? e.curve + coff : -1});
+}
+
+} // namespace
+
+levels::Problem parse_scene(const std::string& text, const std::string& origin,
+                            const std::filesystem::path& base_dir) {
+    Reader rd(origin);
+    toml::table root;
+    try {
+        root = toml::parse(text, origin);
+    } catch (const toml::parse_error& e) {
+        std::ostringstream os;
+        os << origin << ":" << e.source().begin.line << ": malformed TOML: " << e.description();
+        throw InvalidInput(os.str());
+    }
+    rd.check_keys(root, {"scene", "body", "load", "support", "contact", "newton"}, "the scene");
+    Problem p;
+    fem::Plane plane = fem::Plane::strain;
+    {
+        const toml::node* sn = rd.need(root, "scene", "the scene");
+        const toml::table& s = rd.table(sn, "[scene]");
+        rd.check_keys(s, {"name", "description", "units", "plane", "load_steps", "levels"}, "[scene]");
+        p.name = rd.string(s, "name", "[scene]");
+        p.description = rd.string_or(s, "description", "", "[scene]");
+        p.units = rd.string_or(s, "units", "", "[scene]");
+        const std::string pl = rd.string_or(s, "plane", "strain", "[scene]");
+        if (pl == "stress")
+            plane = fem::Plane::stress;
+        else if (pl != "strain")
+            rd.fail(s.get("plane"), "[scene].plane must be \"strain\" or \"stress\", found \"" + pl + "\"");
+        p.load_steps = rd.integer_or(s, "load_steps", 1, "[scene]");
+        if (p.load_steps < 1)
+            rd.fail(s.get("load_steps"), "[scene].load_steps must be at least 1, found " +
+                                             std::to_string(p.load_steps));
+        p.levels = rd.integer_or(s, "levels", 0, "[scene]");
+        if (p.levels < 0 || p.levels > 12)
+            rd.fail(s.get("levels"), "[scene].levels must lie in [0, 12]");
+    }
+    const auto bodies = rd.tables(root, "body", "the scene");
+    if (bodies.empty()) rd.fail(&root, "the scene defines no [[body]]");
+    for (size_t i = 0; i < bodies.size(); ++i) {
+        const toml::table& b = *bodies[i];
+        const std::string w = "[[body]] " + std::to_string(i + 1);
+        rd.check_keys(b, {"name", "E", "nu", "body_force", "mesh"}, w);
+        levels::Body body;
+        body.name = rd.string_or(b, "name", "body" + std::to_string(i + 1), w);
+        body.material.E = rd.number(b, "E", w);
+        body.material.nu = rd.number(b, "nu", w);
+        body.material.plane = plane;
+        at(rd, b.get("E"), [&] { body.material.validate(); return 0; });
+        if (b.get("body_force")) body.body_force = rd.vec2(b, "body_force", w);
+        const toml::node* mn = rd.need(b, "mesh", w);
+        const mesh::Mesh m = parse_mesh(rd, rd.table(mn, w + ".mesh"), w + ".mesh", base_dir);
+        merge_into(p.mesh0, m, static_cast<int>(i));
+        p.bodies.push_back(body);
+    }
+    at(rd, &root, [&] { mesh::check_quality(p.mesh0); return 0; });
+    auto check_tag = [&](const toml::table& t, const std::string& tag, const std::string& w) {
+        if (!p.mesh0.find_tag(tag)) {
+            std::string known;
+            for (const auto& [n, id] : p.mesh0.tag_names) known += (known.empty() ? "" : ", ") + n;
+            rd.fail(t.get("tag") ? t.get("tag") : &t,
+                    w + ": unknown boundary tag '" + tag + "' (the mesh has: " + known + ")");
+        }
+    };
+    for (const toml::table* lt : rd.tables(root, "load", "the scene")) {
+        const std::string w = "[[load]]";
+        rd.check_keys(*lt, {"tag", "pressure", "traction"}, w);
+        levels::Load ld;
+        ld.tag = rd.string(*lt, "tag", w);
+        check_tag(*lt, ld.tag, w);
+        ld.pressure = rd.number_or(*lt, "pressure", 0.0, w);
+        if (lt->get("traction")) ld.traction = rd.vec2(*lt, "traction", w);
+        if (!lt->get("pressure") && !lt->get("traction"))
+            rd.fail(lt, w + " needs a pressure or a traction");
+        p.loads.push_back(ld);
+    }
+    for (const toml::table* st : rd.tables(root, "support", "the scene")) {
+        const std::string w = "[[support]]";
+        rd.check_keys(*st, {"tag", "point", "ux", "uy"}, w);
+        levels::Support s;
+        if (st->get("tag") && st->get("point")) rd.fail(st, w + " takes a tag or a point, not both");
+        if (st->get("tag")) {
+            s.tag = rd.string(*st, "tag", w);
+            check_tag(*st, s.tag, w);
+        } else if (st->get("point")) {
+            s.point = rd.vec2(*st, "point", w);
+        } else {
+            rd.fail(st, w + " needs a tag or a point");
+        }
+        s.ux = rd.optional_number(*st, "ux", w);
+        s.uy = rd.optional_number(*st, "uy", w);
+        if (!s.ux && !s.uy) rd.fail(st, w + " fixes nothing: give ux and/or uy");
+        p.supports.push_back(s);
+    }
+    const double Emax = p.max_young_modulus();
+    for (const toml::table* ct : rd.tables(root, "contact", "the scene")) {
+        const std::string w = "[[contact]]";
+        rd.check_keys(*ct, {"name", "contactor", "region", "mu", "r", "r_over_E", "obstacle"}, w);
+        levels::ContactPair c;
+        c.name = rd.string_or(*ct, "name", "contact" + std::to_string(p.contacts.size() + 1), w);
+        c.contactor = rd.string(*ct, "contactor", w);
+        if (!p.mesh0.find_tag(c.contactor)) rd.fail(ct->get("contactor"), w + ": unknown contactor tag '" + c.contactor + "'");
+        c.mu = rd.number(*ct, "mu", w);
+        if (c.mu < 0) rd.fail(ct->get("mu"), w + ": friction coefficient mu must be >= 0, found " + std::to_string(c.mu));
+        if (ct->get("r") && ct->get("r_over_E")) rd.fail(ct, w + " takes r or r_over_E, not both");
+        if (ct->get("r"))
+            c.r = rd.number(*ct, "r", w);
+        else
+            c.r = rd.number_or(*ct, "r_over_E", 0.1, w) * Emax;
+        if (!(c.r > 0))
+            rd.fail(ct->get("r") ? ct->get("r") : ct->get("r_over_E"),
+                    w + ": augmentation parameter r must be > 0");
+        if (const toml::node* rn = ct->get("region")) {
+            const toml::table& rt = rd.table(rn, w + ".region");
+            rd.check_keys(rt, {"min", "max"}, w + ".region");
+            levels::Box box;
+            if (rt.get("min")) box.lo = rd.vec2(rt, "min", w + ".region");
+            if (rt.get("max")) box.hi = rd.vec2(rt, "max", w + ".region");
+            c.region = box;
+        }
+        const toml::table& ot = rd.table(rd.need(*ct, "obstacle", w), w + ".obstacle");
+        const std::string ow = w + ".obstacle";
+        const std::string type = rd.string(ot, "type", ow);
+        contact::Obstacle o;
+        if (type == "line") {
+            rd.check_keys(ot, {"type", "point", "normal"}, ow);
+            o.kind = contact::Obstacle::Kind::line;
+            o.point = rd.vec2(ot, "point", ow);
+            o.normal = rd.vec2(ot, "normal", ow);
+        } else if (type == "circle") {
+            rd.check_keys(ot, {"type", "center", "radius", "side"}, ow);
+            o.kind = contact::Obstacle::Kind::circle;
+            o.center = rd.vec2(ot, "center", ow);
+            o.radius = rd.number(ot, "radius", ow);
+            const std::string side = rd.string_or(ot, "side", "outside", ow);
+            if (side != "outside" && side != "inside")
+                rd.fail(ot.get("side"), ow + ".side must be \"outside\" or \"inside\"");
+            o.body_outside = side == "outside";
+        } else {
+            rd.fail(ot.get("type"), ow + ".type must be \"line\" or \"circle\", found \"" + type + "\"");
+        }
+        at(rd, &ot, [&] { o.validate(); return 0; });
+        c.obstacle = o;
+        p.contacts.push_back(c);
+    }
+    if (const toml::node* nn = root.get("newton")) {
+        const toml::table& nt = rd.table(nn, "[newton]");
+        rd.check_keys(nt, {"rel_tol", "max_iter"}, "[newton]");
+        p.newton.rel_tol = rd.number_or(nt, "rel_tol", p.newton.rel_tol, "[newton]");
+        p.newton.max_iter = rd.integer_or(nt, "max_iter", p.newton.max_iter, "[newton]");
+        at(rd, nn, [&] { p.newton.validate(); return 0; });
+    }
+    at(rd, &root, [&] { p.validate(); return 0; });
+    return p;
+}
+
+std::vector<std::string> builtin_scene_names() {
+    std::vector<std::string> out;
+    for (const auto& [n, t] : detail::builtin_scenes()) out.push_back(n);
+    return out;
+}
+
+std::string builtin_scene_text(const std::string& name) {
+    const auto& s = detail::builtin_scenes();
+    auto it = s.find(name);
+    return it == s.end() ? std::string() : it->second;
+}
+
+levels::Problem load_scene(const std::string& name_or_path) {
+    const std::filesystem::path path(name_or_path);
+    const bool looks_like_file = path.extension() == ".toml" || path.has_parent_path();
+    if (!looks_like_file || !std::filesystem::exists(path)) {
+        const std::string text = builtin_scene_text(name_or_path);
+        if (!text.empty()) return parse_scene(text, "builtin:" + name_or_path);
+    }
+    if (!std::filesystem::exists(path)) {
+        std::string names;
+        for (const auto& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
+        throw InvalidInput("scene '" + name_or_path +
+                           "' is neither a readable file nor a built-in scene (built-in: " + names + ")");
+    }
+    MLC_CHECK(std::filesystem::is_regular_file(path), "scene '" << name_or_path << "' is not a regular file");
+    std::ifstream in(path);
+    MLC_CHECK(in.good(), "cannot read scene file '" << name_or_path << "'");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return parse_scene(ss.str(), path.string(), path.parent_path());
+}
+
+} // namespace mlc::apps

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+/// @file Contact elements (node on rigid, node on node, node on facet): relative displacement in
+/// the local (t, n) frame, the Alart–Curnier residual, and the element tangent A_ce.
+#pragma once
+
+#include "contact/law.hpp"
+#include "contact/obstacle.hpp"
+#include "core/types.hpp"
+#include "fem/dof_map.hpp"
+#include "mesh/mesh.hpp"
+
+#include <array>
+#include <vector>
+
+namespace mlc::contact {
+
+/// One contact element: a contactor vertex and 0, 1 or 2 target vertices with weights w so that
+/// the relative displacement is u_rel = sum_j w_j u_(vertex j) (formulation.md §2):
+/// node on rigid (1), node on node (1, -1), node on facet (1, -(1-alpha), -alpha).
+struct ContactElement {
+    int n_nodes = 1;                           ///< 1, 2 or 3
+    std::array<int, 3> vertex{-1, -1, -1};     ///< vertex[0] is the contactor node
+    std::array<double, 3> weight{1.0, 0.0, 0.0};
+    Vec2 n = Vec2(0.0, 1.0);                   ///< unit normal of the target, toward the contactor
+    Vec2 t = Vec2(1.0, 0.0);                   ///< t = (n_y, -n_x)
+    double g0 = 0.0;                           ///< initial normal gap (>= 0 apart)
+    double mu = 0.0;                           ///< Coulomb coefficient (0: frictionless)
+    double r = 1.0;                            ///< augmentation parameter (force / length)
+    int pair = 0;                              ///< index of the contact pair in the scene
+    /// Frictional elements carry (lambda_t, lambda_n); frictionless ones lambda_n only.
+    bool frictional() const { return mu > 0.0; }
+    int n_multipliers() const { return frictional() ? 2 : 1; }
+};
+
+/// Node-on-rigid elements for the given contactor vertices against an obstacle.
+std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector<int>& contactors,
+                                          const Obstacle& obstacle, double mu, double r, int pair);
+
+/// Local state of an element at (u, lambda).
+struct ElementState {
+    double d_n = 0.0;        ///< normal gap g0 + n . u_rel
+    double d_t = 0.0;        ///< slip increment t . (u_rel - u_rel_prev)
+    Eigen::Vector2d lambda = Eigen::Vector2d::Zero(); ///< (lambda_t, lambda_n)
+    Projection proj;          ///< Phi(lambda + r d) and M
+};
+
+/// Evaluates element e: relative displacements from the full nodal displacement vectors
+/// (2 per vertex) of the current iterate and of the previous converged load step, and the
+/// multipliers from the unknowns x at `lambda_dof` (lambda_t then lambda_n, or lambda_n alone).
+ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vector& u_prev_full,
+                      const Vector& x, int lambda_dof);
+
+/// Adds the element's residual to R: R_u += sum_j w_j (Phi_t t + Phi_n n) at the free
+/// displacement unknowns of its vertices; R_lambda = -(1/r) (lambda - Phi).
+void add_residual(const ContactElement& e, const ElementState& s, const fem::DofMap& dofs,
+                  int lambda_dof, Vector& R);
+
+/// Element tangent entries (formulation.md §2) in a fixed order: every (row, col) pair of the
+/// element's free unknowns appears once, whatever the status, so the Jacobian pattern never
+/// changes. Calls `add(row, col, value)` for each.
+///   uu: w_j w_k r G M G^T, u-lambda: w_j G M, lambda-u: w_k M G^T, lambda-lambda: (M - I) / r,
+/// with G = [t n] (for frictionless elements only the n column/row and M_nn).
+template <class Add>
+void for_each_tangent_entry(const ContactElement& e, const Eigen::Matrix2d& M,
+                            const fem::DofMap& dofs, int lambda_dof, Add&& add) {
+    Eigen::Matrix2d G;
+    G.col(0) = e.t;
+    G.col(1) = e.n;
+    const int nm = e.n_multipliers();
+    const int m0 = nm == 2 ? 0 : 1; // first local multiplier component (t or n)
+    const Eigen::Matrix2d GMGt = G * M * G.transpose();
+    const Eigen::Matrix2d GM = G * M;
+    const Eigen::Matrix2d MGt = M * G.transpose();
+    for (int j = 0; j < e.n_nodes; ++j) {
+        const int vj = e.vertex[static_cast<size_t>(j)];
+        const double wj = e.weight[static_cast<size_t>(j)];
+        for (int a = 0; a < 2; ++a) {
+            const int row = dofs.u_dof(vj, a);
+            if (row < 0) continue;
+            for (int k = 0; k < e.n_nodes; ++k) {
+                const int vk = e.vertex[static_cast<size_t>(k)];
+                const double wk = e.weight[static_cast<size_t>(k)];
+                for (int b = 0; b < 2; ++b) {
+                    const int col = dofs.u_dof(vk, b);
+                    if (col >= 0) add(row, col, wj * wk * e.r * GMGt(a, b));
+                }
+            }
+            for (int q = m0; q < 2; ++q) add(row, lambda_dof + q - m0, wj * GM(a, q));
+        }
+    }
+    for (int q = m0; q < 2; ++q) {
+        const int row = lambda_dof + q - m0;
+        for (int k = 0; k < e.n_nodes; ++k) {
+            const int vk = e.vertex[static_cast<size_t>(k)];
+            const double wk = e.weight[static_cast<size_t>(k)];
+            for (int b = 0; b < 2; ++b) {
+                const int col = dofs.u_dof(vk, b);
+                if (col >= 0) add(row, col, wk * MGt(q, b));
+            }
+        }
+        for (int p = m0; p < 2; ++p)
+            add(row, lambda_dof + p - m0, (M(q, p) - (q == p ? 1.0 : 0.0)) / e.r);
+    }
+}
+
+} // namespace mlc::contact

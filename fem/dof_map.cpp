@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// Unknown numbering.
+#include "fem/dof_map.hpp"
+
+#include "core/check.hpp"
+
+namespace mlc::fem {
+
+DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra) {
+    MLC_CHECK(fixed.size() == n_extra.size(), "DofMap: " << fixed.size() << " fixed flags for "
+                                                         << n_extra.size() << " vertices");
+    const size_t nv = fixed.size();
+    u_dof_.resize(nv);
+    extra_.assign(nv, -1);
+    int next = 0;
+    for (size_t v = 0; v < nv; ++v) {
+        for (size_t c = 0; c < 2; ++c) {
+            if (fixed[v][c]) {
+                u_dof_[v][c] = -1;
+            } else {
+                u_dof_[v][c] = next++;
+                is_u_.push_back(1);
+                owner_.push_back(static_cast<int>(v));
+                ++n_u_;
+            }
+        }
+        MLC_CHECK(n_extra[v] >= 0 && n_extra[v] <= 2, "DofMap: vertex " << v << " asks for "
+                                                                        << n_extra[v]
+                                                                        << " extra unknowns");
+        if (n_extra[v] > 0) {
+            extra_[v] = next;
+            for (int k = 0; k < n_extra[v]; ++k) {
+                is_u_.push_back(0);
+                owner_.push_back(static_cast<int>(v));
+            }
+            next += n_extra[v];
+        }
+    }
+    n_dofs_ = next;
+}
+
+void DofMap::expand(const Vector& x, const Vector& u_fixed, Vector& u_full) const {
+    const int nv = n_vertices();
+    u_full.resize(2 * nv);
+    for (int v = 0; v < nv; ++v)
+        for (int c = 0; c < 2; ++c) {
+            const int d = u_dof_[static_cast<size_t>(v)][static_cast<size_t>(c)];
+            u_full[2 * v + c] = d >= 0 ? x[d] : u_fixed[2 * v + c];
+        }
+}
+
+} // namespace mlc::fem

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+/// @file Numbering of the unknowns: free displacement components interleaved by vertex, with each
+/// vertex's extra unknowns (contact multipliers) right after its displacements.
+#pragma once
+
+#include "core/types.hpp"
+
+#include <array>
+#include <vector>
+
+namespace mlc::fem {
+
+/// Unknown numbering of one level.
+///
+/// Vertex v contributes, in this order: its free displacement components (x then y; a component
+/// fixed by a Dirichlet condition is not an unknown, `u_dof` is -1 there), then `n_extra(v)`
+/// extra unknowns (the contact multipliers (lambda_t, lambda_n), or lambda_n alone). Keeping a
+/// contact node's multipliers next to its displacements gives ILU nonzero pivots and lets block
+/// smoothers see vertex+multiplier blocks.
+class DofMap {
+public:
+    DofMap() = default;
+    /// @param fixed  fixed[v][c] true when component c of vertex v is prescribed
+    /// @param n_extra number of extra unknowns per vertex (0, 1 or 2)
+    DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra);
+
+    Index n_dofs() const { return n_dofs_; }
+    int n_vertices() const { return static_cast<int>(u_dof_.size()); }
+    /// Unknown index of component c of vertex v, or -1 if prescribed.
+    int u_dof(int v, int c) const { return u_dof_[static_cast<size_t>(v)][static_cast<size_t>(c)]; }
+    /// First extra unknown of vertex v, or -1 when it has none.
+    int extra_dof(int v) const { return extra_[static_cast<size_t>(v)]; }
+    /// Number of free displacement unknowns.
+    Index n_displacement_dofs() const { return n_u_; }
+    /// true when the unknown is a displacement component (false: a multiplier).
+    bool is_displacement(Index dof) const { return is_u_[static_cast<size_t>(dof)]; }
+    /// Vertex owning an unknown.
+    int vertex_of(Index dof) const { return owner_[static_cast<size_t>(dof)]; }
+
+    /// Full nodal displacement vector (2 per vertex, interleaved) from the unknowns x and the
+    /// prescribed values `u_fixed` (2 per vertex; read only where fixed).
+    void expand(const Vector& x, const Vector& u_fixed, Vector& u_full) const;
+
+private:
+    std::vector<std::array<int, 2>> u_dof_;
+    std::vector<int> extra_;
+    std::vector<char> is_u_;
+    std::vector<int> owner_;
+    Index n_dofs_ = 0;
+    Index n_u_ = 0;
+};
+
+} // namespace mlc::fem

@@ -1,0 +1,267 @@
+// SPDX-License-Identifier: MIT
+// Generalized Newton over contact statuses (Alart & Lebon 1995, sect. 2.3).
+#include "levels/newton.hpp"
+
+#include "core/check.hpp"
+
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace mlc::levels {
+
+void StatusCounts::add(contact::Status s) {
+    switch (s) {
+    case contact::Status::gap: ++gap; break;
+    case contact::Status::stick: ++stick; break;
+    case contact::Status::slip_forward: ++slip_forward; break;
+    case contact::Status::slip_backward: ++slip_backward; break;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
+    const SparseMatrix& K = level.elastic.K;
+    const Index n = level.n_unknowns();
+    std::vector<Triplet> trip;
+    trip.reserve(static_cast<size_t>(K.nonZeros()) + 16 * level.contacts.size());
+    for (int i = 0; i < K.outerSize(); ++i)
+        for (SparseMatrix::InnerIterator it(K, i); it; ++it) trip.emplace_back(i, it.col(), 0.0);
+    std::vector<std::pair<int, int>> centries;
+    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+    for (size_t e = 0; e < level.contacts.size(); ++e)
+        contact::for_each_tangent_entry(level.contacts[e], I, level.dofs, level.lambda_dof[e],
+                                        [&](int row, int col, double) {
+                                            trip.emplace_back(row, col, 0.0);
+                                            centries.emplace_back(row, col);
+                                        });
+    J_.resize(n, n);
+    J_.setFromTriplets(trip.begin(), trip.end());
+    J_.makeCompressed();
+    auto position = [&](int row, int col) {
+        const int* begin = J_.innerIndexPtr() + J_.outerIndexPtr()[row];
+        const int* end = J_.innerIndexPtr() + J_.outerIndexPtr()[row + 1];
+        const int* it = std::lower_bound(begin, end, col);
+        MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
+        return static_cast<int>(it - J_.innerIndexPtr());
+    };
+    kpos_.reserve(static_cast<size_t>(K.nonZeros()));
+    for (int i = 0; i < K.outerSize(); ++i)
+        for (SparseMatrix::InnerIterator it(K, i); it; ++it) kpos_.push_back(position(i, it.col()));
+    cpos_.reserve(centries.size());
+    for (auto [r, c] : centries) cpos_.push_back(position(r, c));
+}
+
+void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
+    double* v = J_.valuePtr();
+    std::fill(v, v + J_.nonZeros(), 0.0);
+    const double* kv = level_.elastic.K.valuePtr();
+    for (size_t k = 0; k < kpos_.size(); ++k) v[kpos_[k]] += kv[k];
+    size_t c = 0;
+    for (size_t e = 0; e < level_.contacts.size(); ++e)
+        contact::for_each_tangent_entry(level_.contacts[e], M[e], level_.dofs, level_.lambda_dof[e],
+                                        [&](int, int, double value) { v[cpos_[c++]] += value; });
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+class DirectSolver final : public LinearSolver {
+public:
+    SolveResult solve(const SparseMatrix& J, const Vector& b, Vector& x) override {
+        SolveResult res;
+        const double t0 = wall_seconds();
+        Jc_ = J; // column-major copy for SparseLU
+        if (!analyzed_ || !same_pattern(Jc_)) {
+            lu_.analyzePattern(Jc_);
+            outer_.assign(Jc_.outerIndexPtr(), Jc_.outerIndexPtr() + Jc_.outerSize() + 1);
+            inner_.assign(Jc_.innerIndexPtr(), Jc_.innerIndexPtr() + Jc_.nonZeros());
+            analyzed_ = true;
+        }
+        lu_.factorize(Jc_);
+        if (lu_.info() != Eigen::Success)
+            throw SolverBreakdown("SparseLU factorization failed (singular Jacobian): " +
+                                  lu_.lastErrorMessage());
+        const double t1 = wall_seconds();
+        x = lu_.solve(b);
+        res.setup_seconds = t1 - t0;
+        res.solve_seconds = wall_seconds() - t1;
+        res.converged = true;
+        res.reason = StopReason::converged;
+        res.initial_residual = b.norm();
+        res.final_residual = (b - J * x).norm();
+        res.relative_residual =
+            res.initial_residual > 0 ? res.final_residual / res.initial_residual : 0.0;
+        return res;
+    }
+    std::string name() const override { return "lu"; }
+
+private:
+    bool same_pattern(const SparseMatrixCol& A) const {
+        return static_cast<size_t>(A.nonZeros()) == inner_.size() &&
+               std::equal(outer_.begin(), outer_.end(), A.outerIndexPtr()) &&
+               std::equal(inner_.begin(), inner_.end(), A.innerIndexPtr());
+    }
+    SparseMatrixCol Jc_;
+    Eigen::SparseLU<SparseMatrixCol, Eigen::COLAMDOrdering<int>> lu_;
+    bool analyzed_ = false;
+    std::vector<int> outer_, inner_;
+};
+
+} // namespace
+
+std::unique_ptr<LinearSolver> make_direct_solver() { return std::make_unique<DirectSolver>(); }
+
+// ---------------------------------------------------------------------------------------------
+ContactNewton::ContactNewton(const Level& level, NewtonParams params,
+                             std::unique_ptr<LinearSolver> solver, Timings* timings)
+    : level_(level), params_(params), solver_(std::move(solver)), timings_(timings), jac_(level) {
+    params_.validate();
+    MLC_CHECK(solver_ != nullptr, "ContactNewton needs a linear solver");
+}
+
+double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector& x, Vector& R,
+                               std::vector<contact::Status>* st, std::vector<Eigen::Matrix2d>* M,
+                               double* scale) const {
+    const Level& L = level_;
+    const Vector u_fixed = s * L.u_fixed;
+    Vector u_full;
+    L.dofs.expand(x, u_fixed, u_full);
+    R.noalias() = L.elastic.K * x;
+    const double internal = R.norm();
+    R -= s * L.elastic.f;
+    const double load = s * L.elastic.f.norm();
+    Vector contact_force = Vector::Zero(R.size());
+    double lambda_res2 = 0.0;
+    if (st) st->resize(L.contacts.size());
+    if (M) M->resize(L.contacts.size());
+    for (size_t e = 0; e < L.contacts.size(); ++e) {
+        const auto& el = L.contacts[e];
+        const auto es = contact::evaluate(el, u_full, u_prev_full, x, L.lambda_dof[e]);
+        contact::add_residual(el, es, L.dofs, L.lambda_dof[e], contact_force);
+        // add_residual wrote the multiplier rows of contact_force; move them into R.
+        for (int q = 0; q < el.n_multipliers(); ++q) {
+            const int d = L.lambda_dof[e] + q;
+            R[d] = contact_force[d];
+            lambda_res2 += std::pow(el.r * contact_force[d], 2);
+            contact_force[d] = 0.0;
+        }
+        if (st) (*st)[e] = es.proj.status;
+        if (M) (*M)[e] = es.proj.M;
+    }
+    R += contact_force;
+    // Norm in force units: displacement rows as they are, multiplier rows times r.
+    double ru2 = 0.0;
+    for (Index i = 0; i < R.size(); ++i)
+        if (L.dofs.is_displacement(i)) ru2 += R[i] * R[i];
+    if (scale) *scale = std::max({load, internal, contact_force.norm()});
+    return std::sqrt(ru2 + lambda_res2);
+}
+
+std::vector<contact::Status> ContactNewton::statuses(double s, const Vector& u_prev_full,
+                                                     const Vector& x) const {
+    Vector R(x.size());
+    std::vector<contact::Status> st;
+    residual(s, u_prev_full, x, R, &st, nullptr, nullptr);
+    return st;
+}
+
+StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) {
+    const double t_start = wall_seconds();
+    StepReport rep;
+    rep.load_factor = s;
+    const Index n = level_.n_unknowns();
+    MLC_CHECK(x.size() == n, "Newton initial guess has " << x.size() << " entries, expected " << n);
+    Vector R(n), dx(n);
+    std::vector<contact::Status> st, st_prev;
+    std::vector<Eigen::Matrix2d> M;
+    for (int k = 0;; ++k) {
+        double scale = 0.0, norm = 0.0;
+        {
+            ScopedTimer t(timings_, "newton/residual");
+            norm = residual(s, u_prev_full, x, R, &st, &M, &scale);
+        }
+        const double rel = scale > 0 ? norm / scale : norm;
+        rep.residuals.push_back(rel);
+        int changes = 0;
+        if (k > 0)
+            for (size_t e = 0; e < st.size(); ++e) changes += st[e] != st_prev[e];
+        if (k > 0) rep.status_changes.push_back(changes);
+        if (!std::isfinite(norm)) {
+            rep.message = "the residual became NaN/Inf at Newton iteration " + std::to_string(k);
+            break;
+        }
+        if (norm <= params_.rel_tol * scale && (k == 0 || changes == 0)) {
+            rep.converged = true;
+            break;
+        }
+        if (k == params_.max_iter) {
+            std::ostringstream os;
+            os << "no convergence in " << params_.max_iter << " Newton iterations; relative "
+               << "residual went " << rep.residuals.front() << " -> " << rel << " (tolerance "
+               << params_.rel_tol << "), " << changes << " status changes in the last iteration";
+            rep.message = os.str();
+            break;
+        }
+        {
+            ScopedTimer t(timings_, "newton/jacobian");
+            jac_.assemble(M);
+        }
+        SolveResult lin;
+        {
+            ScopedTimer t(timings_, "newton/linear_solve");
+            R = -R;
+            dx.setZero();
+            lin = solver_->solve(jac_.matrix(), R, dx);
+        }
+        rep.linear_iterations += lin.iterations;
+        if (!lin.converged) {
+            rep.message = "linear solve failed at Newton iteration " + std::to_string(k) + ": " +
+                          std::string(to_string(lin.reason)) +
+                          (lin.message.empty() ? "" : " (" + lin.message + ")");
+            break;
+        }
+        x += dx;
+        st_prev = st;
+        ++rep.iterations;
+    }
+    for (const auto& ns : node_states(s, u_prev_full, x)) rep.counts.add(ns.status);
+    rep.seconds = wall_seconds() - t_start;
+    return rep;
+}
+
+std::vector<ContactNodeState> ContactNewton::node_states(double s, const Vector& u_prev_full,
+                                                         const Vector& x) const {
+    const Level& L = level_;
+    Vector u_full;
+    L.dofs.expand(x, s * L.u_fixed, u_full);
+    // Threshold below which a frictionless node is said not to move: relative to the largest
+    // displacement of the step (no absolute tolerance).
+    const double umax = (u_full - u_prev_full).cwiseAbs().maxCoeff();
+    std::vector<ContactNodeState> out;
+    out.reserve(L.contacts.size());
+    for (size_t e = 0; e < L.contacts.size(); ++e) {
+        const auto& el = L.contacts[e];
+        const auto es = contact::evaluate(el, u_full, u_prev_full, x, L.lambda_dof[e]);
+        ContactNodeState ns;
+        ns.vertex = el.vertex[0];
+        ns.x = L.mesh.vertices[static_cast<size_t>(ns.vertex)];
+        ns.u = u_full.segment<2>(2 * ns.vertex);
+        ns.lambda_t = es.lambda[0];
+        ns.lambda_n = es.lambda[1];
+        ns.d_n = es.d_n;
+        ns.d_t = es.d_t;
+        ns.status = es.proj.status;
+        if (!el.frictional() && ns.status != contact::Status::gap) {
+            if (es.d_t > 1e-9 * umax)
+                ns.status = contact::Status::slip_forward;
+            else if (es.d_t < -1e-9 * umax)
+                ns.status = contact::Status::slip_backward;
+        }
+        out.push_back(ns);
+    }
+    return out;
+}
+
+} // namespace mlc::levels

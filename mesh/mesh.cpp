@@ -1,0 +1,252 @@
+// SPDX-License-Identifier: MIT
+// Mesh queries, quality checks, uniform 1->4 refinement and structured rectangles.
+#include "mesh/mesh.hpp"
+
+#include "core/check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace mlc::mesh {
+
+int Mesh::tag(const std::string& name) const {
+    auto it = tag_names.find(name);
+    if (it == tag_names.end()) {
+        std::string known;
+        for (const auto& [n, id] : tag_names) known += (known.empty() ? "" : ", ") + n;
+        MLC_CHECK(false, "unknown boundary tag '" << name << "'; the mesh has: " << known);
+    }
+    return it->second;
+}
+
+std::optional<int> Mesh::find_tag(const std::string& name) const {
+    auto it = tag_names.find(name);
+    if (it == tag_names.end()) return std::nullopt;
+    return it->second;
+}
+
+std::string Mesh::tag_name(int t) const {
+    for (const auto& [n, id] : tag_names)
+        if (id == t) return n;
+    return "tag " + std::to_string(t);
+}
+
+int Mesh::add_tag(const std::string& name) {
+    auto it = tag_names.find(name);
+    if (it != tag_names.end()) return it->second;
+    int id = 0;
+    for (const auto& [n, t] : tag_names) id = std::max(id, t + 1);
+    tag_names[name] = id;
+    return id;
+}
+
+double Mesh::signed_area(int t) const {
+    const auto& tri = triangles[static_cast<size_t>(t)];
+    const Vec2& a = vertices[static_cast<size_t>(tri[0])];
+    const Vec2& b = vertices[static_cast<size_t>(tri[1])];
+    const Vec2& c = vertices[static_cast<size_t>(tri[2])];
+    return 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+}
+
+std::vector<int> Mesh::vertices_with_tag(int t) const {
+    std::vector<int> out;
+    for (const auto& e : boundary)
+        if (e.tag == t) {
+            out.push_back(e.v0);
+            out.push_back(e.v1);
+        }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+std::pair<double, double> Mesh::edge_length_range() const {
+    double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+    for (const auto& tri : triangles)
+        for (int k = 0; k < 3; ++k) {
+            double l = (vertices[static_cast<size_t>(tri[static_cast<size_t>(k)])] -
+                        vertices[static_cast<size_t>(tri[static_cast<size_t>((k + 1) % 3)])])
+                           .norm();
+            lo = std::min(lo, l);
+            hi = std::max(hi, l);
+        }
+    return {lo, hi};
+}
+
+double Mesh::diameter() const {
+    if (vertices.empty()) return 0.0;
+    Vec2 lo = vertices[0], hi = vertices[0];
+    for (const auto& v : vertices) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+    }
+    return (hi - lo).norm();
+}
+
+int Mesh::nearest_vertex(const Vec2& p) const {
+    int best = -1;
+    double bd = std::numeric_limits<double>::infinity();
+    for (int v = 0; v < n_vertices(); ++v) {
+        double d = (vertices[static_cast<size_t>(v)] - p).squaredNorm();
+        if (d < bd) {
+            bd = d;
+            best = v;
+        }
+    }
+    return best;
+}
+
+namespace {
+
+std::uint64_t edge_key(int a, int b) {
+    if (a > b) std::swap(a, b);
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
+           static_cast<std::uint32_t>(b);
+}
+
+} // namespace
+
+void check_quality(const Mesh& m) {
+    MLC_CHECK(m.n_triangles() > 0, "the mesh has no triangles");
+    const int nv = m.n_vertices();
+    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.triangles.size(),
+              "the mesh has " << m.attribute.size() << " triangle attributes for "
+                              << m.triangles.size() << " triangles");
+    for (const auto& v : m.vertices)
+        MLC_CHECK(std::isfinite(v.x()) && std::isfinite(v.y()), "a mesh vertex is not finite");
+    const double diam = m.diameter();
+    MLC_CHECK(diam > 0, "the mesh has zero extent");
+    for (int t = 0; t < m.n_triangles(); ++t) {
+        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        for (int k = 0; k < 3; ++k)
+            MLC_CHECK(tri[static_cast<size_t>(k)] >= 0 && tri[static_cast<size_t>(k)] < nv,
+                      "triangle " << t << " refers to vertex " << tri[static_cast<size_t>(k)]
+                                  << " but the mesh has " << nv << " vertices");
+        const double a = m.signed_area(t);
+        const Vec2& p = m.vertices[static_cast<size_t>(tri[0])];
+        MLC_CHECK(a > 1e-14 * diam * diam,
+                  "degenerate or inverted triangle " << t << " (vertices " << tri[0] << ", "
+                                                     << tri[1] << ", " << tri[2] << " near ("
+                                                     << p.x() << ", " << p.y()
+                                                     << ")): signed area " << a
+                                                     << "; triangles must be counter-clockwise "
+                                                        "with positive area");
+    }
+    // Duplicate vertices: sort by x and compare neighbours within the tolerance.
+    std::vector<int> order(static_cast<size_t>(nv));
+    for (int i = 0; i < nv; ++i) order[static_cast<size_t>(i)] = i;
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+        return m.vertices[static_cast<size_t>(a)].x() < m.vertices[static_cast<size_t>(b)].x();
+    });
+    const double tol = 1e-10 * diam;
+    for (size_t i = 0; i < order.size(); ++i)
+        for (size_t j = i + 1; j < order.size(); ++j) {
+            const Vec2& a = m.vertices[static_cast<size_t>(order[i])];
+            const Vec2& b = m.vertices[static_cast<size_t>(order[j])];
+            if (b.x() - a.x() > tol) break;
+            MLC_CHECK((a - b).norm() > tol, "duplicate vertices " << order[i] << " and " << order[j]
+                                                                 << " at (" << a.x() << ", "
+                                                                 << a.y() << ")");
+        }
+    std::unordered_map<std::uint64_t, int> edges;
+    edges.reserve(static_cast<size_t>(3 * m.n_triangles()));
+    for (const auto& tri : m.triangles)
+        for (int k = 0; k < 3; ++k)
+            ++edges[edge_key(tri[static_cast<size_t>(k)], tri[static_cast<size_t>((k + 1) % 3)])];
+    for (const auto& e : m.boundary) {
+        auto it = edges.find(edge_key(e.v0, e.v1));
+        MLC_CHECK(it != edges.end() && it->second == 1,
+                  "boundary edge (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
+                                    << "' is not a boundary edge of the triangulation");
+    }
+}
+
+Mesh refine(const Mesh& coarse) {
+    Mesh fine;
+    fine.circles = coarse.circles;
+    fine.tag_names = coarse.tag_names;
+    fine.n_coarse_vertices = coarse.n_vertices();
+    fine.vertices = coarse.vertices;
+    const size_t nt = coarse.triangles.size();
+    fine.vertices.reserve(coarse.vertices.size() + 2 * nt);
+    fine.parents.reserve(2 * nt);
+    std::unordered_map<std::uint64_t, int> midpoint;
+    midpoint.reserve(3 * nt);
+    auto mid = [&](int a, int b) {
+        auto [it, inserted] = midpoint.try_emplace(edge_key(a, b), 0);
+        if (inserted) {
+            it->second = static_cast<int>(fine.vertices.size());
+            fine.vertices.push_back(
+                0.5 * (coarse.vertices[static_cast<size_t>(a)] + coarse.vertices[static_cast<size_t>(b)]));
+            fine.parents.push_back({std::min(a, b), std::max(a, b)});
+        }
+        return it->second;
+    };
+    fine.triangles.reserve(4 * nt);
+    for (const auto& t : coarse.triangles) {
+        const int a = t[0], b = t[1], c = t[2];
+        const int ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+        fine.triangles.push_back({a, ab, ca});
+        fine.triangles.push_back({ab, b, bc});
+        fine.triangles.push_back({ca, bc, c});
+        fine.triangles.push_back({ab, bc, ca});
+    }
+    if (!coarse.attribute.empty()) {
+        fine.attribute.reserve(4 * nt);
+        for (int a : coarse.attribute)
+            for (int k = 0; k < 4; ++k) fine.attribute.push_back(a);
+    }
+    fine.boundary.reserve(2 * coarse.boundary.size());
+    for (const auto& e : coarse.boundary) {
+        const int m = mid(e.v0, e.v1);
+        if (e.curve >= 0) {
+            const Circle& c = coarse.circles[static_cast<size_t>(e.curve)];
+            Vec2& p = fine.vertices[static_cast<size_t>(m)];
+            Vec2 d = p - c.center;
+            const double n = d.norm();
+            MLC_CHECK(n > 0, "boundary edge midpoint at the centre of its circle");
+            p = c.center + (c.radius / n) * d;
+        }
+        fine.boundary.push_back({e.v0, m, e.tag, e.curve});
+        fine.boundary.push_back({m, e.v1, e.tag, e.curve});
+    }
+    return fine;
+}
+
+Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diagonal) {
+    MLC_CHECK(nx >= 1 && ny >= 1, "a structured rectangle needs at least one square each way, got "
+                                      << nx << " x " << ny);
+    MLC_CHECK(size.x() > 0 && size.y() > 0,
+              "a structured rectangle needs a positive size, got " << size.x() << " x " << size.y());
+    Mesh m;
+    m.vertices.reserve(static_cast<size_t>((nx + 1) * (ny + 1)));
+    for (int j = 0; j <= ny; ++j)
+        for (int i = 0; i <= nx; ++i)
+            m.vertices.push_back(corner + Vec2(size.x() * i / nx, size.y() * j / ny));
+    auto id = [&](int i, int j) { return j * (nx + 1) + i; };
+    m.triangles.reserve(static_cast<size_t>(2 * nx * ny));
+    for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+            bool slash = diagonal == Diagonal::right ||
+                         (diagonal == Diagonal::alternate && (i + j) % 2 == 0);
+            if (slash) {
+                m.triangles.push_back({a, b, c});
+                m.triangles.push_back({a, c, d});
+            } else {
+                m.triangles.push_back({a, b, d});
+                m.triangles.push_back({b, c, d});
+            }
+        }
+    const int bottom = m.add_tag("bottom"), right = m.add_tag("right"), top = m.add_tag("top"),
+              left = m.add_tag("left");
+    for (int i = 0; i < nx; ++i) m.boundary.push_back({id(i, 0), id(i + 1, 0), bottom, -1});
+    for (int j = 0; j < ny; ++j) m.boundary.push_back({id(nx, j), id(nx, j + 1), right, -1});
+    for (int i = nx; i > 0; --i) m.boundary.push_back({id(i, ny), id(i - 1, ny), top, -1});
+    for (int j = ny; j > 0; --j) m.boundary.push_back({id(0, j), id(0, j - 1), left, -1});
+    return m;
+}
+
+} // namespace mlc::mesh

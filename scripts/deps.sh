@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs the Debian packages mlcontact needs, only those that are missing.
+# Runs apt-get as root, or through sudo when not root.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev libhypre-dev libopenmpi-dev openmpi-bin
+  libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev
+  python3 python3-matplotlib
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "deps: all Debian packages present"
+  exit 0
+fi
+echo "deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: MIT
+// Element stiffness properties and exact patch tests of P1 elasticity.
+#include "core/check.hpp"
+#include "fem/assembly.hpp"
+
+#include <Eigen/SparseLU>
+#include <functional>
+#include "fem/elasticity.hpp"
+#include "mesh/mesh.hpp"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+using namespace mlc;
+
+TEST(ElementStiffness, RigidBodyModesAreInTheKernel) {
+    const Vec2 a(0.3, -0.2), b(2.1, 0.4), c(0.9, 1.7);
+    for (auto plane : {fem::Plane::strain, fem::Plane::stress}) {
+        fem::Material m{.E = 210e3, .nu = 0.3, .plane = plane};
+        const auto K = fem::element_stiffness(a, b, c, m);
+        Eigen::Matrix<double, 6, 3> R;
+        for (int i = 0; i < 3; ++i) {
+            const Vec2 p = i == 0 ? a : (i == 1 ? b : c);
+            R.row(2 * i) << 1, 0, -p.y();
+            R.row(2 * i + 1) << 0, 1, p.x();
+        }
+        EXPECT_LT((K * R).norm(), 1e-12 * K.norm());
+        EXPECT_LT((K - K.transpose()).norm(), 1e-14 * K.norm());
+        // Exactly three zero eigenvalues, the other three positive.
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(K);
+        const auto ev = es.eigenvalues();
+        for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(ev[i]), 1e-12 * ev[5]);
+        for (int i = 3; i < 6; ++i) EXPECT_GT(ev[i], 1e-3 * ev[5]);
+    }
+}
+
+TEST(ElementStiffness, ConstantStrainEnergyIsExact) {
+    // Energy of u = (e x, 0) on a triangle of area A: 0.5 A (lambda + 2 mu) e^2 (plane strain).
+    const Vec2 a(0, 0), b(2, 0), c(0, 1);
+    fem::Material m{.E = 100.0, .nu = 0.25};
+    const auto K = fem::element_stiffness(a, b, c, m);
+    const double e = 1e-3;
+    Eigen::Matrix<double, 6, 1> u;
+    u << e * a.x(), 0, e * b.x(), 0, e * c.x(), 0;
+    const double energy = 0.5 * u.dot(K * u);
+    const double lam = m.E * m.nu / ((1 + m.nu) * (1 - 2 * m.nu)), mu = m.E / (2 * (1 + m.nu));
+    EXPECT_NEAR(energy, 0.5 * 1.0 * (lam + 2 * mu) * e * e, 1e-15);
+}
+
+TEST(Material, RejectsOutOfRangeParameters) {
+    EXPECT_THROW((fem::Material{.E = 0.0, .nu = 0.3}.validate()), InvalidInput);
+    EXPECT_THROW((fem::Material{.E = -1.0, .nu = 0.3}.validate()), InvalidInput);
+    EXPECT_THROW((fem::Material{.E = 1.0, .nu = 0.5}.validate()), InvalidInput);
+    EXPECT_THROW((fem::Material{.E = 1.0, .nu = -1.0}.validate()), InvalidInput);
+    EXPECT_NO_THROW((fem::Material{.E = 1.0, .nu = 0.4999}.validate()));
+}
+
+namespace {
+
+/// Solves the elastic problem with the boundary displacements prescribed from u_exact on every
+/// boundary vertex; returns the max nodal error over the interior.
+double patch_error(const mesh::Mesh& m, const fem::Material& mat,
+                   const std::function<Vec2(const Vec2&)>& u_exact) {
+    std::vector<std::array<bool, 2>> fixed(static_cast<size_t>(m.n_vertices()), {false, false});
+    Vector u_fixed = Vector::Zero(2 * m.n_vertices());
+    for (const auto& e : m.boundary)
+        for (int v : {e.v0, e.v1}) {
+            fixed[static_cast<size_t>(v)] = {true, true};
+            u_fixed.segment<2>(2 * v) = u_exact(m.vertices[static_cast<size_t>(v)]);
+        }
+    fem::DofMap dofs(fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
+    const auto sys = fem::assemble_elastic(m, {mat}, dofs, Vector::Zero(2 * m.n_vertices()), u_fixed);
+    Eigen::SparseLU<SparseMatrixCol> lu(SparseMatrixCol(sys.K));
+    const Vector x = lu.solve(sys.f);
+    Vector u;
+    dofs.expand(x, u_fixed, u);
+    double err = 0;
+    for (int v = 0; v < m.n_vertices(); ++v)
+        err = std::max(err, (u.segment<2>(2 * v) - u_exact(m.vertices[static_cast<size_t>(v)])).norm());
+    return err;
+}
+
+} // namespace
+
+TEST(Assembly, LinearDisplacementPatchIsReproducedExactly) {
+    // Distorted interior vertices: P1 must still reproduce any linear field exactly.
+    mesh::Mesh m = mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 6, 4, mesh::Diagonal::alternate);
+    for (int j = 1; j < 4; ++j)
+        for (int i = 1; i < 6; ++i)
+            m.vertices[static_cast<size_t>(j * 7 + i)] += Vec2(0.07 * std::sin(i * j), 0.05 * std::cos(i + j));
+    mesh::check_quality(m);
+    auto lin = [](const Vec2& p) { return Vec2(1e-3 * (0.3 + 2 * p.x() - p.y()), 1e-3 * (0.1 + 0.5 * p.x() + 3 * p.y())); };
+    EXPECT_LT(patch_error(m, {.E = 7.0, .nu = 0.35}, lin), 1e-15);
+    EXPECT_LT(patch_error(m, {.E = 7.0, .nu = 0.35, .plane = fem::Plane::stress}, lin), 1e-15);
+}
+
+TEST(Assembly, UniaxialTractionGivesTheClosedFormExtension) {
+    // Plane stress bar [0,4]x[0,1], u_x = 0 on the left, u_y = 0 at one point, traction p on the
+    // right: u_x(L) = p L / E, u_y = -nu p y / E.
+    mesh::Mesh m = mesh::structured_rectangle(Vec2(0, 0), Vec2(4, 1), 8, 2);
+    const fem::Material mat{.E = 200.0, .nu = 0.3, .plane = fem::Plane::stress};
+    std::vector<std::array<bool, 2>> fixed(static_cast<size_t>(m.n_vertices()), {false, false});
+    for (int v : m.vertices_with_tag(m.tag("left"))) fixed[static_cast<size_t>(v)][0] = true;
+    fixed[0][1] = true;
+    fem::DofMap dofs(fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
+    const double p = 2.0;
+    const Vector F = fem::nodal_loads(m, {{.tag = m.tag("right"), .pressure = 0.0, .vector = Vec2(p, 0)}}, {});
+    EXPECT_NEAR(F.sum(), p * 1.0, 1e-14);
+    const auto sys = fem::assemble_elastic(m, {mat}, dofs, F, Vector::Zero(2 * m.n_vertices()));
+    Eigen::SparseLU<SparseMatrixCol> lu(SparseMatrixCol(sys.K));
+    Vector u;
+    dofs.expand(lu.solve(sys.f), Vector::Zero(2 * m.n_vertices()), u);
+    for (int v = 0; v < m.n_vertices(); ++v) {
+        const Vec2 x = m.vertices[static_cast<size_t>(v)];
+        EXPECT_NEAR(u[2 * v], p * x.x() / mat.E, 1e-13);
+        EXPECT_NEAR(u[2 * v + 1], -mat.nu * p * x.y() / mat.E, 1e-13);
+    }
+    const auto s = fem::triangle_stresses(m, {mat}, u);
+    for (int t = 0; t < m.n_triangles(); ++t) {
+        EXPECT_NEAR(s[static_cast<size_t>(3 * t)], p, 1e-11);
+        EXPECT_NEAR(s[static_cast<size_t>(3 * t + 1)], 0.0, 1e-11);
+    }
+}
+
+TEST(Assembly, PressureIsANormalTractionIntoTheBody) {
+    // Pressure on the top of a unit square pushes down: resultant (0, -p).
+    const mesh::Mesh m = mesh::structured_rectangle(Vec2(0, 0), Vec2(1, 1), 3, 3);
+    const Vector F = fem::nodal_loads(m, {{.tag = m.tag("top"), .pressure = 5.0, .vector = Vec2::Zero()}}, {});
+    double fx = 0, fy = 0;
+    for (int v = 0; v < m.n_vertices(); ++v) {
+        fx += F[2 * v];
+        fy += F[2 * v + 1];
+    }
+    EXPECT_NEAR(fx, 0.0, 1e-14);
+    EXPECT_NEAR(fy, -5.0, 1e-14);
+}
