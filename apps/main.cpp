@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
     run->add_option("--steps", ro.load_steps, "number of load steps");
     run->add_option("--out,-o", ro.out, "output folder (default out/<scene name>)");
     run->add_flag("--quiet,-q", ro.quiet, "no per-step progress");
+    run->add_option("--linear", ro.linear, "Newton system solver: schur (condensed, default) or lu")
+        ->check(CLI::IsMember({"schur", "lu"}));
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
@@ -37,7 +39,8 @@ int main(int argc, char** argv) {
     try {
         if (*run) return mlc::apps::run_scene(ro, std::cout);
         if (*scenes) {
-            for (const auto& n : mlc::apps::builtin_scene_names()) std::cout << n << "\n";
+            for (const auto& n : mlc::apps::builtin_scene_names())
+                std::cout << n << "\n";
             return 0;
         }
         if (*show) {

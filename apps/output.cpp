@@ -31,7 +31,8 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
     const auto& L = r.finest();
     os << "scene      " << p.name << (p.units.empty() ? "" : "  [units: " + p.units + "]") << "\n";
     if (!p.description.empty()) os << "           " << p.description << "\n";
-    for (const auto& b : p.bodies) os << "body       " << b.name << ": " << b.material << "\n";
+    for (const auto& b : p.bodies)
+        os << "body       " << b.name << ": " << b.material << "\n";
     os << "mesh       level " << r.levels.size() - 1 << ": " << L.mesh.n_vertices() << " vertices, "
        << L.mesh.n_triangles() << " triangles (" << plane_name(p) << ")\n";
     os << "unknowns   " << L.n_unknowns() << " (" << L.dofs.n_displacement_dofs()
@@ -49,7 +50,8 @@ StateChecks check_state(const levels::Problem& p, const levels::RunResult& r) {
     const auto& L = r.finest();
     c.force_balance = levels::force_balance_error(L, 1.0, r.u_full, r.nodes);
     double lmax = 0.0;
-    for (const auto& n : r.nodes) lmax = std::max(lmax, std::abs(n.lambda_n));
+    for (const auto& n : r.nodes)
+        lmax = std::max(lmax, std::abs(n.lambda_n));
     const double umax = r.u_full.size() ? r.u_full.cwiseAbs().maxCoeff() : 0.0;
     for (size_t e = 0; e < r.nodes.size(); ++e) {
         const auto& n = r.nodes[e];
@@ -77,12 +79,12 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
     os << "\n step   load  newton  lin.it  residual    gap  stick  slip+  slip-   time[s]\n";
     for (const auto& s : r.steps)
         os << std::setw(5) << s.step << std::setw(7) << std::fixed << std::setprecision(3)
-           << s.load_factor << std::setw(8) << s.iterations << std::setw(8)
-           << s.linear_iterations << "  " << std::scientific << std::setprecision(2)
-           << s.residuals.back() << std::setw(7) << s.counts.gap << std::setw(7) << s.counts.stick
-           << std::setw(7) << s.counts.slip_forward << std::setw(7) << s.counts.slip_backward
-           << std::setw(10) << std::fixed << std::setprecision(3) << s.seconds
-           << (s.converged ? "" : "  no conv") << "\n";
+           << s.load_factor << std::setw(8) << s.iterations << std::setw(8) << s.linear_iterations
+           << "  " << std::scientific << std::setprecision(2) << s.residuals.back() << std::setw(7)
+           << s.counts.gap << std::setw(7) << s.counts.stick << std::setw(7)
+           << s.counts.slip_forward << std::setw(7) << s.counts.slip_backward << std::setw(10)
+           << std::fixed << std::setprecision(3) << s.seconds << (s.converged ? "" : "  no conv")
+           << "\n";
     os << std::defaultfloat;
     if (r.converged) {
         const StateChecks c = check_state(p, r);
@@ -100,25 +102,28 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
     const auto& L = r.finest();
     std::filesystem::create_directories(dir);
     // Check everything first so that no partial result set is left behind.
-    for (Index i = 0; i < r.u_full.size(); ++i) require_finite(r.u_full[i], "displacement");
+    for (Index i = 0; i < r.u_full.size(); ++i)
+        require_finite(r.u_full[i], "displacement");
     for (const auto& n : r.nodes) {
         require_finite(n.lambda_t, "lambda_t");
         require_finite(n.lambda_n, "lambda_n");
     }
     for (const auto& s : r.steps)
-        for (double v : s.residuals) require_finite(v, "Newton residual");
+        for (double v : s.residuals)
+            require_finite(v, "Newton residual");
     const auto stresses = fem::triangle_stresses(L.mesh, L.materials, r.u_full);
-    for (double v : stresses) require_finite(v, "stress");
+    for (double v : stresses)
+        require_finite(v, "stress");
 
-    {   // contact.csv: one row per contact node of the final state.
+    { // contact.csv: one row per contact node of the final state.
         std::ofstream f(dir / "contact.csv");
         f << "x,y,ux,uy,lambda_t,lambda_n,status\n" << std::setprecision(17);
         for (const auto& n : r.nodes)
-            f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << ","
-              << n.lambda_t << "," << n.lambda_n << "," << contact::to_string(n.status) << "\n";
+            f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << "," << n.lambda_t
+              << "," << n.lambda_n << "," << contact::to_string(n.status) << "\n";
         MLC_CHECK(f.good(), "cannot write " << (dir / "contact.csv").string());
     }
-    {   // summary.json
+    { // summary.json
         toml::table root;
         root.insert("scene", p.name);
         root.insert("units", p.units);
@@ -139,10 +144,12 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             t.insert("newton_iterations", static_cast<int64_t>(s.iterations));
             t.insert("linear_iterations", static_cast<int64_t>(s.linear_iterations));
             toml::array res;
-            for (double v : s.residuals) res.push_back(v);
+            for (double v : s.residuals)
+                res.push_back(v);
             t.insert("residuals", res);
             toml::array ch;
-            for (int v : s.status_changes) ch.push_back(static_cast<int64_t>(v));
+            for (int v : s.status_changes)
+                ch.push_back(static_cast<int64_t>(v));
             t.insert("status_changes", ch);
             toml::table st;
             st.insert("gap", static_cast<int64_t>(s.counts.gap));
@@ -168,17 +175,20 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             root.insert("checks", ct);
         }
         toml::table tt;
-        for (const auto& [name, e] : r.timings.table()) tt.insert(name, e.seconds);
+        for (const auto& [name, e] : r.timings.table())
+            tt.insert(name, e.seconds);
         root.insert("timings_seconds", tt);
         std::ofstream f(dir / "summary.json");
         f << toml::json_formatter{root} << "\n";
         MLC_CHECK(f.good(), "cannot write " << (dir / "summary.json").string());
     }
-    {   // solution.vtu
+    { // solution.vtu
         const int nv = L.mesh.n_vertices();
-        mesh::Field disp{"displacement", 2, std::vector<double>(r.u_full.data(), r.u_full.data() + r.u_full.size())};
+        mesh::Field disp{"displacement", 2,
+                         std::vector<double>(r.u_full.data(), r.u_full.data() + r.u_full.size())};
         mesh::Field status{"contact_status", 1, std::vector<double>(static_cast<size_t>(nv), -1.0)};
-        mesh::Field force{"contact_force", 2, std::vector<double>(static_cast<size_t>(2 * nv), 0.0)};
+        mesh::Field force{"contact_force", 2,
+                          std::vector<double>(static_cast<size_t>(2 * nv), 0.0)};
         mesh::Field lt{"lambda_t", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
         mesh::Field ln{"lambda_n", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
         for (size_t e = 0; e < r.nodes.size(); ++e) {
@@ -194,10 +204,13 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             ln.values[v] = n.lambda_n;
         }
         mesh::Field stress{"stress", 3, stresses};
-        mesh::Field vm{"von_mises", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()))};
-        mesh::Field body{"body", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()), 0.0)};
+        mesh::Field vm{"von_mises", 1,
+                       std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()))};
+        mesh::Field body{"body", 1,
+                         std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()), 0.0)};
         for (int t = 0; t < L.mesh.n_triangles(); ++t) {
-            const double sx = stresses[static_cast<size_t>(3 * t)], sy = stresses[static_cast<size_t>(3 * t + 1)],
+            const double sx = stresses[static_cast<size_t>(3 * t)],
+                         sy = stresses[static_cast<size_t>(3 * t + 1)],
                          sxy = stresses[static_cast<size_t>(3 * t + 2)];
             const auto& m = fem::material_of(L.mesh, L.materials, t);
             // Plane strain: sigma_zz = nu (sx + sy); plane stress: 0.
@@ -205,9 +218,11 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             vm.values[static_cast<size_t>(t)] = std::sqrt(
                 0.5 * ((sx - sy) * (sx - sy) + (sy - sz) * (sy - sz) + (sz - sx) * (sz - sx)) +
                 3.0 * sxy * sxy);
-            if (!L.mesh.attribute.empty()) body.values[static_cast<size_t>(t)] = L.mesh.attribute[static_cast<size_t>(t)];
+            if (!L.mesh.attribute.empty())
+                body.values[static_cast<size_t>(t)] = L.mesh.attribute[static_cast<size_t>(t)];
         }
-        mesh::write_vtu(dir / "solution.vtu", L.mesh, {disp, status, force, lt, ln}, {stress, vm, body});
+        mesh::write_vtu(dir / "solution.vtu", L.mesh, {disp, status, force, lt, ln},
+                        {stress, vm, body});
     }
 }
 

@@ -18,9 +18,11 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
 
 /// Quality figures of a converged state, all relative (see the README).
 struct StateChecks {
-    double force_balance = 0.0;   ///< |resultant of loads, contact forces, reactions| / sum of magnitudes
-    double coulomb_excess = 0.0;  ///< max (|lambda_t| - mu |lambda_n|)+ / max |lambda_n|
-    double slip_equality = 0.0;   ///< max | |lambda_t| - mu |lambda_n| | at slipping nodes / max |lambda_n|
+    double force_balance =
+        0.0; ///< |resultant of loads, contact forces, reactions| / sum of magnitudes
+    double coulomb_excess = 0.0; ///< max (|lambda_t| - mu |lambda_n|)+ / max |lambda_n|
+    double slip_equality =
+        0.0; ///< max | |lambda_t| - mu |lambda_n| | at slipping nodes / max |lambda_n|
     double complementarity = 0.0; ///< max |lambda_n d_n| / (max |lambda_n| * max |u|)
     double penetration = 0.0;     ///< max (-d_n)+ / max |u|
     double tension = 0.0;         ///< max (lambda_n)+ / max |lambda_n|

@@ -14,7 +14,8 @@ namespace mlc::apps {
 int run_scene(const RunOptions& opt, std::ostream& os) {
     levels::Problem p = load_scene(opt.scene);
     if (opt.levels) {
-        MLC_CHECK(*opt.levels >= 0 && *opt.levels <= 12, "--levels must lie in [0, 12], found " << *opt.levels);
+        MLC_CHECK(*opt.levels >= 0 && *opt.levels <= 12,
+                  "--levels must lie in [0, 12], found " << *opt.levels);
         p.levels = *opt.levels;
     }
     if (opt.load_steps) {
@@ -23,7 +24,8 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     }
     for (auto& c : p.contacts) {
         if (opt.mu) {
-            MLC_CHECK(std::isfinite(*opt.mu) && *opt.mu >= 0, "--mu must be >= 0, found " << *opt.mu);
+            MLC_CHECK(std::isfinite(*opt.mu) && *opt.mu >= 0,
+                      "--mu must be >= 0, found " << *opt.mu);
             c.mu = *opt.mu;
         }
         if (opt.r) {
@@ -34,6 +36,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     p.validate();
     levels::SolveOptions so;
     so.progress = opt.quiet ? nullptr : &os;
+    so.linear_solver = opt.linear;
     os << "mlcontact: solving '" << p.name << "'\n";
     levels::RunResult r = levels::solve(p, so);
     os << "\n";

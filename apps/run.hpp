@@ -11,13 +11,14 @@ namespace mlc::apps {
 
 /// Options of `mlcontact run`.
 struct RunOptions {
-    std::string scene = "square";     ///< file path or built-in scene name
-    std::optional<int> levels;        ///< overrides [scene].levels
-    std::optional<double> mu;         ///< overrides mu of every contact pair
-    std::optional<double> r;          ///< overrides r of every contact pair
-    std::optional<int> load_steps;    ///< overrides [scene].load_steps
-    std::string out;                  ///< output folder; empty: out/<scene name>
-    bool quiet = false;               ///< no per-step progress
+    std::string scene = "square";  ///< file path or built-in scene name
+    std::optional<int> levels;     ///< overrides [scene].levels
+    std::optional<double> mu;      ///< overrides mu of every contact pair
+    std::optional<double> r;       ///< overrides r of every contact pair
+    std::optional<int> load_steps; ///< overrides [scene].load_steps
+    std::string out;               ///< output folder; empty: out/<scene name>
+    bool quiet = false;            ///< no per-step progress
+    std::string linear = "schur";  ///< Newton system solver: schur | lu
 };
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not

@@ -43,10 +43,12 @@ public:
                     const std::string& where) const {
         for (auto&& [k, v] : t) {
             bool ok = false;
-            for (auto a : allowed) ok = ok || k.str() == a;
+            for (auto a : allowed)
+                ok = ok || k.str() == a;
             if (!ok) {
                 std::string list;
-                for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+                for (auto a : allowed)
+                    list += (list.empty() ? "" : ", ") + std::string(a);
                 std::ostringstream os;
                 os << origin_ << ":" << k.source().begin.line << ": unknown key '" << k.str()
                    << "' in " << where << " (allowed: " << list << ")";
@@ -55,7 +57,8 @@ public:
         }
     }
 
-    const toml::node* need(const toml::table& t, std::string_view key, const std::string& where) const {
+    const toml::node* need(const toml::table& t, std::string_view key,
+                           const std::string& where) const {
         const toml::node* n = t.get(key);
         if (!n) fail(&t, "missing key '" + std::string(key) + "' in " + where);
         return n;
@@ -87,7 +90,8 @@ public:
         }
         fail(n, what + " must be an integer, found " + type_name(n));
     }
-    int integer_or(const toml::table& t, std::string_view key, int dflt, const std::string& where) const {
+    int integer_or(const toml::table& t, std::string_view key, int dflt,
+                   const std::string& where) const {
         const toml::node* n = t.get(key);
         return n ? integer(n, where + "." + std::string(key)) : dflt;
     }
@@ -103,7 +107,8 @@ public:
         const toml::node* n = t.get(key);
         return n ? string(n, where + "." + std::string(key)) : dflt;
     }
-    bool boolean_or(const toml::table& t, std::string_view key, bool dflt, const std::string& where) const {
+    bool boolean_or(const toml::table& t, std::string_view key, bool dflt,
+                    const std::string& where) const {
         const toml::node* n = t.get(key);
         if (!n) return dflt;
         if (auto b = n->value_exact<bool>()) return *b;
@@ -129,7 +134,8 @@ public:
         const toml::node* n = t.get(key);
         if (!n) return out;
         if (const toml::array* a = n->as_array()) {
-            for (const auto& e : *a) out.push_back(&table(&e, where + "." + std::string(key)));
+            for (const auto& e : *a)
+                out.push_back(&table(&e, where + "." + std::string(key)));
         } else {
             out.push_back(&table(n, where + "." + std::string(key)));
         }
@@ -144,21 +150,27 @@ private:
     }
     static std::string type_name(const toml::node* n) {
         switch (n->type()) {
-        case toml::node_type::string: return "a string";
-        case toml::node_type::integer: return "an integer";
-        case toml::node_type::floating_point: return "a number";
-        case toml::node_type::boolean: return "a boolean";
-        case toml::node_type::array: return "an array";
-        case toml::node_type::table: return "a table";
-        default: return "a date/time";
+        case toml::node_type::string:
+            return "a string";
+        case toml::node_type::integer:
+            return "an integer";
+        case toml::node_type::floating_point:
+            return "a number";
+        case toml::node_type::boolean:
+            return "a boolean";
+        case toml::node_type::array:
+            return "an array";
+        case toml::node_type::table:
+            return "a table";
+        default:
+            return "a date/time";
         }
     }
     std::string origin_;
 };
 
 /// Wraps a library InvalidInput with the scene position of the entry that caused it.
-template <class F>
-auto at(const Reader& rd, const toml::node* n, F&& f) {
+template <class F> auto at(const Reader& rd, const toml::node* n, F&& f) {
     try {
         return f();
     } catch (const InvalidInput& e) {
@@ -208,7 +220,8 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
         else if (diag == "alternate")
             d = mesh::Diagonal::alternate;
         else if (diag != "right")
-            rd.fail(t.get("diagonal"), where + ".diagonal must be \"right\", \"left\" or \"alternate\"");
+            rd.fail(t.get("diagonal"),
+                    where + ".diagonal must be \"right\", \"left\" or \"alternate\"");
         if (nx < 1 || ny < 1 || nx > 100000 || ny > 100000)
             rd.fail(dn, where + ".divisions must be between 1 and 100000");
         return at(rd, &t, [&] { return mesh::structured_rectangle(corner, size, nx, ny, d); });
@@ -223,7 +236,8 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
         if (const toml::node* f = t.get("focus")) {
             const toml::array* fa = f->as_array();
             if (!fa) rd.fail(f, where + ".focus must be an array of points");
-            for (const auto& p : *fa) sf.focus.push_back(rd.vec2(&p, where + ".focus[]"));
+            for (const auto& p : *fa)
+                sf.focus.push_back(rd.vec2(&p, where + ".focus[]"));
         }
         std::vector<std::vector<mesh::Segment>> loops;
         const auto loop_tables = rd.tables(t, "loop", where);
@@ -253,7 +267,8 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
         const std::string surface = rd.string_or(t, "surface", "", where);
         return at(rd, &t, [&] { return mesh::read_gmsh(file, surface); });
     }
-    rd.fail(t.get("type"), where + ".type must be \"rectangle\", \"domain\" or \"gmsh\", found \"" + type + "\"");
+    rd.fail(t.get("type"),
+            where + ".type must be \"rectangle\", \"domain\" or \"gmsh\", found \"" + type + "\"");
 }
 
 /// Appends mesh b (body index `body`) to the merged mesh: vertices renumbered, tags merged by
@@ -263,7 +278,8 @@ void merge_into(mesh::Mesh& all, const mesh::Mesh& b, int body) {
     const int coff = static_cast<int>(all.circles.size());
     all.vertices.insert(all.vertices.end(), b.vertices.begin(), b.vertices.end());
     all.circles.insert(all.circles.end(), b.circles.begin(), b.circles.end());
-    for (const auto& t : b.triangles) all.triangles.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
+    for (const auto& t : b.triangles)
+        all.triangles.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
     all.attribute.resize(all.triangles.size(), body);
     for (const auto& e : b.boundary)
         all.boundary.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)),
@@ -289,7 +305,8 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
     {
         const toml::node* sn = rd.need(root, "scene", "the scene");
         const toml::table& s = rd.table(sn, "[scene]");
-        rd.check_keys(s, {"name", "description", "units", "plane", "load_steps", "levels"}, "[scene]");
+        rd.check_keys(s, {"name", "description", "units", "plane", "load_steps", "levels"},
+                      "[scene]");
         p.name = rd.string(s, "name", "[scene]");
         p.description = rd.string_or(s, "description", "", "[scene]");
         p.units = rd.string_or(s, "units", "", "[scene]");
@@ -297,11 +314,12 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         if (pl == "stress")
             plane = fem::Plane::stress;
         else if (pl != "strain")
-            rd.fail(s.get("plane"), "[scene].plane must be \"strain\" or \"stress\", found \"" + pl + "\"");
+            rd.fail(s.get("plane"),
+                    "[scene].plane must be \"strain\" or \"stress\", found \"" + pl + "\"");
         p.load_steps = rd.integer_or(s, "load_steps", 1, "[scene]");
         if (p.load_steps < 1)
-            rd.fail(s.get("load_steps"), "[scene].load_steps must be at least 1, found " +
-                                             std::to_string(p.load_steps));
+            rd.fail(s.get("load_steps"),
+                    "[scene].load_steps must be at least 1, found " + std::to_string(p.load_steps));
         p.levels = rd.integer_or(s, "levels", 0, "[scene]");
         if (p.levels < 0 || p.levels > 12)
             rd.fail(s.get("levels"), "[scene].levels must lie in [0, 12]");
@@ -317,18 +335,25 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         body.material.E = rd.number(b, "E", w);
         body.material.nu = rd.number(b, "nu", w);
         body.material.plane = plane;
-        at(rd, b.get("E"), [&] { body.material.validate(); return 0; });
+        at(rd, b.get("E"), [&] {
+            body.material.validate();
+            return 0;
+        });
         if (b.get("body_force")) body.body_force = rd.vec2(b, "body_force", w);
         const toml::node* mn = rd.need(b, "mesh", w);
         const mesh::Mesh m = parse_mesh(rd, rd.table(mn, w + ".mesh"), w + ".mesh", base_dir);
         merge_into(p.mesh0, m, static_cast<int>(i));
         p.bodies.push_back(body);
     }
-    at(rd, &root, [&] { mesh::check_quality(p.mesh0); return 0; });
+    at(rd, &root, [&] {
+        mesh::check_quality(p.mesh0);
+        return 0;
+    });
     auto check_tag = [&](const toml::table& t, const std::string& tag, const std::string& w) {
         if (!p.mesh0.find_tag(tag)) {
             std::string known;
-            for (const auto& [n, id] : p.mesh0.tag_names) known += (known.empty() ? "" : ", ") + n;
+            for (const auto& [n, id] : p.mesh0.tag_names)
+                known += (known.empty() ? "" : ", ") + n;
             rd.fail(t.get("tag") ? t.get("tag") : &t,
                     w + ": unknown boundary tag '" + tag + "' (the mesh has: " + known + ")");
         }
@@ -349,7 +374,8 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         const std::string w = "[[support]]";
         rd.check_keys(*st, {"tag", "point", "ux", "uy"}, w);
         levels::Support s;
-        if (st->get("tag") && st->get("point")) rd.fail(st, w + " takes a tag or a point, not both");
+        if (st->get("tag") && st->get("point"))
+            rd.fail(st, w + " takes a tag or a point, not both");
         if (st->get("tag")) {
             s.tag = rd.string(*st, "tag", w);
             check_tag(*st, s.tag, w);
@@ -370,9 +396,12 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         levels::ContactPair c;
         c.name = rd.string_or(*ct, "name", "contact" + std::to_string(p.contacts.size() + 1), w);
         c.contactor = rd.string(*ct, "contactor", w);
-        if (!p.mesh0.find_tag(c.contactor)) rd.fail(ct->get("contactor"), w + ": unknown contactor tag '" + c.contactor + "'");
+        if (!p.mesh0.find_tag(c.contactor))
+            rd.fail(ct->get("contactor"), w + ": unknown contactor tag '" + c.contactor + "'");
         c.mu = rd.number(*ct, "mu", w);
-        if (c.mu < 0) rd.fail(ct->get("mu"), w + ": friction coefficient mu must be >= 0, found " + std::to_string(c.mu));
+        if (c.mu < 0)
+            rd.fail(ct->get("mu"),
+                    w + ": friction coefficient mu must be >= 0, found " + std::to_string(c.mu));
         if (ct->get("r") && ct->get("r_over_E")) rd.fail(ct, w + " takes r or r_over_E, not both");
         if (ct->get("r"))
             c.r = rd.number(*ct, "r", w);
@@ -408,9 +437,13 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
                 rd.fail(ot.get("side"), ow + ".side must be \"outside\" or \"inside\"");
             o.body_outside = side == "outside";
         } else {
-            rd.fail(ot.get("type"), ow + ".type must be \"line\" or \"circle\", found \"" + type + "\"");
+            rd.fail(ot.get("type"),
+                    ow + ".type must be \"line\" or \"circle\", found \"" + type + "\"");
         }
-        at(rd, &ot, [&] { o.validate(); return 0; });
+        at(rd, &ot, [&] {
+            o.validate();
+            return 0;
+        });
         c.obstacle = o;
         p.contacts.push_back(c);
     }
@@ -419,15 +452,22 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         rd.check_keys(nt, {"rel_tol", "max_iter"}, "[newton]");
         p.newton.rel_tol = rd.number_or(nt, "rel_tol", p.newton.rel_tol, "[newton]");
         p.newton.max_iter = rd.integer_or(nt, "max_iter", p.newton.max_iter, "[newton]");
-        at(rd, nn, [&] { p.newton.validate(); return 0; });
+        at(rd, nn, [&] {
+            p.newton.validate();
+            return 0;
+        });
     }
-    at(rd, &root, [&] { p.validate(); return 0; });
+    at(rd, &root, [&] {
+        p.validate();
+        return 0;
+    });
     return p;
 }
 
 std::vector<std::string> builtin_scene_names() {
     std::vector<std::string> out;
-    for (const auto& [n, t] : detail::builtin_scenes()) out.push_back(n);
+    for (const auto& [n, t] : detail::builtin_scenes())
+        out.push_back(n);
     return out;
 }
 
@@ -446,11 +486,14 @@ levels::Problem load_scene(const std::string& name_or_path) {
     }
     if (!std::filesystem::exists(path)) {
         std::string names;
-        for (const auto& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
+        for (const auto& n : builtin_scene_names())
+            names += (names.empty() ? "" : ", ") + n;
         throw InvalidInput("scene '" + name_or_path +
-                           "' is neither a readable file nor a built-in scene (built-in: " + names + ")");
+                           "' is neither a readable file nor a built-in scene (built-in: " + names +
+                           ")");
     }
-    MLC_CHECK(std::filesystem::is_regular_file(path), "scene '" << name_or_path << "' is not a regular file");
+    MLC_CHECK(std::filesystem::is_regular_file(path),
+              "scene '" << name_or_path << "' is not a regular file");
     std::ifstream in(path);
     MLC_CHECK(in.good(), "cannot read scene file '" << name_or_path << "'");
     std::stringstream ss;

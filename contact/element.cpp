@@ -53,7 +53,8 @@ void add_residual(const ContactElement& e, const ElementState& s, const fem::Dof
     for (int j = 0; j < e.n_nodes; ++j) {
         const int v = e.vertex[static_cast<size_t>(j)];
         for (int a = 0; a < 2; ++a)
-            if (int d = dofs.u_dof(v, a); d >= 0) R[d] += e.weight[static_cast<size_t>(j)] * force[a];
+            if (int d = dofs.u_dof(v, a); d >= 0)
+                R[d] += e.weight[static_cast<size_t>(j)] * force[a];
     }
     if (e.frictional()) {
         R[lambda_dof] = -(s.lambda[0] - s.proj.phi[0]) / e.r;

@@ -18,15 +18,15 @@ namespace mlc::contact {
 /// the relative displacement is u_rel = sum_j w_j u_(vertex j) (formulation.md §2):
 /// node on rigid (1), node on node (1, -1), node on facet (1, -(1-alpha), -alpha).
 struct ContactElement {
-    int n_nodes = 1;                           ///< 1, 2 or 3
-    std::array<int, 3> vertex{-1, -1, -1};     ///< vertex[0] is the contactor node
+    int n_nodes = 1;                       ///< 1, 2 or 3
+    std::array<int, 3> vertex{-1, -1, -1}; ///< vertex[0] is the contactor node
     std::array<double, 3> weight{1.0, 0.0, 0.0};
-    Vec2 n = Vec2(0.0, 1.0);                   ///< unit normal of the target, toward the contactor
-    Vec2 t = Vec2(1.0, 0.0);                   ///< t = (n_y, -n_x)
-    double g0 = 0.0;                           ///< initial normal gap (>= 0 apart)
-    double mu = 0.0;                           ///< Coulomb coefficient (0: frictionless)
-    double r = 1.0;                            ///< augmentation parameter (force / length)
-    int pair = 0;                              ///< index of the contact pair in the scene
+    Vec2 n = Vec2(0.0, 1.0); ///< unit normal of the target, toward the contactor
+    Vec2 t = Vec2(1.0, 0.0); ///< t = (n_y, -n_x)
+    double g0 = 0.0;         ///< initial normal gap (>= 0 apart)
+    double mu = 0.0;         ///< Coulomb coefficient (0: frictionless)
+    double r = 1.0;          ///< augmentation parameter (force / length)
+    int pair = 0;            ///< index of the contact pair in the scene
     /// Frictional elements carry (lambda_t, lambda_n); frictionless ones lambda_n only.
     bool frictional() const { return mu > 0.0; }
     int n_multipliers() const { return frictional() ? 2 : 1; }
@@ -38,10 +38,10 @@ std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector
 
 /// Local state of an element at (u, lambda).
 struct ElementState {
-    double d_n = 0.0;        ///< normal gap g0 + n . u_rel
-    double d_t = 0.0;        ///< slip increment t . (u_rel - u_rel_prev)
+    double d_n = 0.0;                                 ///< normal gap g0 + n . u_rel
+    double d_t = 0.0;                                 ///< slip increment t . (u_rel - u_rel_prev)
     Eigen::Vector2d lambda = Eigen::Vector2d::Zero(); ///< (lambda_t, lambda_n)
-    Projection proj;          ///< Phi(lambda + r d) and M
+    Projection proj;                                  ///< Phi(lambda + r d) and M
 };
 
 /// Evaluates element e: relative displacements from the full nodal displacement vectors
@@ -85,7 +85,8 @@ void for_each_tangent_entry(const ContactElement& e, const Eigen::Matrix2d& M,
                     if (col >= 0) add(row, col, wj * wk * e.r * GMGt(a, b));
                 }
             }
-            for (int q = m0; q < 2; ++q) add(row, lambda_dof + q - m0, wj * GM(a, q));
+            for (int q = m0; q < 2; ++q)
+                add(row, lambda_dof + q - m0, wj * GM(a, q));
         }
     }
     for (int q = m0; q < 2; ++q) {

@@ -8,10 +8,14 @@ namespace mlc::contact {
 
 std::string_view to_string(Status s) {
     switch (s) {
-    case Status::gap: return "gap";
-    case Status::stick: return "stick";
-    case Status::slip_forward: return "slip_forward";
-    case Status::slip_backward: return "slip_backward";
+    case Status::gap:
+        return "gap";
+    case Status::stick:
+        return "stick";
+    case Status::slip_forward:
+        return "slip_forward";
+    case Status::slip_backward:
+        return "slip_backward";
     }
     return "unknown";
 }

@@ -10,10 +10,10 @@ namespace mlc::contact {
 
 /// Contact status of one node: the region of the (sigma_t, sigma_n) plane where Phi is linear.
 enum class Status : unsigned char {
-    gap,           ///< sigma_n > 0: open, Phi = 0
-    stick,         ///< sigma_n <= 0, |sigma_t| <= -mu sigma_n: Phi = sigma
-    slip_forward,  ///< |sigma_t| > -mu sigma_n, sigma_t > 0: Phi_t = +mu |sigma_n|
-    slip_backward  ///< |sigma_t| > -mu sigma_n, sigma_t < 0: Phi_t = -mu |sigma_n|
+    gap,          ///< sigma_n > 0: open, Phi = 0
+    stick,        ///< sigma_n <= 0, |sigma_t| <= -mu sigma_n: Phi = sigma
+    slip_forward, ///< |sigma_t| > -mu sigma_n, sigma_t > 0: Phi_t = +mu |sigma_n|
+    slip_backward ///< |sigma_t| > -mu sigma_n, sigma_t < 0: Phi_t = -mu |sigma_n|
 };
 
 /// "gap", "stick", "slip_forward", "slip_backward".

@@ -14,11 +14,11 @@ namespace mlc::contact {
 struct Obstacle {
     enum class Kind { line, circle };
     Kind kind = Kind::line;
-    Vec2 point = Vec2::Zero();       ///< line: a point on the line
-    Vec2 normal = Vec2(0.0, 1.0);    ///< line: normal toward the body (normalized on validate)
-    Vec2 center = Vec2::Zero();      ///< circle: centre
-    double radius = 0.0;             ///< circle: radius > 0
-    bool body_outside = true;        ///< circle: body outside the disc (a rigid cylinder) or inside a hole
+    Vec2 point = Vec2::Zero();    ///< line: a point on the line
+    Vec2 normal = Vec2(0.0, 1.0); ///< line: normal toward the body (normalized on validate)
+    Vec2 center = Vec2::Zero();   ///< circle: centre
+    double radius = 0.0;          ///< circle: radius > 0
+    bool body_outside = true; ///< circle: body outside the disc (a rigid cylinder) or inside a hole
 
     /// Throws InvalidInput for a zero normal or a non-positive radius; normalizes the normal.
     void validate();

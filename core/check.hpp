@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-/// @file Error types and the always-on input checks (MLC_CHECK) and debug-only asserts (MLC_ASSERT).
+/// @file Error types and the always-on input checks (MLC_CHECK) and debug-only asserts
+/// (MLC_ASSERT).
 #pragma once
 
 #include <sstream>
@@ -33,8 +34,8 @@ namespace detail {
 
 } // namespace mlc
 
-/// Always-on check: throws mlc::InvalidInput with the condition, the streamed message and the place.
-/// Usage: `MLC_CHECK(E > 0, "Young's modulus E must be positive, found " << E);`
+/// Always-on check: throws mlc::InvalidInput with the condition, the streamed message and the
+/// place. Usage: `MLC_CHECK(E > 0, "Young's modulus E must be positive, found " << E);`
 #define MLC_CHECK(cond, msg)                                                                       \
     do {                                                                                           \
         if (!(cond)) {                                                                             \

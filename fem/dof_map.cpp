@@ -7,8 +7,8 @@
 namespace mlc::fem {
 
 DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra) {
-    MLC_CHECK(fixed.size() == n_extra.size(), "DofMap: " << fixed.size() << " fixed flags for "
-                                                         << n_extra.size() << " vertices");
+    MLC_CHECK(fixed.size() == n_extra.size(),
+              "DofMap: " << fixed.size() << " fixed flags for " << n_extra.size() << " vertices");
     const size_t nv = fixed.size();
     u_dof_.resize(nv);
     extra_.assign(nv, -1);
@@ -24,9 +24,8 @@ DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<
                 ++n_u_;
             }
         }
-        MLC_CHECK(n_extra[v] >= 0 && n_extra[v] <= 2, "DofMap: vertex " << v << " asks for "
-                                                                        << n_extra[v]
-                                                                        << " extra unknowns");
+        MLC_CHECK(n_extra[v] >= 0 && n_extra[v] <= 2,
+                  "DofMap: vertex " << v << " asks for " << n_extra[v] << " extra unknowns");
         if (n_extra[v] > 0) {
             extra_[v] = next;
             for (int k = 0; k < n_extra[v]; ++k) {

@@ -18,8 +18,8 @@ enum class Plane {
 
 /// Isotropic linear elastic material. Units are the scene's (stress units for E).
 struct Material {
-    double E = 1.0;             ///< Young's modulus, > 0
-    double nu = 0.3;            ///< Poisson's ratio, in (-1, 0.5)
+    double E = 1.0;              ///< Young's modulus, > 0
+    double nu = 0.3;             ///< Poisson's ratio, in (-1, 0.5)
     Plane plane = Plane::strain; ///< plane strain unless the scene says otherwise
 
     /// Throws InvalidInput naming E or nu if out of range.

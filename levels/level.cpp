@@ -12,7 +12,8 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     L.mesh = std::move(m);
     const auto& mesh = L.mesh;
     const int nv = mesh.n_vertices();
-    for (const auto& b : problem.bodies) L.materials.push_back(b.material);
+    for (const auto& b : problem.bodies)
+        L.materials.push_back(b.material);
 
     // Supports.
     L.fixed.assign(static_cast<size_t>(nv), {false, false});
@@ -24,9 +25,9 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
             const int v = mesh.nearest_vertex(*s.point);
             const double d = (mesh.vertices[static_cast<size_t>(v)] - *s.point).norm();
             MLC_CHECK(d <= 1e-8 * diam, "support point (" << s.point->x() << ", " << s.point->y()
-                                                           << ") is not a mesh vertex (nearest at "
-                                                              "distance "
-                                                           << d << ")");
+                                                          << ") is not a mesh vertex (nearest at "
+                                                             "distance "
+                                                          << d << ")");
             verts.push_back(v);
         } else {
             verts = mesh.vertices_with_tag(mesh.tag(s.tag));
@@ -58,8 +59,8 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
         }
         MLC_CHECK(!nodes.empty(), "contact '" << pair.name << "' has no contactor node on '"
                                               << pair.contactor << "'");
-        auto elems =
-            contact::node_on_rigid(mesh, nodes, *pair.obstacle, pair.mu, pair.r, static_cast<int>(p));
+        auto elems = contact::node_on_rigid(mesh, nodes, *pair.obstacle, pair.mu, pair.r,
+                                            static_cast<int>(p));
         for (const auto& e : elems) {
             L.contact_of_vertex[static_cast<size_t>(e.vertex[0])] =
                 static_cast<int>(L.contacts.size());
@@ -70,7 +71,8 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
 
     L.dofs = fem::DofMap(L.fixed, n_extra);
     L.lambda_dof.reserve(L.contacts.size());
-    for (const auto& e : L.contacts) L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
+    for (const auto& e : L.contacts)
+        L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
 
     std::vector<fem::Traction> tractions;
     for (const auto& ld : problem.loads)

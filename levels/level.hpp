@@ -16,9 +16,9 @@ namespace mlc::levels {
 /// Everything one mesh level needs to solve. Built by `build_level`; immutable afterwards.
 struct Level {
     mesh::Mesh mesh;
-    std::vector<fem::Material> materials;          ///< per body (triangle attribute)
-    std::vector<std::array<bool, 2>> fixed;        ///< per vertex and component
-    Vector u_fixed;                                ///< prescribed displacements at load factor 1
+    std::vector<fem::Material> materials;   ///< per body (triangle attribute)
+    std::vector<std::array<bool, 2>> fixed; ///< per vertex and component
+    Vector u_fixed;                         ///< prescribed displacements at load factor 1
     fem::DofMap dofs;
     fem::ElasticSystem elastic;                    ///< K and f at load factor 1
     std::vector<contact::ContactElement> contacts; ///< one per contactor node

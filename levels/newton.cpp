@@ -4,7 +4,6 @@
 
 #include "core/check.hpp"
 
-#include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -13,110 +12,25 @@ namespace mlc::levels {
 
 void StatusCounts::add(contact::Status s) {
     switch (s) {
-    case contact::Status::gap: ++gap; break;
-    case contact::Status::stick: ++stick; break;
-    case contact::Status::slip_forward: ++slip_forward; break;
-    case contact::Status::slip_backward: ++slip_backward; break;
+    case contact::Status::gap:
+        ++gap;
+        break;
+    case contact::Status::stick:
+        ++stick;
+        break;
+    case contact::Status::slip_forward:
+        ++slip_forward;
+        break;
+    case contact::Status::slip_backward:
+        ++slip_backward;
+        break;
     }
 }
-
-// ---------------------------------------------------------------------------------------------
-JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
-    const SparseMatrix& K = level.elastic.K;
-    const Index n = level.n_unknowns();
-    std::vector<Triplet> trip;
-    trip.reserve(static_cast<size_t>(K.nonZeros()) + 16 * level.contacts.size());
-    for (int i = 0; i < K.outerSize(); ++i)
-        for (SparseMatrix::InnerIterator it(K, i); it; ++it) trip.emplace_back(i, it.col(), 0.0);
-    std::vector<std::pair<int, int>> centries;
-    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-    for (size_t e = 0; e < level.contacts.size(); ++e)
-        contact::for_each_tangent_entry(level.contacts[e], I, level.dofs, level.lambda_dof[e],
-                                        [&](int row, int col, double) {
-                                            trip.emplace_back(row, col, 0.0);
-                                            centries.emplace_back(row, col);
-                                        });
-    J_.resize(n, n);
-    J_.setFromTriplets(trip.begin(), trip.end());
-    J_.makeCompressed();
-    auto position = [&](int row, int col) {
-        const int* begin = J_.innerIndexPtr() + J_.outerIndexPtr()[row];
-        const int* end = J_.innerIndexPtr() + J_.outerIndexPtr()[row + 1];
-        const int* it = std::lower_bound(begin, end, col);
-        MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
-        return static_cast<int>(it - J_.innerIndexPtr());
-    };
-    kpos_.reserve(static_cast<size_t>(K.nonZeros()));
-    for (int i = 0; i < K.outerSize(); ++i)
-        for (SparseMatrix::InnerIterator it(K, i); it; ++it) kpos_.push_back(position(i, it.col()));
-    cpos_.reserve(centries.size());
-    for (auto [r, c] : centries) cpos_.push_back(position(r, c));
-}
-
-void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
-    double* v = J_.valuePtr();
-    std::fill(v, v + J_.nonZeros(), 0.0);
-    const double* kv = level_.elastic.K.valuePtr();
-    for (size_t k = 0; k < kpos_.size(); ++k) v[kpos_[k]] += kv[k];
-    size_t c = 0;
-    for (size_t e = 0; e < level_.contacts.size(); ++e)
-        contact::for_each_tangent_entry(level_.contacts[e], M[e], level_.dofs, level_.lambda_dof[e],
-                                        [&](int, int, double value) { v[cpos_[c++]] += value; });
-}
-
-// ---------------------------------------------------------------------------------------------
-namespace {
-
-class DirectSolver final : public LinearSolver {
-public:
-    SolveResult solve(const SparseMatrix& J, const Vector& b, Vector& x) override {
-        SolveResult res;
-        const double t0 = wall_seconds();
-        Jc_ = J; // column-major copy for SparseLU
-        if (!analyzed_ || !same_pattern(Jc_)) {
-            lu_.analyzePattern(Jc_);
-            outer_.assign(Jc_.outerIndexPtr(), Jc_.outerIndexPtr() + Jc_.outerSize() + 1);
-            inner_.assign(Jc_.innerIndexPtr(), Jc_.innerIndexPtr() + Jc_.nonZeros());
-            analyzed_ = true;
-        }
-        lu_.factorize(Jc_);
-        if (lu_.info() != Eigen::Success)
-            throw SolverBreakdown("SparseLU factorization failed (singular Jacobian): " +
-                                  lu_.lastErrorMessage());
-        const double t1 = wall_seconds();
-        x = lu_.solve(b);
-        res.setup_seconds = t1 - t0;
-        res.solve_seconds = wall_seconds() - t1;
-        res.converged = true;
-        res.reason = StopReason::converged;
-        res.initial_residual = b.norm();
-        res.final_residual = (b - J * x).norm();
-        res.relative_residual =
-            res.initial_residual > 0 ? res.final_residual / res.initial_residual : 0.0;
-        return res;
-    }
-    std::string name() const override { return "lu"; }
-
-private:
-    bool same_pattern(const SparseMatrixCol& A) const {
-        return static_cast<size_t>(A.nonZeros()) == inner_.size() &&
-               std::equal(outer_.begin(), outer_.end(), A.outerIndexPtr()) &&
-               std::equal(inner_.begin(), inner_.end(), A.innerIndexPtr());
-    }
-    SparseMatrixCol Jc_;
-    Eigen::SparseLU<SparseMatrixCol, Eigen::COLAMDOrdering<int>> lu_;
-    bool analyzed_ = false;
-    std::vector<int> outer_, inner_;
-};
-
-} // namespace
-
-std::unique_ptr<LinearSolver> make_direct_solver() { return std::make_unique<DirectSolver>(); }
 
 // ---------------------------------------------------------------------------------------------
 ContactNewton::ContactNewton(const Level& level, NewtonParams params,
-                             std::unique_ptr<LinearSolver> solver, Timings* timings)
-    : level_(level), params_(params), solver_(std::move(solver)), timings_(timings), jac_(level) {
+                             std::unique_ptr<NewtonSystemSolver> solver, Timings* timings)
+    : level_(level), params_(params), solver_(std::move(solver)), timings_(timings) {
     params_.validate();
     MLC_CHECK(solver_ != nullptr, "ContactNewton needs a linear solver");
 }
@@ -186,7 +100,8 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
         rep.residuals.push_back(rel);
         int changes = 0;
         if (k > 0)
-            for (size_t e = 0; e < st.size(); ++e) changes += st[e] != st_prev[e];
+            for (size_t e = 0; e < st.size(); ++e)
+                changes += st[e] != st_prev[e];
         if (k > 0) rep.status_changes.push_back(changes);
         if (!std::isfinite(norm)) {
             rep.message = "the residual became NaN/Inf at Newton iteration " + std::to_string(k);
@@ -204,16 +119,12 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
             rep.message = os.str();
             break;
         }
-        {
-            ScopedTimer t(timings_, "newton/jacobian");
-            jac_.assemble(M);
-        }
         SolveResult lin;
         {
             ScopedTimer t(timings_, "newton/linear_solve");
             R = -R;
             dx.setZero();
-            lin = solver_->solve(jac_.matrix(), R, dx);
+            lin = solver_->solve(M, R, dx);
         }
         rep.linear_iterations += lin.iterations;
         if (!lin.converged) {
@@ -226,7 +137,8 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
         st_prev = st;
         ++rep.iterations;
     }
-    for (const auto& ns : node_states(s, u_prev_full, x)) rep.counts.add(ns.status);
+    for (const auto& ns : node_states(s, u_prev_full, x))
+        rep.counts.add(ns.status);
     rep.seconds = wall_seconds() - t_start;
     return rep;
 }

@@ -7,6 +7,7 @@
 #include "core/linear_operator.hpp"
 #include "core/timer.hpp"
 #include "levels/level.hpp"
+#include "levels/newton_system.hpp"
 
 #include <functional>
 #include <memory>
@@ -24,55 +25,25 @@ struct StatusCounts {
 
 /// What one load step's Newton did.
 struct StepReport {
-    int step = 0;                       ///< 1-based load step
+    int step = 0; ///< 1-based load step
     double load_factor = 0.0;
     bool converged = false;
-    int iterations = 0;                 ///< Newton iterations (linear solves)
-    std::vector<double> residuals;      ///< ||R|| / scale at each iterate (first = initial)
-    std::vector<int> status_changes;    ///< statuses changed between consecutive iterates
-    StatusCounts counts;                ///< final statuses (reported, see node_statuses)
-    int linear_iterations = 0;          ///< Krylov iterations summed over the step (0 if direct)
+    int iterations = 0;              ///< Newton iterations (linear solves)
+    std::vector<double> residuals;   ///< ||R|| / scale at each iterate (first = initial)
+    std::vector<int> status_changes; ///< statuses changed between consecutive iterates
+    StatusCounts counts;             ///< final statuses (reported, see node_statuses)
+    int linear_iterations = 0;       ///< Krylov iterations summed over the step (0 if direct)
     double seconds = 0.0;
-    std::string message;                ///< diagnosis when not converged
+    std::string message; ///< diagnosis when not converged
 };
-
-/// Assembles J = K + sum of contact tangents into a CSR matrix whose pattern is built once, so
-/// values are refreshed in place and a direct solver's symbolic analysis can be reused.
-class JacobianAssembler {
-public:
-    /// `level` must outlive this object.
-    explicit JacobianAssembler(const Level& level);
-    /// Fills the values for the given per-element M matrices.
-    void assemble(const std::vector<Eigen::Matrix2d>& M);
-    const SparseMatrix& matrix() const { return J_; }
-
-private:
-    const Level& level_;
-    SparseMatrix J_;
-    std::vector<int> kpos_; ///< position in J's values of each K value
-    std::vector<int> cpos_; ///< position of each contact tangent entry, in visiting order
-};
-
-/// Solves J dx = b. Implementations: direct (SparseLU with symbolic reuse) or Krylov with a
-/// preconditioner. `same_pattern` is true when J's pattern did not change since the last call.
-class LinearSolver {
-public:
-    virtual ~LinearSolver() = default;
-    /// Solves J x = b; returns the SolveResult (iterations 0 for a direct solve).
-    virtual SolveResult solve(const SparseMatrix& J, const Vector& b, Vector& x) = 0;
-    virtual std::string name() const = 0;
-};
-
-/// Eigen SparseLU; analyzes the pattern on first use and refactors numerically afterwards.
-std::unique_ptr<LinearSolver> make_direct_solver();
 
 /// The full state of a converged (or last) iterate, for reports and output.
 struct ContactNodeState {
     int vertex = -1;
-    Vec2 x = Vec2::Zero();        ///< reference position
-    Vec2 u = Vec2::Zero();        ///< displacement (global axes)
+    Vec2 x = Vec2::Zero(); ///< reference position
+    Vec2 u = Vec2::Zero(); ///< displacement (global axes)
     double lambda_t = 0.0, lambda_n = 0.0;
-    double d_n = 0.0, d_t = 0.0;  ///< gap and slip increment of the step
+    double d_n = 0.0, d_t = 0.0; ///< gap and slip increment of the step
     contact::Status status = contact::Status::gap;
 };
 
@@ -80,8 +51,8 @@ struct ContactNodeState {
 class ContactNewton {
 public:
     /// `level` must outlive this object. `timings` may be null.
-    ContactNewton(const Level& level, NewtonParams params, std::unique_ptr<LinearSolver> solver,
-                  Timings* timings = nullptr);
+    ContactNewton(const Level& level, NewtonParams params,
+                  std::unique_ptr<NewtonSystemSolver> solver, Timings* timings = nullptr);
 
     /// Runs Newton for load factor `s` from the initial guess x (updated in place), with the
     /// slip increment measured from `u_prev_full` (full nodal displacements of the previous
@@ -89,7 +60,8 @@ public:
     StepReport solve(double s, const Vector& u_prev_full, Vector& x);
 
     /// Statuses the projection gives at (x, u_prev) for load factor s (the Newton statuses).
-    std::vector<contact::Status> statuses(double s, const Vector& u_prev_full, const Vector& x) const;
+    std::vector<contact::Status> statuses(double s, const Vector& u_prev_full,
+                                          const Vector& x) const;
 
     /// Per contact node state (reported statuses: a frictionless node in contact is reported as
     /// slip_forward/backward by the sign of its slip increment, or stick if it did not move).
@@ -106,9 +78,8 @@ public:
 private:
     const Level& level_;
     NewtonParams params_;
-    std::unique_ptr<LinearSolver> solver_;
+    std::unique_ptr<NewtonSystemSolver> solver_;
     Timings* timings_;
-    JacobianAssembler jac_;
 };
 
 } // namespace mlc::levels

@@ -42,7 +42,8 @@ void Problem::validate() const {
 
 double Problem::max_young_modulus() const {
     double e = 0;
-    for (const auto& b : bodies) e = std::max(e, b.material.E);
+    for (const auto& b : bodies)
+        e = std::max(e, b.material.E);
     return e;
 }
 

@@ -35,27 +35,27 @@ struct Body {
 /// Uniform surface load on the boundary edges with a tag (at the full load factor 1).
 struct Load {
     std::string tag;
-    double pressure = 0.0;       ///< normal pressure, positive pushes into the body
+    double pressure = 0.0;        ///< normal pressure, positive pushes into the body
     Vec2 traction = Vec2::Zero(); ///< vector traction per unit length
 };
 
 /// Prescribed displacement components on a tagged boundary or at a point (full load factor 1).
 struct Support {
-    std::string tag;             ///< boundary tag, or empty when `point` is given
-    std::optional<Vec2> point;   ///< a vertex position (must coincide with a level-0 vertex)
-    std::optional<double> ux;    ///< prescribed x displacement, if any
-    std::optional<double> uy;    ///< prescribed y displacement, if any
+    std::string tag;           ///< boundary tag, or empty when `point` is given
+    std::optional<Vec2> point; ///< a vertex position (must coincide with a level-0 vertex)
+    std::optional<double> ux;  ///< prescribed x displacement, if any
+    std::optional<double> uy;  ///< prescribed y displacement, if any
 };
 
 /// One contact pair: contactor nodes on a tagged boundary (optionally inside a box) against a
 /// rigid obstacle. (Two-body pairs name a target boundary instead; see node_on_facet.)
 struct ContactPair {
     std::string name;
-    std::string contactor;                ///< boundary tag of the contactor nodes
-    std::optional<Box> region;            ///< keep only contactor vertices inside this box
+    std::string contactor;                     ///< boundary tag of the contactor nodes
+    std::optional<Box> region;                 ///< keep only contactor vertices inside this box
     std::optional<contact::Obstacle> obstacle; ///< rigid target
-    double mu = 0.0;                      ///< Coulomb friction coefficient >= 0
-    double r = 0.0;                       ///< augmentation parameter > 0 (force/length^2 units x length)
+    double mu = 0.0;                           ///< Coulomb friction coefficient >= 0
+    double r = 0.0; ///< augmentation parameter > 0 (force/length^2 units x length)
 };
 
 /// Generalized Newton settings.
@@ -75,14 +75,14 @@ std::ostream& operator<<(std::ostream& os, const NewtonParams& p);
 struct Problem {
     std::string name;
     std::string description;
-    std::string units;                 ///< free text, e.g. "N, mm, N/mm^2"
-    mesh::Mesh mesh0;                  ///< level-0 mesh (all bodies; attribute = body index)
+    std::string units; ///< free text, e.g. "N, mm, N/mm^2"
+    mesh::Mesh mesh0;  ///< level-0 mesh (all bodies; attribute = body index)
     std::vector<Body> bodies;
     std::vector<Load> loads;
     std::vector<Support> supports;
     std::vector<ContactPair> contacts;
-    int load_steps = 1;                ///< proportional loading in equal increments
-    int levels = 0;                    ///< number of 1->4 refinements of mesh0
+    int load_steps = 1; ///< proportional loading in equal increments
+    int levels = 0;     ///< number of 1->4 refinements of mesh0
     NewtonParams newton;
 
     /// Checks materials, pairs (mu >= 0, r > 0), load_steps >= 1, levels >= 0, and the mesh.

@@ -22,7 +22,12 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         }
     }
     const Level& L = res.finest();
-    ContactNewton newton(L, problem.newton, make_direct_solver(), &res.timings);
+    std::unique_ptr<NewtonSystemSolver> system;
+    {
+        ScopedTimer t(&res.timings, "setup/linear_solver");
+        system = make_newton_system_solver(L, options.linear_solver);
+    }
+    ContactNewton newton(L, problem.newton, std::move(system), &res.timings);
     Vector x = Vector::Zero(L.n_unknowns());
     Vector u_prev = Vector::Zero(2 * L.mesh.n_vertices());
     res.converged = true;
@@ -45,9 +50,10 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         res.steps.push_back(rep);
         if (!ok) {
             std::ostringstream os;
-            os << "load step " << step << " (load factor " << s << ") did not converge: "
-               << rep.message << "; residual history:";
-            for (double r : rep.residuals) os << " " << std::scientific << std::setprecision(2) << r;
+            os << "load step " << step << " (load factor " << s
+               << ") did not converge: " << rep.message << "; residual history:";
+            for (double r : rep.residuals)
+                os << " " << std::scientific << std::setprecision(2) << r;
             res.failure = os.str();
             res.converged = false;
             break;
@@ -86,8 +92,9 @@ double force_balance_error(const Level& level, double s, const Vector& u_full,
         double resultant = 0.0, magnitude = 0.0;
         for (int v = 0; v < level.mesh.n_vertices(); ++v) {
             const int i = 2 * v + a;
-            const double Rs =
-                level.fixed[static_cast<size_t>(v)][static_cast<size_t>(a)] ? Ku[i] - F[i] + C[i] : 0.0;
+            const double Rs = level.fixed[static_cast<size_t>(v)][static_cast<size_t>(a)]
+                                  ? Ku[i] - F[i] + C[i]
+                                  : 0.0;
             resultant += F[i] - C[i] + Rs;
             magnitude += std::abs(F[i]) + std::abs(C[i]) + std::abs(Rs);
         }

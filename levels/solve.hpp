@@ -17,21 +17,24 @@ namespace mlc::levels {
 struct SolveOptions {
     std::ostream* progress = nullptr; ///< per-step progress lines, or null for silence
     bool keep_step_states = false;    ///< keep x after every step (for per-step VTU output)
+    /// Newton system solver: "schur" (exact, condensed on the contact set; the default) or
+    /// "lu" (SparseLU on the assembled Jacobian).
+    std::string linear_solver = "schur";
 };
 
 /// Result of a run on the finest level.
 struct RunResult {
-    std::vector<Level> levels;             ///< levels 0..L (only the finest is solved here)
-    std::vector<StepReport> steps;         ///< one per load step, finest level
-    Vector x;                              ///< final unknowns of the finest level
-    Vector u_full;                         ///< final nodal displacements (2 per vertex)
-    Vector u_prev_full;                    ///< nodal displacements at the end of the previous step
-    std::vector<ContactNodeState> nodes;   ///< final contact node states
-    std::vector<Vector> step_u_full;       ///< per step, when keep_step_states
+    std::vector<Level> levels;           ///< levels 0..L (only the finest is solved here)
+    std::vector<StepReport> steps;       ///< one per load step, finest level
+    Vector x;                            ///< final unknowns of the finest level
+    Vector u_full;                       ///< final nodal displacements (2 per vertex)
+    Vector u_prev_full;                  ///< nodal displacements at the end of the previous step
+    std::vector<ContactNodeState> nodes; ///< final contact node states
+    std::vector<Vector> step_u_full;     ///< per step, when keep_step_states
     std::vector<std::vector<ContactNodeState>> step_nodes; ///< per step, when keep_step_states
     Timings timings;
     bool converged = false;
-    std::string failure;                   ///< diagnosis of the first step that failed
+    std::string failure; ///< diagnosis of the first step that failed
     const Level& finest() const { return levels.back(); }
 };
 

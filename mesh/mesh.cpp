@@ -15,7 +15,8 @@ int Mesh::tag(const std::string& name) const {
     auto it = tag_names.find(name);
     if (it == tag_names.end()) {
         std::string known;
-        for (const auto& [n, id] : tag_names) known += (known.empty() ? "" : ", ") + n;
+        for (const auto& [n, id] : tag_names)
+            known += (known.empty() ? "" : ", ") + n;
         MLC_CHECK(false, "unknown boundary tag '" << name << "'; the mesh has: " << known);
     }
     return it->second;
@@ -37,7 +38,8 @@ int Mesh::add_tag(const std::string& name) {
     auto it = tag_names.find(name);
     if (it != tag_names.end()) return it->second;
     int id = 0;
-    for (const auto& [n, t] : tag_names) id = std::max(id, t + 1);
+    for (const auto& [n, t] : tag_names)
+        id = std::max(id, t + 1);
     tag_names[name] = id;
     return id;
 }
@@ -126,17 +128,17 @@ void check_quality(const Mesh& m) {
                                   << " but the mesh has " << nv << " vertices");
         const double a = m.signed_area(t);
         const Vec2& p = m.vertices[static_cast<size_t>(tri[0])];
-        MLC_CHECK(a > 1e-14 * diam * diam,
-                  "degenerate or inverted triangle " << t << " (vertices " << tri[0] << ", "
-                                                     << tri[1] << ", " << tri[2] << " near ("
-                                                     << p.x() << ", " << p.y()
-                                                     << ")): signed area " << a
-                                                     << "; triangles must be counter-clockwise "
-                                                        "with positive area");
+        MLC_CHECK(a > 1e-14 * diam * diam, "degenerate or inverted triangle "
+                                               << t << " (vertices " << tri[0] << ", " << tri[1]
+                                               << ", " << tri[2] << " near (" << p.x() << ", "
+                                               << p.y() << ")): signed area " << a
+                                               << "; triangles must be counter-clockwise "
+                                                  "with positive area");
     }
     // Duplicate vertices: sort by x and compare neighbours within the tolerance.
     std::vector<int> order(static_cast<size_t>(nv));
-    for (int i = 0; i < nv; ++i) order[static_cast<size_t>(i)] = i;
+    for (int i = 0; i < nv; ++i)
+        order[static_cast<size_t>(i)] = i;
     std::sort(order.begin(), order.end(), [&](int a, int b) {
         return m.vertices[static_cast<size_t>(a)].x() < m.vertices[static_cast<size_t>(b)].x();
     });
@@ -147,8 +149,8 @@ void check_quality(const Mesh& m) {
             const Vec2& b = m.vertices[static_cast<size_t>(order[j])];
             if (b.x() - a.x() > tol) break;
             MLC_CHECK((a - b).norm() > tol, "duplicate vertices " << order[i] << " and " << order[j]
-                                                                 << " at (" << a.x() << ", "
-                                                                 << a.y() << ")");
+                                                                  << " at (" << a.x() << ", "
+                                                                  << a.y() << ")");
         }
     std::unordered_map<std::uint64_t, int> edges;
     edges.reserve(static_cast<size_t>(3 * m.n_triangles()));
@@ -178,8 +180,8 @@ Mesh refine(const Mesh& coarse) {
         auto [it, inserted] = midpoint.try_emplace(edge_key(a, b), 0);
         if (inserted) {
             it->second = static_cast<int>(fine.vertices.size());
-            fine.vertices.push_back(
-                0.5 * (coarse.vertices[static_cast<size_t>(a)] + coarse.vertices[static_cast<size_t>(b)]));
+            fine.vertices.push_back(0.5 * (coarse.vertices[static_cast<size_t>(a)] +
+                                           coarse.vertices[static_cast<size_t>(b)]));
             fine.parents.push_back({std::min(a, b), std::max(a, b)});
         }
         return it->second;
@@ -196,7 +198,8 @@ Mesh refine(const Mesh& coarse) {
     if (!coarse.attribute.empty()) {
         fine.attribute.reserve(4 * nt);
         for (int a : coarse.attribute)
-            for (int k = 0; k < 4; ++k) fine.attribute.push_back(a);
+            for (int k = 0; k < 4; ++k)
+                fine.attribute.push_back(a);
     }
     fine.boundary.reserve(2 * coarse.boundary.size());
     for (const auto& e : coarse.boundary) {
@@ -218,8 +221,8 @@ Mesh refine(const Mesh& coarse) {
 Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diagonal) {
     MLC_CHECK(nx >= 1 && ny >= 1, "a structured rectangle needs at least one square each way, got "
                                       << nx << " x " << ny);
-    MLC_CHECK(size.x() > 0 && size.y() > 0,
-              "a structured rectangle needs a positive size, got " << size.x() << " x " << size.y());
+    MLC_CHECK(size.x() > 0 && size.y() > 0, "a structured rectangle needs a positive size, got "
+                                                << size.x() << " x " << size.y());
     Mesh m;
     m.vertices.reserve(static_cast<size_t>((nx + 1) * (ny + 1)));
     for (int j = 0; j <= ny; ++j)
@@ -242,10 +245,14 @@ Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diago
         }
     const int bottom = m.add_tag("bottom"), right = m.add_tag("right"), top = m.add_tag("top"),
               left = m.add_tag("left");
-    for (int i = 0; i < nx; ++i) m.boundary.push_back({id(i, 0), id(i + 1, 0), bottom, -1});
-    for (int j = 0; j < ny; ++j) m.boundary.push_back({id(nx, j), id(nx, j + 1), right, -1});
-    for (int i = nx; i > 0; --i) m.boundary.push_back({id(i, ny), id(i - 1, ny), top, -1});
-    for (int j = ny; j > 0; --j) m.boundary.push_back({id(0, j), id(0, j - 1), left, -1});
+    for (int i = 0; i < nx; ++i)
+        m.boundary.push_back({id(i, 0), id(i + 1, 0), bottom, -1});
+    for (int j = 0; j < ny; ++j)
+        m.boundary.push_back({id(nx, j), id(nx, j + 1), right, -1});
+    for (int i = nx; i > 0; --i)
+        m.boundary.push_back({id(i, ny), id(i - 1, ny), top, -1});
+    for (int j = ny; j > 0; --j)
+        m.boundary.push_back({id(0, j), id(0, j - 1), left, -1});
     return m;
 }
 

@@ -24,8 +24,8 @@ struct Circle {
 struct BoundaryEdge {
     int v0 = -1;
     int v1 = -1;
-    int tag = 0;     ///< boundary tag id; names in Mesh::tag_names
-    int curve = -1;  ///< index into Mesh::circles, or -1 for a straight edge
+    int tag = 0;    ///< boundary tag id; names in Mesh::tag_names
+    int curve = -1; ///< index into Mesh::circles, or -1 for a straight edge
 };
 
 /// A 2D triangle mesh of one body.
@@ -41,7 +41,7 @@ struct Mesh {
     std::vector<int> attribute;
     std::vector<BoundaryEdge> boundary;
     std::vector<Circle> circles;
-    std::map<std::string, int> tag_names;  ///< name -> tag id
+    std::map<std::string, int> tag_names; ///< name -> tag id
     /// For a refined mesh: parents[v - n_coarse] = the two coarse vertices of new vertex v.
     /// Empty for a level-0 mesh.
     std::vector<std::array<int, 2>> parents;
@@ -85,13 +85,14 @@ Mesh refine(const Mesh& coarse);
 
 /// How a structured rectangle's squares are cut into two triangles.
 enum class Diagonal {
-    right,     ///< "/" from lower-left to upper-right in every square
-    left,      ///< "\" from lower-right to upper-left
-    alternate  ///< union-jack style alternation
+    right,    ///< "/" from lower-left to upper-right in every square
+    left,     ///< "\" from lower-right to upper-left
+    alternate ///< union-jack style alternation
 };
 
 /// Structured mesh of [x0, x0+lx] x [y0, y0+ly] with nx x ny squares cut along one diagonal.
 /// Boundary tags "bottom", "right", "top", "left". Vertex (i, j) has index j*(nx+1) + i.
-Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diagonal = Diagonal::right);
+Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny,
+                          Diagonal diagonal = Diagonal::right);
 
 } // namespace mlc::mesh

@@ -10,7 +10,9 @@ using namespace mlc;
 
 namespace {
 
-std::string square_text() { return apps::builtin_scene_text("square"); }
+std::string square_text() {
+    return apps::builtin_scene_text("square");
+}
 
 std::string replace(std::string s, const std::string& from, const std::string& to) {
     const auto pos = s.find(from);

@@ -14,7 +14,8 @@ namespace {
 levels::RunResult solve_square(int level, double mu) {
     auto p = apps::load_scene("square");
     p.levels = level;
-    for (auto& c : p.contacts) c.mu = mu;
+    for (auto& c : p.contacts)
+        c.mu = mu;
     return levels::solve(p);
 }
 
@@ -25,7 +26,8 @@ TEST(Square, UnknownCountsMatchTheBenchmarkLadder) {
     for (auto [level, n] : {std::pair{0, 592}, {1, 2208}}) {
         p.levels = level;
         mesh::Mesh m = p.mesh0;
-        for (int l = 0; l < level; ++l) m = mesh::refine(m);
+        for (int l = 0; l < level; ++l)
+            m = mesh::refine(m);
         const auto L = levels::build_level(p, m);
         EXPECT_EQ(L.n_unknowns(), n) << "level " << level;
         EXPECT_EQ(L.n_contact_nodes(), 16 << level);
@@ -45,7 +47,8 @@ TEST(Square, ConvergedStateSatisfiesEquilibriumAndTheContactLaws) {
         EXPECT_LT(c.complementarity, 1e-8);
         EXPECT_LT(c.penetration, 1e-8);
         EXPECT_LT(c.tension, 1e-8);
-        for (const auto& s : r.steps) EXPECT_LE(s.iterations, 20);
+        for (const auto& s : r.steps)
+            EXPECT_LE(s.iterations, 20);
     }
 }
 
@@ -55,9 +58,9 @@ TEST(Square, LiftsOffAtTheLeftSlipsForwardAndSticksNearTheSymmetryPlane) {
     auto nodes = r.nodes;
     std::sort(nodes.begin(), nodes.end(), [](auto& a, auto& b) { return a.x.x() < b.x.x(); });
     using contact::Status;
-    EXPECT_EQ(nodes.front().status, Status::gap);       // left end lifts off
+    EXPECT_EQ(nodes.front().status, Status::gap); // left end lifts off
     EXPECT_GT(nodes.front().u.y(), 0.0);
-    EXPECT_EQ(nodes.back().status, Status::stick);       // next to the symmetry plane
+    EXPECT_EQ(nodes.back().status, Status::stick); // next to the symmetry plane
     int slip = 0, backward = 0;
     for (const auto& n : nodes) {
         slip += n.status == Status::slip_forward;
@@ -84,7 +87,8 @@ TEST(Square, VerticalContactResultantCarriesTheTopLoadWithTheCornerReaction) {
     const auto r = solve_square(1, 0.3);
     ASSERT_TRUE(r.converged) << r.failure;
     double sum_n = 0;
-    for (const auto& n : r.nodes) sum_n += n.lambda_n;
+    for (const auto& n : r.nodes)
+        sum_n += n.lambda_n;
     // The top load is 50 * 40 = 2000 (N/mm). The fixed corner carries part of it, so the contact
     // resultant is compressive and at most the load.
     EXPECT_LT(sum_n, 0.0);

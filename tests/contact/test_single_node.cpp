@@ -40,9 +40,10 @@ struct Solved {
     int iterations;
 };
 
-Solved solve_single(double kt, double kn, Vec2 f, double mu, double r) {
+Solved solve_single(double kt, double kn, Vec2 f, double mu, double r,
+                    const std::string& solver = "schur") {
     const auto L = single_node(kt, kn, f, mu, r);
-    levels::ContactNewton newton(L, {}, levels::make_direct_solver());
+    levels::ContactNewton newton(L, {}, levels::make_newton_system_solver(L, solver));
     Vector x = Vector::Zero(L.n_unknowns());
     const auto rep = newton.solve(1.0, Vector::Zero(2), x);
     EXPECT_TRUE(rep.converged) << rep.message;
@@ -69,6 +70,17 @@ TEST(SingleNode, SlipsForward) {
     EXPECT_NEAR(s.lambda.x(), 1.0, 1e-13);
     EXPECT_NEAR(s.u.x(), (3.0 - 1.0) / 10.0, 1e-14);
     EXPECT_NEAR(s.u.y(), 0.0, 1e-14);
+}
+
+TEST(SingleNode, AssembledLUAndCondensedSolversAgree) {
+    for (Vec2 f : {Vec2(0.9, -2.0), Vec2(3.0, -2.0), Vec2(-3.0, -2.0), Vec2(1.0, 2.0)}) {
+        const auto a = solve_single(10.0, 20.0, f, 0.5, 3.0, "lu");
+        const auto b = solve_single(10.0, 20.0, f, 0.5, 3.0, "schur");
+        EXPECT_EQ(a.status, b.status);
+        EXPECT_EQ(a.iterations, b.iterations);
+        EXPECT_NEAR((a.u - b.u).norm(), 0.0, 1e-14);
+        EXPECT_NEAR((a.lambda - b.lambda).norm(), 0.0, 1e-12);
+    }
 }
 
 TEST(SingleNode, SlipsBackward) {

@@ -3,10 +3,10 @@
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 
-#include <Eigen/SparseLU>
-#include <functional>
 #include "fem/elasticity.hpp"
 #include "mesh/mesh.hpp"
+#include <Eigen/SparseLU>
+#include <functional>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -29,8 +29,10 @@ TEST(ElementStiffness, RigidBodyModesAreInTheKernel) {
         // Exactly three zero eigenvalues, the other three positive.
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> es(K);
         const auto ev = es.eigenvalues();
-        for (int i = 0; i < 3; ++i) EXPECT_LT(std::abs(ev[i]), 1e-12 * ev[5]);
-        for (int i = 3; i < 6; ++i) EXPECT_GT(ev[i], 1e-3 * ev[5]);
+        for (int i = 0; i < 3; ++i)
+            EXPECT_LT(std::abs(ev[i]), 1e-12 * ev[5]);
+        for (int i = 3; i < 6; ++i)
+            EXPECT_GT(ev[i], 1e-3 * ev[5]);
     }
 }
 
@@ -69,14 +71,16 @@ double patch_error(const mesh::Mesh& m, const fem::Material& mat,
             u_fixed.segment<2>(2 * v) = u_exact(m.vertices[static_cast<size_t>(v)]);
         }
     fem::DofMap dofs(fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
-    const auto sys = fem::assemble_elastic(m, {mat}, dofs, Vector::Zero(2 * m.n_vertices()), u_fixed);
+    const auto sys =
+        fem::assemble_elastic(m, {mat}, dofs, Vector::Zero(2 * m.n_vertices()), u_fixed);
     Eigen::SparseLU<SparseMatrixCol> lu(SparseMatrixCol(sys.K));
     const Vector x = lu.solve(sys.f);
     Vector u;
     dofs.expand(x, u_fixed, u);
     double err = 0;
     for (int v = 0; v < m.n_vertices(); ++v)
-        err = std::max(err, (u.segment<2>(2 * v) - u_exact(m.vertices[static_cast<size_t>(v)])).norm());
+        err = std::max(err,
+                       (u.segment<2>(2 * v) - u_exact(m.vertices[static_cast<size_t>(v)])).norm());
     return err;
 }
 
@@ -84,12 +88,16 @@ double patch_error(const mesh::Mesh& m, const fem::Material& mat,
 
 TEST(Assembly, LinearDisplacementPatchIsReproducedExactly) {
     // Distorted interior vertices: P1 must still reproduce any linear field exactly.
-    mesh::Mesh m = mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 6, 4, mesh::Diagonal::alternate);
+    mesh::Mesh m =
+        mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 6, 4, mesh::Diagonal::alternate);
     for (int j = 1; j < 4; ++j)
         for (int i = 1; i < 6; ++i)
-            m.vertices[static_cast<size_t>(j * 7 + i)] += Vec2(0.07 * std::sin(i * j), 0.05 * std::cos(i + j));
+            m.vertices[static_cast<size_t>(j * 7 + i)] +=
+                Vec2(0.07 * std::sin(i * j), 0.05 * std::cos(i + j));
     mesh::check_quality(m);
-    auto lin = [](const Vec2& p) { return Vec2(1e-3 * (0.3 + 2 * p.x() - p.y()), 1e-3 * (0.1 + 0.5 * p.x() + 3 * p.y())); };
+    auto lin = [](const Vec2& p) {
+        return Vec2(1e-3 * (0.3 + 2 * p.x() - p.y()), 1e-3 * (0.1 + 0.5 * p.x() + 3 * p.y()));
+    };
     EXPECT_LT(patch_error(m, {.E = 7.0, .nu = 0.35}, lin), 1e-15);
     EXPECT_LT(patch_error(m, {.E = 7.0, .nu = 0.35, .plane = fem::Plane::stress}, lin), 1e-15);
 }
@@ -100,11 +108,13 @@ TEST(Assembly, UniaxialTractionGivesTheClosedFormExtension) {
     mesh::Mesh m = mesh::structured_rectangle(Vec2(0, 0), Vec2(4, 1), 8, 2);
     const fem::Material mat{.E = 200.0, .nu = 0.3, .plane = fem::Plane::stress};
     std::vector<std::array<bool, 2>> fixed(static_cast<size_t>(m.n_vertices()), {false, false});
-    for (int v : m.vertices_with_tag(m.tag("left"))) fixed[static_cast<size_t>(v)][0] = true;
+    for (int v : m.vertices_with_tag(m.tag("left")))
+        fixed[static_cast<size_t>(v)][0] = true;
     fixed[0][1] = true;
     fem::DofMap dofs(fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
     const double p = 2.0;
-    const Vector F = fem::nodal_loads(m, {{.tag = m.tag("right"), .pressure = 0.0, .vector = Vec2(p, 0)}}, {});
+    const Vector F =
+        fem::nodal_loads(m, {{.tag = m.tag("right"), .pressure = 0.0, .vector = Vec2(p, 0)}}, {});
     EXPECT_NEAR(F.sum(), p * 1.0, 1e-14);
     const auto sys = fem::assemble_elastic(m, {mat}, dofs, F, Vector::Zero(2 * m.n_vertices()));
     Eigen::SparseLU<SparseMatrixCol> lu(SparseMatrixCol(sys.K));
@@ -125,7 +135,8 @@ TEST(Assembly, UniaxialTractionGivesTheClosedFormExtension) {
 TEST(Assembly, PressureIsANormalTractionIntoTheBody) {
     // Pressure on the top of a unit square pushes down: resultant (0, -p).
     const mesh::Mesh m = mesh::structured_rectangle(Vec2(0, 0), Vec2(1, 1), 3, 3);
-    const Vector F = fem::nodal_loads(m, {{.tag = m.tag("top"), .pressure = 5.0, .vector = Vec2::Zero()}}, {});
+    const Vector F =
+        fem::nodal_loads(m, {{.tag = m.tag("top"), .pressure = 5.0, .vector = Vec2::Zero()}}, {});
     double fx = 0, fy = 0;
     for (int v = 0; v < m.n_vertices(); ++v) {
         fx += F[2 * v];

@@ -13,7 +13,8 @@ TEST(StructuredRectangle, SquareLadderCounts) {
     EXPECT_EQ(m.n_triangles(), 512);
     EXPECT_EQ(m.vertices_with_tag(m.tag("bottom")).size(), 17u);
     double area = 0;
-    for (int t = 0; t < m.n_triangles(); ++t) area += m.signed_area(t);
+    for (int t = 0; t < m.n_triangles(); ++t)
+        area += m.signed_area(t);
     EXPECT_NEAR(area, 1600.0, 1e-10);
     EXPECT_NO_THROW(mesh::check_quality(m));
 }
@@ -29,7 +30,8 @@ TEST(Refine, SplitsEveryTriangleInFourAndKeepsCoarseVertices) {
             EXPECT_EQ(g.vertices[static_cast<size_t>(v)], f.vertices[static_cast<size_t>(v)]);
         for (size_t k = 0; k < g.parents.size(); ++k) {
             const auto [a, b] = g.parents[k];
-            const Vec2 mid = 0.5 * (f.vertices[static_cast<size_t>(a)] + f.vertices[static_cast<size_t>(b)]);
+            const Vec2 mid =
+                0.5 * (f.vertices[static_cast<size_t>(a)] + f.vertices[static_cast<size_t>(b)]);
             EXPECT_LT((g.vertices[f.vertices.size() + k] - mid).norm(), 1e-13);
         }
         EXPECT_NO_THROW(mesh::check_quality(g));
@@ -47,9 +49,11 @@ TEST(Refine, MovesArcMidpointsOntoTheCircle) {
     for (auto& e : m.boundary)
         if (e.tag == m.tag("bottom")) e.curve = 0;
     const auto f = mesh::refine(m);
-    for (const auto& e : f.boundary)
-        if (e.curve == 0 && e.v0 >= m.n_vertices())
+    for (const auto& e : f.boundary) {
+        if (e.curve == 0 && e.v0 >= m.n_vertices()) {
             EXPECT_NEAR((f.vertices[static_cast<size_t>(e.v0)] - Vec2(0, 5)).norm(), 5.0, 1e-14);
+        }
+    }
 }
 
 TEST(CheckQuality, RejectsDegenerateInvertedAndDuplicate) {

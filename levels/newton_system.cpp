@@ -1,0 +1,289 @@
+// SPDX-License-Identifier: MIT
+// Newton system solvers: assembled (SparseLU or iterative) and condensed on the contact set.
+#include "levels/newton_system.hpp"
+
+#include "core/check.hpp"
+#include "core/timer.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <algorithm>
+
+namespace mlc::levels {
+
+// ---------------------------------------------------------------------------------------------
+JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
+    const SparseMatrix& K = level.elastic.K;
+    const Index n = level.n_unknowns();
+    std::vector<Triplet> trip;
+    trip.reserve(static_cast<size_t>(K.nonZeros()) + 16 * level.contacts.size());
+    for (int i = 0; i < K.outerSize(); ++i)
+        for (SparseMatrix::InnerIterator it(K, i); it; ++it)
+            trip.emplace_back(i, it.col(), 0.0);
+    std::vector<std::pair<int, int>> centries;
+    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+    for (size_t e = 0; e < level.contacts.size(); ++e)
+        contact::for_each_tangent_entry(level.contacts[e], I, level.dofs, level.lambda_dof[e],
+                                        [&](int row, int col, double) {
+                                            trip.emplace_back(row, col, 0.0);
+                                            centries.emplace_back(row, col);
+                                        });
+    J_.resize(n, n);
+    J_.setFromTriplets(trip.begin(), trip.end());
+    J_.makeCompressed();
+    auto position = [&](int row, int col) {
+        const int* begin = J_.innerIndexPtr() + J_.outerIndexPtr()[row];
+        const int* end = J_.innerIndexPtr() + J_.outerIndexPtr()[row + 1];
+        const int* it = std::lower_bound(begin, end, col);
+        MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
+        return static_cast<int>(it - J_.innerIndexPtr());
+    };
+    kpos_.reserve(static_cast<size_t>(K.nonZeros()));
+    for (int i = 0; i < K.outerSize(); ++i)
+        for (SparseMatrix::InnerIterator it(K, i); it; ++it)
+            kpos_.push_back(position(i, it.col()));
+    cpos_.reserve(centries.size());
+    for (auto [r, c] : centries)
+        cpos_.push_back(position(r, c));
+}
+
+void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
+    double* v = J_.valuePtr();
+    std::fill(v, v + J_.nonZeros(), 0.0);
+    const double* kv = level_.elastic.K.valuePtr();
+    for (size_t k = 0; k < kpos_.size(); ++k)
+        v[kpos_[k]] += kv[k];
+    size_t c = 0;
+    for (size_t e = 0; e < level_.contacts.size(); ++e)
+        contact::for_each_tangent_entry(level_.contacts[e], M[e], level_.dofs, level_.lambda_dof[e],
+                                        [&](int, int, double value) { v[cpos_[c++]] += value; });
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+class SparseLUSolver final : public LinearSolver {
+public:
+    SolveResult solve(const SparseMatrix& J, const Vector& b, Vector& x) override {
+        SolveResult res;
+        const double t0 = wall_seconds();
+        Jc_ = J; // column-major copy for SparseLU
+        if (!analyzed_ || !same_pattern(Jc_)) {
+            lu_.analyzePattern(Jc_);
+            outer_.assign(Jc_.outerIndexPtr(), Jc_.outerIndexPtr() + Jc_.outerSize() + 1);
+            inner_.assign(Jc_.innerIndexPtr(), Jc_.innerIndexPtr() + Jc_.nonZeros());
+            analyzed_ = true;
+        }
+        lu_.factorize(Jc_);
+        if (lu_.info() != Eigen::Success)
+            throw SolverBreakdown("SparseLU factorization failed (singular Jacobian): " +
+                                  lu_.lastErrorMessage());
+        const double t1 = wall_seconds();
+        x = lu_.solve(b);
+        res.setup_seconds = t1 - t0;
+        res.solve_seconds = wall_seconds() - t1;
+        res.converged = true;
+        res.reason = StopReason::converged;
+        res.initial_residual = b.norm();
+        res.final_residual = (b - J * x).norm();
+        res.relative_residual =
+            res.initial_residual > 0 ? res.final_residual / res.initial_residual : 0.0;
+        return res;
+    }
+    std::string name() const override { return "lu"; }
+
+private:
+    bool same_pattern(const SparseMatrixCol& A) const {
+        return static_cast<size_t>(A.nonZeros()) == inner_.size() &&
+               std::equal(outer_.begin(), outer_.end(), A.outerIndexPtr()) &&
+               std::equal(inner_.begin(), inner_.end(), A.innerIndexPtr());
+    }
+    SparseMatrixCol Jc_;
+    Eigen::SparseLU<SparseMatrixCol, Eigen::COLAMDOrdering<int>> lu_;
+    bool analyzed_ = false;
+    std::vector<int> outer_, inner_;
+};
+
+class AssembledSystemSolver final : public NewtonSystemSolver {
+public:
+    AssembledSystemSolver(const Level& level, std::unique_ptr<LinearSolver> solver)
+        : jac_(level), solver_(std::move(solver)) {
+        MLC_CHECK(solver_ != nullptr, "no linear solver given");
+    }
+    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) override {
+        jac_.assemble(M);
+        if (dx.size() != b.size()) dx = Vector::Zero(b.size());
+        return solver_->solve(jac_.matrix(), b, dx);
+    }
+    std::string name() const override { return solver_->name(); }
+
+private:
+    JacobianAssembler jac_;
+    std::unique_ptr<LinearSolver> solver_;
+};
+
+class SchurSystemSolver final : public NewtonSystemSolver {
+public:
+    explicit SchurSystemSolver(const Level& level) : level_(level) {
+        const double t0 = wall_seconds();
+        const auto& dofs = level.dofs;
+        const Index n = level.n_unknowns();
+        // Compact numbering of the displacement unknowns.
+        u_of_dof_.assign(static_cast<size_t>(n), -1);
+        for (Index i = 0; i < n; ++i)
+            if (dofs.is_displacement(i)) {
+                u_of_dof_[static_cast<size_t>(i)] = static_cast<int>(dof_of_u_.size());
+                dof_of_u_.push_back(static_cast<int>(i));
+            }
+        const Index nu = static_cast<Index>(dof_of_u_.size());
+        // Contact components: offsets and B (m x nu).
+        std::vector<Triplet> bt;
+        for (const auto& e : level.contacts) {
+            comp_.push_back(m_);
+            const int me = e.n_multipliers();
+            for (int q = 0; q < me; ++q) {
+                const Vec2 g = (me == 2 && q == 0) ? e.t : e.n;
+                for (int j = 0; j < e.n_nodes; ++j)
+                    for (int a = 0; a < 2; ++a) {
+                        const int d = dofs.u_dof(e.vertex[static_cast<size_t>(j)], a);
+                        if (d >= 0)
+                            bt.emplace_back(m_ + q, u_of_dof_[static_cast<size_t>(d)],
+                                            e.weight[static_cast<size_t>(j)] * g[a]);
+                    }
+                rdiag_.push_back(e.r);
+            }
+            m_ += me;
+        }
+        B_.resize(m_, nu);
+        B_.setFromTriplets(bt.begin(), bt.end());
+        // K0 = K_uu + B^T diag(r) B.
+        std::vector<Triplet> kt;
+        const SparseMatrix& K = level.elastic.K;
+        kt.reserve(static_cast<size_t>(K.nonZeros()));
+        for (int i = 0; i < K.outerSize(); ++i)
+            for (SparseMatrix::InnerIterator it(K, i); it; ++it)
+                kt.emplace_back(u_of_dof_[static_cast<size_t>(i)],
+                                u_of_dof_[static_cast<size_t>(it.col())], it.value());
+        SparseMatrixCol K0(nu, nu);
+        K0.setFromTriplets(kt.begin(), kt.end());
+        Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(rdiag_.data(), m_);
+        K0 += SparseMatrixCol(B_.transpose() * r.asDiagonal() * B_);
+        chol_.compute(K0);
+        MLC_CHECK(chol_.info() == Eigen::Success,
+                  "the elastic operator regularized by the contact penalty is singular: some "
+                  "rigid-body motion is held neither by supports nor by the contact candidates "
+                  "(add a support, or widen the contact region)");
+        // S = B K0^{-1} B^T in column blocks.
+        S_.resize(m_, m_);
+        const SparseMatrixCol Bt = B_.transpose();
+        constexpr Index block = 64;
+        for (Index c0 = 0; c0 < m_; c0 += block) {
+            const Index nc = std::min(block, m_ - c0);
+            Eigen::MatrixXd rhs = Eigen::MatrixXd(Bt.middleCols(c0, nc));
+            const Eigen::MatrixXd X = chol_.solve(rhs);
+            S_.middleCols(c0, nc) = B_ * X;
+        }
+        setup_seconds_ = wall_seconds() - t0;
+        bu_.resize(nu);
+        du_.resize(nu);
+        sys_.resize(2 * m_, 2 * m_);
+        D1_.resize(m_, 2);
+        D2_.resize(m_, 2);
+        rhs_.resize(2 * m_);
+    }
+
+    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) override {
+        const double t0 = wall_seconds();
+        const Level& L = level_;
+        const Index nu = static_cast<Index>(dof_of_u_.size());
+        for (Index k = 0; k < nu; ++k)
+            bu_[k] = b[dof_of_u_[static_cast<size_t>(k)]];
+        du_ = chol_.solve(bu_);
+        const Eigen::VectorXd w = B_ * du_;
+        // Block-diagonal D1 = r (M - I), D2 = M, D3 = (M - I) / r on the element components;
+        // the products with S are formed block by block (O(m^2), not O(m^3)).
+        sys_.setZero();
+        for (size_t e = 0; e < L.contacts.size(); ++e) {
+            const auto& el = L.contacts[e];
+            const int me = el.n_multipliers(), c = comp_[e], q0 = me == 2 ? 0 : 1;
+            const Eigen::MatrixXd Me = M[e].block(q0, q0, me, me);
+            const Eigen::MatrixXd Mi = Me - Eigen::MatrixXd::Identity(me, me);
+            D1_.block(c, 0, me, me) = el.r * Mi;
+            D2_.block(c, 0, me, me) = Me;
+            sys_.block(0, c, m_, me).noalias() = S_.middleCols(c, me) * (el.r * Mi);
+            sys_.block(0, m_ + c, m_, me).noalias() = S_.middleCols(c, me) * Me;
+            sys_.block(m_ + c, c, me, me) = Me;
+            sys_.block(m_ + c, m_ + c, me, me) = Mi / el.r;
+            for (int q = 0; q < me; ++q)
+                rhs_[m_ + c + q] = b[L.lambda_dof[e] + q];
+        }
+        sys_.topLeftCorner(m_, m_).diagonal().array() += 1.0;
+        rhs_.head(m_) = w;
+        lu_.compute(sys_);
+        const Eigen::VectorXd zl = lu_.solve(rhs_);
+        Eigen::VectorXd y(m_);
+        for (size_t e = 0; e < L.contacts.size(); ++e) {
+            const int me = L.contacts[e].n_multipliers(), c = comp_[e];
+            y.segment(c, me) = D1_.block(c, 0, me, me) * zl.segment(c, me) +
+                               D2_.block(c, 0, me, me) * zl.segment(m_ + c, me);
+        }
+        bu_ -= B_.transpose() * y;
+        du_ = chol_.solve(bu_);
+        dx.setZero(b.size());
+        for (Index k = 0; k < nu; ++k)
+            dx[dof_of_u_[static_cast<size_t>(k)]] = du_[k];
+        for (size_t e = 0; e < L.contacts.size(); ++e)
+            for (int q = 0; q < L.contacts[e].n_multipliers(); ++q)
+                dx[L.lambda_dof[e] + q] = zl[m_ + comp_[e] + q];
+        SolveResult res;
+        res.converged = dx.allFinite();
+        res.reason = res.converged ? StopReason::converged : StopReason::breakdown;
+        if (!res.converged) res.message = "the condensed contact system is singular";
+        res.setup_seconds = first_ ? setup_seconds_ : 0.0;
+        first_ = false;
+        res.solve_seconds = wall_seconds() - t0;
+        res.initial_residual = b.norm();
+        return res;
+    }
+    std::string name() const override { return "schur"; }
+
+private:
+    const Level& level_;
+    std::vector<int> u_of_dof_, dof_of_u_;
+    std::vector<int> comp_;     ///< first contact component of each element
+    std::vector<double> rdiag_; ///< r per component
+    Index m_ = 0;               ///< number of contact components
+    SparseMatrix B_;
+    Eigen::SimplicialLLT<SparseMatrixCol, Eigen::Lower, Eigen::AMDOrdering<int>> chol_;
+    Eigen::MatrixXd S_, sys_;
+    Eigen::MatrixXd D1_, D2_; ///< per element component block (me x me) of D1, D2, stacked
+    Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+    Eigen::VectorXd bu_, du_, rhs_;
+    double setup_seconds_ = 0.0;
+    bool first_ = true;
+};
+
+} // namespace
+
+std::unique_ptr<LinearSolver> make_sparse_lu_solver() {
+    return std::make_unique<SparseLUSolver>();
+}
+
+std::unique_ptr<NewtonSystemSolver>
+make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> solver) {
+    return std::make_unique<AssembledSystemSolver>(level, std::move(solver));
+}
+
+std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level) {
+    return std::make_unique<SchurSystemSolver>(level);
+}
+
+std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level,
+                                                              const std::string& name) {
+    if (name == "schur") return make_schur_system_solver(level);
+    if (name == "lu") return make_assembled_system_solver(level, make_sparse_lu_solver());
+    MLC_CHECK(false, "unknown linear solver '" << name << "' (known: schur, lu)");
+    return nullptr;
+}
+
+} // namespace mlc::levels

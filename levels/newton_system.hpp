@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: MIT
+/// @file Solvers for the Newton system J(M) dx = b of one level, where J(M) is the generalized
+/// Jacobian for the per-element status matrices M (formulation.md §2).
+#pragma once
+
+#include "core/linear_operator.hpp"
+#include "levels/level.hpp"
+
+#include <Eigen/Dense>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mlc::levels {
+
+/// Assembles J = K + sum of contact tangents into a CSR matrix whose pattern is built once, so
+/// values are refreshed in place and a direct solver's symbolic analysis can be reused.
+class JacobianAssembler {
+public:
+    /// `level` must outlive this object.
+    explicit JacobianAssembler(const Level& level);
+    /// Fills the values for the given per-element M matrices.
+    void assemble(const std::vector<Eigen::Matrix2d>& M);
+    const SparseMatrix& matrix() const { return J_; }
+
+private:
+    const Level& level_;
+    SparseMatrix J_;
+    std::vector<int> kpos_; ///< position in J's values of each K value
+    std::vector<int> cpos_; ///< position of each contact tangent entry, in visiting order
+};
+
+/// Solves J x = b for an assembled matrix.
+class LinearSolver {
+public:
+    virtual ~LinearSolver() = default;
+    /// Solves J x = b (x holds the initial guess on entry); returns iterations, residuals, times.
+    virtual SolveResult solve(const SparseMatrix& J, const Vector& b, Vector& x) = 0;
+    virtual std::string name() const = 0;
+};
+
+/// Eigen SparseLU on the assembled J; analyzes the pattern once and refactors numerically
+/// afterwards (the pattern of J is fixed per level).
+std::unique_ptr<LinearSolver> make_sparse_lu_solver();
+
+/// Strategy for one Newton linear system J(M) dx = b on a level.
+class NewtonSystemSolver {
+public:
+    virtual ~NewtonSystemSolver() = default;
+    /// dx = J(M)^{-1} b. dx is resized; its content on entry is the initial guess of an
+    /// iterative method (zero is fine).
+    virtual SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b,
+                              Vector& dx) = 0;
+    /// "lu", "schur", or the Krylov/preconditioner pair.
+    virtual std::string name() const = 0;
+};
+
+/// Assembles J(M) (pattern fixed per level) and calls `solver` on it. `level` must outlive it.
+std::unique_ptr<NewtonSystemSolver>
+make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> solver);
+
+/// Exact solve by condensation on the contact components ("schur").
+///
+/// With B the map from displacement unknowns to the local contact components (t, n per
+/// frictional node, n per frictionless node), K0 = K + B^T diag(r) B is symmetric positive
+/// definite whenever the problem with every candidate node stuck is well posed (this is what
+/// lets a body held only by contact be solved), and does not depend on the statuses. So K0 is
+/// factored once (sparse Cholesky) and S = B K0^{-1} B^T computed once per level; each Newton
+/// system is then, with D1 = r (M - I), D2 = M, D3 = (M - I) / r blockwise,
+///     [I + S D1, S D2; D2, D3] [z; dlambda] = [B K0^{-1} b_u; b_lambda]
+/// (dense, size twice the number of contact components), and du = K0^{-1}(b_u - B^T (D1 z +
+/// D2 dlambda)). Two sparse triangular solve pairs per Newton step; nothing is refactored when
+/// statuses change. Cost: one Cholesky, and one solve per contact component for S, per level.
+std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level);
+
+/// Builds the solver named `name`: "schur" (default) or "lu".
+std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level,
+                                                              const std::string& name);
+
+} // namespace mlc::levels

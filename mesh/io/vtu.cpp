@@ -1,0 +1,267 @@
+// SPDX-License-Identifier: MIT
+// Hand-written VTK XML writers: everything is validated first, then streamed through a large
+// buffer with std::to_chars into a temporary file that is renamed into place.
+#include "mesh/io/vtu.hpp"
+
+#include "core/check.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <stdexcept>
+#include <string_view>
+#include <system_error>
+
+namespace mlc::mesh {
+
+namespace {
+
+/// Output through a 1 MiB buffer; numbers are formatted with std::to_chars (shortest form that
+/// round-trips). Errors are remembered and reported by close().
+class BufferedFile {
+public:
+    explicit BufferedFile(const std::filesystem::path& path)
+        : file_(std::fopen(path.c_str(), "wb")), buf_(1 << 20) {}
+    BufferedFile(const BufferedFile&) = delete;
+    BufferedFile& operator=(const BufferedFile&) = delete;
+    ~BufferedFile() {
+        if (file_) std::fclose(file_);
+    }
+
+    bool is_open() const { return file_ != nullptr; }
+
+    void put(std::string_view s) {
+        if (buf_.size() - n_ < s.size()) flush();
+        if (s.size() > buf_.size()) {
+            failed_ |= std::fwrite(s.data(), 1, s.size(), file_) != s.size();
+            return;
+        }
+        s.copy(buf_.data() + n_, s.size());
+        n_ += s.size();
+    }
+    void put(char c) {
+        if (n_ == buf_.size()) flush();
+        buf_[n_++] = c;
+    }
+    template <class Number> void put_number(Number v) {
+        if (buf_.size() - n_ < 32) flush();
+        const auto r = std::to_chars(buf_.data() + n_, buf_.data() + buf_.size(), v);
+        n_ = static_cast<std::size_t>(r.ptr - buf_.data());
+    }
+
+    /// Flushes and closes; false if any write failed.
+    bool close() {
+        flush();
+        const bool closed = std::fclose(file_) == 0;
+        file_ = nullptr;
+        return closed && !failed_;
+    }
+
+private:
+    void flush() {
+        if (n_ > 0) failed_ |= std::fwrite(buf_.data(), 1, n_, file_) != n_;
+        n_ = 0;
+    }
+
+    std::FILE* file_;
+    std::vector<char> buf_;
+    std::size_t n_ = 0;
+    bool failed_ = false;
+};
+
+std::string xml_escape(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+        case '&':
+            out += "&amp;";
+            break;
+        case '<':
+            out += "&lt;";
+            break;
+        case '>':
+            out += "&gt;";
+            break;
+        case '"':
+            out += "&quot;";
+            break;
+        case '\'':
+            out += "&apos;";
+            break;
+        default:
+            out += c;
+        }
+    }
+    return out;
+}
+
+void check_fields(const std::vector<Field>& fields, const char* kind, const char* entity,
+                  std::size_t n_entities) {
+    std::set<std::string> names;
+    for (const Field& f : fields) {
+        MLC_CHECK(!f.name.empty(), "write_vtu: a " << kind << " field has an empty name");
+        MLC_CHECK(names.insert(f.name).second,
+                  "write_vtu: two " << kind << " fields are named '" << f.name << "'");
+        MLC_CHECK(f.n_components >= 1, "write_vtu: " << kind << " field '" << f.name << "' has "
+                                                     << f.n_components
+                                                     << " components; expected >= 1");
+        const std::size_t nc = static_cast<std::size_t>(f.n_components);
+        MLC_CHECK(f.values.size() == n_entities * nc,
+                  "write_vtu: " << kind << " field '" << f.name << "' has " << f.values.size()
+                                << " values; expected " << n_entities << " " << entity << "s x "
+                                << nc << " components = " << n_entities * nc);
+        for (std::size_t i = 0; i < f.values.size(); ++i)
+            MLC_CHECK(std::isfinite(f.values[i]),
+                      "write_vtu: " << kind << " field '" << f.name << "' has the non-finite value "
+                                    << f.values[i] << " at " << entity << " " << i / nc
+                                    << ", component " << i % nc << "; nothing was written");
+    }
+}
+
+void put_fields(BufferedFile& out, const std::vector<Field>& fields, const char* section) {
+    out.put("      <");
+    out.put(section);
+    out.put(">\n");
+    for (const Field& f : fields) {
+        const int nc = f.n_components == 2 ? 3 : f.n_components;
+        out.put("        <DataArray type=\"Float64\" Name=\"");
+        out.put(xml_escape(f.name));
+        out.put("\" NumberOfComponents=\"");
+        out.put_number(nc);
+        out.put("\" format=\"ascii\">\n");
+        const std::size_t n = f.values.size() / static_cast<std::size_t>(f.n_components);
+        for (std::size_t i = 0; i < n; ++i) {
+            for (int c = 0; c < f.n_components; ++c) {
+                if (c > 0) out.put(' ');
+                out.put_number(f.values[i * static_cast<std::size_t>(f.n_components) +
+                                        static_cast<std::size_t>(c)]);
+            }
+            if (f.n_components == 2) out.put(" 0");
+            out.put('\n');
+        }
+        out.put("        </DataArray>\n");
+    }
+    out.put("      </");
+    out.put(section);
+    out.put(">\n");
+}
+
+/// Runs `write` on a temporary file next to `file` and renames it into place; on any failure
+/// the temporary is removed and nothing is left at `file`'s path by us.
+template <class Write>
+void write_atomically(const std::filesystem::path& file, const char* who, Write&& write) {
+    std::filesystem::path tmp = file;
+    tmp += ".tmp";
+    BufferedFile out(tmp);
+    MLC_CHECK(out.is_open(), who << ": cannot open '" << tmp.string()
+                                 << "' for writing; does the directory exist and is it writable?");
+    try {
+        write(out);
+        if (!out.close())
+            throw std::runtime_error(std::string(who) + ": writing '" + tmp.string() +
+                                     "' failed (disk full?)");
+        std::error_code ec;
+        std::filesystem::rename(tmp, file, ec);
+        if (ec)
+            throw std::runtime_error(std::string(who) + ": cannot rename '" + tmp.string() +
+                                     "' to '" + file.string() + "': " + ec.message());
+    } catch (...) {
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw;
+    }
+}
+
+} // namespace
+
+void write_vtu(const std::filesystem::path& file, const Mesh& m,
+               const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields) {
+    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    for (std::size_t v = 0; v < nv; ++v)
+        MLC_CHECK(m.vertices[v].allFinite(),
+                  "write_vtu: vertex " << v << " has a non-finite coordinate (" << m.vertices[v].x()
+                                       << ", " << m.vertices[v].y() << "); nothing was written");
+    for (std::size_t t = 0; t < nt; ++t)
+        for (int k : m.triangles[t])
+            MLC_CHECK(k >= 0 && static_cast<std::size_t>(k) < nv,
+                      "write_vtu: triangle " << t << " refers to vertex " << k
+                                             << " but the mesh has " << nv << " vertices");
+    check_fields(point_fields, "point", "vertex", nv);
+    check_fields(cell_fields, "cell", "triangle", nt);
+
+    write_atomically(file, "write_vtu", [&](BufferedFile& out) {
+        out.put("<?xml version=\"1.0\"?>\n"
+                "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+                "byte_order=\"LittleEndian\">\n"
+                "  <UnstructuredGrid>\n"
+                "    <Piece NumberOfPoints=\"");
+        out.put_number(nv);
+        out.put("\" NumberOfCells=\"");
+        out.put_number(nt);
+        out.put("\">\n");
+        put_fields(out, point_fields, "PointData");
+        put_fields(out, cell_fields, "CellData");
+        out.put("      <Points>\n"
+                "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" "
+                "format=\"ascii\">\n");
+        for (const Vec2& p : m.vertices) {
+            out.put_number(p.x());
+            out.put(' ');
+            out.put_number(p.y());
+            out.put(" 0\n");
+        }
+        out.put("        </DataArray>\n"
+                "      </Points>\n"
+                "      <Cells>\n"
+                "        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n");
+        for (const auto& t : m.triangles) {
+            out.put_number(t[0]);
+            out.put(' ');
+            out.put_number(t[1]);
+            out.put(' ');
+            out.put_number(t[2]);
+            out.put('\n');
+        }
+        out.put("        </DataArray>\n"
+                "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+        for (std::size_t t = 0; t < nt; ++t) {
+            out.put_number(3 * (t + 1));
+            out.put((t % 16 == 15 || t + 1 == nt) ? '\n' : ' ');
+        }
+        out.put("        </DataArray>\n"
+                "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
+        for (std::size_t t = 0; t < nt; ++t)
+            out.put((t % 32 == 31 || t + 1 == nt) ? "5\n" : "5 ");
+        out.put("        </DataArray>\n"
+                "      </Cells>\n"
+                "    </Piece>\n"
+                "  </UnstructuredGrid>\n"
+                "</VTKFile>\n");
+    });
+}
+
+void write_pvd(const std::filesystem::path& file,
+               const std::vector<std::pair<double, std::string>>& steps) {
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        MLC_CHECK(std::isfinite(steps[i].first),
+                  "write_pvd: step " << i << " has the non-finite time " << steps[i].first);
+        MLC_CHECK(!steps[i].second.empty(), "write_pvd: step " << i << " has an empty file name");
+    }
+    write_atomically(file, "write_pvd", [&](BufferedFile& out) {
+        out.put("<?xml version=\"1.0\"?>\n"
+                "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+                "  <Collection>\n");
+        for (const auto& [time, name] : steps) {
+            out.put("    <DataSet timestep=\"");
+            out.put_number(time);
+            out.put("\" group=\"\" part=\"0\" file=\"");
+            out.put(xml_escape(name));
+            out.put("\"/>\n");
+        }
+        out.put("  </Collection>\n"
+                "</VTKFile>\n");
+    });
+}
+
+} // namespace mlc::mesh

@@ -1,0 +1,493 @@
+// SPDX-License-Identifier: MIT
+// CGS, BiCG, BiCGStab and restarted GMRES with shared entry checks, breakdown detection and a
+// true-residual check before convergence is declared.
+#include "solvers/krylov.hpp"
+
+#include "core/check.hpp"
+#include "core/timer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace mlc::solvers {
+
+void KrylovParams::validate() const {
+    MLC_CHECK(std::isfinite(rel_tol) && rel_tol >= 0.0 && rel_tol < 1.0,
+              "KrylovParams::rel_tol must be in [0, 1), found " << rel_tol);
+    MLC_CHECK(std::isfinite(abs_tol) && abs_tol >= 0.0,
+              "KrylovParams::abs_tol must be finite and >= 0, found " << abs_tol);
+    MLC_CHECK(max_iter >= 0, "KrylovParams::max_iter must be >= 0, found " << max_iter);
+    MLC_CHECK(restart >= 1, "KrylovParams::restart must be >= 1, found " << restart);
+}
+
+std::ostream& operator<<(std::ostream& os, const KrylovParams& p) {
+    return os << "KrylovParams{rel_tol=" << p.rel_tol << ", abs_tol=" << p.abs_tol
+              << ", max_iter=" << p.max_iter << ", restart=" << p.restart
+              << ", record_history=" << (p.record_history ? "true" : "false") << "}";
+}
+
+namespace {
+
+// A zero or non-finite inner product ends a Lanczos-type recursion.
+bool bad(double v) {
+    return v == 0.0 || !std::isfinite(v);
+}
+
+// Entry checks, tolerances, history and the final report shared by the four methods.
+class Run {
+public:
+    Run(const char* who, const LinearOperator& A, const Vector& b, Vector& x, const KrylovParams& p)
+        : who_(who), A_(A), b_(b), x_(x), p_(p), t0_(wall_seconds()) {
+        p.validate();
+        MLC_CHECK(A.rows() == A.cols(),
+                  who << ": A must be square, found " << A.rows() << " x " << A.cols());
+        MLC_CHECK(b.size() == A.rows(),
+                  who << ": b has size " << b.size() << ", expected A.rows() = " << A.rows());
+        if (x.size() == 0) x.setZero(b.size());
+        MLC_CHECK(x.size() == b.size(), who << ": initial guess x has size " << x.size()
+                                            << ", expected " << b.size() << " (or empty for 0)");
+        if (!b.allFinite()) {
+            std::ostringstream os;
+            os << who
+               << ": the right-hand side b contains NaN or Inf; check the assembly of "
+                  "the residual before the linear solve";
+            throw SolverBreakdown(os.str());
+        }
+        MLC_CHECK(x.allFinite(), who << ": the initial guess x contains NaN or Inf");
+        bnorm_ = b.norm();
+        tol_ = std::max(p.rel_tol * bnorm_, p.abs_tol);
+        if (p.record_history) res_.history.reserve(static_cast<size_t>(p.max_iter) + 2);
+    }
+
+    // b = 0: x = 0 exactly, nothing to iterate.
+    bool trivial() {
+        if (bnorm_ > 0.0) return false;
+        x_.setZero();
+        res_.converged = true;
+        res_.reason = StopReason::converged;
+        if (p_.record_history) res_.history.push_back(0.0);
+        res_.solve_seconds = wall_seconds() - t0_;
+        return true;
+    }
+
+    bool ok(double rnorm) const { return rnorm <= tol_; }
+    const KrylovParams& params() const { return p_; }
+
+    void initial(double rnorm) {
+        res_.initial_residual = rnorm;
+        record(rnorm);
+    }
+    void record(double rnorm) {
+        if (p_.record_history) res_.history.push_back(rnorm);
+    }
+
+    // t = b - A x; returns ||t||.
+    double true_residual(Vector& t) const {
+        A_.apply(x_, t);
+        t = b_ - t;
+        return t.norm();
+    }
+
+    // Ends the solve: the reported residual is the true one, `true_rnorm` = ||b - A x||.
+    SolveResult finish(StopReason reason, int iterations, double true_rnorm,
+                       std::string message = {}) {
+        res_.iterations = iterations;
+        res_.final_residual = true_rnorm;
+        res_.relative_residual = true_rnorm / bnorm_;
+        if (!std::isfinite(true_rnorm)) {
+            reason = StopReason::breakdown;
+            if (message.empty()) message = "the true residual is not finite";
+        } else if (ok(true_rnorm)) {
+            reason = StopReason::converged; // the true residual is what counts
+            message.clear();
+        } else if (reason == StopReason::converged) {
+            reason = StopReason::max_iter; // cannot happen by construction; stay honest
+        }
+        res_.reason = reason;
+        res_.converged = reason == StopReason::converged;
+        if (!message.empty()) res_.message = std::string(who_) + ": " + message;
+        if (iterations > 0 && res_.initial_residual > 0.0 && std::isfinite(true_rnorm))
+            res_.average_rate =
+                std::pow(true_rnorm / res_.initial_residual, 1.0 / static_cast<double>(iterations));
+        res_.solve_seconds = wall_seconds() - t0_;
+        return std::move(res_);
+    }
+
+    SolveResult result() { return std::move(res_); }
+
+private:
+    const char* who_;
+    const LinearOperator& A_;
+    const Vector& b_;
+    Vector& x_;
+    const KrylovParams& p_;
+    double t0_;
+    double bnorm_ = 0.0;
+    double tol_ = 0.0;
+    SolveResult res_;
+};
+
+std::string at(const char* what, int it, double value) {
+    std::ostringstream os;
+    os << what << " = " << value << " at iteration " << it;
+    return os.str();
+}
+
+} // namespace
+
+SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& b, Vector& x,
+                const KrylovParams& params) {
+    Run run("cgs", A, b, x, params);
+    if (run.trivial()) return run.result();
+    const Index n = b.size();
+    Vector r(n), z0(n), z(n), p(n), q(n), y(n), h(n), w(n), t(n);
+
+    double rn = run.true_residual(t);
+    r = t;
+    run.initial(rn);
+    if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
+
+    int it = 0;
+    bool restart = true;
+    double rho = 0.0;
+    while (true) {
+        if (restart) { // (re)start the recursion from the true residual r
+            M.apply(r, z0);
+            p = z0;
+            q = z0;
+            rho = z0.squaredNorm();
+            if (bad(rho))
+                return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                                  at("(z0, z0) with z0 = C^{-1} r0", it, rho));
+            restart = false;
+        }
+        if (it >= params.max_iter)
+            return run.finish(StopReason::max_iter, it, run.true_residual(t));
+
+        A.apply(q, t);
+        M.apply(t, y); // y = C^{-1} A q
+        const double sigma = z0.dot(y);
+        if (bad(sigma))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("(z0, C^{-1} A q)", it, sigma));
+        const double a = rho / sigma;
+        if (!std::isfinite(a))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t), at("alpha", it, a));
+        h = p - a * y;
+        w = p + h;
+        x += a * w;
+        A.apply(w, t);
+        r -= a * t;
+        ++it;
+        rn = r.norm();
+        run.record(rn);
+        if (!std::isfinite(rn))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("residual norm", it, rn));
+        if (run.ok(rn)) {
+            const double tr = run.true_residual(t);
+            if (run.ok(tr) || !std::isfinite(tr)) return run.finish(StopReason::converged, it, tr);
+            r = t; // recursive residual drifted: restart from the true one
+            restart = true;
+            continue;
+        }
+        M.apply(r, z);
+        const double rho_new = z0.dot(z);
+        if (bad(rho_new))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("(z0, C^{-1} r)", it, rho_new));
+        const double beta = rho_new / rho;
+        rho = rho_new;
+        p = z + beta * h;
+        q = p + beta * (h + beta * q);
+    }
+}
+
+SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector& b, Vector& x,
+                 const KrylovParams& params) {
+    Run run("bicg", A, b, x, params);
+    if (run.trivial()) return run.result();
+    const Index n = b.size();
+    Vector r(n), rt(n), z(n), zt(n), p(n), pt(n), q(n), qt(n), t(n);
+
+    double rn = run.true_residual(t);
+    r = t;
+    rt = r;
+    run.initial(rn);
+    if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
+
+    int it = 0;
+    bool restart = true;
+    double rho_old = 1.0;
+    while (true) {
+        if (it >= params.max_iter)
+            return run.finish(StopReason::max_iter, it, run.true_residual(t));
+        M.apply(r, z);
+        M.apply_transpose(rt, zt);
+        const double rho = z.dot(rt);
+        if (bad(rho))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("rho = (C^{-1} r, r~)", it, rho));
+        if (restart) {
+            p = z;
+            pt = zt;
+            restart = false;
+        } else {
+            const double beta = rho / rho_old;
+            p = z + beta * p;
+            pt = zt + beta * pt;
+        }
+        A.apply(p, q);
+        A.apply_transpose(pt, qt);
+        const double d = pt.dot(q);
+        if (bad(d))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("(p~, A p)", it, d));
+        const double alpha = rho / d;
+        x += alpha * p;
+        r -= alpha * q;
+        rt -= alpha * qt;
+        rho_old = rho;
+        ++it;
+        rn = r.norm();
+        run.record(rn);
+        if (!std::isfinite(rn) || !std::isfinite(alpha))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("residual norm", it, rn));
+        if (run.ok(rn)) {
+            const double tr = run.true_residual(t);
+            if (run.ok(tr) || !std::isfinite(tr)) return run.finish(StopReason::converged, it, tr);
+            r = t;
+            rt = r;
+            restart = true;
+        }
+    }
+}
+
+SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vector& b, Vector& x,
+                     const KrylovParams& params) {
+    Run run("bicgstab", A, b, x, params);
+    if (run.trivial()) return run.result();
+    const Index n = b.size();
+    Vector r(n), rh(n), p(n), ph(n), v(n), sh(n), t(n);
+
+    double rn = run.true_residual(t);
+    r = t;
+    run.initial(rn);
+    if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
+
+    int it = 0;
+    bool restart = true;
+    double rho_old = 1.0, alpha = 1.0, omega = 1.0;
+    // On a claimed convergence: accept when the true residual agrees, else restart from it.
+    auto check_true = [&](bool& done, SolveResult& out) {
+        const double tr = run.true_residual(t);
+        if (run.ok(tr) || !std::isfinite(tr)) {
+            out = run.finish(StopReason::converged, it, tr);
+            done = true;
+            return;
+        }
+        r = t;
+        restart = true;
+    };
+    while (true) {
+        if (restart) {
+            rh = r;
+            rho_old = alpha = omega = 1.0;
+            v.setZero();
+            p.setZero();
+            restart = false;
+        }
+        if (it >= params.max_iter)
+            return run.finish(StopReason::max_iter, it, run.true_residual(t));
+        const double rho = rh.dot(r);
+        if (bad(rho))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("rho = (r^, r)", it, rho));
+        const double beta = (rho / rho_old) * (alpha / omega);
+        p = r + beta * (p - omega * v);
+        M.apply(p, ph);
+        A.apply(ph, v);
+        const double d = rh.dot(v);
+        if (bad(d))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("(r^, A C^{-1} p)", it, d));
+        alpha = rho / d;
+        r -= alpha * v; // r now holds s
+        const double sn = r.norm();
+        if (!std::isfinite(sn) || !std::isfinite(alpha))
+            return run.finish(StopReason::breakdown, it + 1, run.true_residual(t),
+                              at("half-step residual norm", it + 1, sn));
+        if (run.ok(sn)) { // converged at the half step: x += alpha p^
+            x += alpha * ph;
+            ++it;
+            run.record(sn);
+            bool done = false;
+            SolveResult out;
+            check_true(done, out);
+            if (done) return out;
+            continue;
+        }
+        M.apply(r, sh);
+        A.apply(sh, t);
+        const double tt = t.squaredNorm();
+        const double ts = t.dot(r);
+        omega = ts / tt;
+        if (bad(tt) || bad(omega)) {
+            x += alpha * ph; // the half step is still a valid update
+            return run.finish(StopReason::breakdown, it + 1, run.true_residual(t),
+                              at("omega = (t, s) / (t, t)", it + 1, omega));
+        }
+        x += alpha * ph + omega * sh;
+        r -= omega * t;
+        rho_old = rho;
+        ++it;
+        rn = r.norm();
+        run.record(rn);
+        if (!std::isfinite(rn))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("residual norm", it, rn));
+        if (run.ok(rn)) {
+            bool done = false;
+            SolveResult out;
+            check_true(done, out);
+            if (done) return out;
+        }
+    }
+}
+
+SolveResult gmres(const LinearOperator& A, const Preconditioner& M, const Vector& b, Vector& x,
+                  const KrylovParams& params) {
+    Run run("gmres", A, b, x, params);
+    if (run.trivial()) return run.result();
+    const Index n = b.size();
+    const Index m = std::min<Index>(params.restart, n);
+    Eigen::MatrixXd V(n, m + 1), H(m + 1, m);
+    Vector cs(m), sn(m), g(m + 1), y(m), w(n), t(n), u(n);
+
+    double beta = run.true_residual(w);
+    run.initial(beta);
+    int it = 0;
+    while (true) {
+        if (run.ok(beta)) return run.finish(StopReason::converged, it, beta);
+        if (it >= params.max_iter) return run.finish(StopReason::max_iter, it, beta);
+
+        V.col(0) = w / beta;
+        g.setZero();
+        g(0) = beta;
+        Index k = 0; // Arnoldi columns done in this cycle
+        std::string failure;
+        while (k < m && it < params.max_iter) {
+            const Index j = k;
+            t = V.col(j);
+            M.apply(t, u);
+            A.apply(u, w);                   // w = A C^{-1} v_j
+            for (Index i = 0; i <= j; ++i) { // modified Gram-Schmidt
+                const double hij = w.dot(V.col(i));
+                w -= hij * V.col(i);
+                H(i, j) = hij;
+            }
+            const double hn = w.norm();
+            H(j + 1, j) = hn;
+            if (!std::isfinite(hn)) {
+                failure = at("Arnoldi norm h(j+1,j)", it + 1, hn);
+                break;
+            }
+            if (hn > 0.0) V.col(j + 1) = w / hn;
+            for (Index i = 0; i < j; ++i) { // previous Givens rotations
+                const double hi = H(i, j), hi1 = H(i + 1, j);
+                H(i, j) = cs(i) * hi + sn(i) * hi1;
+                H(i + 1, j) = -sn(i) * hi + cs(i) * hi1;
+            }
+            const double den = std::hypot(H(j, j), H(j + 1, j));
+            if (bad(den)) {
+                failure =
+                    at("Hessenberg pivot (A C^{-1} singular on the Krylov space)", it + 1, den);
+                break;
+            }
+            cs(j) = H(j, j) / den;
+            sn(j) = H(j + 1, j) / den;
+            H(j, j) = den;
+            H(j + 1, j) = 0.0;
+            g(j + 1) = -sn(j) * g(j);
+            g(j) = cs(j) * g(j);
+            ++k;
+            ++it;
+            const double est = std::abs(g(j + 1));
+            run.record(est);
+            if (run.ok(est) || hn == 0.0) break;
+        }
+        // x += C^{-1} V_k y_k with H_k y_k = g_k (back substitution, no allocation).
+        if (k > 0) {
+            for (Index i = k - 1; i >= 0; --i) {
+                double s = g(i);
+                for (Index l = i + 1; l < k; ++l)
+                    s -= H(i, l) * y(l);
+                y(i) = s / H(i, i);
+            }
+            t.noalias() = V.leftCols(k) * y.head(k);
+            M.apply(t, u);
+            x += u;
+        }
+        const double beta_old = beta;
+        beta = run.true_residual(w);
+        if (!failure.empty()) return run.finish(StopReason::breakdown, it, beta, failure);
+        if (!std::isfinite(beta))
+            return run.finish(StopReason::breakdown, it, beta, at("true residual", it, beta));
+        if (!run.ok(beta) && !(beta < beta_old) && it < params.max_iter)
+            return run.finish(StopReason::breakdown, it, beta,
+                              "a full restart cycle did not reduce the residual (stagnation); "
+                              "use a larger restart or a better preconditioner");
+    }
+}
+
+std::string_view to_string(Krylov k) {
+    switch (k) {
+    case Krylov::cgs:
+        return "cgs";
+    case Krylov::bicg:
+        return "bicg";
+    case Krylov::bicgstab:
+        return "bicgstab";
+    case Krylov::gmres:
+        return "gmres";
+    }
+    return "unknown";
+}
+
+std::ostream& operator<<(std::ostream& os, Krylov k) {
+    return os << to_string(k);
+}
+
+Krylov parse_krylov(std::string_view name) {
+    for (Krylov k : {Krylov::cgs, Krylov::bicg, Krylov::bicgstab, Krylov::gmres})
+        if (name == to_string(k)) return k;
+    MLC_CHECK(false,
+              "unknown Krylov method '" << name << "'; valid names: cgs, bicg, bicgstab, gmres");
+    return Krylov::cgs; // not reached
+}
+
+SolveResult solve(Krylov method, const LinearOperator& A, const Preconditioner& M, const Vector& b,
+                  Vector& x, const KrylovParams& params) {
+    switch (method) {
+    case Krylov::cgs:
+        return cgs(A, M, b, x, params);
+    case Krylov::bicg:
+        return bicg(A, M, b, x, params);
+    case Krylov::bicgstab:
+        return bicgstab(A, M, b, x, params);
+    case Krylov::gmres:
+        return gmres(A, M, b, x, params);
+    }
+    MLC_CHECK(false, "solve: invalid Krylov value " << static_cast<int>(method));
+    return {};
+}
+
+SolveResult solve(Krylov method, const SparseMatrix& A, const Preconditioner& M, const Vector& b,
+                  Vector& x, const KrylovParams& params) {
+    const MatrixOperator op(A);
+    return solve(method, op, M, b, x, params);
+}
+
+} // namespace mlc::solvers
