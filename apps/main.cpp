@@ -25,8 +25,12 @@ int main(int argc, char** argv) {
     run->add_option("--steps", ro.load_steps, "number of load steps");
     run->add_option("--out,-o", ro.out, "output folder (default out/<scene name>)");
     run->add_flag("--quiet,-q", ro.quiet, "no per-step progress");
-    run->add_option("--linear", ro.linear, "Newton system solver: schur (condensed, default) or lu")
-        ->check(CLI::IsMember({"schur", "lu"}));
+    run->add_option("--linear", ro.linear,
+                    "Newton system solver: schur (exact, condensed; default), lu, or krylov")
+        ->check(CLI::IsMember({"schur", "lu", "krylov"}));
+    run->add_option("--krylov", ro.krylov, "Krylov method with --linear krylov: cgs, bicg, bicgstab, gmres");
+    run->add_option("--pc", ro.pc, "preconditioner with --linear krylov, e.g. diag, ilu:1, cf, sorcf:omega=1.2, ebe");
+    run->add_option("--linear-tol", ro.linear_rel_tol, "relative tolerance of each Krylov solve");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");

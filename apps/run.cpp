@@ -36,7 +36,11 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     p.validate();
     levels::SolveOptions so;
     so.progress = opt.quiet ? nullptr : &os;
-    so.linear_solver = opt.linear;
+    so.linear.method = opt.linear;
+    so.linear.krylov = opt.krylov;
+    so.linear.pc = opt.pc;
+    so.linear.rel_tol = opt.linear_rel_tol;
+    so.linear.validate();
     os << "mlcontact: solving '" << p.name << "'\n";
     levels::RunResult r = levels::solve(p, so);
     os << "\n";

@@ -18,7 +18,10 @@ struct RunOptions {
     std::optional<int> load_steps; ///< overrides [scene].load_steps
     std::string out;               ///< output folder; empty: out/<scene name>
     bool quiet = false;            ///< no per-step progress
-    std::string linear = "schur";  ///< Newton system solver: schur | lu
+    std::string linear = "schur";  ///< Newton system solver: schur | lu | krylov
+    std::string krylov = "cgs";    ///< Krylov method when linear == krylov
+    std::string pc = "ilu:0";      ///< preconditioner spec when linear == krylov
+    double linear_rel_tol = 1e-10; ///< relative tolerance of each Krylov solve
 };
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not

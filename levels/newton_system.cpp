@@ -4,6 +4,7 @@
 
 #include "core/check.hpp"
 #include "core/timer.hpp"
+#include "levels/krylov_system.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
@@ -278,12 +279,27 @@ std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level)
     return std::make_unique<SchurSystemSolver>(level);
 }
 
+void LinearSolverSpec::validate() const {
+    MLC_CHECK(method == "schur" || method == "lu" || method == "krylov",
+              "unknown linear solver method '" << method << "' (known: schur, lu, krylov)");
+    MLC_CHECK(rel_tol > 0 && rel_tol < 1, "linear rel_tol must lie in (0, 1), found " << rel_tol);
+    MLC_CHECK(max_iter >= 1, "linear max_iter must be >= 1, found " << max_iter);
+    MLC_CHECK(restart >= 1, "GMRES restart must be >= 1, found " << restart);
+}
+
+std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s) {
+    if (s.method != "krylov") return os << s.method;
+    return os << s.krylov << " + " << s.pc << " (rel_tol " << s.rel_tol << ", max_iter "
+              << s.max_iter << ")";
+}
+
 std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level,
-                                                              const std::string& name) {
-    if (name == "schur") return make_schur_system_solver(level);
-    if (name == "lu") return make_assembled_system_solver(level, make_sparse_lu_solver());
-    MLC_CHECK(false, "unknown linear solver '" << name << "' (known: schur, lu)");
-    return nullptr;
+                                                              const LinearSolverSpec& spec,
+                                                              const CoarseContext* context) {
+    spec.validate();
+    if (spec.method == "schur") return make_schur_system_solver(level);
+    if (spec.method == "lu") return make_assembled_system_solver(level, make_sparse_lu_solver());
+    return make_krylov_system_solver(level, spec, context);
 }
 
 } // namespace mlc::levels

@@ -5,6 +5,7 @@
 
 #include "core/linear_operator.hpp"
 #include "levels/level.hpp"
+#include "transfer/transfer.hpp"
 
 #include <Eigen/Dense>
 #include <memory>
@@ -73,8 +74,37 @@ make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> s
 /// statuses change. Cost: one Cholesky, and one solve per contact component for S, per level.
 std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level);
 
-/// Builds the solver named `name`: "schur" (default) or "lu".
+/// How each Newton system is solved.
+struct LinearSolverSpec {
+    /// "schur" (exact, condensed on the contact set; default), "lu" (SparseLU on the assembled
+    /// Jacobian) or "krylov" (the `krylov` method with the `pc` preconditioner).
+    std::string method = "schur";
+    std::string krylov = "cgs";  ///< cgs | bicg | bicgstab | gmres (method "krylov")
+    std::string pc = "ilu:0";    ///< preconditioner spec, e.g. "ilu:1", "cf", "sorcf:omega=1.2", "ebe"
+    /// Relative tolerance of the linear solve, ||b - J dx|| <= rel_tol ||b||. 1e-10 keeps the
+    /// Newton iterates as exact as the papers' (they solve to near round-off).
+    double rel_tol = 1e-10;
+    int max_iter = 5000;         ///< Krylov iterations per Newton step
+    int restart = 50;            ///< GMRES restart length
+    void validate() const;
+};
+
+std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s);
+
+/// What multilevel preconditioners may use from the level below; all null/empty on level 0.
+struct CoarseContext {
+    const Level* coarse = nullptr;                    ///< the level below
+    const transfer::LevelTransfer* transfer = nullptr; ///< coarse -> this level
+    NewtonSystemSolver* coarse_solver = nullptr;      ///< exact solver of the coarse Jacobian
+    std::vector<Eigen::Matrix2d> coarse_M;            ///< converged coarse statuses (per element)
+    bool available() const { return coarse && transfer && coarse_solver; }
+};
+
+/// Builds the Newton system solver of `spec` for a level. `context` (may be null) gives
+/// two-level preconditioners what they need; they throw InvalidInput without it. The context's
+/// pointees must outlive the returned object.
 std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level,
-                                                              const std::string& name);
+                                                              const LinearSolverSpec& spec,
+                                                              const CoarseContext* context = nullptr);
 
 } // namespace mlc::levels

@@ -25,7 +25,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     std::unique_ptr<NewtonSystemSolver> system;
     {
         ScopedTimer t(&res.timings, "setup/linear_solver");
-        system = make_newton_system_solver(L, options.linear_solver);
+        system = make_newton_system_solver(L, options.linear);
     }
     ContactNewton newton(L, problem.newton, std::move(system), &res.timings);
     Vector x = Vector::Zero(L.n_unknowns());

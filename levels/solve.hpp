@@ -6,6 +6,7 @@
 #include "core/timer.hpp"
 #include "levels/level.hpp"
 #include "levels/newton.hpp"
+#include "levels/newton_system.hpp"
 #include "levels/problem.hpp"
 
 #include <ostream>
@@ -17,9 +18,8 @@ namespace mlc::levels {
 struct SolveOptions {
     std::ostream* progress = nullptr; ///< per-step progress lines, or null for silence
     bool keep_step_states = false;    ///< keep x after every step (for per-step VTU output)
-    /// Newton system solver: "schur" (exact, condensed on the contact set; the default) or
-    /// "lu" (SparseLU on the assembled Jacobian).
-    std::string linear_solver = "schur";
+    /// How Newton systems are solved (default: exact, condensed on the contact set).
+    LinearSolverSpec linear;
 };
 
 /// Result of a run on the finest level.

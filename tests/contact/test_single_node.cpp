@@ -43,7 +43,7 @@ struct Solved {
 Solved solve_single(double kt, double kn, Vec2 f, double mu, double r,
                     const std::string& solver = "schur") {
     const auto L = single_node(kt, kn, f, mu, r);
-    levels::ContactNewton newton(L, {}, levels::make_newton_system_solver(L, solver));
+    levels::ContactNewton newton(L, {}, levels::make_newton_system_solver(L, {.method = solver}));
     Vector x = Vector::Zero(L.n_unknowns());
     const auto rep = newton.solve(1.0, Vector::Zero(2), x);
     EXPECT_TRUE(rep.converged) << rep.message;

@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+/// @file Interpolation between two nested levels (fine = coarse with every triangle split into
+/// four): P for displacements, Q for contact multipliers (Alart & Lebon 1995, sect. 2.4), their
+/// restrictions, and the coarse/fine splitting of the fine unknowns.
+#pragma once
+
+#include "core/types.hpp"
+#include "fem/dof_map.hpp"
+#include "mesh/mesh.hpp"
+
+#include <vector>
+
+namespace mlc::transfer {
+
+/// The contact nodes of one level, as plain data (one entry per contact element).
+struct ContactNodes {
+    std::vector<int> vertex;        ///< contactor vertex
+    std::vector<int> lambda_dof;    ///< first multiplier unknown
+    std::vector<int> n_multipliers; ///< 1 (lambda_n) or 2 (lambda_t, lambda_n)
+};
+
+/// How Q treats the ends of a contact boundary.
+enum class QRule {
+    /// The paper's rule: lambda_h = lambda_H / 2 at a coarse contact vertex, (lambda_H(x1) +
+    /// lambda_H(x2)) / 4 at the midpoint of a coarse contact edge (x1, x2). Preserves the
+    /// resultant only when the end nodes of the contact boundary carry no force.
+    paper,
+    /// Same, except that a coarse contact vertex keeps 1 - (number of fine contact midpoints next
+    /// to it) / 4 of its force (3/4 at an end node with one contact edge), so the resultant of
+    /// every coarse multiplier field is preserved exactly.
+    conservative
+};
+
+/// Transfer operators from a coarse level to the fine level refined from it.
+struct LevelTransfer {
+    /// Nodal interpolation, one scalar per vertex (n_fine_vertices x n_coarse_vertices):
+    /// identity at coarse vertices, 1/2, 1/2 at edge midpoints.
+    SparseMatrix P_vertex;
+    /// The same for interleaved nodal displacement vectors (2 n_fine x 2 n_coarse).
+    SparseMatrix P_nodal;
+    /// On the unknowns (fine n_dofs x coarse n_dofs): P on displacement unknowns (rows and columns
+    /// of prescribed components dropped, so it maps homogeneous corrections), Q on multiplier
+    /// unknowns, component by component (t to t, n to n).
+    SparseMatrix T;
+    /// Q alone on the multiplier unknowns, as rows/cols of T (fine n_dofs x coarse n_dofs, zero
+    /// on displacement rows). T = P_u + Q.
+    SparseMatrix Q;
+    /// Restriction of residuals, R = T^T (stored explicitly; style.md §3).
+    SparseMatrix R;
+    /// Coarse/fine splitting of the fine unknowns: `coarse_set` lists the fine unknowns that
+    /// live on coarse vertices (their displacements, and the multipliers of coarse contact
+    /// nodes), in increasing order; `fine_set` the others (new vertices), increasing.
+    std::vector<int> coarse_set, fine_set;
+    /// For each entry of coarse_set, the coarse-level unknown it corresponds to (a bijection
+    /// onto the coarse unknowns: T restricted to coarse_set rows is the identity on
+    /// displacements and 1/2 (paper) on multipliers).
+    std::vector<int> coarse_dof;
+    QRule rule = QRule::paper;
+
+    /// Interpolates a full nodal displacement vector (2 per vertex): u_f = P_nodal u_c.
+    void interpolate_nodal(const Vector& u_coarse, Vector& u_fine) const;
+    /// x_f = T x_c on unknowns.
+    void prolongate(const Vector& x_coarse, Vector& x_fine) const;
+    /// r_c = R r_f.
+    void restrict_to_coarse(const Vector& r_fine, Vector& r_coarse) const;
+};
+
+/// Builds the transfer from a coarse level to the fine level. `fine` must come from
+/// mesh::refine(coarse mesh) (its `parents` and `n_coarse_vertices` are used). Every coarse
+/// contact vertex must be a fine contact vertex with the same number of multipliers.
+/// Throws InvalidInput when the meshes or numberings do not nest.
+LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
+                             const fem::DofMap& fine_dofs, const ContactNodes& coarse_contacts,
+                             const ContactNodes& fine_contacts, QRule rule = QRule::paper);
+
+} // namespace mlc::transfer
