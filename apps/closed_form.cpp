@@ -33,7 +33,7 @@ PressureProfile pressure_profile(std::vector<levels::ContactNodeState> nodes) {
         const double right = i + 1 < n ? 0.5 * (nodes[i + 1].x.x() - nodes[i].x.x()) : 0.0;
         prof.x.push_back(nodes[i].x.x());
         prof.p.push_back(-nodes[i].lambda_n / (left + right));
-        if (nodes[i].lambda_n < 0) last = static_cast<int>(i);
+        if (nodes[i].status != contact::Status::gap) last = static_cast<int>(i);
     }
     MLC_CHECK(last >= 0, "no node is in contact");
     MLC_CHECK(last + 1 < static_cast<int>(n),

@@ -25,7 +25,7 @@ struct Hertz {
 struct PressureProfile {
     std::vector<double> x;
     std::vector<double> p;
-    /// Half-width estimate: midway between the last node in contact and the next one.
+    /// Half-width estimate: midway between the last node in contact (status not gap) and the next.
     double half_width = 0.0;
     /// Spacing of the nodes around the contact edge (uncertainty of half_width is half of it).
     double edge_spacing = 0.0;

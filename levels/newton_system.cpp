@@ -177,8 +177,12 @@ public:
         // S = B K0^{-1} B^T in column blocks.
         S_.resize(m_, m_);
         const SparseMatrixCol Bt = B_.transpose();
-        constexpr Index block = 64;
-        for (Index c0 = 0; c0 < m_; c0 += block) {
+        constexpr Index block = 32;
+        const Index n_blocks = (m_ + block - 1) / block;
+        // Independent solves: one block of columns per thread (the factor is only read).
+#pragma omp parallel for schedule(dynamic)
+        for (Index k = 0; k < n_blocks; ++k) {
+            const Index c0 = k * block;
             const Index nc = std::min(block, m_ - c0);
             Eigen::MatrixXd rhs = Eigen::MatrixXd(Bt.middleCols(c0, nc));
             const Eigen::MatrixXd X = chol_.solve(rhs);
@@ -187,10 +191,9 @@ public:
         setup_seconds_ = wall_seconds() - t0;
         bu_.resize(nu);
         du_.resize(nu);
-        sys_.resize(2 * m_, 2 * m_);
-        D1_.resize(m_, 2);
-        D2_.resize(m_, 2);
-        rhs_.resize(2 * m_);
+        sys_.resize(m_, m_);
+        rhs_.resize(m_);
+        bl_.resize(m_);
     }
 
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) override {
@@ -201,33 +204,21 @@ public:
             bu_[k] = b[dof_of_u_[static_cast<size_t>(k)]];
         du_ = chol_.solve(bu_);
         const Eigen::VectorXd w = B_ * du_;
-        // Block-diagonal D1 = r (M - I), D2 = M, D3 = (M - I) / r on the element components;
-        // the products with S are formed block by block (O(m^2), not O(m^3)).
-        sys_.setZero();
+        // Reduced system on the contact components (M is a projector, M^2 = M, so the 2m x 2m
+        // system [I + S D1, S D2; D2, D3] of the header collapses): with y = r (M - I) z + M dl,
+        //   (S - (I - M) / r) y = w - M b_lambda,  z = w - S y,  dl = y + r (z - b_lambda).
+        sys_ = S_;
         for (size_t e = 0; e < L.contacts.size(); ++e) {
             const auto& el = L.contacts[e];
             const int me = el.n_multipliers(), c = comp_[e], q0 = me == 2 ? 0 : 1;
             const Eigen::MatrixXd Me = M[e].block(q0, q0, me, me);
-            const Eigen::MatrixXd Mi = Me - Eigen::MatrixXd::Identity(me, me);
-            D1_.block(c, 0, me, me) = el.r * Mi;
-            D2_.block(c, 0, me, me) = Me;
-            sys_.block(0, c, m_, me).noalias() = S_.middleCols(c, me) * (el.r * Mi);
-            sys_.block(0, m_ + c, m_, me).noalias() = S_.middleCols(c, me) * Me;
-            sys_.block(m_ + c, c, me, me) = Me;
-            sys_.block(m_ + c, m_ + c, me, me) = Mi / el.r;
-            for (int q = 0; q < me; ++q)
-                rhs_[m_ + c + q] = b[L.lambda_dof[e] + q];
+            sys_.block(c, c, me, me) -= (Eigen::MatrixXd::Identity(me, me) - Me) / el.r;
+            for (int q = 0; q < me; ++q) bl_[c + q] = b[L.lambda_dof[e] + q];
+            rhs_.segment(c, me) = w.segment(c, me) - Me * bl_.segment(c, me);
         }
-        sys_.topLeftCorner(m_, m_).diagonal().array() += 1.0;
-        rhs_.head(m_) = w;
         lu_.compute(sys_);
-        const Eigen::VectorXd zl = lu_.solve(rhs_);
-        Eigen::VectorXd y(m_);
-        for (size_t e = 0; e < L.contacts.size(); ++e) {
-            const int me = L.contacts[e].n_multipliers(), c = comp_[e];
-            y.segment(c, me) = D1_.block(c, 0, me, me) * zl.segment(c, me) +
-                               D2_.block(c, 0, me, me) * zl.segment(m_ + c, me);
-        }
+        const Eigen::VectorXd y = lu_.solve(rhs_);
+        const Eigen::VectorXd z = w - S_ * y;
         bu_ -= B_.transpose() * y;
         du_ = chol_.solve(bu_);
         dx.setZero(b.size());
@@ -235,7 +226,8 @@ public:
             dx[dof_of_u_[static_cast<size_t>(k)]] = du_[k];
         for (size_t e = 0; e < L.contacts.size(); ++e)
             for (int q = 0; q < L.contacts[e].n_multipliers(); ++q)
-                dx[L.lambda_dof[e] + q] = zl[m_ + comp_[e] + q];
+                dx[L.lambda_dof[e] + q] =
+                    y[comp_[e] + q] + L.contacts[e].r * (z[comp_[e] + q] - bl_[comp_[e] + q]);
         SolveResult res;
         res.converged = dx.allFinite();
         res.reason = res.converged ? StopReason::converged : StopReason::breakdown;
@@ -257,9 +249,8 @@ private:
     SparseMatrix B_;
     Eigen::SimplicialLLT<SparseMatrixCol, Eigen::Lower, Eigen::AMDOrdering<int>> chol_;
     Eigen::MatrixXd S_, sys_;
-    Eigen::MatrixXd D1_, D2_; ///< per element component block (me x me) of D1, D2, stacked
     Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
-    Eigen::VectorXd bu_, du_, rhs_;
+    Eigen::VectorXd bu_, du_, rhs_, bl_;
     double setup_seconds_ = 0.0;
     bool first_ = true;
 };

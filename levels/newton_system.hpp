@@ -66,12 +66,13 @@ make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> s
 /// frictional node, n per frictionless node), K0 = K + B^T diag(r) B is symmetric positive
 /// definite whenever the problem with every candidate node stuck is well posed (this is what
 /// lets a body held only by contact be solved), and does not depend on the statuses. So K0 is
-/// factored once (sparse Cholesky) and S = B K0^{-1} B^T computed once per level; each Newton
-/// system is then, with D1 = r (M - I), D2 = M, D3 = (M - I) / r blockwise,
-///     [I + S D1, S D2; D2, D3] [z; dlambda] = [B K0^{-1} b_u; b_lambda]
-/// (dense, size twice the number of contact components), and du = K0^{-1}(b_u - B^T (D1 z +
-/// D2 dlambda)). Two sparse triangular solve pairs per Newton step; nothing is refactored when
-/// statuses change. Cost: one Cholesky, and one solve per contact component for S, per level.
+/// factored once (sparse Cholesky) and S = B K0^{-1} B^T (m x m, m contact components) computed
+/// once per level. Because every status matrix M is a projector (M^2 = M), each Newton system
+/// J(M) [du; dl] = [b_u; b_l] then reduces exactly to the dense m x m system
+///     (S - (I - M) / r) y = w - M b_l,   w = B K0^{-1} b_u,
+/// followed by z = w - S y, dl = y + r (z - b_l), du = K0^{-1} (b_u - B^T y).
+/// Two sparse triangular solve pairs and one dense LU of size m per Newton step; nothing sparse
+/// is refactored when statuses change. Setup: one Cholesky and m solves for S per level.
 std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level);
 
 /// How each Newton system is solved.
