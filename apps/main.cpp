@@ -8,6 +8,7 @@
 // breakdown.
 #include "apps/run.hpp"
 #include "apps/scene.hpp"
+#include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 
 #include <CLI/CLI.hpp>
@@ -25,12 +26,27 @@ int main(int argc, char** argv) {
     run->add_option("--steps", ro.load_steps, "number of load steps");
     run->add_option("--out,-o", ro.out, "output folder (default out/<scene name>)");
     run->add_flag("--quiet,-q", ro.quiet, "no per-step progress");
+    run->add_flag("--cold", ro.cold,
+                  "solve the finest level from the previous step alone (default: coarse-to-fine)");
     run->add_option("--linear", ro.linear,
                     "Newton system solver: schur (exact, condensed; default), lu, or krylov")
         ->check(CLI::IsMember({"schur", "lu", "krylov"}));
     run->add_option("--krylov", ro.krylov, "Krylov method with --linear krylov: cgs, bicg, bicgstab, gmres");
     run->add_option("--pc", ro.pc, "preconditioner with --linear krylov, e.g. diag, ilu:1, cf, sorcf:omega=1.2, ebe");
     run->add_option("--linear-tol", ro.linear_rel_tol, "relative tolerance of each Krylov solve");
+    auto* study = app.add_subcommand("study", "run a study (see README: Studies)");
+    study->require_subcommand(1);
+    mlc::apps::StatusTransferOptions sto;
+    std::string sto_scene = "square", sto_out, sto_q = "paper";
+    auto* st = study->add_subcommand("status-transfer",
+                                     "predicted vs converged statuses and Newton iterations, "
+                                     "coarse-to-fine vs cold, per level");
+    st->add_option("scene", sto_scene, "scene file or built-in name (default square)");
+    st->add_option("--levels,-l", sto.levels, "finest level (default 3)");
+    st->add_option("--out,-o", sto_out, "output folder (default out/<scene>/status_transfer)");
+    st->add_option("--q-rule", sto_q, "multiplier interpolation: paper (default) or conservative")
+        ->check(CLI::IsMember({"paper", "conservative"}));
+    st->add_flag("!--no-plot", sto.plot, "do not draw the PNG");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
@@ -42,6 +58,11 @@ int main(int argc, char** argv) {
     }
     try {
         if (*run) return mlc::apps::run_scene(ro, std::cout);
+        if (*st) {
+            sto.out = sto_out;
+            sto.q_rule = sto_q == "paper" ? mlc::transfer::QRule::paper : mlc::transfer::QRule::conservative;
+            return mlc::apps::study_status_transfer(mlc::apps::load_scene(sto_scene), sto, std::cout);
+        }
         if (*scenes) {
             for (const auto& n : mlc::apps::builtin_scene_names())
                 std::cout << n << "\n";

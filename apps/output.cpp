@@ -33,7 +33,7 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
     if (!p.description.empty()) os << "           " << p.description << "\n";
     for (const auto& b : p.bodies)
         os << "body       " << b.name << ": " << b.material << "\n";
-    os << "mesh       level " << r.levels.size() - 1 << ": " << L.mesh.n_vertices() << " vertices, "
+    os << "mesh       level " << r.levels().size() - 1 << ": " << L.mesh.n_vertices() << " vertices, "
        << L.mesh.n_triangles() << " triangles (" << plane_name(p) << ")\n";
     os << "unknowns   " << L.n_unknowns() << " (" << L.dofs.n_displacement_dofs()
        << " displacement, " << L.n_unknowns() - L.dofs.n_displacement_dofs() << " multipliers), "
@@ -127,7 +127,7 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
         toml::table root;
         root.insert("scene", p.name);
         root.insert("units", p.units);
-        root.insert("level", static_cast<int64_t>(r.levels.size() - 1));
+        root.insert("level", static_cast<int64_t>(r.levels().size() - 1));
         root.insert("unknowns", static_cast<int64_t>(L.n_unknowns()));
         root.insert("displacement_unknowns", static_cast<int64_t>(L.dofs.n_displacement_dofs()));
         root.insert("contact_nodes", static_cast<int64_t>(L.n_contact_nodes()));
@@ -163,6 +163,29 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             total_newton += s.iterations;
         }
         root.insert("steps", steps);
+        toml::array lv;
+        for (size_t l = 0; l < r.level_steps.size(); ++l) {
+            if (r.level_steps[l].empty()) continue;
+            const auto& L = r.levels()[l];
+            toml::table t;
+            t.insert("level", static_cast<int64_t>(l));
+            t.insert("unknowns", static_cast<int64_t>(L.n_unknowns()));
+            t.insert("contact_nodes", static_cast<int64_t>(L.n_contact_nodes()));
+            toml::array ls;
+            for (const auto& st : r.level_steps[l]) {
+                toml::table u;
+                u.insert("step", static_cast<int64_t>(st.report.step));
+                u.insert("newton_iterations", static_cast<int64_t>(st.report.iterations));
+                u.insert("linear_iterations", static_cast<int64_t>(st.report.linear_iterations));
+                u.insert("predicted_status_agreement", st.agreement());
+                u.insert("initial_guess", st.predicted ? "interpolated" : "previous step");
+                u.insert("seconds", st.report.seconds);
+                ls.push_back(u);
+            }
+            t.insert("steps", ls);
+            lv.push_back(t);
+        }
+        root.insert("levels", lv);
         root.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
         if (r.converged) {
             const StateChecks c = check_state(p, r);

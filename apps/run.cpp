@@ -36,6 +36,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     p.validate();
     levels::SolveOptions so;
     so.progress = opt.quiet ? nullptr : &os;
+    so.coarse_to_fine = !opt.cold;
     so.linear.method = opt.linear;
     so.linear.krylov = opt.krylov;
     so.linear.pc = opt.pc;

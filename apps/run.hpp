@@ -18,6 +18,7 @@ struct RunOptions {
     std::optional<int> load_steps; ///< overrides [scene].load_steps
     std::string out;               ///< output folder; empty: out/<scene name>
     bool quiet = false;            ///< no per-step progress
+    bool cold = false;             ///< finest level from the previous step only (no coarse-to-fine)
     std::string linear = "schur";  ///< Newton system solver: schur | lu | krylov
     std::string krylov = "cgs";    ///< Krylov method when linear == krylov
     std::string pc = "ilu:0";      ///< preconditioner spec when linear == krylov

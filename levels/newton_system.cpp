@@ -157,7 +157,10 @@ public:
         }
         B_.resize(m_, nu);
         B_.setFromTriplets(bt.begin(), bt.end());
-        // K0 = K_uu + B^T diag(r) B.
+        // K0 = K_uu + B^T diag(r) B, factored with the unknowns B touches ("c") ordered last and
+        // the others by AMD. Then P K0 P^T = L L^T with L = [L_ii 0; L_ci L_cc] and, as B only
+        // touches c, S = B K0^{-1} B^T = X^T X with X = L_cc^{-1} B_c^T: the factorization gives
+        // S without a solve per contact component.
         std::vector<Triplet> kt;
         const SparseMatrix& K = level.elastic.K;
         kt.reserve(static_cast<size_t>(K.nonZeros()));
@@ -169,25 +172,61 @@ public:
         K0.setFromTriplets(kt.begin(), kt.end());
         Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(rdiag_.data(), m_);
         K0 += SparseMatrixCol(B_.transpose() * r.asDiagonal() * B_);
-        chol_.compute(K0);
+        std::vector<char> is_c(static_cast<size_t>(nu), 0);
+        for (int i = 0; i < B_.outerSize(); ++i)
+            for (SparseMatrix::InnerIterator it(B_, i); it; ++it) is_c[static_cast<size_t>(it.col())] = 1;
+        std::vector<int> interior, local(static_cast<size_t>(nu), -1);
+        for (Index k = 0; k < nu; ++k)
+            if (!is_c[static_cast<size_t>(k)]) {
+                local[static_cast<size_t>(k)] = static_cast<int>(interior.size());
+                interior.push_back(static_cast<int>(k));
+            }
+        const Index ni = static_cast<Index>(interior.size());
+        std::vector<Triplet> it_trip;
+        for (int j = 0; j < K0.outerSize(); ++j)
+            for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it)
+                if (local[static_cast<size_t>(it.row())] >= 0 && local[static_cast<size_t>(j)] >= 0)
+                    it_trip.emplace_back(local[static_cast<size_t>(it.row())],
+                                         local[static_cast<size_t>(j)], 1.0);
+        SparseMatrixCol Aii(ni, ni);
+        Aii.setFromTriplets(it_trip.begin(), it_trip.end());
+        Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order;
+        Eigen::AMDOrdering<int>()(Aii, order); // order.indices()[new] = old
+        newpos_.assign(static_cast<size_t>(nu), -1);
+        for (Index k = 0; k < ni; ++k)
+            newpos_[static_cast<size_t>(interior[static_cast<size_t>(order.indices()[k])])] = static_cast<int>(k);
+        Index next = ni;
+        for (Index k = 0; k < nu; ++k)
+            if (is_c[static_cast<size_t>(k)]) newpos_[static_cast<size_t>(k)] = static_cast<int>(next++);
+        const Index nc = nu - ni;
+        std::vector<Triplet> pt;
+        pt.reserve(static_cast<size_t>(K0.nonZeros()));
+        for (int j = 0; j < K0.outerSize(); ++j)
+            for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it)
+                pt.emplace_back(newpos_[static_cast<size_t>(it.row())], newpos_[static_cast<size_t>(j)],
+                                it.value());
+        SparseMatrixCol K0p(nu, nu);
+        K0p.setFromTriplets(pt.begin(), pt.end());
+        chol_.compute(K0p);
         MLC_CHECK(chol_.info() == Eigen::Success,
                   "the elastic operator regularized by the contact penalty is singular: some "
                   "rigid-body motion is held neither by supports nor by the contact candidates "
                   "(add a support, or widen the contact region)");
-        // S = B K0^{-1} B^T in column blocks.
-        S_.resize(m_, m_);
-        const SparseMatrixCol Bt = B_.transpose();
-        constexpr Index block = 32;
-        const Index n_blocks = (m_ + block - 1) / block;
-        // Independent solves: one block of columns per thread (the factor is only read).
-#pragma omp parallel for schedule(dynamic)
-        for (Index k = 0; k < n_blocks; ++k) {
-            const Index c0 = k * block;
-            const Index nc = std::min(block, m_ - c0);
-            Eigen::MatrixXd rhs = Eigen::MatrixXd(Bt.middleCols(c0, nc));
-            const Eigen::MatrixXd X = chol_.solve(rhs);
-            S_.middleCols(c0, nc) = B_ * X;
-        }
+        const auto& Lm = chol_.matrixL().nestedExpression();
+        const Eigen::MatrixXd Lcc = Eigen::MatrixXd(Lm.bottomRightCorner(nc, nc));
+        Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nc, m_);
+        for (int i = 0; i < B_.outerSize(); ++i)
+            for (SparseMatrix::InnerIterator it(B_, i); it; ++it)
+                X(newpos_[static_cast<size_t>(it.col())] - ni, i) = it.value();
+        Lcc.triangularView<Eigen::Lower>().solveInPlace(X);
+        S_.noalias() = X.transpose() * X;
+        // From here on displacement vectors live in the factor's (permuted) numbering.
+        std::vector<Triplet> bp;
+        for (int i = 0; i < B_.outerSize(); ++i)
+            for (SparseMatrix::InnerIterator it(B_, i); it; ++it)
+                bp.emplace_back(i, newpos_[static_cast<size_t>(it.col())], it.value());
+        B_.setZero();
+        B_.setFromTriplets(bp.begin(), bp.end());
         setup_seconds_ = wall_seconds() - t0;
         bu_.resize(nu);
         du_.resize(nu);
@@ -201,7 +240,7 @@ public:
         const Level& L = level_;
         const Index nu = static_cast<Index>(dof_of_u_.size());
         for (Index k = 0; k < nu; ++k)
-            bu_[k] = b[dof_of_u_[static_cast<size_t>(k)]];
+            bu_[newpos_[static_cast<size_t>(k)]] = b[dof_of_u_[static_cast<size_t>(k)]];
         du_ = chol_.solve(bu_);
         const Eigen::VectorXd w = B_ * du_;
         // Reduced system on the contact components (M is a projector, M^2 = M, so the 2m x 2m
@@ -223,7 +262,7 @@ public:
         du_ = chol_.solve(bu_);
         dx.setZero(b.size());
         for (Index k = 0; k < nu; ++k)
-            dx[dof_of_u_[static_cast<size_t>(k)]] = du_[k];
+            dx[dof_of_u_[static_cast<size_t>(k)]] = du_[newpos_[static_cast<size_t>(k)]];
         for (size_t e = 0; e < L.contacts.size(); ++e)
             for (int q = 0; q < L.contacts[e].n_multipliers(); ++q)
                 dx[L.lambda_dof[e] + q] =
@@ -243,11 +282,12 @@ public:
 private:
     const Level& level_;
     std::vector<int> u_of_dof_, dof_of_u_;
+    std::vector<int> newpos_;     ///< compact displacement index -> position in the factor
     std::vector<int> comp_;     ///< first contact component of each element
     std::vector<double> rdiag_; ///< r per component
     Index m_ = 0;               ///< number of contact components
     SparseMatrix B_;
-    Eigen::SimplicialLLT<SparseMatrixCol, Eigen::Lower, Eigen::AMDOrdering<int>> chol_;
+    Eigen::SimplicialLLT<SparseMatrixCol, Eigen::Lower, Eigen::NaturalOrdering<int>> chol_;
     Eigen::MatrixXd S_, sys_;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
     Eigen::VectorXd bu_, du_, rhs_, bl_;

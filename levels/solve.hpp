@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: MIT
-/// @file Runs a problem through its load steps on the finest level and collects what the report
-/// and the output files need.
+/// @file Runs a problem through its load steps on the level hierarchy: coarse-to-fine (the
+/// multilevel Newton of Alart & Lebon 1995, sect. 2.4) or cold (each level from its own previous
+/// step), and collects what the report, the studies and the output files need.
 #pragma once
 
 #include "core/timer.hpp"
-#include "levels/level.hpp"
+#include "levels/hierarchy.hpp"
 #include "levels/newton.hpp"
 #include "levels/newton_system.hpp"
 #include "levels/problem.hpp"
 
+#include <array>
 #include <ostream>
 #include <vector>
 
@@ -17,35 +19,59 @@ namespace mlc::levels {
 /// Options of one run that are not part of the problem.
 struct SolveOptions {
     std::ostream* progress = nullptr; ///< per-step progress lines, or null for silence
-    bool keep_step_states = false;    ///< keep x after every step (for per-step VTU output)
-    /// How Newton systems are solved (default: exact, condensed on the contact set).
+    bool keep_step_states = false;    ///< keep the finest state after every step
+    /// Coarse-to-fine: in every load step solve level 0, interpolate (P u, Q lambda) to level 1 as
+    /// the initial guess, solve there, and so on to the finest. Off ("cold"): only the finest
+    /// level is solved, from its previous step's state (every level when the preconditioner
+    /// needs the level below).
+    bool coarse_to_fine = true;
+    transfer::QRule q_rule = transfer::QRule::paper; ///< multiplier interpolation rule
+    /// How Newton systems are solved on levels >= 1 (level 0 always uses the exact "schur").
     LinearSolverSpec linear;
+    /// Solve every level even in cold mode (the status-transfer study compares per level).
+    bool solve_all_levels = false;
 };
 
-/// Result of a run on the finest level.
+/// Confusion table of predicted (rows) against converged (columns) statuses, indexed by
+/// contact::Status (gap, stick, slip_forward, slip_backward).
+using Confusion = std::array<std::array<int, 4>, 4>;
+
+/// A load step on one level, with what coarse-to-fine predicted.
+struct LevelStep {
+    int level = 0;
+    StepReport report;
+    bool predicted = false;                          ///< an interpolated initial guess was used
+    std::vector<contact::Status> predicted_statuses; ///< statuses of the initial guess
+    std::vector<contact::Status> final_statuses;     ///< Newton (projection) statuses at the end
+    Confusion confusion{};                           ///< predicted x final counts
+    /// Fraction of contact nodes whose predicted status was final (1 when not predicted).
+    double agreement() const;
+};
+
+/// Result of a run.
 struct RunResult {
-    std::vector<Level> levels;           ///< levels 0..L (only the finest is solved here)
-    std::vector<StepReport> steps;       ///< one per load step, finest level
-    Vector x;                            ///< final unknowns of the finest level
-    Vector u_full;                       ///< final nodal displacements (2 per vertex)
-    Vector u_prev_full;                  ///< nodal displacements at the end of the previous step
-    std::vector<ContactNodeState> nodes; ///< final contact node states
-    std::vector<Vector> step_u_full;     ///< per step, when keep_step_states
+    Hierarchy hierarchy;
+    /// level_steps[l][k]: load step k+1 on level l (empty for levels not solved).
+    std::vector<std::vector<LevelStep>> level_steps;
+    std::vector<StepReport> steps;         ///< finest level, one per load step
+    Vector x;                              ///< final unknowns of the finest level
+    Vector u_full;                         ///< final nodal displacements (2 per vertex)
+    std::vector<ContactNodeState> nodes;   ///< final contact node states (finest)
+    std::vector<Vector> step_u_full;       ///< finest, per step, when keep_step_states
     std::vector<std::vector<ContactNodeState>> step_nodes; ///< per step, when keep_step_states
     Timings timings;
     bool converged = false;
-    std::string failure; ///< diagnosis of the first step that failed
-    const Level& finest() const { return levels.back(); }
+    std::string failure;                   ///< diagnosis of the first step that failed
+    const Level& finest() const { return hierarchy.finest(); }
+    const std::vector<Level>& levels() const { return hierarchy.levels; }
 };
 
-/// Builds levels 0..problem.levels by uniform refinement and solves every load step on the
-/// finest level with the generalized Newton method (previous step's state as initial guess).
-/// Stops at the first step that does not converge (RunResult::converged false, failure set).
+/// Builds the hierarchy and solves every load step (see SolveOptions). Stops at the first level
+/// and step that does not converge (RunResult::converged false, failure set).
 RunResult solve(const Problem& problem, const SolveOptions& options = {});
 
-/// Sum over the unknown rows of the contact forces and of the loads: global force balance
-/// check. Returns |sum of reactions + loads + contact forces| / |largest of them| over the
-/// free and fixed components, computed from the full nodal vectors.
+/// Relative global force balance: |resultant of loads, contact forces and support reactions| /
+/// sum of their magnitudes, per axis, the worse of the two.
 double force_balance_error(const Level& level, double s, const Vector& u_full,
                            const std::vector<ContactNodeState>& nodes);
 
