@@ -5,6 +5,7 @@
 #include "core/check.hpp"
 #include "core/timer.hpp"
 #include "levels/krylov_system.hpp"
+#include "solvers/cholesky.hpp"
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
@@ -158,7 +159,7 @@ public:
         B_.resize(m_, nu);
         B_.setFromTriplets(bt.begin(), bt.end());
         // K0 = K_uu + B^T diag(r) B, factored with the unknowns B touches ("c") ordered last and
-        // the others by AMD. Then P K0 P^T = L L^T with L = [L_ii 0; L_ci L_cc] and, as B only
+        // the others by nested dissection. Then P K0 P^T = L L^T with L = [L_ii 0; L_ci L_cc] and, as B only
         // touches c, S = B K0^{-1} B^T = X^T X with X = L_cc^{-1} B_c^T: the factorization gives
         // S without a solve per contact component.
         std::vector<Triplet> kt;
@@ -187,14 +188,14 @@ public:
             for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it)
                 if (local[static_cast<size_t>(it.row())] >= 0 && local[static_cast<size_t>(j)] >= 0)
                     it_trip.emplace_back(local[static_cast<size_t>(it.row())],
-                                         local[static_cast<size_t>(j)], 1.0);
+                                         local[static_cast<size_t>(j)], it.value());
         SparseMatrixCol Aii(ni, ni);
         Aii.setFromTriplets(it_trip.begin(), it_trip.end());
-        Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order;
-        Eigen::AMDOrdering<int>()(Aii, order); // order.indices()[new] = old
+        const std::vector<int> order = solvers::SparseCholesky::fill_reducing_order(Aii);
         newpos_.assign(static_cast<size_t>(nu), -1);
         for (Index k = 0; k < ni; ++k)
-            newpos_[static_cast<size_t>(interior[static_cast<size_t>(order.indices()[k])])] = static_cast<int>(k);
+            newpos_[static_cast<size_t>(interior[static_cast<size_t>(order[static_cast<size_t>(k)])])] =
+                static_cast<int>(k);
         Index next = ni;
         for (Index k = 0; k < nu; ++k)
             if (is_c[static_cast<size_t>(k)]) newpos_[static_cast<size_t>(k)] = static_cast<int>(next++);
@@ -207,13 +208,15 @@ public:
                                 it.value());
         SparseMatrixCol K0p(nu, nu);
         K0p.setFromTriplets(pt.begin(), pt.end());
-        chol_.compute(K0p);
-        MLC_CHECK(chol_.info() == Eigen::Success,
-                  "the elastic operator regularized by the contact penalty is singular: some "
-                  "rigid-body motion is held neither by supports nor by the contact candidates "
-                  "(add a support, or widen the contact region)");
-        const auto& Lm = chol_.matrixL().nestedExpression();
-        const Eigen::MatrixXd Lcc = Eigen::MatrixXd(Lm.bottomRightCorner(nc, nc));
+        try {
+            chol_.factor(K0p);
+        } catch (const InvalidInput& e) {
+            throw InvalidInput(std::string("the elastic operator regularized by the contact penalty "
+                                           "is singular: some rigid-body motion is held neither by "
+                                           "supports nor by the contact candidates (add a support, "
+                                           "or widen the contact region); ") + e.what());
+        }
+        const Eigen::MatrixXd Lcc = chol_.trailing_block(nc);
         Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nc, m_);
         for (int i = 0; i < B_.outerSize(); ++i)
             for (SparseMatrix::InnerIterator it(B_, i); it; ++it)
@@ -241,7 +244,7 @@ public:
         const Index nu = static_cast<Index>(dof_of_u_.size());
         for (Index k = 0; k < nu; ++k)
             bu_[newpos_[static_cast<size_t>(k)]] = b[dof_of_u_[static_cast<size_t>(k)]];
-        du_ = chol_.solve(bu_);
+        chol_.solve(bu_, du_);
         const Eigen::VectorXd w = B_ * du_;
         // Reduced system on the contact components (M is a projector, M^2 = M, so the 2m x 2m
         // system [I + S D1, S D2; D2, D3] of the header collapses): with y = r (M - I) z + M dl,
@@ -259,7 +262,7 @@ public:
         const Eigen::VectorXd y = lu_.solve(rhs_);
         const Eigen::VectorXd z = w - S_ * y;
         bu_ -= B_.transpose() * y;
-        du_ = chol_.solve(bu_);
+        chol_.solve(bu_, du_);
         dx.setZero(b.size());
         for (Index k = 0; k < nu; ++k)
             dx[dof_of_u_[static_cast<size_t>(k)]] = du_[newpos_[static_cast<size_t>(k)]];
@@ -287,7 +290,7 @@ private:
     std::vector<double> rdiag_; ///< r per component
     Index m_ = 0;               ///< number of contact components
     SparseMatrix B_;
-    Eigen::SimplicialLLT<SparseMatrixCol, Eigen::Lower, Eigen::NaturalOrdering<int>> chol_;
+    solvers::SparseCholesky chol_;
     Eigen::MatrixXd S_, sys_;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
     Eigen::VectorXd bu_, du_, rhs_, bl_;

@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libhypre-dev libopenmpi-dev openmpi-bin
-  libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev
+  libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev libsuitesparse-dev
   python3 python3-matplotlib
 )
 missing=()

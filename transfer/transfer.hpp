@@ -25,9 +25,10 @@ enum class QRule {
     /// lambda_H(x2)) / 4 at the midpoint of a coarse contact edge (x1, x2). Preserves the
     /// resultant only when the end nodes of the contact boundary carry no force.
     paper,
-    /// Same, except that a coarse contact vertex keeps 1 - (number of fine contact midpoints next
-    /// to it) / 4 of its force (3/4 at an end node with one contact edge), so the resultant of
-    /// every coarse multiplier field is preserved exactly.
+    /// Same, except that a coarse contact vertex keeps 1 - k / 4 of its force, k being the number
+    /// of fine contact nodes that are midpoints of coarse edges incident to it and receive from
+    /// it (k = 2: 1/2 as in `paper`; an end node with one contact edge, k = 1: 3/4), so that
+    /// sum_h Q lambda = sum_H lambda, component by component, for every coarse multiplier field.
     conservative
 };
 
@@ -58,19 +59,42 @@ struct LevelTransfer {
     QRule rule = QRule::paper;
 
     /// Interpolates a full nodal displacement vector (2 per vertex): u_f = P_nodal u_c.
+    /// u_f is resized (the only allocation); it must not be u_c. Throws InvalidInput on a size
+    /// mismatch.
     void interpolate_nodal(const Vector& u_coarse, Vector& u_fine) const;
-    /// x_f = T x_c on unknowns.
+    /// x_f = T x_c on unknowns. x_f is resized (the only allocation); it must not be x_c.
     void prolongate(const Vector& x_coarse, Vector& x_fine) const;
-    /// r_c = R r_f.
+    /// r_c = R r_f (= T^T r_f). r_c is resized (the only allocation); it must not be r_f.
     void restrict_to_coarse(const Vector& r_fine, Vector& r_coarse) const;
 };
 
 /// Builds the transfer from a coarse level to the fine level. `fine` must come from
 /// mesh::refine(coarse mesh) (its `parents` and `n_coarse_vertices` are used). Every coarse
-/// contact vertex must be a fine contact vertex with the same number of multipliers.
-/// Throws InvalidInput when the meshes or numberings do not nest.
+/// contact vertex must be a fine contact vertex with the same number of multipliers, and every
+/// fine contact node on a coarse vertex a coarse contact node; a coarse vertex has the same
+/// prescribed components on both levels. `lambda_dof` of each node must be the `extra_dof` of its
+/// vertex in the matching DofMap.
+///
+/// Displacements (P_u, rows and columns of free components only):
+///   fine vertex v < n_coarse:  u_h(v, c) = u_H(v, c);
+///   new vertex m of edge (a, b): u_h(m, c) = (u_H(a, c) + u_H(b, c)) / 2,
+/// where a prescribed parent component contributes 0 (T maps homogeneous corrections).
+/// Multipliers (Q), per component c in {t, n} (a node with one multiplier has n only):
+///   coarse contact vertex:    lambda_h(c) = w lambda_H(c), w = 1/2 (paper) or 1 - k/4
+///                             (conservative, see QRule);
+///   contact midpoint of (a, b): lambda_h(c) = (lambda_H(a, c) + lambda_H(b, c)) / 4,
+/// where a parent that is not a coarse contact node, or lacks component c, contributes 0 (the
+/// square's fully fixed corner). A fine contact midpoint neither of whose parents is a coarse
+/// contact node therefore gets 0: it has no coarse force to inherit.
+///
+/// Throws InvalidInput when the meshes, numberings or contact nodes do not nest.
 LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
                              const fem::DofMap& fine_dofs, const ContactNodes& coarse_contacts,
                              const ContactNodes& fine_contacts, QRule rule = QRule::paper);
+
+/// Resultant of a multiplier field: (sum_i lambda_t(i), sum_i lambda_n(i)) over the contact nodes,
+/// read from the unknowns x at `lambda_dof` (a node with one multiplier adds to lambda_n only).
+/// These are the sums that Q preserves (QRule). Precondition: x.size() covers every lambda_dof.
+Eigen::Vector2d multiplier_resultant(const ContactNodes& nodes, const Vector& x);
 
 } // namespace mlc::transfer
