@@ -8,6 +8,7 @@
 // breakdown.
 #include "apps/run.hpp"
 #include "apps/scene.hpp"
+#include "apps/study_extremes.hpp"
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 
@@ -47,6 +48,13 @@ int main(int argc, char** argv) {
     st->add_option("--q-rule", sto_q, "multiplier interpolation: paper (default) or conservative")
         ->check(CLI::IsMember({"paper", "conservative"}));
     st->add_flag("!--no-plot", sto.plot, "do not draw the PNG");
+    mlc::apps::ExtremesOptions exo;
+    std::string exo_out;
+    auto* ex = study->add_subcommand("extremes", "stiff and extreme cases, each bounded in time");
+    ex->add_option("--levels,-l", exo.levels, "finest level of every case (default 2)");
+    ex->add_option("--seconds", exo.seconds_per_case, "time bound per case (default 120)");
+    ex->add_option("--only", exo.only, "run only cases whose name contains this text");
+    ex->add_option("--out,-o", exo_out, "output folder (default out/studies/extremes)");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
@@ -58,6 +66,10 @@ int main(int argc, char** argv) {
     }
     try {
         if (*run) return mlc::apps::run_scene(ro, std::cout);
+        if (*ex) {
+            exo.out = exo_out;
+            return mlc::apps::study_extremes(exo, std::cout);
+        }
         if (*st) {
             sto.out = sto_out;
             sto.q_rule = sto_q == "paper" ? mlc::transfer::QRule::paper : mlc::transfer::QRule::conservative;

@@ -33,6 +33,8 @@ struct StepReport {
     std::vector<int> status_changes; ///< statuses changed between consecutive iterates
     StatusCounts counts;             ///< final statuses (reported, see node_statuses)
     int linear_iterations = 0;       ///< Krylov iterations summed over the step (0 if direct)
+    int cycling_detected_at = -1;    ///< iterate at which statuses returned to an earlier set
+    int damped_steps = 0;            ///< steps taken with backtracking on ||R|| after cycling
     double seconds = 0.0;
     std::string message; ///< diagnosis when not converged
 };

@@ -81,3 +81,19 @@ TEST(CoarseToFine, FailureNamesTheLevelAndStep) {
     EXPECT_NE(r.failure.find("on level 0"), std::string::npos) << r.failure;
     EXPECT_NE(r.failure.find("residual history"), std::string::npos) << r.failure;
 }
+
+TEST(Newton, SolutionDoesNotDependOnTheAugmentationParameter) {
+    // The discrete solution of the Alart-Curnier equations is independent of r; a very large r
+    // makes the generalized Newton cycle between status sets, which must be detected and damped.
+    auto p = apps::load_scene("square");
+    p.levels = 2;
+    const auto ref = levels::solve(p);
+    ASSERT_TRUE(ref.converged) << ref.failure;
+    for (double rf : {1e-4, 1e4}) {
+        auto q = p;
+        q.contacts[0].r = rf * q.bodies[0].material.E;
+        const auto r = levels::solve(q);
+        ASSERT_TRUE(r.converged) << "r = " << rf << " E: " << r.failure;
+        EXPECT_LT((r.u_full - ref.u_full).norm(), 1e-8 * ref.u_full.norm()) << "r = " << rf << " E";
+    }
+}
