@@ -8,6 +8,7 @@
 // breakdown.
 #include "apps/run.hpp"
 #include "apps/scene.hpp"
+#include "apps/study_error_vs_time.hpp"
 #include "apps/study_extremes.hpp"
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
@@ -55,6 +56,13 @@ int main(int argc, char** argv) {
     ex->add_option("--seconds", exo.seconds_per_case, "time bound per case (default 120)");
     ex->add_option("--only", exo.only, "run only cases whose name contains this text");
     ex->add_option("--out,-o", exo_out, "output folder (default out/studies/extremes)");
+    mlc::apps::ErrorVsTimeOptions evo;
+    std::string evo_scene = "square", evo_out;
+    auto* ev = study->add_subcommand("error-vs-time", "error against wall time over levels and solvers");
+    ev->add_option("scene", evo_scene, "scene file or built-in name (default square)");
+    ev->add_option("--levels,-l", evo.max_level, "configurations on levels 0..L (default 3)");
+    ev->add_option("--out,-o", evo_out, "output folder (default out/studies/<scene>_error_vs_time)");
+    ev->add_flag("!--no-plot", evo.plot, "do not draw the PNG");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
@@ -66,6 +74,10 @@ int main(int argc, char** argv) {
     }
     try {
         if (*run) return mlc::apps::run_scene(ro, std::cout);
+        if (*ev) {
+            evo.out = evo_out;
+            return mlc::apps::study_error_vs_time(mlc::apps::load_scene(evo_scene), evo, std::cout);
+        }
         if (*ex) {
             exo.out = exo_out;
             return mlc::apps::study_extremes(exo, std::cout);
