@@ -9,6 +9,28 @@
 
 namespace mlc::solvers {
 
+namespace {
+
+/// A CHOLMOD view (no copy) of the lower triangle of a compressed column-major matrix.
+cholmod_sparse lower_view(SparseMatrixCol& A, int xtype) {
+    cholmod_sparse S;
+    std::memset(&S, 0, sizeof(S));
+    S.nrow = S.ncol = static_cast<size_t>(A.rows());
+    S.nzmax = static_cast<size_t>(A.nonZeros());
+    S.p = A.outerIndexPtr();
+    S.i = A.innerIndexPtr();
+    S.x = A.valuePtr();
+    S.stype = -1; // lower triangle stored
+    S.itype = CHOLMOD_INT;
+    S.xtype = xtype;
+    S.dtype = CHOLMOD_DOUBLE;
+    S.sorted = 1;
+    S.packed = 1;
+    return S;
+}
+
+} // namespace
+
 struct SparseCholesky::Impl {
     cholmod_common c;
     cholmod_factor* L = nullptr;
@@ -36,19 +58,7 @@ void SparseCholesky::factor(const SparseMatrixCol& A_in) {
     A.makeCompressed();
     auto& c = impl_->c;
     if (impl_->L) cholmod_free_factor(&impl_->L, &c);
-    cholmod_sparse S;
-    std::memset(&S, 0, sizeof(S));
-    S.nrow = S.ncol = static_cast<size_t>(A.rows());
-    S.nzmax = static_cast<size_t>(A.nonZeros());
-    S.p = A.outerIndexPtr();
-    S.i = A.innerIndexPtr();
-    S.x = A.valuePtr();
-    S.stype = -1; // lower triangle stored
-    S.itype = CHOLMOD_INT;
-    S.xtype = CHOLMOD_REAL;
-    S.dtype = CHOLMOD_DOUBLE;
-    S.sorted = 1;
-    S.packed = 1;
+    cholmod_sparse S = lower_view(A, CHOLMOD_REAL);
     impl_->L = cholmod_analyze(&S, &c);
     MLC_CHECK(impl_->L != nullptr, "CHOLMOD analysis failed (status " << c.status << ")");
     cholmod_factorize(&S, impl_->L, &c);
@@ -102,19 +112,7 @@ std::vector<int> SparseCholesky::fill_reducing_order(const SparseMatrixCol& A_in
     c.print = 0;
     c.nmethods = 1;
     c.method[0].ordering = CHOLMOD_NESDIS; // nested dissection (METIS-based): least fill on 2D meshes
-    cholmod_sparse S;
-    std::memset(&S, 0, sizeof(S));
-    S.nrow = S.ncol = static_cast<size_t>(A.rows());
-    S.nzmax = static_cast<size_t>(A.nonZeros());
-    S.p = A.outerIndexPtr();
-    S.i = A.innerIndexPtr();
-    S.x = A.valuePtr();
-    S.stype = -1;
-    S.itype = CHOLMOD_INT;
-    S.xtype = CHOLMOD_PATTERN;
-    S.dtype = CHOLMOD_DOUBLE;
-    S.sorted = 1;
-    S.packed = 1;
+    cholmod_sparse S = lower_view(A, CHOLMOD_PATTERN);
     cholmod_factor* L = cholmod_analyze(&S, &c);
     if (!L) {
         // No METIS in this CHOLMOD build: fall back to its default choice.
