@@ -10,6 +10,7 @@
 #include "apps/scene.hpp"
 #include "apps/study_error_vs_time.hpp"
 #include "apps/study_extremes.hpp"
+#include "apps/study_preconditioners.hpp"
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 
@@ -63,6 +64,22 @@ int main(int argc, char** argv) {
     ev->add_option("--levels,-l", evo.max_level, "configurations on levels 0..L (default 3)");
     ev->add_option("--out,-o", evo_out, "output folder (default out/studies/<scene>_error_vs_time)");
     ev->add_flag("!--no-plot", evo.plot, "do not draw the PNG");
+    mlc::apps::PreconditionerStudyOptions pso;
+    std::string pso_scene = "square", pso_out;
+    auto* ps = study->add_subcommand("preconditioners",
+                                     "Krylov iterations and times per Newton step per preconditioner");
+    ps->add_option("scene", pso_scene, "scene file or built-in name (default square)");
+    ps->add_option("--levels,-l", pso.levels, "finest level (default 2)");
+    ps->add_option("--mu", pso.mu, "friction coefficients (list)")->delimiter(',');
+    ps->add_option("--r", pso.r_over_E, "penalty factors r/E (list)")->delimiter(',');
+    ps->add_option("--pc", pso.pcs, "preconditioners (list; default diag ilu:0 cf sorcf ebe ebe:variant=c5)");
+    ps->add_option("--krylov", pso.krylovs, "Krylov methods (list; default cgs)")->delimiter(',');
+    ps->add_option("--steps", pso.load_steps, "load steps (default: the scene's)");
+    ps->add_option("--tol", pso.rel_tol, "Krylov relative tolerance (default 1e-8)");
+    ps->add_option("--max-iter", pso.max_iter, "Krylov iterations per Newton step (default 5000)");
+    ps->add_option("--seconds", pso.seconds_per_run, "time bound per combination (default 600)");
+    ps->add_option("--out,-o", pso_out, "output folder");
+    ps->add_flag("!--no-plot", pso.plot, "do not draw the PNG");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
@@ -77,6 +94,10 @@ int main(int argc, char** argv) {
         if (*ev) {
             evo.out = evo_out;
             return mlc::apps::study_error_vs_time(mlc::apps::load_scene(evo_scene), evo, std::cout);
+        }
+        if (*ps) {
+            pso.out = pso_out;
+            return mlc::apps::study_preconditioners(mlc::apps::load_scene(pso_scene), pso, std::cout);
         }
         if (*ex) {
             exo.out = exo_out;
