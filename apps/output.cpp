@@ -27,22 +27,60 @@ const char* plane_name(const levels::Problem& p) {
 
 } // namespace
 
+void print_not_found(std::ostream& os, const levels::Problem& p, const levels::Level& L,
+                     int max_listed) {
+    for (size_t k = 0; k < L.not_found.size() && k < p.contacts.size(); ++k) {
+        const auto& nf = L.not_found[k];
+        if (nf.empty()) continue;
+        os << "contact '" << p.contacts[k].name << "': " << nf.size()
+           << " contactor nodes found no "
+           << (p.contacts[k].element == levels::ContactElementKind::node_on_node ? "target node"
+                                                                                 : "facet")
+           << ":";
+        for (size_t i = 0; i < nf.size(); ++i) {
+            if (max_listed >= 0 && static_cast<int>(i) == max_listed) {
+                os << " ... (" << nf.size() - i << " more)";
+                break;
+            }
+            const Vec2& x = L.mesh.vertices[static_cast<size_t>(nf[i])];
+            os << " (" << x.x() << "," << x.y() << ")";
+        }
+        os << "\n";
+    }
+}
+
 void print_header(std::ostream& os, const levels::Problem& p, const levels::RunResult& r) {
     const auto& L = r.finest();
     os << "scene      " << p.name << (p.units.empty() ? "" : "  [units: " + p.units + "]") << "\n";
     if (!p.description.empty()) os << "           " << p.description << "\n";
     for (const auto& b : p.bodies)
         os << "body       " << b.name << ": " << b.material << "\n";
-    os << "mesh       level " << r.levels().size() - 1 << ": " << L.mesh.n_vertices() << " vertices, "
-       << L.mesh.n_triangles() << " triangles (" << plane_name(p) << ")\n";
+    os << "mesh       level " << r.levels().size() - 1 << ": " << L.mesh.n_vertices()
+       << " vertices, " << L.mesh.n_triangles() << " triangles (" << plane_name(p) << ")\n";
     os << "unknowns   " << L.n_unknowns() << " (" << L.dofs.n_displacement_dofs()
        << " displacement, " << L.n_unknowns() - L.dofs.n_displacement_dofs() << " multipliers), "
        << L.n_contact_nodes() << " contact nodes\n";
-    for (const auto& c : p.contacts)
-        os << "contact    " << c.name << ": nodes on '" << c.contactor << "' against "
-           << *c.obstacle << ", mu = " << c.mu << ", r = " << c.r << "\n";
-    os << "loading    " << p.load_steps << " proportional load step(s); Newton " << p.newton
-       << "\n";
+    for (size_t k = 0; k < p.contacts.size(); ++k) {
+        const auto& c = p.contacts[k];
+        int n_nodes = 0;
+        for (const auto& e : L.contacts)
+            n_nodes += e.pair == static_cast<int>(k);
+        os << "contact    " << c.name << ": " << n_nodes << " nodes on '" << c.contactor
+           << "' against ";
+        if (c.obstacle)
+            os << *c.obstacle;
+        else
+            os << "'" << c.target << "' (" << levels::to_string(c.element) << ")";
+        os << ", mu = " << c.mu << ", r = " << c.r << "\n";
+    }
+    print_not_found(os, p, L);
+    const int K = p.n_path_points();
+    if (K == 1)
+        os << "loading    " << p.load_steps << " proportional load step(s)";
+    else
+        os << "loading    " << p.load_steps << " load step(s) along a " << K
+           << "-point loading path";
+    os << "; Newton " << p.newton << "\n";
 }
 
 StateChecks check_state(const levels::Problem& p, const levels::RunResult& r) {
@@ -94,6 +132,21 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
            << c.force_balance << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| "
            << c.slip_equality << "  complementarity " << c.complementarity << "  penetration "
            << c.penetration << std::defaultfloat << "\n";
+        // Per pair: the resultant force the target exerts on the contactor nodes (global axes),
+        // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
+        const auto& L = r.finest();
+        for (size_t k = 0; k < p.contacts.size(); ++k) {
+            Vec2 f = Vec2::Zero();
+            int closed = 0;
+            for (size_t e = 0; e < L.contacts.size(); ++e) {
+                if (L.contacts[e].pair != static_cast<int>(k)) continue;
+                f -= r.nodes[e].lambda_t * L.contacts[e].t + r.nodes[e].lambda_n * L.contacts[e].n;
+                closed += r.nodes[e].status != contact::Status::gap;
+            }
+            os << "contact '" << p.contacts[k].name << "': resultant on the contactor ("
+               << std::setprecision(6) << f.x() << ", " << f.y() << "), " << closed
+               << " nodes in contact\n";
+        }
     }
     os << "\ntimings\n";
     r.timings.print(os);

@@ -122,6 +122,15 @@ public:
     Vec2 vec2(const toml::table& t, std::string_view key, const std::string& where) const {
         return vec2(need(t, key, where), where + "." + std::string(key));
     }
+    /// A non-empty array of numbers.
+    std::vector<double> numbers(const toml::node* n, const std::string& what) const {
+        const toml::array* a = n->as_array();
+        if (!a || a->empty()) fail(n, what + " must be a non-empty array of numbers");
+        std::vector<double> out;
+        for (size_t i = 0; i < a->size(); ++i)
+            out.push_back(number(a->get(i), what + "[" + std::to_string(i) + "]"));
+        return out;
+    }
     const toml::table& table(const toml::node* n, const std::string& what) const {
         const toml::table* t = n->as_table();
         if (!t) fail(n, what + " must be a table, found " + type_name(n));
@@ -178,6 +187,55 @@ template <class F> auto at(const Reader& rd, const toml::node* n, F&& f) {
     }
 }
 
+/// The mesh of a half domain (every vertex on one side of the line x = x0, some on it) reflected
+/// about that line and glued to itself: vertices on the line are shared, the straight boundary
+/// edges lying on it disappear (they become interior), everything else is doubled with
+/// orientations restored (triangles and boundary edges counter-clockwise). An exactly mirror-
+/// symmetric mesh gives an exactly mirror-symmetric discrete problem.
+mesh::Mesh mirror_about_x(const mesh::Mesh& h, double x0) {
+    const double tol = 1e-10 * h.diameter();
+    const int nv = h.n_vertices();
+    mesh::Mesh m = h;
+    m.boundary.clear();
+    std::vector<int> image(static_cast<size_t>(nv));
+    int side = 0;
+    bool on_line = false;
+    for (int v = 0; v < nv; ++v) {
+        const Vec2 p = h.vertices[static_cast<size_t>(v)];
+        if (std::abs(p.x() - x0) <= tol) {
+            image[static_cast<size_t>(v)] = v;
+            on_line = true;
+            continue;
+        }
+        const int sv = p.x() > x0 ? 1 : -1;
+        MLC_CHECK(side == 0 || sv == side, "mirror_x = " << x0 << ": the domain has vertices on "
+                                                         << "both sides of the mirror line; "
+                                                         << "describe one half only");
+        side = sv;
+        image[static_cast<size_t>(v)] = m.n_vertices();
+        m.vertices.emplace_back(2.0 * x0 - p.x(), p.y());
+    }
+    MLC_CHECK(on_line, "mirror_x = " << x0 << ": no boundary vertex lies on the mirror line; the "
+                                     << "half domain must have an edge on it");
+    for (const auto& t : h.triangles)
+        m.triangles.push_back({image[static_cast<size_t>(t[0])], image[static_cast<size_t>(t[2])],
+                               image[static_cast<size_t>(t[1])]});
+    if (!h.attribute.empty())
+        m.attribute.insert(m.attribute.end(), h.attribute.begin(), h.attribute.end());
+    const int coff = static_cast<int>(h.circles.size());
+    for (const auto& c : h.circles)
+        m.circles.push_back({Vec2(2.0 * x0 - c.center.x(), c.center.y()), c.radius});
+    auto on = [&](int v) { return image[static_cast<size_t>(v)] == v; };
+    for (const auto& e : h.boundary) {
+        if (e.curve < 0 && on(e.v0) && on(e.v1)) continue; // on the mirror line: now interior
+        m.boundary.push_back(e);
+        m.boundary.push_back({image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)],
+                              e.tag, e.curve >= 0 ? e.curve + coff : -1});
+    }
+    mesh::check_quality(m);
+    return m;
+}
+
 #ifdef MLC_HAVE_CGAL
 mesh::Segment parse_segment(const Reader& rd, const toml::table& t, const std::string& where) {
     rd.check_keys(t, {"type", "from", "to", "center", "ccw", "tag"}, where);
@@ -228,7 +286,8 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
     }
     if (type == "domain") {
 #ifdef MLC_HAVE_CGAL
-        rd.check_keys(t, {"type", "max_size", "min_size", "focus", "grading", "loop"}, where);
+        rd.check_keys(t, {"type", "max_size", "min_size", "focus", "grading", "loop", "mirror_x"},
+                      where);
         mesh::SizeField sf;
         sf.max_size = rd.number(t, "max_size", where);
         sf.min_size = rd.number_or(t, "min_size", sf.max_size, where);
@@ -254,6 +313,10 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
                 loop.push_back(parse_segment(rd, rd.table(sa->get(j), sw), sw));
             }
             loops.push_back(std::move(loop));
+        }
+        if (const toml::node* mx = t.get("mirror_x")) {
+            const double x0 = rd.number(mx, where + ".mirror_x");
+            return at(rd, mx, [&] { return mirror_about_x(mesh::mesh_domain(loops, sf), x0); });
         }
         return at(rd, &t, [&] { return mesh::mesh_domain(loops, sf); });
 #else
@@ -329,7 +392,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
     for (size_t i = 0; i < bodies.size(); ++i) {
         const toml::table& b = *bodies[i];
         const std::string w = "[[body]] " + std::to_string(i + 1);
-        rd.check_keys(b, {"name", "E", "nu", "body_force", "mesh"}, w);
+        rd.check_keys(b, {"name", "E", "nu", "body_force", "mesh", "tags"}, w);
         levels::Body body;
         body.name = rd.string_or(b, "name", "body" + std::to_string(i + 1), w);
         body.material.E = rd.number(b, "E", w);
@@ -341,7 +404,37 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         });
         if (b.get("body_force")) body.body_force = rd.vec2(b, "body_force", w);
         const toml::node* mn = rd.need(b, "mesh", w);
-        const mesh::Mesh m = parse_mesh(rd, rd.table(mn, w + ".mesh"), w + ".mesh", base_dir);
+        mesh::Mesh m = parse_mesh(rd, rd.table(mn, w + ".mesh"), w + ".mesh", base_dir);
+        if (const toml::node* tn = b.get("tags")) {
+            // Renames this body's boundary tags before merging (tags merge by name).
+            const toml::table& tt = rd.table(tn, w + ".tags");
+            std::map<int, std::string> new_name; // tag id -> new name
+            for (auto&& [k, v] : tt) {
+                const std::string from(k.str());
+                const std::string to = rd.string(&v, w + ".tags." + from);
+                if (!m.find_tag(from)) {
+                    std::string known;
+                    for (const auto& [n, id] : m.tag_names)
+                        known += (known.empty() ? "" : ", ") + n;
+                    rd.fail(&v, w + ".tags: the body's mesh has no tag '" + from +
+                                    "' (it has: " + known + ")");
+                }
+                if (to.empty()) rd.fail(&v, w + ".tags." + from + ": the new name is empty");
+                new_name[m.tag(from)] = to;
+            }
+            // Tags that end up with one name are merged (as tags of two bodies are).
+            std::map<std::string, int> names;
+            std::map<int, int> merged; // tag id -> id it merges into
+            for (const auto& [name, id] : m.tag_names) {
+                const auto it = new_name.find(id);
+                const std::string n = it == new_name.end() ? name : it->second;
+                const auto [pos, inserted] = names.emplace(n, id);
+                if (!inserted) merged[id] = pos->second;
+            }
+            for (auto& e : m.boundary)
+                if (const auto it = merged.find(e.tag); it != merged.end()) e.tag = it->second;
+            m.tag_names = std::move(names);
+        }
         merge_into(p.mesh0, m, static_cast<int>(i));
         p.bodies.push_back(body);
     }
@@ -360,7 +453,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
     };
     for (const toml::table* lt : rd.tables(root, "load", "the scene")) {
         const std::string w = "[[load]]";
-        rd.check_keys(*lt, {"tag", "pressure", "traction"}, w);
+        rd.check_keys(*lt, {"tag", "pressure", "traction", "factors"}, w);
         levels::Load ld;
         ld.tag = rd.string(*lt, "tag", w);
         check_tag(*lt, ld.tag, w);
@@ -368,6 +461,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         if (lt->get("traction")) ld.traction = rd.vec2(*lt, "traction", w);
         if (!lt->get("pressure") && !lt->get("traction"))
             rd.fail(lt, w + " needs a pressure or a traction");
+        if (const toml::node* fn = lt->get("factors")) ld.factors = rd.numbers(fn, w + ".factors");
         p.loads.push_back(ld);
     }
     for (const toml::table* st : rd.tables(root, "support", "the scene")) {
@@ -384,15 +478,30 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         } else {
             rd.fail(st, w + " needs a tag or a point");
         }
-        s.ux = rd.optional_number(*st, "ux", w);
-        s.uy = rd.optional_number(*st, "uy", w);
+        // A number (proportional to the load parameter) or a list of values per path point.
+        for (int c = 0; c < 2; ++c) {
+            const char* key = c == 0 ? "ux" : "uy";
+            const toml::node* n = st->get(key);
+            if (!n) continue;
+            auto& full = c == 0 ? s.ux : s.uy;
+            auto& path = c == 0 ? s.ux_path : s.uy_path;
+            if (n->is_array()) {
+                path = rd.numbers(n, w + "." + key);
+                full = path.back();
+            } else {
+                full = rd.number(n, w + "." + key);
+            }
+        }
         if (!s.ux && !s.uy) rd.fail(st, w + " fixes nothing: give ux and/or uy");
         p.supports.push_back(s);
     }
     const double Emax = p.max_young_modulus();
     for (const toml::table* ct : rd.tables(root, "contact", "the scene")) {
         const std::string w = "[[contact]]";
-        rd.check_keys(*ct, {"name", "contactor", "region", "mu", "r", "r_over_E", "obstacle"}, w);
+        rd.check_keys(*ct,
+                      {"name", "contactor", "region", "mu", "r", "r_over_E", "obstacle", "target",
+                       "element", "search_radius", "match_tolerance"},
+                      w);
         levels::ContactPair c;
         c.name = rd.string_or(*ct, "name", "contact" + std::to_string(p.contacts.size() + 1), w);
         c.contactor = rd.string(*ct, "contactor", w);
@@ -418,6 +527,40 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
             if (rt.get("max")) box.hi = rd.vec2(rt, "max", w + ".region");
             c.region = box;
         }
+        if (ct->get("obstacle") && ct->get("target"))
+            rd.fail(ct, w + " takes an obstacle (rigid) or a target tag (two bodies), not both");
+        if (!ct->get("obstacle") && !ct->get("target"))
+            rd.fail(ct, w + " needs an obstacle (rigid) or a target tag (two bodies)");
+        if (ct->get("target")) {
+            c.target = rd.string(*ct, "target", w);
+            if (!p.mesh0.find_tag(c.target))
+                rd.fail(ct->get("target"), w + ": unknown target tag '" + c.target + "'");
+            if (c.target == c.contactor)
+                rd.fail(ct->get("target"), w + ": the target tag is the contactor tag");
+            const std::string el = rd.string_or(*ct, "element", "node_on_facet", w);
+            if (el == "node_on_facet")
+                c.element = levels::ContactElementKind::node_on_facet;
+            else if (el == "node_on_node")
+                c.element = levels::ContactElementKind::node_on_node;
+            else
+                rd.fail(ct->get("element"), w +
+                                                ".element must be \"node_on_facet\" or "
+                                                "\"node_on_node\", found \"" +
+                                                el + "\"");
+            c.search_radius = rd.number_or(*ct, "search_radius", c.search_radius, w);
+            if (!(c.search_radius > 0))
+                rd.fail(ct->get("search_radius"), w + ".search_radius must be > 0");
+            c.match_tolerance = rd.number_or(*ct, "match_tolerance", c.match_tolerance, w);
+            if (!(c.match_tolerance > 0 && c.match_tolerance < 0.5))
+                rd.fail(ct->get("match_tolerance"), w + ".match_tolerance must lie in (0, 0.5)");
+            p.contacts.push_back(c);
+            continue;
+        }
+        for (const char* k : {"element", "search_radius", "match_tolerance"})
+            if (ct->get(k))
+                rd.fail(ct->get(k), w + ": '" + std::string(k) +
+                                        "' applies to two-body pairs (with a target), not to an "
+                                        "obstacle");
         const toml::table& ot = rd.table(rd.need(*ct, "obstacle", w), w + ".obstacle");
         const std::string ow = w + ".obstacle";
         const std::string type = rd.string(ot, "type", ow);

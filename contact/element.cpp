@@ -4,6 +4,8 @@
 
 #include "core/check.hpp"
 
+#include <cmath>
+
 namespace mlc::contact {
 
 std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector<int>& contactors,
@@ -23,6 +25,44 @@ std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector
         out.push_back(e);
     }
     return out;
+}
+
+ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, double g0, double mu,
+                             double r, int pair) {
+    MLC_CHECK(alpha >= 0.0 && alpha <= 1.0,
+              "node_on_facet: barycentric coordinate alpha must lie in [0, 1], found " << alpha);
+    MLC_CHECK(std::abs(n.norm() - 1.0) < 1e-12,
+              "node_on_facet: the normal must have unit length, found |n| = " << n.norm());
+    MLC_CHECK(c != a && c != b,
+              "node_on_facet: contactor vertex " << c << " is an end of its facet");
+    ContactElement e;
+    e.n_nodes = 3;
+    e.vertex = {c, a, b};
+    e.weight = {1.0, -(1.0 - alpha), -alpha};
+    e.n = n;
+    e.t = Vec2(n.y(), -n.x());
+    e.g0 = g0;
+    e.mu = mu;
+    e.r = r;
+    e.pair = pair;
+    return e;
+}
+
+ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, double r, int pair) {
+    MLC_CHECK(std::abs(n.norm() - 1.0) < 1e-12,
+              "node_on_node: the normal must have unit length, found |n| = " << n.norm());
+    MLC_CHECK(c != a, "node_on_node: contactor vertex " << c << " is its own target");
+    ContactElement e;
+    e.n_nodes = 2;
+    e.vertex = {c, a, -1};
+    e.weight = {1.0, -1.0, 0.0};
+    e.n = n;
+    e.t = Vec2(n.y(), -n.x());
+    e.g0 = g0;
+    e.mu = mu;
+    e.r = r;
+    e.pair = pair;
+    return e;
 }
 
 ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vector& u_prev_full,

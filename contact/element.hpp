@@ -36,6 +36,18 @@ struct ContactElement {
 std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector<int>& contactors,
                                           const Obstacle& obstacle, double mu, double r, int pair);
 
+/// Node-on-facet element: contactor vertex c against the target facet (a, b), the projection of
+/// c at barycentric coordinate alpha in [0, 1] (0 at a, 1 at b): weights (1, -(1-alpha), -alpha),
+/// n the unit facet normal toward the contactor, t = (n_y, -n_x), g0 the initial signed gap.
+/// Throws InvalidInput for alpha outside [0, 1] or a normal that is not of unit length.
+ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, double g0, double mu,
+                             double r, int pair);
+
+/// Node-on-node element: contactor vertex c against target vertex a (a matching interface):
+/// weights (1, -1), n the unit target normal toward the contactor, t = (n_y, -n_x).
+/// Throws InvalidInput for a normal that is not of unit length.
+ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, double r, int pair);
+
 /// Local state of an element at (u, lambda).
 struct ElementState {
     double d_n = 0.0;                                 ///< normal gap g0 + n . u_rel

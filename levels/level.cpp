@@ -2,9 +2,40 @@
 // Level construction: supports, contact candidates, numbering, assembly.
 #include "levels/level.hpp"
 
+#include "contact/search.hpp"
 #include "core/check.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace mlc::levels {
+
+namespace {
+
+/// Piecewise-linear interpolation of path values P[k-1] at s = k / K, with P = 0 at s = 0.
+/// For K = 1 this is s * P[0], bit for bit the proportional loading.
+/// A level made by hand (tests) has no path: then proportional to `full`.
+Vector path_at(const std::vector<Vector>& P, const Vector& full, double s) {
+    const int K = static_cast<int>(P.size());
+    if (K == 0) return s * full;
+    const double t = s * K;
+    const int k = std::clamp(static_cast<int>(std::floor(t)), 0, K - 1);
+    const double theta = t - k;
+    if (k == 0) return theta * P[0];
+    return (1.0 - theta) * P[static_cast<size_t>(k - 1)] + theta * P[static_cast<size_t>(k)];
+}
+
+} // namespace
+
+Vector Level::u_fixed_at(double s) const {
+    return path_at(path_u_fixed, u_fixed, s);
+}
+Vector Level::f_at(double s) const {
+    return path_at(path_f, elastic.f, s);
+}
+Vector Level::f_nodal_at(double s) const {
+    return path_at(path_f_nodal, elastic.f_nodal_full, s);
+}
 
 Level build_level(const Problem& problem, mesh::Mesh m) {
     mesh::check_quality(m);
@@ -15,9 +46,10 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     for (const auto& b : problem.bodies)
         L.materials.push_back(b.material);
 
-    // Supports.
+    // Supports: fixed components, and the prescribed values at every path point.
+    const int K = problem.n_path_points();
     L.fixed.assign(static_cast<size_t>(nv), {false, false});
-    L.u_fixed = Vector::Zero(2 * nv);
+    L.path_u_fixed.assign(static_cast<size_t>(K), Vector::Zero(2 * nv));
     const double diam = mesh.diameter();
     for (const auto& s : problem.supports) {
         std::vector<int> verts;
@@ -32,20 +64,21 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
         } else {
             verts = mesh.vertices_with_tag(mesh.tag(s.tag));
         }
-        for (int v : verts) {
-            if (s.ux) {
-                L.fixed[static_cast<size_t>(v)][0] = true;
-                L.u_fixed[2 * v] = *s.ux;
+        for (int v : verts)
+            for (int c = 0; c < 2; ++c) {
+                const auto& full = c == 0 ? s.ux : s.uy;
+                if (!full) continue;
+                L.fixed[static_cast<size_t>(v)][static_cast<size_t>(c)] = true;
+                for (int k = 1; k <= K; ++k)
+                    L.path_u_fixed[static_cast<size_t>(k - 1)][2 * v + c] =
+                        Problem::path_value(c == 0 ? s.ux_path : s.uy_path, *full, k, K);
             }
-            if (s.uy) {
-                L.fixed[static_cast<size_t>(v)][1] = true;
-                L.u_fixed[2 * v + 1] = *s.uy;
-            }
-        }
     }
+    L.u_fixed = L.path_u_fixed.back();
 
     // Contactor nodes per pair (a vertex belongs to the first pair that claims it).
     L.contact_of_vertex.assign(static_cast<size_t>(nv), -1);
+    L.not_found.assign(problem.contacts.size(), {});
     std::vector<int> n_extra(static_cast<size_t>(nv), 0);
     for (size_t p = 0; p < problem.contacts.size(); ++p) {
         const auto& pair = problem.contacts[p];
@@ -59,8 +92,41 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
         }
         MLC_CHECK(!nodes.empty(), "contact '" << pair.name << "' has no contactor node on '"
                                               << pair.contactor << "'");
-        auto elems = contact::node_on_rigid(mesh, nodes, *pair.obstacle, pair.mu, pair.r,
-                                            static_cast<int>(p));
+        std::vector<contact::ContactElement> elems;
+        const int ip = static_cast<int>(p);
+        switch (pair.element) {
+        case ContactElementKind::node_on_rigid:
+            elems = contact::node_on_rigid(mesh, nodes, *pair.obstacle, pair.mu, pair.r, ip);
+            break;
+        case ContactElementKind::node_on_facet: {
+            // Whether a vertex is a contact node is decided on the level-0 target facets: the
+            // same on every level, so that the contact nodes nest (transfer/ requires it).
+            const auto& m0 = problem.mesh0;
+            const contact::FacetIndex reference(m0.vertices,
+                                                contact::target_facets(m0, m0.tag(pair.target)));
+            auto found =
+                contact::node_on_facet_search(mesh, nodes, mesh.tag(pair.target), reference,
+                                              pair.search_radius, pair.mu, pair.r, ip);
+            elems = std::move(found.elements);
+            L.not_found[p] = std::move(found.not_found);
+            break;
+        }
+        case ContactElementKind::node_on_node: {
+            auto found = contact::node_on_node_search(mesh, nodes, mesh.tag(pair.target),
+                                                      pair.match_tolerance, pair.mu, pair.r, ip);
+            elems = std::move(found.elements);
+            L.not_found[p] = std::move(found.not_found);
+            break;
+        }
+        }
+        MLC_CHECK(!elems.empty(), "contact '" << pair.name << "': none of the " << nodes.size()
+                                              << " contactor nodes on '" << pair.contactor
+                                              << "' found a "
+                                              << (pair.element == ContactElementKind::node_on_node
+                                                      ? "coincident target node"
+                                                      : "target facet within the search radius")
+                                              << " on '" << pair.target
+                                              << "' (check the tags, or raise search_radius)");
         for (const auto& e : elems) {
             L.contact_of_vertex[static_cast<size_t>(e.vertex[0])] =
                 static_cast<int>(L.contacts.size());
@@ -74,9 +140,7 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     for (const auto& e : L.contacts)
         L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
 
-    std::vector<fem::Traction> tractions;
-    for (const auto& ld : problem.loads)
-        tractions.push_back({mesh.tag(ld.tag), ld.pressure, ld.traction});
+    // Loads at every path point; the last one gives the assembled right-hand side.
     std::vector<Vec2> body_force;
     bool any_body_force = false;
     for (const auto& b : problem.bodies) {
@@ -84,8 +148,35 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
         any_body_force = any_body_force || b.body_force.squaredNorm() > 0;
     }
     if (!any_body_force) body_force.clear();
-    const Vector F = fem::nodal_loads(mesh, tractions, body_force);
-    L.elastic = fem::assemble_elastic(mesh, L.materials, L.dofs, F, L.u_fixed);
+    auto nodal_loads_at = [&](int k) {
+        std::vector<fem::Traction> tractions;
+        for (const auto& ld : problem.loads) {
+            const double a = Problem::path_value(ld.factors, 1.0, k, K);
+            tractions.push_back({mesh.tag(ld.tag), a * ld.pressure, a * ld.traction});
+        }
+        // Body forces grow in proportion to s (they take no per-point factors).
+        std::vector<Vec2> bf = body_force;
+        for (auto& b : bf)
+            b *= static_cast<double>(k) / K;
+        return fem::nodal_loads(mesh, tractions, bf);
+    };
+    L.elastic = fem::assemble_elastic(mesh, L.materials, L.dofs, nodal_loads_at(K), L.u_fixed);
+    L.path_f.resize(static_cast<size_t>(K));
+    L.path_f_nodal.resize(static_cast<size_t>(K));
+    for (int k = 1; k < K; ++k) {
+        // f_k = F_k,free - K_(free,fixed) u_fixed,k, the lifting from element-wise K u.
+        const Vector F = nodal_loads_at(k);
+        const Vector Ku =
+            fem::internal_forces(mesh, L.materials, L.path_u_fixed[static_cast<size_t>(k - 1)]);
+        Vector f = Vector::Zero(L.dofs.n_dofs());
+        for (int v = 0; v < nv; ++v)
+            for (int c = 0; c < 2; ++c)
+                if (const int d = L.dofs.u_dof(v, c); d >= 0) f[d] = F[2 * v + c] - Ku[2 * v + c];
+        L.path_f[static_cast<size_t>(k - 1)] = std::move(f);
+        L.path_f_nodal[static_cast<size_t>(k - 1)] = F;
+    }
+    L.path_f.back() = L.elastic.f;
+    L.path_f_nodal.back() = L.elastic.f_nodal_full;
     return L;
 }
 

@@ -24,15 +24,38 @@ struct Level {
     std::vector<contact::ContactElement> contacts; ///< one per contactor node
     std::vector<int> lambda_dof;                   ///< first multiplier unknown of each element
     std::vector<int> contact_of_vertex;            ///< element index of a contactor vertex, or -1
+    /// Per contact pair: contactor vertices left out because the search found no target facet
+    /// (node_on_facet) or no coincident target vertex (node_on_node). Empty for rigid pairs.
+    std::vector<std::vector<int>> not_found;
+
+    /// Loading path (Problem::n_path_points K): prescribed displacements (2 per vertex), loads on
+    /// the unknowns (f = F_free - K_(free,fixed) u_fixed) and nodal loads (2 per vertex) at path
+    /// points k = 1..K, entry k-1. The last entries equal u_fixed, elastic.f, elastic.f_nodal_full.
+    /// Empty in a level assembled by hand: the loading is then proportional to those.
+    std::vector<Vector> path_u_fixed, path_f, path_f_nodal;
+
+    /// Prescribed displacements at path parameter s in [0, 1] (s = step / load_steps): linear
+    /// between path points, 0 at s = 0; s * u_fixed for proportional loading (K = 1).
+    Vector u_fixed_at(double s) const;
+    /// Loads on the unknowns at path parameter s (s * elastic.f for proportional loading).
+    Vector f_at(double s) const;
+    /// Nodal loads (2 per vertex) at path parameter s (s * elastic.f_nodal_full if proportional).
+    Vector f_nodal_at(double s) const;
 
     Index n_unknowns() const { return dofs.n_dofs(); }
     int n_contact_nodes() const { return static_cast<int>(contacts.size()); }
 };
 
-/// Builds a level from the problem and a mesh of it (level 0 or a refinement).
+/// Builds a level from the problem and a mesh of it (level 0 or a refinement of
+/// problem.mesh0).
+///
 /// Contactor nodes: vertices on the pair's contactor tag (inside its region, if any) that are
-/// not fully fixed. Throws InvalidInput for an unknown tag, a support point that is not a vertex,
-/// or a pair with no contactor node.
+/// not fully fixed and not claimed by an earlier pair. Rigid pairs make node-on-rigid elements;
+/// two-body pairs search their target once, on the reference configuration
+/// (contact::node_on_facet_search with the level-0 target facets setting the search radius, or
+/// contact::node_on_node_search); contactor nodes that find nothing are left out and listed in
+/// `not_found`. Throws InvalidInput for an unknown tag, a support point that is not a vertex, or
+/// a pair with no contact node.
 Level build_level(const Problem& problem, mesh::Mesh m);
 
 } // namespace mlc::levels

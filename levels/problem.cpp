@@ -35,9 +35,75 @@ void Problem::validate() const {
         MLC_CHECK(std::isfinite(c.r) && c.r > 0,
                   "contact '" << c.name << "': augmentation parameter r must be > 0, found "
                               << c.r);
-        MLC_CHECK(c.obstacle.has_value(), "contact '" << c.name << "' has no target");
+        if (c.element == ContactElementKind::node_on_rigid) {
+            MLC_CHECK(c.obstacle.has_value(),
+                      "contact '" << c.name << "' has no target: give an obstacle or a target tag");
+        } else {
+            MLC_CHECK(!c.obstacle.has_value(), "contact '" << c.name << "' is "
+                                                           << to_string(c.element)
+                                                           << " but also has a rigid obstacle");
+            MLC_CHECK(!c.target.empty(), "contact '" << c.name << "' is " << to_string(c.element)
+                                                     << " but names no target tag");
+            MLC_CHECK(c.target != c.contactor, "contact '" << c.name << "': the target tag '"
+                                                           << c.target
+                                                           << "' is also the contactor tag");
+        }
+        MLC_CHECK(std::isfinite(c.search_radius) && c.search_radius > 0,
+                  "contact '" << c.name << "': search_radius must be > 0, found "
+                              << c.search_radius);
+        MLC_CHECK(std::isfinite(c.match_tolerance) && c.match_tolerance > 0 &&
+                      c.match_tolerance < 0.5,
+                  "contact '" << c.name << "': match_tolerance must lie in (0, 0.5), found "
+                              << c.match_tolerance);
+    }
+    // Loading path: every per-point list has the same length.
+    int K = 0;
+    auto check_len = [&](size_t n, const std::string& what) {
+        if (n == 0) return;
+        MLC_CHECK(K == 0 || static_cast<int>(n) == K,
+                  what << " has " << n << " path values but another list has " << K
+                       << "; every per-step list must have the same length");
+        K = static_cast<int>(n);
+    };
+    for (const auto& l : loads)
+        check_len(l.factors.size(), "load on '" + l.tag + "'");
+    for (const auto& s : supports) {
+        const std::string where = s.point ? "support at a point" : "support on '" + s.tag + "'";
+        check_len(s.ux_path.size(), where + " (ux)");
+        check_len(s.uy_path.size(), where + " (uy)");
+        MLC_CHECK(s.ux_path.empty() || (s.ux && *s.ux == s.ux_path.back()),
+                  where << ": ux must equal the last entry of ux_path");
+        MLC_CHECK(s.uy_path.empty() || (s.uy && *s.uy == s.uy_path.back()),
+                  where << ": uy must equal the last entry of uy_path");
     }
     newton.validate();
+}
+
+int Problem::n_path_points() const {
+    for (const auto& l : loads)
+        if (!l.factors.empty()) return static_cast<int>(l.factors.size());
+    for (const auto& s : supports) {
+        if (!s.ux_path.empty()) return static_cast<int>(s.ux_path.size());
+        if (!s.uy_path.empty()) return static_cast<int>(s.uy_path.size());
+    }
+    return 1;
+}
+
+double Problem::path_value(const std::vector<double>& path, double full, int k, int K) {
+    if (path.empty()) return full * static_cast<double>(k) / static_cast<double>(K);
+    return path[static_cast<size_t>(k - 1)];
+}
+
+std::string_view to_string(ContactElementKind k) {
+    switch (k) {
+    case ContactElementKind::node_on_rigid:
+        return "node_on_rigid";
+    case ContactElementKind::node_on_facet:
+        return "node_on_facet";
+    case ContactElementKind::node_on_node:
+        return "node_on_node";
+    }
+    return "?";
 }
 
 double Problem::max_young_modulus() const {

@@ -12,6 +12,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace mlc::levels {
@@ -33,29 +34,63 @@ struct Body {
 };
 
 /// Uniform surface load on the boundary edges with a tag (at the full load factor 1).
+///
+/// Loading path (see Problem::n_path_points): without `factors` the load grows in proportion to
+/// the path parameter s in [0, 1]; with `factors` = (f_1 .. f_K) it is f_k times (pressure,
+/// traction) at path point k (s = k / K), linear in between, and 0 at s = 0.
 struct Load {
     std::string tag;
     double pressure = 0.0;        ///< normal pressure, positive pushes into the body
     Vec2 traction = Vec2::Zero(); ///< vector traction per unit length
+    std::vector<double> factors;  ///< per path point, or empty (proportional)
 };
 
 /// Prescribed displacement components on a tagged boundary or at a point (full load factor 1).
+///
+/// A component is either proportional (`ux` alone: s * ux along the path) or given per path point
+/// (`ux_path` = (u_1 .. u_K), linear in between, 0 at s = 0; `ux` then holds u_K).
 struct Support {
-    std::string tag;           ///< boundary tag, or empty when `point` is given
-    std::optional<Vec2> point; ///< a vertex position (must coincide with a level-0 vertex)
-    std::optional<double> ux;  ///< prescribed x displacement, if any
-    std::optional<double> uy;  ///< prescribed y displacement, if any
+    std::string tag;             ///< boundary tag, or empty when `point` is given
+    std::optional<Vec2> point;   ///< a vertex position (must coincide with a level-0 vertex)
+    std::optional<double> ux;    ///< prescribed x displacement at s = 1, if any
+    std::optional<double> uy;    ///< prescribed y displacement at s = 1, if any
+    std::vector<double> ux_path; ///< x displacement per path point, or empty (proportional)
+    std::vector<double> uy_path; ///< y displacement per path point, or empty (proportional)
 };
 
+/// Kind of contact element a pair is discretized with (formulation.md §2).
+enum class ContactElementKind {
+    node_on_rigid, ///< contactor nodes against a rigid obstacle
+    node_on_facet, ///< contactor nodes against the closest facet of a target boundary
+    node_on_node   ///< contactor nodes against coincident target nodes (matching interface)
+};
+
+/// "node_on_rigid", "node_on_facet", "node_on_node".
+std::string_view to_string(ContactElementKind k);
+
 /// One contact pair: contactor nodes on a tagged boundary (optionally inside a box) against a
-/// rigid obstacle. (Two-body pairs name a target boundary instead; see node_on_facet.)
+/// rigid obstacle, or against the boundary edges ("facets") tagged `target` of another body.
 struct ContactPair {
     std::string name;
     std::string contactor;                     ///< boundary tag of the contactor nodes
     std::optional<Box> region;                 ///< keep only contactor vertices inside this box
-    std::optional<contact::Obstacle> obstacle; ///< rigid target
-    double mu = 0.0;                           ///< Coulomb friction coefficient >= 0
-    double r = 0.0; ///< augmentation parameter > 0 (force/length^2 units x length)
+    std::optional<contact::Obstacle> obstacle; ///< rigid target (node_on_rigid)
+    std::string target; ///< boundary tag of the target facets (node_on_facet, node_on_node)
+    ContactElementKind element = ContactElementKind::node_on_rigid;
+    /// node_on_facet: a contactor node is kept when its distance to the closest target facet is
+    /// at most search_radius * h0, h0 the length of the level-0 target facet whose midpoint is
+    /// nearest to it (the same radius on every level, so that contact nodes nest under
+    /// refinement), and it is not beyond an end of the target boundary. 2 keeps nodes a couple
+    /// of elements away (curved surfaces opening slowly) and drops nodes on parts of the
+    /// contactor boundary that face no target.
+    double search_radius = 2.0;
+    /// node_on_node: a target vertex matches when it lies within match_tolerance * h (h the
+    /// length of its adjacent target facets) of the contactor vertex. Relative, so that a
+    /// matching interface in any unit system matches; 1e-6 accepts mesher round-off only.
+    double match_tolerance = 1e-6;
+    double mu = 0.0; ///< Coulomb friction coefficient >= 0
+    double r = 0.0;  ///< augmentation parameter > 0 (force/length^2 units x length)
+    bool two_body() const { return element != ContactElementKind::node_on_rigid; }
 };
 
 /// Generalized Newton settings.
@@ -81,15 +116,25 @@ struct Problem {
     std::vector<Load> loads;
     std::vector<Support> supports;
     std::vector<ContactPair> contacts;
-    int load_steps = 1; ///< proportional loading in equal increments
-    int levels = 0;     ///< number of 1->4 refinements of mesh0
+    /// Load steps: step j solves at the path parameter s = j / load_steps (equal increments).
+    int load_steps = 1;
+    int levels = 0; ///< number of 1->4 refinements of mesh0
     NewtonParams newton;
 
-    /// Checks materials, pairs (mu >= 0, r > 0), load_steps >= 1, levels >= 0, and the mesh.
+    /// Checks materials, pairs (mu >= 0, r > 0, one target of the right kind), load_steps >= 1,
+    /// levels >= 0, and the loading path (every per-point list of the same length).
     /// Throws InvalidInput naming the offending entry.
     void validate() const;
     /// Characteristic Young's modulus (the largest), for defaults such as r = 0.1 E.
     double max_young_modulus() const;
+
+    /// Number K of points of the loading path: the common length of the per-point lists of
+    /// loads (`factors`) and supports (`ux_path`, `uy_path`), or 1 when there is none
+    /// (proportional loading). Path point k (1..K) sits at s = k / K; s = 0 is the unloaded state.
+    int n_path_points() const;
+    /// Value at path point k (1..K) of a proportional quantity `full` (k / K * full) or of a
+    /// per-point list (`path[k-1]`).
+    static double path_value(const std::vector<double>& path, double full, int k, int K);
 };
 
 } // namespace mlc::levels

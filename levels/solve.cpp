@@ -132,7 +132,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 res.converged = false;
                 break;
             }
-            L.dofs.expand(x[li], s * L.u_fixed, u_now[li]);
+            L.dofs.expand(x[li], L.u_fixed_at(s), u_now[li]);
             if (l + 1 < n_levels) {
                 // The level above needs this level's converged statuses (two-level preconditioners).
                 Vector R(x[li].size());
@@ -159,7 +159,7 @@ double force_balance_error(const Level& level, double s, const Vector& u_full,
     // Rs = K u - F + C on the fixed components (nodal equilibrium K u = F - C + Rs). The
     // resultant F - C + Rs must vanish per axis; K u is recomputed element by element.
     const Vector Ku = fem::internal_forces(level.mesh, level.materials, u_full);
-    const Vector F = s * level.elastic.f_nodal_full;
+    const Vector F = level.f_nodal_at(s);
     Vector C = Vector::Zero(Ku.size());
     for (size_t e = 0; e < level.contacts.size(); ++e) {
         const auto& el = level.contacts[e];

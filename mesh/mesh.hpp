@@ -73,8 +73,9 @@ struct Mesh {
 };
 
 /// Checks a mesh for use: at least one triangle, indices in range, every triangle with positive
-/// area (relative to the square of the mesh diameter), no two vertices closer than a relative
-/// 1e-10 of the diameter, boundary edges that are edges of a triangle.
+/// area (relative to the square of the mesh diameter), no two vertices of one body (triangle
+/// attribute) closer than a relative 1e-10 of the diameter (vertices of two touching bodies may
+/// coincide), boundary edges that are edges of a triangle.
 /// Throws InvalidInput naming the first defect (triangle or vertex index and coordinates).
 void check_quality(const Mesh& m);
 

@@ -382,6 +382,9 @@ void read_elements_41(Reader& in, MshData& d) {
 MshData parse(const std::filesystem::path& file) {
     std::ifstream stream(file, std::ios::binary);
     MLC_CHECK(stream.good(), "read_gmsh: cannot open '" << file.string() << "'");
+    // The whole file is read into memory: a device (/dev/zero) or a pipe would never end.
+    MLC_CHECK(std::filesystem::is_regular_file(file),
+              "read_gmsh: '" << file.string() << "' is not a regular file");
     std::stringstream buffer;
     buffer << stream.rdbuf();
     Reader in(file, buffer.str());

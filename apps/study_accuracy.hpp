@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: MIT
+/// @file `mlcontact study accuracy`: errors of the closed-form quantities of the benchmark scenes
+/// (hertz, mindlin, patch) per level, with the observed convergence orders between levels.
+#pragma once
+
+#include "levels/problem.hpp"
+#include "levels/solve.hpp"
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace mlc::apps {
+
+/// Options of the accuracy study.
+struct AccuracyOptions {
+    int levels = 3;            ///< levels 0..levels are solved (each coarse-to-fine from level 0)
+    std::filesystem::path out; ///< output folder (default out/<scene>/accuracy)
+    bool plot = true;          ///< draw accuracy.png with scripts/plot_accuracy.py
+};
+
+/// One measured quantity of a converged state against its closed form.
+struct AccuracyValue {
+    std::string name;       ///< e.g. "half_width", "c_over_a"
+    double value = 0.0;     ///< measured
+    double reference = 0.0; ///< closed form (equal to value for information-only rows)
+    /// Relative error (value - reference) / reference, or a quantity that is itself an error
+    /// (an rms relative to a peak); NaN for information-only rows (P, Q, Q / (mu P)).
+    double error = 0.0;
+    std::string note; ///< what the error is relative to
+};
+
+/// Mindlin partial slip (benchmarks.md `mindlin`), measured on the finest level of a run:
+/// P = -sum lambda_n, Q = |sum lambda_t| (per unit thickness); a, c the half-widths of the
+/// contact and stick zones (each end midway between the last node inside and the first outside,
+/// from the final statuses); nodal tractions p = -lambda_n / l, q = |lambda_t| / l with l the
+/// tributary length along x. Closed form: a = sqrt(4 P R / (pi E*)), E* = E / (2 (1 - nu^2)),
+/// p(x) = p0 sqrt(1 - x^2 / a^2), p0 = 2 P / (pi a), c / a = sqrt(1 - Q / (mu P)),
+/// q(x) = mu p0 / a (sqrt(a^2 - x^2) - [|x| < c] sqrt(c^2 - x^2)).
+struct MindlinMeasures {
+    double P = 0.0, Q = 0.0;
+    double a = 0.0, a_closed = 0.0;
+    double c = 0.0;
+    double c_over_a = 0.0, c_over_a_closed = 0.0;
+    /// rms over the slip-zone nodes of (q - mu p_closed(x)) / (mu p0).
+    double slip_traction_rms = 0.0;
+    /// rms over the nodes with |x| < 0.9 a of (q - q_closed(x)) / (mu p0).
+    double q_profile_rms = 0.0;
+    /// rms over the nodes with |x| < 0.9 a of (p - p_closed(x)) / p0.
+    double pressure_rms = 0.0;
+    /// After load step 1: max |lambda_t| / (mu max |lambda_n|) (0 in the half-space theory).
+    double step1_tangential = 0.0;
+    int n_stick = 0, n_slip = 0, n_closed = 0;
+};
+
+/// Measures a Mindlin run. `r` must come from levels::solve with keep_step_states (step 1 is
+/// read from r.step_nodes[0]) and at least two load steps. E and nu are the first body's, mu
+/// the first pair's, R the radius of the circle the contactor boundary lies on.
+/// Throws InvalidInput when these are missing or a zone is not resolved by the candidates.
+MindlinMeasures measure_mindlin(const levels::Problem& p, const levels::RunResult& r);
+
+/// Contact patch test (benchmarks.md `patch`): exact uniform pressure p = E |u_top| / H and
+/// interface displacement u_top / 2 (H = 2 the height of the stack, u_top the prescribed platen
+/// u_y, nu = 0). Pressures are -lambda_n / l at the contactor nodes, l the tributary length.
+struct PatchMeasures {
+    double p_exact = 0.0, uy_exact = 0.0;
+    double pressure_max_error = 0.0;          ///< max |p - p_exact| / p_exact, every node
+    double pressure_interior_max_error = 0.0; ///< the same without the two end nodes
+    double uy_max_error = 0.0;                ///< max |u_y - uy_exact| / |uy_exact|
+    double resultant_error = 0.0;             ///< |sum -lambda_n - p_exact width| / (p_exact width)
+};
+
+/// Measures a patch-test run (nu = 0 required; throws InvalidInput otherwise).
+PatchMeasures measure_patch(const levels::Problem& p, const levels::RunResult& r);
+
+/// The closed-form quantities of a converged run of a benchmark scene, chosen by the scene name:
+/// `hertz` (half-width, peak pressure, profile rms; P from the contact resultant of the half
+/// model), `mindlin` (MindlinMeasures), `patch` and `patch_matching` (PatchMeasures).
+/// Throws InvalidInput for another scene (no closed form known).
+std::vector<AccuracyValue> accuracy_values(const levels::Problem& p, const levels::RunResult& r);
+
+/// Solves the scene on levels 0..opt.levels (each run coarse-to-fine from level 0), prints per
+/// level the closed-form quantities, their errors and the observed orders
+/// log2(|e_(l-1)| / |e_l|) (h halves per level), and writes accuracy.csv (one row per level and
+/// quantity: level, unknowns, contact_nodes, seconds, quantity, value, reference, error, order),
+/// accuracy.json and accuracy.png. Returns 0, or 2 if a level did not converge.
+int study_accuracy(const levels::Problem& problem, const AccuracyOptions& opt, std::ostream& os);
+
+} // namespace mlc::apps

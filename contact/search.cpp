@@ -1,0 +1,293 @@
+// SPDX-License-Identifier: MIT
+// Contact search on the reference configuration: closest facets (node on facet) and coincident
+// vertices (node on node), with a CGAL Kd-tree (Orthogonal_k_neighbor_search, Fuzzy_sphere).
+#include "contact/search.hpp"
+
+#include "core/check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#ifdef MLC_HAVE_CGAL
+#include <CGAL/Fuzzy_sphere.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Search_traits_2.h>
+#include <CGAL/Search_traits_adapter.h>
+#include <CGAL/Simple_cartesian.h>
+#include <CGAL/property_map.h>
+#include <boost/tuple/tuple.hpp>
+#endif
+
+namespace mlc::contact {
+
+namespace {
+
+/// Indexed points with nearest-point and range queries.
+class PointIndex {
+public:
+    explicit PointIndex(const std::vector<Vec2>& pts);
+    /// Index of the point nearest to x.
+    int nearest(const Vec2& x) const;
+    /// Indices of the points within distance `radius` of x (unordered).
+    std::vector<int> within(const Vec2& x, double radius) const;
+
+private:
+#ifdef MLC_HAVE_CGAL
+    using K = CGAL::Simple_cartesian<double>;
+    using Point = K::Point_2;
+    using PointAndIndex = boost::tuple<Point, int>;
+    using Traits = CGAL::Search_traits_adapter<
+        PointAndIndex, CGAL::Nth_of_tuple_property_map<0, PointAndIndex>, CGAL::Search_traits_2<K>>;
+    using KNN = CGAL::Orthogonal_k_neighbor_search<Traits>;
+    using Tree = KNN::Tree;
+    Tree tree_;
+#else
+    std::vector<Vec2> pts_;
+#endif
+};
+
+#ifdef MLC_HAVE_CGAL
+PointIndex::PointIndex(const std::vector<Vec2>& pts) {
+    std::vector<PointAndIndex> data;
+    data.reserve(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i)
+        data.emplace_back(Point(pts[i].x(), pts[i].y()), static_cast<int>(i));
+    tree_.insert(data.begin(), data.end());
+    tree_.build();
+}
+
+int PointIndex::nearest(const Vec2& x) const {
+    KNN search(tree_, Point(x.x(), x.y()), 1);
+    return boost::get<1>(search.begin()->first);
+}
+
+std::vector<int> PointIndex::within(const Vec2& x, double radius) const {
+    std::vector<PointAndIndex> found;
+    CGAL::Fuzzy_sphere<Traits> sphere(Point(x.x(), x.y()), radius, 0.0);
+    tree_.search(std::back_inserter(found), sphere);
+    std::vector<int> out;
+    out.reserve(found.size());
+    for (const auto& p : found)
+        out.push_back(boost::get<1>(p));
+    return out;
+}
+#else
+// Without CGAL: linear scans (O(n) per query; fine for the contact boundaries of test meshes).
+PointIndex::PointIndex(const std::vector<Vec2>& pts) : pts_(pts) {}
+
+int PointIndex::nearest(const Vec2& x) const {
+    int best = 0;
+    for (size_t i = 1; i < pts_.size(); ++i)
+        if ((pts_[i] - x).squaredNorm() < (pts_[static_cast<size_t>(best)] - x).squaredNorm())
+            best = static_cast<int>(i);
+    return best;
+}
+
+std::vector<int> PointIndex::within(const Vec2& x, double radius) const {
+    std::vector<int> out;
+    for (size_t i = 0; i < pts_.size(); ++i)
+        if ((pts_[i] - x).norm() <= radius) out.push_back(static_cast<int>(i));
+    return out;
+}
+#endif
+
+} // namespace
+
+std::vector<Facet> target_facets(const mesh::Mesh& m, int tag) {
+    std::vector<Facet> out;
+    for (const auto& e : m.boundary)
+        if (e.tag == tag) out.push_back({e.v0, e.v1});
+    return out;
+}
+
+FacetProjection project_on_facet(const Vec2& x, const Vec2& xa, const Vec2& xb) {
+    const Vec2 d = xb - xa;
+    const double len2 = d.squaredNorm();
+    MLC_CHECK(len2 > 0, "contact search: a target facet has zero length at (" << xa.x() << ", "
+                                                                              << xa.y() << ")");
+    FacetProjection p;
+    p.alpha = std::clamp((x - xa).dot(d) / len2, 0.0, 1.0);
+    p.n = Vec2(d.y(), -d.x()) / std::sqrt(len2);
+    p.g0 = p.n.dot(x - xa);
+    p.distance = (x - (xa + p.alpha * d)).norm();
+    return p;
+}
+
+// ---------------------------------------------------------------------------------------------
+struct FacetIndex::Impl {
+    std::vector<Facet> facets;
+    std::map<int, int> degree; ///< number of facets at each vertex
+    std::vector<std::array<Vec2, 2>> ends;
+    double max_length = 0.0;
+    std::vector<double> length;
+    PointIndex midpoints;
+    Impl(std::vector<Facet> f, std::vector<std::array<Vec2, 2>> e, std::vector<Vec2> mid)
+        : facets(std::move(f)), ends(std::move(e)), midpoints(mid) {
+        for (const auto& p : ends) {
+            length.push_back((p[1] - p[0]).norm());
+            max_length = std::max(max_length, length.back());
+        }
+    }
+};
+
+FacetIndex::FacetIndex(const std::vector<Vec2>& vertices, std::vector<Facet> facets) {
+    MLC_CHECK(!facets.empty(), "contact search: no target facet to search");
+    std::vector<std::array<Vec2, 2>> ends;
+    std::vector<Vec2> mid;
+    const int nv = static_cast<int>(vertices.size());
+    for (const auto& f : facets) {
+        MLC_CHECK(f.a >= 0 && f.a < nv && f.b >= 0 && f.b < nv,
+                  "contact search: facet (" << f.a << ", " << f.b << ") refers to a vertex out of "
+                                            << "range (" << nv << " vertices)");
+        const Vec2 xa = vertices[static_cast<size_t>(f.a)], xb = vertices[static_cast<size_t>(f.b)];
+        MLC_CHECK((xb - xa).norm() > 0,
+                  "contact search: facet (" << f.a << ", " << f.b << ") has zero length");
+        ends.push_back({xa, xb});
+        mid.push_back(0.5 * (xa + xb));
+    }
+    impl_ = std::make_unique<Impl>(std::move(facets), std::move(ends), std::move(mid));
+    for (const auto& f : impl_->facets) {
+        ++impl_->degree[f.a];
+        ++impl_->degree[f.b];
+    }
+}
+
+FacetIndex::~FacetIndex() = default;
+FacetIndex::FacetIndex(FacetIndex&&) noexcept = default;
+FacetIndex& FacetIndex::operator=(FacetIndex&&) noexcept = default;
+
+const std::vector<Facet>& FacetIndex::facets() const {
+    return impl_->facets;
+}
+
+double FacetIndex::max_length() const {
+    return impl_->max_length;
+}
+
+double FacetIndex::local_size(const Vec2& x) const {
+    return impl_->length[static_cast<size_t>(impl_->midpoints.nearest(x))];
+}
+
+std::optional<FacetProjection> FacetIndex::closest(const Vec2& x, double radius, int skip) const {
+    const Impl& I = *impl_;
+    std::vector<int> cand = I.midpoints.within(x, radius + 0.5 * I.max_length);
+    std::sort(cand.begin(), cand.end());
+    std::optional<FacetProjection> best;
+    bool best_inside = false;
+    double best_raw = 0.0;
+    // Two distances closer than this (relative to the facet size) are a tie.
+    const double tie = 1e-12 * I.max_length;
+    for (int i : cand) {
+        const Facet& f = I.facets[static_cast<size_t>(i)];
+        if (f.a == skip || f.b == skip) continue;
+        const auto& e = I.ends[static_cast<size_t>(i)];
+        FacetProjection p = project_on_facet(x, e[0], e[1]);
+        if (p.distance > radius) continue;
+        p.facet = i;
+        const Vec2 d = e[1] - e[0];
+        const double a_raw = (x - e[0]).dot(d) / d.squaredNorm();
+        const bool inside = a_raw >= 0.0 && a_raw <= 1.0;
+        if (!best || p.distance < best->distance - tie ||
+            (std::abs(p.distance - best->distance) <= tie && inside && !best_inside)) {
+            best = p;
+            best_inside = inside;
+            best_raw = a_raw;
+        }
+    }
+    // The closest point is an end of the whole target boundary (no other facet there), reached
+    // from beyond: x is over no facet. Round-off (a node at the very end) counts as inside.
+    if (best) {
+        constexpr double end_tol = 1e-9;
+        const Facet& f = I.facets[static_cast<size_t>(best->facet)];
+        if ((best_raw < -end_tol && I.degree.at(f.a) < 2) ||
+            (best_raw > 1.0 + end_tol && I.degree.at(f.b) < 2))
+            return std::nullopt;
+    }
+    return best;
+}
+
+// ---------------------------------------------------------------------------------------------
+SearchResult node_on_facet_search(const mesh::Mesh& m, const std::vector<int>& contactors,
+                                  int target_tag, const FacetIndex& reference, double search_radius,
+                                  double mu, double r, int pair) {
+    std::vector<Facet> facets = target_facets(m, target_tag);
+    MLC_CHECK(!facets.empty(), "contact search: the mesh has no boundary edge tagged '"
+                                   << m.tag_name(target_tag) << "' to search");
+    const FacetIndex index(m.vertices, facets);
+    SearchResult res;
+    res.elements.reserve(contactors.size());
+    for (int c : contactors) {
+        const Vec2& x = m.vertices[static_cast<size_t>(c)];
+        // Whether c is a contact node is decided on the reference facets, so that the decision
+        // does not depend on the level (a curved target's polygon moves under refinement).
+        const double radius = search_radius * reference.local_size(x);
+        const auto on_reference = reference.closest(x, radius, c);
+        // The element itself uses this level's facets; the closest one lies within the
+        // reference distance plus the polygons' difference (less than a reference facet).
+        const auto hit =
+            on_reference ? index.closest(x, radius + reference.max_length(), c) : std::nullopt;
+        if (!hit) {
+            res.not_found.push_back(c);
+            continue;
+        }
+        const Facet& f = index.facets()[static_cast<size_t>(hit->facet)];
+        res.elements.push_back(
+            node_on_facet(c, f.a, f.b, hit->alpha, hit->n, hit->g0, mu, r, pair));
+    }
+    return res;
+}
+
+SearchResult node_on_node_search(const mesh::Mesh& m, const std::vector<int>& contactors,
+                                 int target_tag, double match_tolerance, double mu, double r,
+                                 int pair) {
+    const std::vector<Facet> facets = target_facets(m, target_tag);
+    MLC_CHECK(!facets.empty(), "contact search: the mesh has no boundary edge tagged '"
+                                   << m.tag_name(target_tag) << "' to search");
+    // Target vertices with the sum of the outward normals and lengths of their facets.
+    std::map<int, size_t> slot;
+    std::vector<int> verts;
+    std::vector<Vec2> pos, normal_sum;
+    std::vector<double> length_sum;
+    std::vector<int> n_facets;
+    for (const auto& f : facets) {
+        const Vec2 xa = m.vertices[static_cast<size_t>(f.a)];
+        const Vec2 xb = m.vertices[static_cast<size_t>(f.b)];
+        const FacetProjection p = project_on_facet(xa, xa, xb);
+        for (int v : {f.a, f.b}) {
+            auto [it, inserted] = slot.try_emplace(v, verts.size());
+            if (inserted) {
+                verts.push_back(v);
+                pos.push_back(m.vertices[static_cast<size_t>(v)]);
+                normal_sum.push_back(Vec2::Zero());
+                length_sum.push_back(0.0);
+                n_facets.push_back(0);
+            }
+            normal_sum[it->second] += p.n;
+            length_sum[it->second] += (xb - xa).norm();
+            ++n_facets[it->second];
+        }
+    }
+    const PointIndex index(pos);
+    SearchResult res;
+    for (int c : contactors) {
+        const Vec2& x = m.vertices[static_cast<size_t>(c)];
+        const size_t k = static_cast<size_t>(index.nearest(x));
+        const double h = length_sum[k] / n_facets[k];
+        if (verts[k] == c || (pos[k] - x).norm() > match_tolerance * h) {
+            res.not_found.push_back(c);
+            continue;
+        }
+        // Average direction of the adjacent facet normals; at a corner where the normals
+        // cancel (a facet and its reverse) there is no meaningful normal.
+        MLC_CHECK(normal_sum[k].norm() > 1e-6 * n_facets[k],
+                  "contact search: the target normals cancel at vertex "
+                      << verts[k] << " (" << pos[k].x() << ", " << pos[k].y() << ")");
+        const Vec2 n = normal_sum[k].normalized();
+        res.elements.push_back(node_on_node(c, verts[k], n, n.dot(x - pos[k]), mu, r, pair));
+    }
+    return res;
+}
+
+} // namespace mlc::contact
