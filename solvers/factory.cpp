@@ -78,6 +78,29 @@ std::unique_ptr<Preconditioner> build_lu(SpecOptions& o) {
     return std::make_unique<SparseLUPreconditioner>();
 }
 
+// The level-aware preconditioners are built by levels::make_krylov_system_solver from the level
+// data; they are listed here so that error messages name them.
+[[noreturn]] void throw_level_aware(const char* name) {
+    std::ostringstream os;
+    os << "preconditioner '" << name
+       << "' is built from the level hierarchy, not from a matrix alone: use it as a "
+          "Newton-system preconditioner (--linear krylov --pc "
+       << name << "; cf and sorcf need --levels >= 1 and the coarse-to-fine solve)";
+    throw InvalidInput(os.str());
+}
+
+std::unique_ptr<Preconditioner> build_cf(SpecOptions&) {
+    throw_level_aware("cf");
+}
+
+std::unique_ptr<Preconditioner> build_sorcf(SpecOptions&) {
+    throw_level_aware("sorcf");
+}
+
+std::unique_ptr<Preconditioner> build_ebe(SpecOptions&) {
+    throw_level_aware("ebe");
+}
+
 } // namespace
 
 const std::vector<PreconditionerEntry>& preconditioner_registry() {
@@ -90,6 +113,16 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          &build_sor},
         {"ssor", "ssor[:omega=W,sweeps=N,block=B] (symmetric SOR, same options)", "", &build_ssor},
         {"lu", "lu (sparse direct LU)", "", &build_lu},
+        {"cf",
+         "cf[:inner=lu|cgs,tol=T,maxit=N,scale=q|none|qt|qinv,coarse=lu|solver] (coarse/fine, "
+         "1995; needs the level below)",
+         "", &build_cf},
+        {"sorcf",
+         "sorcf[:omega=W,block=0|1,scale=...,coarse=...] (SOR coarse/fine, 1995; needs the "
+         "level below)",
+         "", &build_sorcf},
+        {"ebe", "ebe[:variant=c1|c4|c5,unit=multipliers|contact] (element-by-element, 1997)", "",
+         &build_ebe},
     };
     return table;
 }
