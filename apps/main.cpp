@@ -8,6 +8,7 @@
 // breakdown.
 #include "apps/run.hpp"
 #include "apps/scene.hpp"
+#include "apps/study_accuracy.hpp"
 #include "apps/study_error_vs_time.hpp"
 #include "apps/study_extremes.hpp"
 #include "apps/study_preconditioners.hpp"
@@ -80,6 +81,14 @@ int main(int argc, char** argv) {
     ps->add_option("--seconds", pso.seconds_per_run, "time bound per combination (default 600)");
     ps->add_option("--out,-o", pso_out, "output folder");
     ps->add_flag("!--no-plot", pso.plot, "do not draw the PNG");
+    mlc::apps::AccuracyOptions aco;
+    std::string aco_scene = "hertz", aco_out;
+    auto* ac = study->add_subcommand("accuracy",
+                                     "closed-form errors per level and observed orders (hertz, mindlin, patch)");
+    ac->add_option("scene", aco_scene, "scene file or built-in name (default hertz)");
+    ac->add_option("--levels,-l", aco.levels, "levels 0..L (default 3)");
+    ac->add_option("--out,-o", aco_out, "output folder (default out/<scene>/accuracy)");
+    ac->add_flag("!--no-plot", aco.plot, "do not draw the PNG");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
@@ -94,6 +103,10 @@ int main(int argc, char** argv) {
         if (*ev) {
             evo.out = evo_out;
             return mlc::apps::study_error_vs_time(mlc::apps::load_scene(evo_scene), evo, std::cout);
+        }
+        if (*ac) {
+            aco.out = aco_out;
+            return mlc::apps::study_accuracy(mlc::apps::load_scene(aco_scene), aco, std::cout);
         }
         if (*ps) {
             pso.out = pso_out;
