@@ -9,8 +9,10 @@
 #endif
 #include "mesh/io/gmsh.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -495,7 +497,13 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         if (!s.ux && !s.uy) rd.fail(st, w + " fixes nothing: give ux and/or uy");
         p.supports.push_back(s);
     }
-    const double Emax = p.max_young_modulus();
+    // Default augmentation: r = r_over_E x the smallest Young's modulus of the scene. The softer
+    // body governs the compliance of a contact pair; scaling r with the stiffer one makes r many
+    // times the soft body's stiffness when the moduli differ (extremes study, contrast 1e6: the
+    // statuses cycle and Newton does not converge), while a smaller r only costs iterations.
+    double Emin = std::numeric_limits<double>::infinity();
+    for (const auto& b : p.bodies)
+        Emin = std::min(Emin, b.material.E);
     for (const toml::table* ct : rd.tables(root, "contact", "the scene")) {
         const std::string w = "[[contact]]";
         rd.check_keys(*ct,
@@ -515,7 +523,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         if (ct->get("r"))
             c.r = rd.number(*ct, "r", w);
         else
-            c.r = rd.number_or(*ct, "r_over_E", 0.1, w) * Emax;
+            c.r = rd.number_or(*ct, "r_over_E", 0.1, w) * Emin;
         if (!(c.r > 0))
             rd.fail(ct->get("r") ? ct->get("r") : ct->get("r_over_E"),
                     w + ": augmentation parameter r must be > 0");

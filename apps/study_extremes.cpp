@@ -159,6 +159,53 @@ obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
 )";
                       return solve_case(parse_scene(text, "extremes:slender"), std::min(l, 1));
                   }});
+    // Two bodies, Young's moduli 1e6 apart, node on facet with friction, the default
+    // r = 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, the statuses cycle
+    // and Newton fails). Both ways round: a soft block on a stiff base, a stiff block on a soft one.
+    for (const bool soft_on_stiff : {true, false})
+        cs.push_back({soft_on_stiff ? "contrast 1e6 soft/stiff" : "contrast 1e6 stiff/soft",
+                      soft_on_stiff ? "two bodies: block E = 1 pressed on a base E = 1e6, side load"
+                                    : "two bodies: block E = 1e6 pressed on a base E = 1, side load",
+                      [soft_on_stiff](int l) {
+                          const double Eb = soft_on_stiff ? 1.0 : 1e6;
+                          const double Ebase = soft_on_stiff ? 1e6 : 1.0;
+                          std::ostringstream t;
+                          t << std::setprecision(17) << R"(
+[scene]
+name = "contrast"
+load_steps = 3
+[[body]]
+name = "base"
+E = )" << Ebase << R"(
+nu = 0.3
+mesh = { type = "rectangle", corner = [0.0, 0.0], size = [2.0, 1.0], divisions = [8, 4] }
+tags = { bottom = "base_bottom", top = "base_top", left = "base_left", right = "base_right" }
+[[body]]
+name = "block"
+E = )" << Eb << R"(
+nu = 0.3
+mesh = { type = "rectangle", corner = [0.5, 1.0], size = [1.0, 1.0], divisions = [5, 5] }
+tags = { bottom = "block_bottom", top = "block_top", left = "block_left", right = "block_right" }
+[[support]]
+tag = "base_bottom"
+ux = 0.0
+uy = 0.0
+[[support]]
+tag = "block_top"
+ux = 0.0
+uy = -0.01
+[[load]]
+tag = "block_left"
+pressure = )" << 2e-3 * Eb << R"(
+[[contact]]
+name = "interface"
+contactor = "block_bottom"
+target = "base_top"
+element = "node_on_facet"
+mu = 0.3
+)";
+                          return solve_case(parse_scene(t.str(), "extremes:contrast"), l);
+                      }});
     cs.push_back({"units N/m/Pa vs N/mm/MPa", "square in SI and in mm units; compare", [](int l) {
                       auto mm = square();
                       auto si = square();
