@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
     st->add_option("--out,-o", sto_out, "output folder (default out/<scene>/status_transfer)");
     st->add_option("--q-rule", sto_q, "multiplier interpolation: paper (default) or conservative")
         ->check(CLI::IsMember({"paper", "conservative"}));
+    st->add_flag("--increment", sto.increment,
+                 "warm start = own previous state + interpolated coarse increment");
     st->add_flag("!--no-plot", sto.plot, "do not draw the PNG");
     mlc::apps::ExtremesOptions exo;
     std::string exo_out;

@@ -85,10 +85,12 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
 
     os << "status-transfer study: scene '" << problem.name << "', levels 0.." << opt.levels << ", "
        << problem.load_steps << " load steps, Q rule "
-       << (opt.q_rule == transfer::QRule::paper ? "paper" : "conservative") << "\n";
+       << (opt.q_rule == transfer::QRule::paper ? "paper" : "conservative")
+       << (opt.increment ? ", warm start from the interpolated increment" : "") << "\n";
     levels::SolveOptions warm_opt;
     warm_opt.coarse_to_fine = true;
     warm_opt.q_rule = opt.q_rule;
+    warm_opt.transfer_increment = opt.increment;
     os << "  solving coarse-to-fine ...\n" << std::flush;
     const levels::RunResult warm = levels::solve(problem, warm_opt);
     levels::SolveOptions cold_opt;

@@ -18,6 +18,7 @@ struct StatusTransferOptions {
     int levels = 3;                                 ///< finest level
     std::filesystem::path out;                      ///< output folder (default out/<scene>/status_transfer)
     transfer::QRule q_rule = transfer::QRule::paper;
+    bool increment = false; ///< warm start from the interpolated coarse increment (SolveOptions::transfer_increment)
     bool plot = true;                               ///< draw the PNG with matplotlib
 };
 

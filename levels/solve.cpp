@@ -82,6 +82,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         x[static_cast<size_t>(l)] = Vector::Zero(levels[static_cast<size_t>(l)].n_unknowns());
         u_prev[static_cast<size_t>(l)] = Vector::Zero(2 * levels[static_cast<size_t>(l)].mesh.n_vertices());
     }
+    std::vector<Vector> x_before(static_cast<size_t>(n_levels)); // each level's state before its solve
     res.level_steps.resize(static_cast<size_t>(n_levels));
     res.converged = true;
     for (int step = 1; step <= problem.load_steps && res.converged; ++step) {
@@ -92,21 +93,28 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             ContactNewton& nw = *newton[li];
             LevelStep ls;
             ls.level = l;
+            x_before[li] = x[li];
             if (options.coarse_to_fine && l > first) {
                 // Initial guess (P u_H, Q lambda_H): displacements through the full nodal vectors
                 // (prescribed values included), multipliers through Q.
                 ScopedTimer t(&res.timings, "newton/interpolate");
                 const auto& T = res.hierarchy.transfers[li - 1];
+                // Increment mode: interpolate the coarse change over this step and add it to the
+                // level's own previous state (x[li] still holds step - 1).
+                const bool inc = options.transfer_increment && step > 1;
                 Vector uf;
-                T.interpolate_nodal(u_now[li - 1], uf);
-                const Vector q = T.Q * x[li - 1];
+                T.interpolate_nodal(inc ? Vector(u_now[li - 1] - u_prev[li - 1]) : u_now[li - 1], uf);
+                const Vector q = T.Q * (inc ? Vector(x[li - 1] - x_before[li - 1]) : x[li - 1]);
                 Vector& xl = x[li];
                 for (int v = 0; v < L.mesh.n_vertices(); ++v)
                     for (int c = 0; c < 2; ++c)
-                        if (const int d = L.dofs.u_dof(v, c); d >= 0) xl[d] = uf[2 * v + c];
+                        if (const int d = L.dofs.u_dof(v, c); d >= 0)
+                            xl[d] = (inc ? xl[d] : 0.0) + uf[2 * v + c];
                 for (size_t e = 0; e < L.contacts.size(); ++e)
-                    for (int k = 0; k < L.contacts[e].n_multipliers(); ++k)
-                        xl[L.lambda_dof[e] + k] = q[L.lambda_dof[e] + k];
+                    for (int k = 0; k < L.contacts[e].n_multipliers(); ++k) {
+                        const Index d = L.lambda_dof[e] + k;
+                        xl[d] = (inc ? xl[d] : 0.0) + q[d];
+                    }
                 ls.predicted = true;
                 ls.predicted_statuses = nw.statuses(s, u_prev[li], xl);
             }

@@ -26,6 +26,12 @@ struct SolveOptions {
     /// needs the level below).
     bool coarse_to_fine = true;
     transfer::QRule q_rule = transfer::QRule::paper; ///< multiplier interpolation rule
+    /// Coarse-to-fine initial guess of level l in load step k: false (the paper's): the
+    /// interpolated coarse state (P u_H^k, Q lambda_H^k); true: the level's own state of step
+    /// k-1 plus the interpolated coarse increment, x_h^(k-1) + (P, Q)(x_H^k - x_H^(k-1)). The
+    /// two agree in step 1; later, the increment keeps the fine level's own resolution of the
+    /// zone ends and interpolates only what changed.
+    bool transfer_increment = false;
     /// How Newton systems are solved on levels >= 1 (level 0 always uses the exact "schur").
     LinearSolverSpec linear;
     /// Solve every level even in cold mode (the status-transfer study compares per level).

@@ -97,3 +97,27 @@ TEST(Newton, SolutionDoesNotDependOnTheAugmentationParameter) {
         EXPECT_LT((r.u_full - ref.u_full).norm(), 1e-8 * ref.u_full.norm()) << "r = " << rf << " E";
     }
 }
+
+TEST(CoarseToFine, IncrementTransferGivesTheSameSolutionAndPredictsAtLeastAsWell) {
+    auto p = apps::load_scene("square");
+    p.levels = 3;
+    levels::SolveOptions a, b;
+    b.transfer_increment = true;
+    const auto ra = levels::solve(p, a);
+    const auto rb = levels::solve(p, b);
+    ASSERT_TRUE(ra.converged && rb.converged);
+    EXPECT_LT((ra.x - rb.x).norm(), 1e-9 * ra.x.norm());
+    for (int l = 1; l <= 3; ++l) {
+        const auto& sa = ra.level_steps[static_cast<size_t>(l)];
+        const auto& sb = rb.level_steps[static_cast<size_t>(l)];
+        ASSERT_EQ(sa.size(), sb.size());
+        // Step 1 starts from zero in both modes: the same guess, the same prediction.
+        EXPECT_EQ(sa[0].predicted_statuses, sb[0].predicted_statuses);
+        double agree_a = 0, agree_b = 0;
+        for (size_t k = 1; k < sa.size(); ++k) {
+            agree_a += sa[k].agreement();
+            agree_b += sb[k].agreement();
+        }
+        EXPECT_GE(agree_b, agree_a - 1e-12) << "level " << l;
+    }
+}
