@@ -54,6 +54,12 @@ std::string run_combination(const levels::Problem& base, const PreconditionerStu
         LevelRow row;
         row.level = static_cast<int>(l);
         row.unknowns = r.levels()[l].n_unknowns();
+        // This level's verdict: every load step solved and converged here. A run stops at the
+        // first failure (a load step visits levels 0..L in turn), so the levels above the failing
+        // one have fewer steps, possibly none.
+        int steps_ok = 0;
+        for (const auto& st : r.level_steps[l]) steps_ok += st.report.converged;
+        const int verdict = steps_ok == p.load_steps ? 1 : r.level_steps[l].empty() ? 2 : 0;
         std::vector<int> its;
         double lin_s = 0, setup = 0, total = 0;
         for (const auto& st : r.level_steps[l]) {
@@ -73,7 +79,7 @@ std::string run_combination(const levels::Problem& base, const PreconditionerStu
         }
         out << "level " << row.level << " " << row.unknowns << " " << row.newton << " "
             << row.krylov_mean << " " << row.krylov_max << " " << row.seconds_per_newton << " "
-            << setup << " " << total << "\n";
+            << setup << " " << total << " " << verdict << "\n";
     }
     if (!r.converged) {
         std::string f = r.failure;
@@ -187,11 +193,13 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
                     for (size_t k = 0; k < lines.size(); ++k) {
                         std::istringstream ls(lines[k]);
                         LevelRow row;
+                        int verdict = 0;
                         ls >> row.level >> row.unknowns >> row.newton >> row.krylov_mean >> row.krylov_max >>
-                            row.seconds_per_newton >> row.setup_seconds >> row.total_seconds;
-                        // The last level listed is the one that failed, if the run failed.
-                        const bool failed_here = !failure.empty() && k + 1 == lines.size();
-                        const std::string result = failed_here ? "no conv" : "converged";
+                            row.seconds_per_newton >> row.setup_seconds >> row.total_seconds >> verdict;
+                        // converged: every load step on this level; no conv: this level failed;
+                        // not reached: a level below failed first (nothing measured here).
+                        const std::string result =
+                            verdict == 1 ? "converged" : verdict == 2 ? "not reached" : "no conv";
                         os << std::left << std::setw(8) << kr << std::setw(16) << pc << std::right
                            << std::setw(6) << mu << std::setw(8) << rf << std::setw(7) << row.level
                            << std::setw(10) << row.unknowns << std::setw(8) << row.newton << std::setw(11)
