@@ -28,9 +28,10 @@ struct PreconditionerStudyOptions {
     std::filesystem::path out;                        ///< default out/studies/<scene>_preconditioners
 };
 
-/// Runs the grid: every combination, coarse-to-fine over levels 0..L (each level's Newton
-/// systems solved by the Krylov method with the preconditioner; the coarsest exactly), one
-/// process per combination with a time bound. Writes preconditioners.csv/json, prints the table
+/// Runs the grid: every combination and every finest level l = 1..L, coarse-to-fine over levels
+/// 0..l (each level's Newton systems solved by the Krylov method with the preconditioner; the
+/// coarsest exactly), one process per (combination, l) with a time bound, reporting level l;
+/// after a failure or a timeout the finer levels of that combination are not run. Writes preconditioners.csv/json, prints the table
 /// next to the 1997 paper's (square test) and draws preconditioners.png.
 int study_preconditioners(const levels::Problem& problem, const PreconditionerStudyOptions& opt,
                           std::ostream& os);
