@@ -91,6 +91,8 @@ int main(int argc, char** argv) {
     ac->add_option("--levels,-l", aco.levels, "levels 0..L (default 3)");
     ac->add_option("--out,-o", aco_out, "output folder (default out/<scene>/accuracy)");
     ac->add_flag("!--no-plot", aco.plot, "do not draw the PNG");
+    ac->add_flag("!--no-compare", aco.compare_integration,
+                 "node-on-facet scenes: do not also solve with the other integration variants");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");

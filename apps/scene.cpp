@@ -508,7 +508,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         const std::string w = "[[contact]]";
         rd.check_keys(*ct,
                       {"name", "contactor", "region", "mu", "r", "r_over_E", "obstacle", "target",
-                       "element", "search_radius", "match_tolerance"},
+                       "element", "integration", "search_radius", "match_tolerance"},
                       w);
         levels::ContactPair c;
         c.name = rd.string_or(*ct, "name", "contact" + std::to_string(p.contacts.size() + 1), w);
@@ -555,6 +555,24 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
                                                 ".element must be \"node_on_facet\" or "
                                                 "\"node_on_node\", found \"" +
                                                 el + "\"");
+            const std::string integ = rd.string_or(*ct, "integration", "nodal", w);
+            if (integ == "nodal")
+                c.integration = contact::FacetIntegration::nodal;
+            else if (integ == "segment")
+                c.integration = contact::FacetIntegration::segment;
+            else if (integ == "dual")
+                c.integration = contact::FacetIntegration::dual;
+            else
+                rd.fail(ct->get("integration"), w +
+                                                    ".integration must be \"nodal\", "
+                                                    "\"segment\" or \"dual\", found \"" +
+                                                    integ + "\"");
+            if (c.integration != contact::FacetIntegration::nodal &&
+                c.element != levels::ContactElementKind::node_on_facet)
+                rd.fail(ct->get("integration"),
+                        w + ".integration = \"" + integ +
+                            "\" applies to element = \"node_on_facet\" only, not to \"" + el +
+                            "\"");
             c.search_radius = rd.number_or(*ct, "search_radius", c.search_radius, w);
             if (!(c.search_radius > 0))
                 rd.fail(ct->get("search_radius"), w + ".search_radius must be > 0");
@@ -564,7 +582,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
             p.contacts.push_back(c);
             continue;
         }
-        for (const char* k : {"element", "search_radius", "match_tolerance"})
+        for (const char* k : {"element", "integration", "search_radius", "match_tolerance"})
             if (ct->get(k))
                 rd.fail(ct->get(k), w + ": '" + std::string(k) +
                                         "' applies to two-body pairs (with a target), not to an "

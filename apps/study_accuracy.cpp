@@ -99,6 +99,24 @@ MindlinMeasures measure_mindlin(const levels::Problem& p, const levels::RunResul
             ln = std::max(ln, std::abs(n.lambda_n));
         }
         m.step1_tangential = ln > 0 ? lt / (mu * ln) : 0.0;
+        double P1 = 0;
+        for (const auto& n : s1.n)
+            P1 -= n.lambda_n;
+        if (P1 > 0) {
+            const double a1 = std::sqrt(4.0 * P1 * R / (std::numbers::pi * E_star));
+            const double mu_p0 = mu * 2.0 * P1 / (std::numbers::pi * a1);
+            double s2 = 0;
+            int k = 0;
+            for (size_t i = 0; i < s1.n.size(); ++i) {
+                const double q = std::abs(s1.n[i].lambda_t) / s1.trib[i] / mu_p0;
+                m.step1_traction_max = std::max(m.step1_traction_max, q);
+                if (s1.n[i].status != contact::Status::gap) {
+                    s2 += q * q;
+                    ++k;
+                }
+            }
+            m.step1_traction_rms = k > 0 ? std::sqrt(s2 / k) : 0.0;
+        }
     }
     const SortedNodes s = sorted_nodes(L, r.nodes);
     double sum_t = 0;
@@ -229,6 +247,10 @@ std::vector<AccuracyValue> accuracy_values(const levels::Problem& p, const level
                        "rms of q - q_closed over |x| < 0.9 a, / (mu p0)"});
         out.push_back({"step1_tangential", m.step1_tangential, 0.0, m.step1_tangential,
                        "max |lambda_t| / (mu max |lambda_n|) after step 1"});
+        out.push_back({"step1_traction_rms", m.step1_traction_rms, 0.0, m.step1_traction_rms,
+                       "rms of q / (mu p0) over the closed nodes after step 1"});
+        out.push_back({"step1_traction_max", m.step1_traction_max, 0.0, m.step1_traction_max,
+                       "max q / (mu p0) after step 1"});
         return out;
     }
     if (p.name == "patch" || p.name == "patch_matching") {
@@ -266,6 +288,29 @@ int study_accuracy(const levels::Problem& problem_in, const AccuracyOptions& opt
         std::vector<AccuracyValue> values;
     };
     std::vector<Row> rows;
+    // The scene with its node-on-facet pairs in each other integration, to compare.
+    std::vector<std::pair<std::string, levels::Problem>> others;
+    std::string this_name;
+    for (const auto& c : problem.contacts)
+        if (opt.compare_integration && c.element == levels::ContactElementKind::node_on_facet) {
+            this_name = std::string(contact::to_string(c.integration));
+            for (auto f : {contact::FacetIntegration::nodal, contact::FacetIntegration::segment,
+                           contact::FacetIntegration::dual}) {
+                if (f == c.integration) continue;
+                levels::Problem q = problem;
+                for (auto& oc : q.contacts)
+                    if (oc.element == levels::ContactElementKind::node_on_facet) oc.integration = f;
+                others.emplace_back(std::string(contact::to_string(f)), std::move(q));
+            }
+            break;
+        }
+    if (!others.empty()) {
+        os << "node-on-facet integration: " << this_name << " (the scene's); the quantities with "
+           << "the suffix";
+        for (const auto& o : others)
+            os << " _" << o.first;
+        os << " are the other variants'\n";
+    }
     for (int l = 0; l <= opt.levels; ++l) {
         problem.levels = l;
         levels::SolveOptions so;
@@ -279,14 +324,31 @@ int study_accuracy(const levels::Problem& problem_in, const AccuracyOptions& opt
         }
         rows.push_back({l, r.finest().n_unknowns(), r.finest().n_contact_nodes(), sec,
                         accuracy_values(problem, r)});
+        for (auto& [name, other] : others) {
+            // The same level with another node-on-facet integration: its errors, suffixed.
+            other.levels = l;
+            const levels::RunResult ro = levels::solve(other, so);
+            if (!ro.converged) {
+                os << "error: level " << l << " with " << name
+                   << " integration did not converge: " << ro.failure << "\n";
+                return 2;
+            }
+            for (auto v : accuracy_values(other, ro)) {
+                if (std::isnan(v.error)) continue;
+                v.name += "_" + name;
+                v.note += " (" + name + " integration)";
+                rows.back().values.push_back(v);
+            }
+        }
         const Row& row = rows.back();
         os << "\nlevel " << l << ": " << row.unknowns << " unknowns, " << row.contacts
            << " contact nodes, " << std::fixed << std::setprecision(2) << sec << " s"
            << std::defaultfloat << "\n";
-        os << "  quantity                 value          closed form    error       order\n";
+        os << "  quantity                         value          closed form    error       "
+              "order\n";
         for (size_t q = 0; q < row.values.size(); ++q) {
             const auto& v = row.values[q];
-            os << "  " << std::left << std::setw(22) << v.name << std::right << std::scientific
+            os << "  " << std::left << std::setw(30) << v.name << std::right << std::scientific
                << std::setprecision(5) << std::setw(14) << v.value << " " << std::setw(14)
                << v.reference << " ";
             if (std::isnan(v.error))

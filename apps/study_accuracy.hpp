@@ -18,6 +18,10 @@ struct AccuracyOptions {
     int levels = 3;            ///< levels 0..levels are solved (each coarse-to-fine from level 0)
     std::filesystem::path out; ///< output folder (default out/<scene>/accuracy)
     bool plot = true;          ///< draw accuracy.png with scripts/plot_accuracy.py
+    /// For scenes with node-on-facet pairs, also solve each level with the other
+    /// contact::FacetIntegration variants (nodal, segment, dual) and list their errors with the
+    /// suffix "_nodal", "_segment" or "_dual", so that the variants can be read side by side.
+    bool compare_integration = true;
 };
 
 /// One measured quantity of a converged state against its closed form.
@@ -51,6 +55,10 @@ struct MindlinMeasures {
     double pressure_rms = 0.0;
     /// After load step 1: max |lambda_t| / (mu max |lambda_n|) (0 in the half-space theory).
     double step1_tangential = 0.0;
+    /// After load step 1: tangential tractions q = |lambda_t| / l against mu p0_1, p0_1 the
+    /// closed-form peak pressure of step 1's own measured normal force P_1: the rms over the
+    /// nodes in contact after step 1, and the maximum over all nodes.
+    double step1_traction_rms = 0.0, step1_traction_max = 0.0;
     int n_stick = 0, n_slip = 0, n_closed = 0;
 };
 

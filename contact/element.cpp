@@ -8,6 +8,18 @@
 
 namespace mlc::contact {
 
+std::string_view to_string(FacetIntegration f) {
+    switch (f) {
+    case FacetIntegration::nodal:
+        return "nodal";
+    case FacetIntegration::segment:
+        return "segment";
+    case FacetIntegration::dual:
+        return "dual";
+    }
+    return "?";
+}
+
 std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector<int>& contactors,
                                           const Obstacle& obstacle, double mu, double r, int pair) {
     std::vector<ContactElement> out;
@@ -15,8 +27,8 @@ std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector
     for (int v : contactors) {
         ContactElement e;
         e.n_nodes = 1;
-        e.vertex = {v, -1, -1};
-        e.weight = {1.0, 0.0, 0.0};
+        e.vertex[0] = v;
+        e.weight[0] = 1.0;
         obstacle.frame(m.vertices[static_cast<size_t>(v)], e.n, e.g0);
         e.t = Vec2(e.n.y(), -e.n.x());
         e.mu = mu;
@@ -37,8 +49,56 @@ ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, d
               "node_on_facet: contactor vertex " << c << " is an end of its facet");
     ContactElement e;
     e.n_nodes = 3;
-    e.vertex = {c, a, b};
-    e.weight = {1.0, -(1.0 - alpha), -alpha};
+    e.vertex[0] = c;
+    e.vertex[1] = a;
+    e.vertex[2] = b;
+    e.weight[0] = 1.0;
+    e.weight[1] = -(1.0 - alpha);
+    e.weight[2] = -alpha;
+    e.n = n;
+    e.t = Vec2(n.y(), -n.x());
+    e.g0 = g0;
+    e.mu = mu;
+    e.r = r;
+    e.pair = pair;
+    return e;
+}
+
+ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
+                                      const std::vector<double>& weights, const Vec2& n, double g0,
+                                      double mu, double r, int pair) {
+    constexpr int max_targets = ContactElement::kMaxNodes - 1;
+    MLC_CHECK(targets.size() == weights.size(),
+              "node_on_facet_weighted: " << targets.size() << " target vertices but "
+                                         << weights.size() << " weights");
+    MLC_CHECK(!targets.empty() && static_cast<int>(targets.size()) <= max_targets,
+              "node on facet (segment integration): contactor vertex "
+                  << c << " touches " << targets.size() << " target vertices, at most "
+                  << max_targets
+                  << " are supported (the target mesh is much finer than the contactor's there: "
+                     "refine the contactor, swap contactor and target, or use integration = "
+                     "\"nodal\")");
+    MLC_CHECK(std::abs(n.norm() - 1.0) < 1e-12,
+              "node_on_facet_weighted: the normal must have unit length, found |n| = " << n.norm());
+    ContactElement e;
+    e.n_nodes = 1 + static_cast<int>(targets.size());
+    e.vertex[0] = c;
+    e.weight[0] = 1.0;
+    double sum = 0.0;
+    for (size_t k = 0; k < targets.size(); ++k) {
+        MLC_CHECK(targets[k] != c,
+                  "node_on_facet_weighted: contactor vertex " << c << " is its own target");
+        for (size_t j = 0; j < k; ++j)
+            MLC_CHECK(targets[j] != targets[k],
+                      "node_on_facet_weighted: target vertex " << targets[k] << " repeats");
+        MLC_CHECK(std::isfinite(weights[k]), "node_on_facet_weighted: weight of target vertex "
+                                                 << targets[k] << " is not finite");
+        e.vertex[k + 1] = targets[k];
+        e.weight[k + 1] = weights[k];
+        sum += weights[k];
+    }
+    MLC_CHECK(std::abs(sum + 1.0) < 1e-10,
+              "node_on_facet_weighted: the target weights sum to " << sum << ", not -1");
     e.n = n;
     e.t = Vec2(n.y(), -n.x());
     e.g0 = g0;
@@ -54,8 +114,10 @@ ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, d
     MLC_CHECK(c != a, "node_on_node: contactor vertex " << c << " is its own target");
     ContactElement e;
     e.n_nodes = 2;
-    e.vertex = {c, a, -1};
-    e.weight = {1.0, -1.0, 0.0};
+    e.vertex[0] = c;
+    e.vertex[1] = a;
+    e.weight[0] = 1.0;
+    e.weight[1] = -1.0;
     e.n = n;
     e.t = Vec2(n.y(), -n.x());
     e.g0 = g0;

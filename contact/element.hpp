@@ -10,17 +10,50 @@
 #include "mesh/mesh.hpp"
 
 #include <array>
+#include <string_view>
 #include <vector>
 
 namespace mlc::contact {
 
-/// One contact element: a contactor vertex and 0, 1 or 2 target vertices with weights w so that
-/// the relative displacement is u_rel = sum_j w_j u_(vertex j) (formulation.md §2):
-/// node on rigid (1), node on node (1, -1), node on facet (1, -(1-alpha), -alpha).
+/// How a node-on-facet element spreads its contactor node's force over the target.
+enum class FacetIntegration {
+    /// The papers' one-pass element: the target facet under the node, weights
+    /// (1, -(1-alpha), -alpha) (nodal interpolation of the contactor's forces on the target).
+    nodal,
+    /// Segment-integrated (mortar-type, lumped; El-Abbasi & Bathe 2001): weights
+    /// (1, -M_ik / D_i) over the target vertices k under the support of the contactor node's
+    /// shape function N_i, D_i = int N_i ds, M_ik = int N_i N_k ds (node_on_facet_search).
+    segment,
+    /// Segment-integrated with dual (biorthogonal) test functions psi_i = 3 N_i - 1 on each
+    /// contactor edge (Wohlmuth 2000): M_ik = int psi_i N_k ds, D_i = int N_i ds. Identity weights
+    /// on matching meshes, no smoothing of the contactor by the target.
+    dual
+};
+
+/// "nodal", "segment", "dual".
+std::string_view to_string(FacetIntegration f);
+
+namespace detail {
+template <size_t N> constexpr std::array<int, N> filled_minus_one() {
+    std::array<int, N> a{};
+    for (auto& v : a)
+        v = -1;
+    return a;
+}
+} // namespace detail
+
+/// One contact element: a contactor vertex and up to kMaxNodes - 1 target vertices with weights
+/// w so that the relative displacement is u_rel = sum_j w_j u_(vertex j) (formulation.md §2):
+/// node on rigid (1), node on node (1, -1), node on facet (1, -(1-alpha), -alpha), segment-
+/// integrated node on facet (1, -M_i1 / D_i, ..., -M_im / D_i). Entries at and beyond n_nodes
+/// are unused.
 struct ContactElement {
-    int n_nodes = 1;                       ///< 1, 2 or 3
-    std::array<int, 3> vertex{-1, -1, -1}; ///< vertex[0] is the contactor node
-    std::array<double, 3> weight{1.0, 0.0, 0.0};
+    static constexpr int kMaxNodes = 8;
+    int n_nodes = 1; ///< 1 .. kMaxNodes
+    /// vertex[0] is the contactor node; unused entries are -1.
+    std::array<int, kMaxNodes> vertex = detail::filled_minus_one<kMaxNodes>();
+    /// weight[0] = 1; unused entries 0.
+    std::array<double, kMaxNodes> weight{1.0};
     Vec2 n = Vec2(0.0, 1.0); ///< unit normal of the target, toward the contactor
     Vec2 t = Vec2(1.0, 0.0); ///< t = (n_y, -n_x)
     double g0 = 0.0;         ///< initial normal gap (>= 0 apart)
@@ -42,6 +75,14 @@ std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector
 /// Throws InvalidInput for alpha outside [0, 1] or a normal that is not of unit length.
 ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, double g0, double mu,
                              double r, int pair);
+
+/// Node-on-facet element with given target vertices and weights (segment integration):
+/// vertex c with weight 1, then targets[k] with weights[k]. Throws InvalidInput when there are
+/// more than ContactElement::kMaxNodes - 1 targets, a target is c or repeats, the weights do not
+/// sum to -1 (to 1e-10: rigid translations must give no gap), or the normal is not unit.
+ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
+                                      const std::vector<double>& weights, const Vec2& n, double g0,
+                                      double mu, double r, int pair);
 
 /// Node-on-node element: contactor vertex c against target vertex a (a matching interface):
 /// weights (1, -1), n the unit target normal toward the contactor, t = (n_y, -n_x).

@@ -170,6 +170,24 @@ double FacetIndex::local_size(const Vec2& x) const {
     return impl_->length[static_cast<size_t>(impl_->midpoints.nearest(x))];
 }
 
+const std::array<Vec2, 2>& FacetIndex::ends(int i) const {
+    MLC_CHECK(i >= 0 && i < static_cast<int>(impl_->ends.size()),
+              "FacetIndex::ends: facet " << i << " out of range");
+    return impl_->ends[static_cast<size_t>(i)];
+}
+
+std::vector<int> FacetIndex::within(const Vec2& x, double radius) const {
+    const Impl& I = *impl_;
+    std::vector<int> cand = I.midpoints.within(x, radius + 0.5 * I.max_length);
+    std::sort(cand.begin(), cand.end());
+    std::vector<int> out;
+    for (int i : cand) {
+        const auto& e = I.ends[static_cast<size_t>(i)];
+        if (project_on_facet(x, e[0], e[1]).distance <= radius) out.push_back(i);
+    }
+    return out;
+}
+
 std::optional<FacetProjection> FacetIndex::closest(const Vec2& x, double radius, int skip) const {
     const Impl& I = *impl_;
     std::vector<int> cand = I.midpoints.within(x, radius + 0.5 * I.max_length);
@@ -209,13 +227,110 @@ std::optional<FacetProjection> FacetIndex::closest(const Vec2& x, double radius,
 }
 
 // ---------------------------------------------------------------------------------------------
+namespace {
+
+/// Segment-integrated node-on-facet element of contactor vertex c (search.hpp): `nbrs` are the
+/// other ends of the contactor edges at c, `hit` the closest facet (normal, gap, and the nodal
+/// fallback), `reach` the largest distance from a contactor piece to a facet that counts.
+/// `dual`: test with the dual (biorthogonal) function psi_i = 3 N_i - 1 per edge instead of N_i,
+/// unless the support of N_i is only partly over the target.
+ContactElement segment_element(const mesh::Mesh& m, int c, const std::vector<int>& nbrs,
+                               const FacetIndex& index, const FacetProjection& hit, double reach,
+                               double mu, double r, int pair, bool dual) {
+    const Vec2 xc = m.vertices[static_cast<size_t>(c)];
+    struct Piece {
+        int a, b;      // facet ends
+        double lo, hi; // facet coordinates of the overlap
+        double sc, ds; // contactor tau = (s - sc) / ds
+        double jac;    // ds(contactor) per unit of s, times (hi - lo) / 2
+    };
+    std::vector<Piece> pieces;
+    double D = 0.0;
+    for (int d : nbrs) {
+        const Vec2 xd = m.vertices[static_cast<size_t>(d)];
+        const double L = (xd - xc).norm();
+        if (!(L > 0.0)) continue;
+        D += 0.5 * L; // int of the hat N_i over the edge
+        for (int i : index.within(0.5 * (xc + xd), 0.5 * L + reach)) {
+            const Facet& f = index.facets()[static_cast<size_t>(i)];
+            if (f.a == c || f.b == c || f.a == d || f.b == d) continue;
+            const auto& e = index.ends(i);
+            const Vec2 dv = e[1] - e[0];
+            const double len2 = dv.squaredNorm();
+            const Vec2 nf = Vec2(dv.y(), -dv.x()) / std::sqrt(len2);
+            if (nf.dot(hit.n) <= 0.0) continue; // a facet facing another way
+            // Facet coordinates s of the orthogonal projections of the edge ends (s in [0, 1]
+            // on the facet); the contactor point over s is at tau = (s - sc) / (sd - sc).
+            const double sc = (xc - e[0]).dot(dv) / len2;
+            const double sd = (xd - e[0]).dot(dv) / len2;
+            const double ds = sd - sc;
+            if (std::abs(ds) < 1e-12) continue; // the edge is perpendicular to the facet
+            const double lo = std::max(0.0, std::min(sc, sd));
+            const double hi = std::min(1.0, std::max(sc, sd));
+            if (hi - lo <= 1e-12) continue; // no overlap
+            auto x_at = [&](double s) { return Vec2(xc + (s - sc) / ds * (xd - xc)); };
+            const double gap =
+                std::min(std::abs(nf.dot(x_at(lo) - e[0])), std::abs(nf.dot(x_at(hi) - e[0])));
+            if (gap > reach) continue;
+            // ds along the contactor = L |dtau/ds| ds(facet coordinate).
+            pieces.push_back({f.a, f.b, lo, hi, sc, ds, 0.5 * (hi - lo) * L / std::abs(ds)});
+        }
+    }
+    // 2-point Gauss on [-1, 1]: exact for the quadratic integrands.
+    const double xi = 1.0 / std::sqrt(3.0);
+    auto integrate = [&](bool use_dual, std::map<int, double>& M) {
+        double covered = 0.0;
+        for (const Piece& p : pieces)
+            for (double g : {-xi, xi}) {
+                const double s = 0.5 * (p.lo + p.hi) + 0.5 * (p.hi - p.lo) * g;
+                const double Nc = 1.0 - (s - p.sc) / p.ds;
+                const double test = use_dual ? 3.0 * Nc - 1.0 : Nc;
+                covered += p.jac * test;
+                M[p.a] += p.jac * test * (1.0 - s);
+                M[p.b] += p.jac * test * s;
+            }
+        return covered;
+    };
+    std::map<int, double> M;
+    double covered = integrate(false, M);
+    const Facet& fh = index.facets()[static_cast<size_t>(hit.facet)];
+    if (!(covered > 1e-12 * D)) // nothing covered (degenerate): the nodal weights
+        return node_on_facet(c, fh.a, fh.b, hit.alpha, hit.n, hit.g0, mu, r, pair);
+    if (dual && covered > (1.0 - 1e-9) * D) {
+        M.clear();
+        covered = integrate(true, M);
+    }
+    std::vector<int> targets;
+    std::vector<double> weights;
+    for (const auto& [k, Mk] : M)
+        if (Mk != 0.0) {
+            targets.push_back(k);
+            weights.push_back(-Mk / covered);
+        }
+    return node_on_facet_weighted(c, targets, weights, hit.n, hit.g0, mu, r, pair);
+}
+
+} // namespace
+
 SearchResult node_on_facet_search(const mesh::Mesh& m, const std::vector<int>& contactors,
                                   int target_tag, const FacetIndex& reference, double search_radius,
-                                  double mu, double r, int pair) {
+                                  double mu, double r, int pair, FacetIntegration integration,
+                                  int contactor_tag) {
     std::vector<Facet> facets = target_facets(m, target_tag);
     MLC_CHECK(!facets.empty(), "contact search: the mesh has no boundary edge tagged '"
                                    << m.tag_name(target_tag) << "' to search");
     const FacetIndex index(m.vertices, facets);
+    // Segment integration: the contactor edges at each vertex (the support of its hat function).
+    std::map<int, std::vector<int>> neighbours;
+    if (integration != FacetIntegration::nodal) {
+        MLC_CHECK(contactor_tag >= 0,
+                  "contact search: segment integration needs the contactor boundary's tag");
+        for (const auto& e : m.boundary)
+            if (e.tag == contactor_tag) {
+                neighbours[e.v0].push_back(e.v1);
+                neighbours[e.v1].push_back(e.v0);
+            }
+    }
     SearchResult res;
     res.elements.reserve(contactors.size());
     for (int c : contactors) {
@@ -230,6 +345,18 @@ SearchResult node_on_facet_search(const mesh::Mesh& m, const std::vector<int>& c
             on_reference ? index.closest(x, radius + reference.max_length(), c) : std::nullopt;
         if (!hit) {
             res.not_found.push_back(c);
+            continue;
+        }
+        if (integration != FacetIntegration::nodal) {
+            const auto it = neighbours.find(c);
+            MLC_CHECK(it != neighbours.end(),
+                      "contact search: contactor vertex "
+                          << c << " (" << x.x() << ", " << x.y() << ") is on no edge tagged '"
+                          << m.tag_name(contactor_tag)
+                          << "': segment integration needs the contactor boundary edges");
+            res.elements.push_back(segment_element(m, c, it->second, index, *hit,
+                                                   radius + reference.max_length(), mu, r, pair,
+                                                   integration == FacetIntegration::dual));
             continue;
         }
         const Facet& f = index.facets()[static_cast<size_t>(hit->facet)];

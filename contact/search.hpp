@@ -8,6 +8,7 @@
 #include "core/types.hpp"
 #include "mesh/mesh.hpp"
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -61,6 +62,10 @@ public:
     /// `radius` has its midpoint within radius + half the longest facet of x, and only those
     /// are examined.
     std::optional<FacetProjection> closest(const Vec2& x, double radius, int skip = -1) const;
+    /// Indices (ascending) of the facets whose distance to x is at most `radius`.
+    std::vector<int> within(const Vec2& x, double radius) const;
+    /// End points of facet i.
+    const std::array<Vec2, 2>& ends(int i) const;
     /// Length of the facet whose midpoint is nearest to x: the local target mesh size.
     double local_size(const Vec2& x) const;
     const std::vector<Facet>& facets() const;
@@ -87,10 +92,37 @@ struct SearchResult {
 /// `target_tag`: weights (1, -(1-alpha), -alpha), the facet normal toward the contactor,
 /// t = (n_y, -n_x) and g0 = the signed distance of c to the facet line. Contactor vertices that
 /// are not contact nodes are listed in `not_found`, in input order.
-/// Throws InvalidInput when the mesh has no facet tagged `target_tag`.
+///
+/// With `integration` = FacetIntegration::segment or dual (then `contactor_tag`, the tag of the
+/// contactor boundary edges, is required) the contact nodes, n, t and g0 are the same, but the
+/// weights are segment-integrated (mortar-type, lumped; El-Abbasi & Bathe 2001): N_i the hat
+/// function of contactor node c on the contactor boundary (its support: the edges tagged
+/// `contactor_tag` at c) and N_k those of the target vertices on the target facets,
+///   D_i = int N_i ds,  M_ik = int N_i N_k ds   (ds along the contactor),
+/// integrated over the pieces where a contactor edge, projected orthogonally on a target facet's
+/// line, overlaps that facet (2-point Gauss per piece: exact, the integrands are quadratic).
+/// Facets count when they lie within the node's search distance of the piece and face the same
+/// way as the node's facet (n_f . n > 0). Weights (1, -M_ik / D_i^cov) with D_i^cov the part
+/// of D_i that is covered (the sum over the pieces): they sum to 0 exactly, so rigid
+/// translations give no gap. D_i^cov = D_i when the support of N_i projects entirely onto the
+/// target; at an end of the target boundary (or at a convex corner of it) only the covered part
+/// counts, i.e. the weights are renormalised by it. A node whose support covers nothing (a
+/// degenerate case) keeps the nodal weights. With uniform pressure p the multipliers
+/// lambda_i = p D_i pass to the target vertex k as sum_i lambda_i M_ik / D_i = p int N_k ds:
+/// the consistent load, so the contact patch test is passed exactly.
+/// FacetIntegration::dual uses psi_i = 3 N_i - 1 on each contactor edge in place of N_i in M_ik
+/// (biorthogonal: int psi_i N_j = delta_ij D_i; Wohlmuth 2000), so that the weights are (1, -1)
+/// on a matching interface and the contactor is not smoothed by the target (segment's lumped
+/// weights are, which makes tractions oscillate on similar meshes); sum psi_i = 1 keeps the
+/// patch test exact. A node whose support is only partly over the target keeps N_i (segment).
+/// Throws InvalidInput when the mesh has no facet tagged `target_tag`, or (segment, dual) when
+/// `contactor_tag` is missing or a node touches more than ContactElement::kMaxNodes - 1 target
+/// vertices.
 SearchResult node_on_facet_search(const mesh::Mesh& m, const std::vector<int>& contactors,
                                   int target_tag, const FacetIndex& reference, double search_radius,
-                                  double mu, double r, int pair);
+                                  double mu, double r, int pair,
+                                  FacetIntegration integration = FacetIntegration::nodal,
+                                  int contactor_tag = -1);
 
 /// Node-on-node search for matching interfaces: for each contactor vertex c, the target vertex
 /// (an end of a facet tagged `target_tag`) nearest to c, accepted when within

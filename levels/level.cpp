@@ -104,9 +104,9 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
             const auto& m0 = problem.mesh0;
             const contact::FacetIndex reference(m0.vertices,
                                                 contact::target_facets(m0, m0.tag(pair.target)));
-            auto found =
-                contact::node_on_facet_search(mesh, nodes, mesh.tag(pair.target), reference,
-                                              pair.search_radius, pair.mu, pair.r, ip);
+            auto found = contact::node_on_facet_search(
+                mesh, nodes, mesh.tag(pair.target), reference, pair.search_radius, pair.mu, pair.r,
+                ip, pair.integration, mesh.tag(pair.contactor));
             elems = std::move(found.elements);
             L.not_found[p] = std::move(found.not_found);
             break;

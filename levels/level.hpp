@@ -52,7 +52,8 @@ struct Level {
 /// Contactor nodes: vertices on the pair's contactor tag (inside its region, if any) that are
 /// not fully fixed and not claimed by an earlier pair. Rigid pairs make node-on-rigid elements;
 /// two-body pairs search their target once, on the reference configuration
-/// (contact::node_on_facet_search with the level-0 target facets setting the search radius, or
+/// (contact::node_on_facet_search with the level-0 target facets setting the search radius and
+/// the pair's integration, nodal, segment or dual, computed on this level's meshes, or
 /// contact::node_on_node_search); contactor nodes that find nothing are left out and listed in
 /// `not_found`. Throws InvalidInput for an unknown tag, a support point that is not a vertex, or
 /// a pair with no contact node.

@@ -48,6 +48,11 @@ void Problem::validate() const {
                                                            << c.target
                                                            << "' is also the contactor tag");
         }
+        MLC_CHECK(
+            c.integration == contact::FacetIntegration::nodal ||
+                c.element == ContactElementKind::node_on_facet,
+            "contact '" << c.name << "': integration = \"" << contact::to_string(c.integration)
+                        << "\" applies to node_on_facet only, not to " << to_string(c.element));
         MLC_CHECK(std::isfinite(c.search_radius) && c.search_radius > 0,
                   "contact '" << c.name << "': search_radius must be > 0, found "
                               << c.search_radius);

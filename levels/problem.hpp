@@ -4,6 +4,7 @@
 /// parsed into this (apps/), and every level is built from it and a mesh.
 #pragma once
 
+#include "contact/element.hpp"
 #include "contact/obstacle.hpp"
 #include "core/types.hpp"
 #include "fem/elasticity.hpp"
@@ -88,6 +89,11 @@ struct ContactPair {
     /// length of its adjacent target facets) of the contactor vertex. Relative, so that a
     /// matching interface in any unit system matches; 1e-6 accepts mesher round-off only.
     double match_tolerance = 1e-6;
+    /// node_on_facet: how a contactor node's force is spread over the target (contact::
+    /// FacetIntegration): nodal (the papers' weights (1, -(1-alpha), -alpha), default), segment
+    /// (mortar-type lumped weights, passes the contact patch test exactly) or dual (the same with
+    /// dual test functions: also exact, and no smoothing of the contactor by the target).
+    contact::FacetIntegration integration = contact::FacetIntegration::nodal;
     double mu = 0.0; ///< Coulomb friction coefficient >= 0
     double r = 0.0;  ///< augmentation parameter > 0 (force/length^2 units x length)
     bool two_body() const { return element != ContactElementKind::node_on_rigid; }
@@ -121,7 +127,8 @@ struct Problem {
     int levels = 0; ///< number of 1->4 refinements of mesh0
     NewtonParams newton;
 
-    /// Checks materials, pairs (mu >= 0, r > 0, one target of the right kind), load_steps >= 1,
+    /// Checks materials, pairs (mu >= 0, r > 0, one target of the right kind, an integration
+    /// other than nodal only with node_on_facet), load_steps >= 1,
     /// levels >= 0, and the loading path (every per-point list of the same length).
     /// Throws InvalidInput naming the offending entry.
     void validate() const;
