@@ -6,6 +6,7 @@
 // starting point for your own scene file. Every error is reported as one line on stderr with a
 // non-zero exit code: 1 for bad input, 2 for a solve that did not converge, 3 for a numerical
 // breakdown.
+#include "apps/bench.hpp"
 #include "apps/run.hpp"
 #include "apps/scene.hpp"
 #include "apps/study_accuracy.hpp"
@@ -93,6 +94,29 @@ int main(int argc, char** argv) {
     ac->add_flag("!--no-plot", aco.plot, "do not draw the PNG");
     ac->add_flag("!--no-compare", aco.compare_integration,
                  "node-on-facet scenes: do not also solve with the other integration variants");
+    auto* bench = app.add_subcommand("bench", "scaling benchmarks (see README: Multilevel preconditioner)");
+    bench->require_subcommand(1);
+    mlc::apps::BenchSquareOptions bso;
+    std::string bso_out;
+    auto* bsq = bench->add_subcommand("square", "full coarse-to-fine solve per solver: JSON per level");
+    bsq->add_option("scene", bso.scene, "scene file or built-in name (default square)");
+    bsq->add_option("--levels,-l", bso.levels, "finest level (default 3)");
+    bsq->add_option("--pc", bso.pcs,
+                    "solvers (space-separated list): schur, lu, or preconditioner specs (default mg)");
+    bsq->add_option("--krylov", bso.krylov, "Krylov method for the preconditioners (default cgs)");
+    bsq->add_option("--tol", bso.rel_tol, "Krylov relative tolerance (default 1e-8)");
+    bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
+    bsq->add_option("--repeat", bso.repeat, "runs per solver, times are medians (default 1)");
+    bsq->add_option("--out,-o", bso_out, "JSON file (default out/bench/<scene>_L<L>.json)");
+    mlc::apps::BenchElasticOptions beo;
+    std::string beo_out;
+    auto* bel = bench->add_subcommand("elastic", "elastic block: BoomerAMG-PCG vs mg-CG/GMRES");
+    bel->add_option("scene", beo.scene, "scene file or built-in name (default square)");
+    bel->add_option("--levels,-l", beo.levels, "level of the elastic block (default 3)");
+    bel->add_option("--tol", beo.rel_tol, "relative tolerance of every solve (default 1e-8)");
+    bel->add_option("--max-iter", beo.max_iter, "iterations of every solve (default 1000)");
+    bel->add_option("--repeat", beo.repeat, "runs per solver, times are medians (default 1)");
+    bel->add_option("--out,-o", beo_out, "JSON file (default out/bench/elastic_<scene>_L<L>.json)");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
@@ -104,6 +128,14 @@ int main(int argc, char** argv) {
     }
     try {
         if (*run) return mlc::apps::run_scene(ro, std::cout);
+        if (*bsq) {
+            bso.out = bso_out;
+            return mlc::apps::bench_square(bso, std::cout);
+        }
+        if (*bel) {
+            beo.out = beo_out;
+            return mlc::apps::bench_elastic(beo, std::cout);
+        }
         if (*ev) {
             evo.out = evo_out;
             return mlc::apps::study_error_vs_time(mlc::apps::load_scene(evo_scene), evo, std::cout);

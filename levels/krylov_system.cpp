@@ -9,6 +9,7 @@
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/krylov.hpp"
+#include "solvers/mg.hpp"
 #include "solvers/sorcf.hpp"
 
 #include <algorithm>
@@ -80,6 +81,13 @@ public:
             build_coarse_fine(parsed, context);
         else if (parsed.name == "ebe")
             build_ebe(parsed);
+        else if (parsed.name == "mg")
+            build_mg(parsed, context);
+        else if (parsed.name == "amg" && !level.contacts.empty())
+            MLC_CHECK(false, "amg (hypre BoomerAMG) preconditions the elastic block only (symmetric "
+                             "positive definite); the contact Jacobian has zero multiplier "
+                             "diagonals: use --pc mg, or compare on the elastic block with "
+                             "`mlcontact bench elastic`");
         else
             pc_ = solvers::make_preconditioner(spec.pc);
     }
@@ -89,6 +97,30 @@ public:
                   "Newton system: " << M.size() << " status matrices for " << level_.contacts.size()
                                     << " contact elements");
         const double t0 = wall_seconds();
+        prepare(M);
+        const double t1 = wall_seconds();
+        if (dx.size() != b.size()) dx = Vector::Zero(b.size());
+        // mg: the unrolled mat-vec (solvers::CsrOperator); the others keep Eigen's, so
+        // their published iteration counts stay bit-for-bit reproducible.
+        SolveResult r =
+            mg_ ? solvers::solve(method_, solvers::CsrOperator(jac_.matrix()), *pc_, b, dx, params_)
+                : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params_);
+        r.setup_seconds = t1 - t0;
+        return r;
+    }
+    std::string name() const override { return spec_.krylov + "+" + pc_->name(); }
+
+    const Preconditioner* preconditioner_for(const std::vector<Eigen::Matrix2d>& M) override {
+        MLC_CHECK(M.size() == level_.contacts.size(),
+                  "preconditioner_for: " << M.size() << " status matrices for "
+                                         << level_.contacts.size() << " contact elements");
+        prepare(M);
+        return pc_.get();
+    }
+
+private:
+    // Assembles J(M) and sets the preconditioner up, unless M is the last call's.
+    void prepare(const std::vector<Eigen::Matrix2d>& M) {
         if (ctx_ != nullptr) refresh_coarse();
         // The same statuses as the last call (e.g. this solver serving as the coarse solve of
         // the level above, once per preconditioner application): J and C are unchanged.
@@ -104,15 +136,8 @@ public:
             first_ = false;
             last_M_ = M;
         }
-        const double t1 = wall_seconds();
-        if (dx.size() != b.size()) dx = Vector::Zero(b.size());
-        SolveResult r = solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params_);
-        r.setup_seconds = t1 - t0;
-        return r;
     }
-    std::string name() const override { return spec_.krylov + "+" + pc_->name(); }
 
-private:
     // The coarse statuses are read from the context at every solve (the driver updates them
     // after each coarse load step); with coarse=lu the coarse Jacobian is refactored when they
     // changed.
@@ -123,6 +148,21 @@ private:
                                                 << ctx_->coarse->contacts.size()
                                                 << " coarse contact elements; solve the level "
                                                    "below first and set CoarseContext::coarse_M");
+        if (mg_) {
+            // The level below's own V-cycle at its converged statuses when it has one (which
+            // makes the cycle recursive down to level 1); else (level 0, solved by a direct
+            // method) a sparse LU of its Jacobian here.
+            const Preconditioner* below = ctx_->coarse_solver->preconditioner_for(cM);
+            if (dynamic_cast<const solvers::MultigridCycle*>(below) != nullptr) {
+                mg_coarse_ = below;
+            } else {
+                if (!coarse_lu_) {
+                    coarse_jac_ = std::make_unique<JacobianAssembler>(*ctx_->coarse);
+                    coarse_lu_ = std::make_unique<solvers::SparseLUPreconditioner>();
+                }
+                mg_coarse_ = coarse_lu_.get();
+            }
+        }
         if (coarse_lu_ && (!coarse_factored_ || cM != coarse_M_used_)) {
             coarse_jac_->assemble(cM);
             if (!coarse_factored_)
@@ -180,6 +220,31 @@ private:
         }
     }
 
+    void build_mg(const solvers::PreconditionerSpec& parsed, const CoarseContext* context) {
+        MLC_CHECK(context != nullptr && context->available(),
+                  "mg needs the level below: use with --levels >= 1 and the coarse-to-fine solve");
+        ctx_ = context;
+        Options o(parsed);
+        solvers::MultigridParams p;
+        p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
+        p.post_sweeps = o.get_int("post", p.post_sweeps);
+        p.omega = o.get_double("omega", p.omega);
+        o.finish();
+        const auto& T = ctx_->transfer->T;
+        MLC_CHECK(T.rows() == level_.n_unknowns() && T.cols() == ctx_->coarse->n_unknowns(),
+                  "mg: the transfer is " << T.rows() << " x " << T.cols() << ", expected "
+                                         << level_.n_unknowns() << " x "
+                                         << ctx_->coarse->n_unknowns());
+        std::vector<int> owner(static_cast<size_t>(level_.n_unknowns()));
+        for (Index i = 0; i < level_.n_unknowns(); ++i)
+            owner[static_cast<size_t>(i)] = level_.dofs.vertex_of(i);
+        mg_ = true;
+        pc_ = std::make_unique<solvers::MultigridCycle>(
+            T, ctx_->transfer->R,
+            [this](const Vector& r, Vector& z) { mg_coarse_->apply(r, z); },
+            solvers::vertex_block_starts(owner), p);
+    }
+
     void build_ebe(const solvers::PreconditionerSpec& parsed) {
         Options o(parsed);
         smoothers::EBEParams p;
@@ -210,6 +275,9 @@ private:
     std::unique_ptr<solvers::SparseLUPreconditioner> coarse_lu_;
     bool coarse_factored_ = false;
     std::vector<Eigen::Matrix2d> coarse_M_used_;
+    // MG: the coarse correction (the level below's cycle, or coarse_lu_), set at every solve.
+    bool mg_ = false;
+    const Preconditioner* mg_coarse_ = nullptr;
     // EBE: elastic element matrices first, then one per contact element (refreshed per solve).
     std::vector<smoothers::ElementMatrix> ebe_elements_;
     size_t ebe_n_elastic_ = 0;

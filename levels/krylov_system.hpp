@@ -44,8 +44,17 @@ namespace mlc::levels {
 ///   statuses (default c1); unit: where W~ = 1 (default multipliers; "contact", formulation.md's
 ///   reading, diverges with c1 on the square).
 ///
-/// "cf" and "sorcf" need `context` with the level below (context->available()); without it they
-/// throw mlc::InvalidInput ("cf needs the level below: use with --levels >= 1 and the
+/// - "mg[:pre=N,post=N,omega=W]": one V-cycle over all levels (solvers/mg.hpp): N forward /
+///   backward vertex-block Gauss–Seidel sweeps before / after the coarse correction (defaults
+///   1, 1; relaxation W, default 1), restriction R = T^T and prolongation T of the context's
+///   transfer, and as coarse correction the level below's own cycle, set up on its Jacobian at
+///   the converged coarse statuses through `NewtonSystemSolver::preconditioner_for` (so the
+///   cycle recurses down to level 1), or, when the level below has no cycle (level 0, solved by
+///   "schur"), a sparse LU of its Jacobian at those statuses. A fixed linear operator per
+///   Newton system: CGS, BiCGStab and GMRES apply. Its mat-vecs use solvers::CsrOperator.
+///
+/// "cf", "sorcf" and "mg" need `context` with the level below (context->available()); without
+/// it they throw mlc::InvalidInput ("cf needs the level below: use with --levels >= 1 and the
 /// coarse-to-fine solve"). The context is borrowed and read at every solve: the driver may fill
 /// or update coarse_M between load steps (it must hold the coarse level's statuses, converged
 /// for the current load step, when `solve` is called). The context and its pointees must

@@ -54,6 +54,13 @@ public:
                               Vector& dx) = 0;
     /// "lu", "schur", or the Krylov/preconditioner pair.
     virtual std::string name() const = 0;
+    /// For the multilevel preconditioner of the level above: this solver's preconditioner set
+    /// up on J(M) (assembled, and refreshed only when M differs from the last call's), or null
+    /// when it has none (direct solvers). Valid until the next `solve` or call of this function.
+    virtual const Preconditioner* preconditioner_for(const std::vector<Eigen::Matrix2d>& M) {
+        (void)M;
+        return nullptr;
+    }
 };
 
 /// Assembles J(M) (pattern fixed per level) and calls `solver` on it. `level` must outlive it.

@@ -7,6 +7,7 @@
 #include "smoothers/iluk.hpp"
 #include "smoothers/jacobi.hpp"
 #include "solvers/direct.hpp"
+#include "solvers/hypre/boomeramg.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -101,6 +102,21 @@ std::unique_ptr<Preconditioner> build_ebe(SpecOptions&) {
     throw_level_aware("ebe");
 }
 
+std::unique_ptr<Preconditioner> build_mg(SpecOptions&) {
+    throw_level_aware("mg");
+}
+
+std::unique_ptr<Preconditioner> build_amg(SpecOptions& o) {
+    BoomerAMGParams p;
+    p.num_functions = o.get_int("fn", p.num_functions);
+    p.nodal = o.get_int("nodal", p.nodal);
+    p.strong_threshold = o.get_double("theta", p.strong_threshold);
+    p.agg_num_levels = o.get_int("agg", p.agg_num_levels);
+    o.finish();
+    p.validate();
+    return std::make_unique<BoomerAMGPreconditioner>(p);
+}
+
 } // namespace
 
 const std::vector<PreconditionerEntry>& preconditioner_registry() {
@@ -123,6 +139,14 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          "", &build_sorcf},
         {"ebe", "ebe[:variant=c1|c4|c5,unit=multipliers|contact] (element-by-element, 1997)", "",
          &build_ebe},
+        {"mg",
+         "mg[:pre=N,post=N,omega=W] (multilevel V-cycle over all levels, vertex-block "
+         "Gauss-Seidel; needs the level below)",
+         "", &build_mg},
+        {"amg",
+         "amg[:fn=2,nodal=0,theta=0.25,agg=0] (hypre BoomerAMG V-cycle, for the elastic "
+         "block: symmetric positive definite, fn interleaved components per vertex)",
+         "", &build_amg},
     };
     return table;
 }

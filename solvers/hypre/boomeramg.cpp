@@ -1,0 +1,238 @@
+// SPDX-License-Identifier: MIT
+// hypre BoomerAMG (one V-cycle as a Preconditioner) and hypre PCG + BoomerAMG.
+#include "solvers/hypre/boomeramg.hpp"
+
+#include "core/check.hpp"
+#include "core/timer.hpp"
+#include "smoothers/matrix_checks.hpp"
+
+#include <HYPRE.h>
+#include <HYPRE_krylov.h>
+#include <HYPRE_parcsr_ls.h>
+#include <mpi.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <numeric>
+#include <sstream>
+#include <vector>
+
+namespace mlc::solvers {
+
+void BoomerAMGParams::validate() const {
+    MLC_CHECK(num_functions >= 1, "BoomerAMG: num_functions must be >= 1, found " << num_functions);
+    MLC_CHECK(nodal >= 0, "BoomerAMG: nodal must be >= 0, found " << nodal);
+    MLC_CHECK(strong_threshold > 0 && strong_threshold < 1,
+              "BoomerAMG: strong_threshold must be in (0, 1), found " << strong_threshold);
+    MLC_CHECK(p_max_elmts >= 0, "BoomerAMG: p_max_elmts must be >= 0, found " << p_max_elmts);
+    MLC_CHECK(agg_num_levels >= 0, "BoomerAMG: agg_num_levels must be >= 0, found " << agg_num_levels);
+}
+
+std::ostream& operator<<(std::ostream& os, const BoomerAMGParams& p) {
+    return os << "BoomerAMGParams{num_functions=" << p.num_functions << ", nodal=" << p.nodal
+              << ", strong_threshold=" << p.strong_threshold << ", coarsen_type=" << p.coarsen_type
+              << ", interp_type=" << p.interp_type << ", p_max_elmts=" << p.p_max_elmts
+              << ", relax_type=" << p.relax_type << ", agg_num_levels=" << p.agg_num_levels << "}";
+}
+
+bool have_hypre() { return true; }
+
+namespace {
+
+void finalize_hypre() {
+    HYPRE_Finalize();
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (!finalized) MPI_Finalize();
+}
+
+} // namespace
+
+void ensure_hypre_initialized() {
+    static const bool done = [] {
+        int initialized = 0;
+        MPI_Initialized(&initialized);
+        if (!initialized) {
+            int argc = 0;
+            char** argv = nullptr;
+            MLC_CHECK(MPI_Init(&argc, &argv) == MPI_SUCCESS, "BoomerAMG: MPI_Init failed");
+        }
+        HYPRE_Init();
+        std::atexit(finalize_hypre);
+        return true;
+    }();
+    (void)done;
+}
+
+// The hypre objects of one matrix: IJ matrix and two IJ vectors (b, x) with their ParCSR views.
+struct BoomerAMGPreconditioner::Impl {
+    HYPRE_IJMatrix ij_A = nullptr;
+    HYPRE_ParCSRMatrix A = nullptr;
+    HYPRE_IJVector ij_b = nullptr, ij_x = nullptr;
+    HYPRE_ParVector b = nullptr, x = nullptr;
+    HYPRE_Solver amg = nullptr;
+    std::vector<HYPRE_BigInt> rows;
+    HYPRE_Int n = 0;
+
+    explicit Impl(const SparseMatrix& M) {
+        ensure_hypre_initialized();
+        n = static_cast<HYPRE_Int>(M.rows());
+        const HYPRE_BigInt last = n - 1;
+        HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, last, 0, last, &ij_A);
+        HYPRE_IJMatrixSetObjectType(ij_A, HYPRE_PARCSR);
+        std::vector<HYPRE_Int> ncols(static_cast<size_t>(n));
+        for (HYPRE_Int i = 0; i < n; ++i)
+            ncols[static_cast<size_t>(i)] = M.outerIndexPtr()[i + 1] - M.outerIndexPtr()[i];
+        HYPRE_IJMatrixSetRowSizes(ij_A, ncols.data());
+        HYPRE_IJMatrixInitialize(ij_A);
+        rows.resize(static_cast<size_t>(n));
+        std::iota(rows.begin(), rows.end(), HYPRE_BigInt{0});
+        std::vector<HYPRE_BigInt> cols(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros());
+        HYPRE_IJMatrixSetValues(ij_A, n, ncols.data(), rows.data(), cols.data(), M.valuePtr());
+        HYPRE_IJMatrixAssemble(ij_A);
+        HYPRE_IJMatrixGetObject(ij_A, reinterpret_cast<void**>(&A));
+        for (auto* v : {&ij_b, &ij_x}) {
+            HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, last, v);
+            HYPRE_IJVectorSetObjectType(*v, HYPRE_PARCSR);
+            HYPRE_IJVectorInitialize(*v);
+            HYPRE_IJVectorAssemble(*v);
+        }
+        HYPRE_IJVectorGetObject(ij_b, reinterpret_cast<void**>(&b));
+        HYPRE_IJVectorGetObject(ij_x, reinterpret_cast<void**>(&x));
+    }
+    ~Impl() {
+        if (amg) HYPRE_BoomerAMGDestroy(amg);
+        if (ij_A) HYPRE_IJMatrixDestroy(ij_A);
+        if (ij_b) HYPRE_IJVectorDestroy(ij_b);
+        if (ij_x) HYPRE_IJVectorDestroy(ij_x);
+    }
+    Impl(const Impl&) = delete;
+    Impl& operator=(const Impl&) = delete;
+
+    void create_amg(const BoomerAMGParams& p, bool as_preconditioner,
+                    const std::vector<int>& dof_func) {
+        HYPRE_BoomerAMGCreate(&amg);
+        HYPRE_BoomerAMGSetPrintLevel(amg, 0);
+        HYPRE_BoomerAMGSetNumFunctions(amg, p.num_functions);
+        if (!dof_func.empty()) {
+            MLC_CHECK(static_cast<HYPRE_Int>(dof_func.size()) == n,
+                      "BoomerAMG: dof_func has " << dof_func.size() << " entries for " << n
+                                                 << " unknowns");
+            // hypre takes ownership of the array and frees it with free() (host memory).
+            auto* f = static_cast<HYPRE_Int*>(std::malloc(sizeof(HYPRE_Int) * dof_func.size()));
+            MLC_CHECK(f != nullptr, "BoomerAMG: out of memory");
+            for (size_t i = 0; i < dof_func.size(); ++i) {
+                MLC_CHECK(dof_func[i] >= 0 && dof_func[i] < p.num_functions,
+                          "BoomerAMG: dof_func[" << i << "] = " << dof_func[i]
+                                                 << " is not in [0, " << p.num_functions << ")");
+                f[i] = dof_func[i];
+            }
+            HYPRE_BoomerAMGSetDofFunc(amg, f);
+        }
+        if (p.nodal > 0) HYPRE_BoomerAMGSetNodal(amg, p.nodal);
+        HYPRE_BoomerAMGSetStrongThreshold(amg, p.strong_threshold);
+        HYPRE_BoomerAMGSetCoarsenType(amg, p.coarsen_type);
+        HYPRE_BoomerAMGSetInterpType(amg, p.interp_type);
+        HYPRE_BoomerAMGSetPMaxElmts(amg, p.p_max_elmts);
+        HYPRE_BoomerAMGSetRelaxType(amg, p.relax_type);
+        HYPRE_BoomerAMGSetAggNumLevels(amg, p.agg_num_levels);
+        HYPRE_BoomerAMGSetNumSweeps(amg, 1);
+        if (as_preconditioner) {
+            HYPRE_BoomerAMGSetTol(amg, 0.0);
+            HYPRE_BoomerAMGSetMaxIter(amg, 1);
+        }
+    }
+    void set_vector(HYPRE_IJVector v, const Vector& src) const {
+        HYPRE_IJVectorSetValues(v, n, rows.data(), src.data());
+    }
+    void get_vector(HYPRE_IJVector v, Vector& dst) const {
+        HYPRE_IJVectorGetValues(v, n, rows.data(), dst.data());
+    }
+};
+
+BoomerAMGPreconditioner::BoomerAMGPreconditioner(BoomerAMGParams params) : params_(params) {
+    params_.validate();
+}
+
+BoomerAMGPreconditioner::~BoomerAMGPreconditioner() = default;
+
+void BoomerAMGPreconditioner::setup(const SparseMatrix& A) {
+    smoothers::check_setup_matrix(A, "BoomerAMGPreconditioner::setup");
+    MLC_CHECK(!dof_func_.empty() || A.rows() % params_.num_functions == 0,
+              "BoomerAMG: " << A.rows() << " unknowns are not a multiple of num_functions = "
+                            << params_.num_functions << " (interleaved vertex components expected)");
+    impl_ = std::make_unique<Impl>(A);
+    impl_->create_amg(params_, true, dof_func_);
+    HYPRE_BoomerAMGSetup(impl_->amg, impl_->A, impl_->b, impl_->x);
+}
+
+void BoomerAMGPreconditioner::apply(const Vector& r, Vector& z) const {
+    MLC_CHECK(impl_ != nullptr, "BoomerAMGPreconditioner: call setup first");
+    smoothers::check_size(r, impl_->n, "BoomerAMGPreconditioner::apply", "r");
+    z.setZero(r.size());
+    impl_->set_vector(impl_->ij_b, r);
+    impl_->set_vector(impl_->ij_x, z);
+    HYPRE_BoomerAMGSolve(impl_->amg, impl_->A, impl_->b, impl_->x);
+    impl_->get_vector(impl_->ij_x, z);
+}
+
+std::string BoomerAMGPreconditioner::name() const {
+    std::ostringstream os;
+    os << "amg(fn=" << params_.num_functions << ",theta=" << params_.strong_threshold << ")";
+    return os.str();
+}
+
+SolveResult boomeramg_pcg(const SparseMatrix& A, const Vector& b, Vector& x, double rel_tol,
+                          int max_iter, const BoomerAMGParams& params,
+                          const std::vector<int>& dof_func) {
+    params.validate();
+    smoothers::check_setup_matrix(A, "boomeramg_pcg");
+    smoothers::check_size(b, A.rows(), "boomeramg_pcg", "b");
+    MLC_CHECK(rel_tol > 0 && rel_tol < 1, "boomeramg_pcg: rel_tol must be in (0, 1), found " << rel_tol);
+    MLC_CHECK(max_iter >= 1, "boomeramg_pcg: max_iter must be >= 1, found " << max_iter);
+    ensure_hypre_initialized(); // once per process, not part of the setup time
+    if (x.size() != b.size()) x = Vector::Zero(b.size());
+    SolveResult res;
+    Vector r = b;
+    r.noalias() -= A * x;
+    res.initial_residual = r.norm();
+    const double t0 = wall_seconds();
+    BoomerAMGPreconditioner::Impl h(A);
+    h.create_amg(params, true, dof_func);
+    h.set_vector(h.ij_b, b);
+    h.set_vector(h.ij_x, x);
+    HYPRE_Solver pcg = nullptr;
+    HYPRE_ParCSRPCGCreate(MPI_COMM_SELF, &pcg);
+    HYPRE_PCGSetTol(pcg, rel_tol);
+    HYPRE_PCGSetAbsoluteTol(pcg, 0.0);
+    HYPRE_PCGSetMaxIter(pcg, max_iter);
+    HYPRE_PCGSetTwoNorm(pcg, 1);
+    HYPRE_PCGSetPrintLevel(pcg, 0);
+    HYPRE_PCGSetPrecond(pcg, reinterpret_cast<HYPRE_PtrToSolverFcn>(HYPRE_BoomerAMGSolve),
+                        reinterpret_cast<HYPRE_PtrToSolverFcn>(HYPRE_BoomerAMGSetup), h.amg);
+    HYPRE_ParCSRPCGSetup(pcg, h.A, h.b, h.x);
+    const double t1 = wall_seconds();
+    HYPRE_ParCSRPCGSolve(pcg, h.A, h.b, h.x);
+    const double t2 = wall_seconds();
+    HYPRE_Int its = 0;
+    HYPRE_Real rel = 0.0;
+    HYPRE_PCGGetNumIterations(pcg, &its);
+    HYPRE_PCGGetFinalRelativeResidualNorm(pcg, &rel);
+    HYPRE_ParCSRPCGDestroy(pcg);
+    h.get_vector(h.ij_x, x);
+    res.iterations = static_cast<int>(its);
+    r = b;
+    r.noalias() -= A * x;
+    res.final_residual = r.norm();
+    const double bn = b.norm();
+    res.relative_residual = bn > 0 ? res.final_residual / bn : res.final_residual;
+    res.converged = std::isfinite(rel) && rel <= rel_tol;
+    res.reason = res.converged ? StopReason::converged : StopReason::max_iter;
+    if (its > 0 && res.initial_residual > 0)
+        res.average_rate = std::pow(res.final_residual / res.initial_residual, 1.0 / its);
+    res.setup_seconds = t1 - t0;
+    res.solve_seconds = t2 - t1;
+    return res;
+}
+
+} // namespace mlc::solvers

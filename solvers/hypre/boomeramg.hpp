@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: MIT
+/// @file hypre BoomerAMG as the outside reference for the elastic block (K on the free
+/// displacement unknowns): a Preconditioner doing one AMG V-cycle, and hypre's own PCG with it.
+/// Compiled only with MLC_WITH_HYPRE (MLC_HAVE_HYPRE defined); without it the functions below
+/// throw mlc::InvalidInput. MPI is initialised once, on first use, as a single process (no
+/// mpirun needed), and finalised at exit.
+#pragma once
+
+#include "core/linear_operator.hpp"
+
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace mlc::solvers {
+
+/// BoomerAMG settings (names as in hypre's HYPRE_BoomerAMGSet* functions). The defaults are the
+/// usual choice for 2D linear elasticity: systems AMG with the two displacement components as
+/// two functions (unknown-based coarsening, interpolation within each component), HMIS
+/// coarsening, extended+i interpolation truncated to 4 entries per row, l1-scaled symmetric
+/// hybrid Gauss–Seidel, strength threshold 0.25 (hypre's value for 2D problems).
+struct BoomerAMGParams {
+    int num_functions = 2;        ///< unknowns per vertex, interleaved (SetNumFunctions)
+    int nodal = 0;                ///< 0: unknown-based; >= 1: nodal coarsening norm (SetNodal)
+    double strong_threshold = 0.25; ///< SetStrongThreshold, in (0, 1)
+    int coarsen_type = 10;        ///< SetCoarsenType: 10 HMIS, 8 PMIS, 6 Falgout
+    int interp_type = 6;          ///< SetInterpType: 6 extended+i
+    int p_max_elmts = 4;          ///< SetPMaxElmts: interpolation truncation (0: none)
+    int relax_type = 8;           ///< SetRelaxType: 8 l1-symmetric hybrid Gauss–Seidel
+    int agg_num_levels = 0;       ///< SetAggNumLevels: aggressive coarsening levels
+    void validate() const;
+};
+
+std::ostream& operator<<(std::ostream& os, const BoomerAMGParams& p);
+
+/// True when built with hypre.
+bool have_hypre();
+
+/// Calls MPI_Init once (single process) if MPI is not initialised yet, and HYPRE_Init; registers
+/// their finalisation at exit. Throws mlc::InvalidInput when built without hypre.
+void ensure_hypre_initialized();
+
+/// One BoomerAMG V-cycle as a preconditioner (z = AMG(r) from z = 0). For symmetric positive
+/// definite matrices with interleaved 2-component vertices (the elastic block). `setup` copies A
+/// into hypre; `apply` copies r in and z out (no allocation). Not thread-safe.
+class BoomerAMGPreconditioner final : public Preconditioner {
+public:
+    explicit BoomerAMGPreconditioner(BoomerAMGParams params = {});
+    ~BoomerAMGPreconditioner() override;
+    BoomerAMGPreconditioner(const BoomerAMGPreconditioner&) = delete;
+    BoomerAMGPreconditioner& operator=(const BoomerAMGPreconditioner&) = delete;
+    void setup(const SparseMatrix& A) override;
+    void apply(const Vector& r, Vector& z) const override;
+    /// "amg(fn=2,theta=0.25)".
+    std::string name() const override;
+    /// Function (displacement component) of every unknown, for systems AMG when the components
+    /// are not strictly interleaved (a vertex with one prescribed component); values in
+    /// [0, num_functions). Empty (default): unknown i has function i % num_functions.
+    void set_dof_func(std::vector<int> dof_func) { dof_func_ = std::move(dof_func); }
+
+    struct Impl;
+
+private:
+    BoomerAMGParams params_;
+    std::vector<int> dof_func_;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// hypre's PCG preconditioned by BoomerAMG on A x = b to ||b - A x|| <= rel_tol ||b|| (two-norm).
+/// Returns iterations, residuals and the setup (AMG hierarchy) and solve seconds separately.
+/// x holds the initial guess on entry (resized to zero if empty).
+/// `dof_func`: as BoomerAMGPreconditioner::set_dof_func (empty: interleaved).
+SolveResult boomeramg_pcg(const SparseMatrix& A, const Vector& b, Vector& x, double rel_tol,
+                          int max_iter, const BoomerAMGParams& params = {},
+                          const std::vector<int>& dof_func = {});
+
+} // namespace mlc::solvers
