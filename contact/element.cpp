@@ -39,6 +39,20 @@ std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector
     return out;
 }
 
+namespace {
+/// Sets the local frame (n, t = (n_y, -n_x)), initial gap and pair data of a two-body element.
+ContactElement with_frame(ContactElement e, const Vec2& n, double g0, double mu, double r,
+                          int pair) {
+    e.n = n;
+    e.t = Vec2(n.y(), -n.x());
+    e.g0 = g0;
+    e.mu = mu;
+    e.r = r;
+    e.pair = pair;
+    return e;
+}
+} // namespace
+
 ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, double g0, double mu,
                              double r, int pair) {
     MLC_CHECK(alpha >= 0.0 && alpha <= 1.0,
@@ -55,13 +69,7 @@ ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, d
     e.weight[0] = 1.0;
     e.weight[1] = -(1.0 - alpha);
     e.weight[2] = -alpha;
-    e.n = n;
-    e.t = Vec2(n.y(), -n.x());
-    e.g0 = g0;
-    e.mu = mu;
-    e.r = r;
-    e.pair = pair;
-    return e;
+    return with_frame(e, n, g0, mu, r, pair);
 }
 
 ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
@@ -99,13 +107,7 @@ ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
     }
     MLC_CHECK(std::abs(sum + 1.0) < 1e-10,
               "node_on_facet_weighted: the target weights sum to " << sum << ", not -1");
-    e.n = n;
-    e.t = Vec2(n.y(), -n.x());
-    e.g0 = g0;
-    e.mu = mu;
-    e.r = r;
-    e.pair = pair;
-    return e;
+    return with_frame(e, n, g0, mu, r, pair);
 }
 
 ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, double r, int pair) {
@@ -118,13 +120,7 @@ ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, d
     e.vertex[1] = a;
     e.weight[0] = 1.0;
     e.weight[1] = -1.0;
-    e.n = n;
-    e.t = Vec2(n.y(), -n.x());
-    e.g0 = g0;
-    e.mu = mu;
-    e.r = r;
-    e.pair = pair;
-    return e;
+    return with_frame(e, n, g0, mu, r, pair);
 }
 
 ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vector& u_prev_full,
