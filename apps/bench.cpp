@@ -5,6 +5,7 @@
 #include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "core/timer.hpp"
+#include "levels/elastic_block.hpp"
 #include "levels/hierarchy.hpp"
 #include "levels/solve.hpp"
 #include "solvers/direct.hpp"
@@ -61,12 +62,12 @@ long jacobian_nonzeros(const levels::Level& L) {
     std::set<std::pair<int, int>> extra;
     const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
     for (size_t e = 0; e < L.contacts.size(); ++e)
-        contact::for_each_tangent_entry(L.contacts[e], I, L.dofs, L.lambda_dof[e],
-                                        [&](int row, int col, double) {
-                                            const int* b = K.innerIndexPtr() + K.outerIndexPtr()[row];
-                                            const int* en = K.innerIndexPtr() + K.outerIndexPtr()[row + 1];
-                                            if (!std::binary_search(b, en, col)) extra.emplace(row, col);
-                                        });
+        contact::for_each_tangent_entry(
+            L.contacts[e], I, L.dofs, L.lambda_dof[e], [&](int row, int col, double) {
+                const int* b = K.innerIndexPtr() + K.outerIndexPtr()[row];
+                const int* en = K.innerIndexPtr() + K.outerIndexPtr()[row + 1];
+                if (!std::binary_search(b, en, col)) extra.emplace(row, col);
+            });
     return static_cast<long>(K.nonZeros()) + static_cast<long>(extra.size());
 }
 
@@ -102,7 +103,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     os << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
        << std::setw(11) << "nonzeros" << std::setw(7) << "newton" << std::setw(10) << "its/newt"
        << std::setw(6) << "max" << std::setw(10) << "setup s" << std::setw(10) << "solve s"
-       << std::setw(11) << "s/newton" << std::setw(13) << "us/newt/unk" << "\n";
+       << std::setw(11) << "s/newton" << std::setw(13) << "us/newt/unk"
+       << "\n";
     int code = 0;
     for (size_t ip = 0; ip < opt.pcs.size(); ++ip) {
         const std::string& pc = opt.pcs[ip];
@@ -111,7 +113,10 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         if (pc == "schur" || pc == "lu")
             so.linear.method = pc;
         else
-            so.linear = {.method = "krylov", .krylov = opt.krylov, .pc = pc, .rel_tol = opt.rel_tol,
+            so.linear = {.method = "krylov",
+                         .krylov = opt.krylov,
+                         .pc = pc,
+                         .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
         std::vector<SquareRow> rows;
         std::vector<double> walls;
@@ -146,7 +151,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
                 }
                 row.newton = newton;
                 double sum = 0;
-                for (int i : its) sum += i;
+                for (int i : its)
+                    sum += i;
                 row.its_mean = its.empty() ? 0.0 : sum / static_cast<double>(its.size());
                 row.its_max = its.empty() ? 0.0 : *std::max_element(its.begin(), its.end());
                 row.setup_s.push_back(setup);
@@ -170,23 +176,22 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
                << ", \"unknowns\": " << row.unknowns << ", \"nonzeros\": " << row.nonzeros
                << ", \"newton_steps\": " << row.newton
                << ", \"krylov_per_newton\": " << row.its_mean
-               << ", \"krylov_per_newton_max\": " << row.its_max
-               << ", \"setup_seconds\": " << setup << ", \"solve_seconds\": " << solve
-               << ", \"level_seconds\": " << median(row.total_s)
+               << ", \"krylov_per_newton_max\": " << row.its_max << ", \"setup_seconds\": " << setup
+               << ", \"solve_seconds\": " << solve << ", \"level_seconds\": " << median(row.total_s)
                << ", \"seconds_per_newton\": " << per_newton
                << ", \"seconds_per_newton_per_unknown\": " << per_unknown << "}";
-            os << std::setw(14) << pc << std::setw(6) << row.level << std::setw(10)
-               << row.unknowns << std::setw(11) << row.nonzeros << std::setw(7) << row.newton
-               << std::setw(10) << std::fixed << std::setprecision(1) << row.its_mean
-               << std::setw(6) << std::setprecision(0) << row.its_max << std::setw(10)
-               << std::setprecision(3) << setup << std::setw(10) << solve << std::setw(11)
-               << std::setprecision(4) << per_newton << std::setw(13) << std::setprecision(3)
-               << 1e6 * per_unknown << std::defaultfloat << "\n";
+            os << std::setw(14) << pc << std::setw(6) << row.level << std::setw(10) << row.unknowns
+               << std::setw(11) << row.nonzeros << std::setw(7) << row.newton << std::setw(10)
+               << std::fixed << std::setprecision(1) << row.its_mean << std::setw(6)
+               << std::setprecision(0) << row.its_max << std::setw(10) << std::setprecision(3)
+               << setup << std::setw(10) << solve << std::setw(11) << std::setprecision(4)
+               << per_newton << std::setw(13) << std::setprecision(3) << 1e6 * per_unknown
+               << std::defaultfloat << "\n";
         }
         js << "\n     ]}";
         os << std::setw(14) << pc << "  total wall " << std::fixed << std::setprecision(2)
-           << median(walls) << " s (median), peak RSS " << std::setprecision(0) << rss
-           << " MiB" << std::defaultfloat << (converged ? "" : "  FAILED: " + failure) << "\n";
+           << median(walls) << " s (median), peak RSS " << std::setprecision(0) << rss << " MiB"
+           << std::defaultfloat << (converged ? "" : "  FAILED: " + failure) << "\n";
     }
     js << "\n  ]\n}\n";
     os << "wrote " << out.string() << "\n";
@@ -194,58 +199,6 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
 }
 
 namespace {
-
-// The elastic block of one level: K on the displacement unknowns (compact numbering, vertex
-// order kept), the compact index of every unknown (-1 for multipliers) and the vertex and
-// component of every compact unknown.
-struct ElasticBlock {
-    SparseMatrix K;
-    std::vector<int> compact, vertex, component;
-};
-
-ElasticBlock elastic_block(const levels::Level& L) {
-    ElasticBlock b;
-    const Index n = L.n_unknowns();
-    b.compact.assign(static_cast<size_t>(n), -1);
-    int m = 0;
-    for (Index i = 0; i < n; ++i)
-        if (L.dofs.is_displacement(i)) {
-            b.compact[static_cast<size_t>(i)] = m++;
-            b.vertex.push_back(L.dofs.vertex_of(i));
-        }
-    b.component.assign(static_cast<size_t>(m), 0);
-    for (int v = 0; v < L.mesh.n_vertices(); ++v)
-        for (int c = 0; c < 2; ++c)
-            if (const int d = L.dofs.u_dof(v, c); d >= 0)
-                b.component[static_cast<size_t>(b.compact[static_cast<size_t>(d)])] = c;
-    std::vector<Triplet> t;
-    t.reserve(static_cast<size_t>(L.elastic.K.nonZeros()));
-    for (Index i = 0; i < n; ++i)
-        for (SparseMatrix::InnerIterator it(L.elastic.K, i); it; ++it) {
-            const int r = b.compact[static_cast<size_t>(i)], c = b.compact[static_cast<size_t>(it.col())];
-            if (r >= 0 && c >= 0) t.emplace_back(r, c, it.value());
-        }
-    b.K.resize(m, m);
-    b.K.setFromTriplets(t.begin(), t.end());
-    b.K.makeCompressed();
-    return b;
-}
-
-// P restricted to displacement unknowns (fine compact x coarse compact).
-SparseMatrix displacement_prolongation(const SparseMatrix& T, const ElasticBlock& fine,
-                                       const ElasticBlock& coarse) {
-    std::vector<Triplet> t;
-    for (Index i = 0; i < T.rows(); ++i)
-        for (SparseMatrix::InnerIterator it(T, i); it; ++it) {
-            const int r = fine.compact[static_cast<size_t>(i)];
-            const int c = coarse.compact[static_cast<size_t>(it.col())];
-            if (r >= 0 && c >= 0) t.emplace_back(r, c, it.value());
-        }
-    SparseMatrix P(fine.K.rows(), coarse.K.rows());
-    P.setFromTriplets(t.begin(), t.end());
-    P.makeCompressed();
-    return P;
-}
 
 struct ElasticResult {
     std::string name;
@@ -269,14 +222,11 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
     const levels::Hierarchy h = levels::build_hierarchy(problem);
     const double hierarchy_s = wall_seconds() - th0;
     const int nl = h.n_levels();
-    std::vector<ElasticBlock> blocks;
+    std::vector<levels::ElasticBlock> blocks;
     for (const auto& L : h.levels)
-        blocks.push_back(elastic_block(L));
-    const ElasticBlock& fine = blocks.back();
-    Vector b(fine.K.rows());
-    const Vector& f = h.finest().elastic.f;
-    for (Index i = 0; i < f.size(); ++i)
-        if (const int c = fine.compact[static_cast<size_t>(i)]; c >= 0) b[c] = f[i];
+        blocks.push_back(levels::elastic_block(L));
+    const levels::ElasticBlock& fine = blocks.back();
+    const Vector b = fine.restrict(h.finest().elastic.f);
     MLC_CHECK(b.norm() > 0, "bench elastic: the scene has no load on the free unknowns");
     const auto n = fine.K.rows();
     os << "bench elastic: " << opt.scene << " level " << opt.levels << ", elastic block " << n
@@ -292,8 +242,8 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
         r.name = "boomeramg-pcg";
         for (int rep = 0; rep < opt.repeat; ++rep) {
             x_amg = Vector::Zero(n);
-            const SolveResult s = solvers::boomeramg_pcg(fine.K, b, x_amg, opt.rel_tol, opt.max_iter,
-                                                         {}, fine.component);
+            const SolveResult s = solvers::boomeramg_pcg(fine.K, b, x_amg, opt.rel_tol,
+                                                         opt.max_iter, {}, fine.component);
             r.setup.push_back(s.setup_seconds);
             r.solve.push_back(s.solve_seconds);
             r.iterations = s.iterations;
@@ -314,10 +264,11 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
             std::vector<std::unique_ptr<solvers::MultigridCycle>> cycle(static_cast<size_t>(nl));
             for (int l = 1; l < nl; ++l) {
                 const auto li = static_cast<size_t>(l);
-                P[li] = displacement_prolongation(h.transfers[li - 1].T, blocks[li], blocks[li - 1]);
+                P[li] = levels::displacement_prolongation(h.transfers[li - 1].T, blocks[li],
+                                                          blocks[li - 1]);
                 R[li] = P[li].transpose();
-                const Preconditioner* below = l == 1 ? static_cast<const Preconditioner*>(lu.get())
-                                                     : cycle[li - 1].get();
+                const Preconditioner* below =
+                    l == 1 ? static_cast<const Preconditioner*>(lu.get()) : cycle[li - 1].get();
                 cycle[li] = std::make_unique<solvers::MultigridCycle>(
                     P[li], R[li], [below](const Vector& rc, Vector& zc) { below->apply(rc, zc); },
                     solvers::vertex_block_starts(blocks[li].vertex));

@@ -149,6 +149,15 @@ void GeneralizedSSOR::apply(const Vector& r, Vector& z) const {
     }
     const auto nb = static_cast<Index>(starts_.size()) - 1;
     double t[16];
+    // out = B t for a dense row-major m x m block B (m <= 4).
+    auto block_multiply = [](const double* B, Index size, const double* x, double* out) {
+        for (Index a = 0; a < size; ++a) {
+            double acc = 0.0;
+            for (Index c = 0; c < size; ++c)
+                acc += B[a * size + c] * x[c];
+            out[a] = acc;
+        }
+    };
     // Forward block sweep: y_I = D_I^{-1} (r_I - omega sum_{J < I} A_IJ y_J).
     for (Index b = 0; b < nb; ++b) {
         const Index i0 = starts_[static_cast<size_t>(b)];
@@ -160,13 +169,7 @@ void GeneralizedSSOR::apply(const Vector& r, Vector& z) const {
                 s -= w * val[p] * y_[inner[p]];
             t[a] = s;
         }
-        const double* Di = dinv_.data() + offset_[static_cast<size_t>(b)];
-        for (Index a = 0; a < m; ++a) {
-            double s = 0.0;
-            for (Index c = 0; c < m; ++c)
-                s += Di[a * m + c] * t[c];
-            y_[i0 + a] = s;
-        }
+        block_multiply(dinv_.data() + offset_[static_cast<size_t>(b)], m, t, y_.data() + i0);
     }
     // Backward block sweep: z_I = D_I^{-1} (D_I y_I - omega sum_{J > I} A_IJ z_J).
     for (Index b = nb - 1; b >= 0; --b) {
@@ -183,13 +186,7 @@ void GeneralizedSSOR::apply(const Vector& r, Vector& z) const {
                 s -= w * val[p] * z[inner[p]];
             t[a] = s;
         }
-        const double* Di = dinv_.data() + offset_[static_cast<size_t>(b)];
-        for (Index a = 0; a < m; ++a) {
-            double s = 0.0;
-            for (Index c = 0; c < m; ++c)
-                s += Di[a * m + c] * t[c];
-            z[i0 + a] = s;
-        }
+        block_multiply(dinv_.data() + offset_[static_cast<size_t>(b)], m, t, z.data() + i0);
     }
     z *= scale;
 }

@@ -2,6 +2,7 @@
 // Scene parsing: every bad input of the foundation issue gets an InvalidInput naming it.
 #include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "tests/common/scene_text.hpp"
 
 #include <gtest/gtest.h>
 #include <regex>
@@ -14,22 +15,8 @@ std::string square_text() {
     return apps::builtin_scene_text("square");
 }
 
-std::string replace(std::string s, const std::string& from, const std::string& to) {
-    const auto pos = s.find(from);
-    EXPECT_NE(pos, std::string::npos) << from;
-    if (pos != std::string::npos) s.replace(pos, from.size(), to);
-    return s;
-}
-
-/// Parses and returns the error message (empty when no error).
-std::string error_of(const std::string& text) {
-    try {
-        apps::parse_scene(text, "test.toml");
-    } catch (const InvalidInput& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::error_of;
+using test::replace;
 
 } // namespace
 

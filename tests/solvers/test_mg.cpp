@@ -4,6 +4,7 @@
 // mg-CG and BoomerAMG-PCG both reach the tolerance and agree with a sparse direct solve.
 #include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "levels/elastic_block.hpp"
 #include "levels/hierarchy.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
@@ -19,43 +20,10 @@ using namespace mlc;
 
 namespace {
 
-// K on the displacement unknowns of one level (compact numbering, vertex order kept).
-struct Block {
-    SparseMatrix K;
-    std::vector<int> compact, vertex, component;
-};
-
-Block block_of(const levels::Level& L) {
-    Block b;
-    b.compact.assign(static_cast<size_t>(L.n_unknowns()), -1);
-    int m = 0;
-    for (Index i = 0; i < L.n_unknowns(); ++i)
-        if (L.dofs.is_displacement(i)) {
-            b.compact[static_cast<size_t>(i)] = m++;
-            b.vertex.push_back(L.dofs.vertex_of(i));
-        }
-    b.component.assign(static_cast<size_t>(m), 0);
-    for (int v = 0; v < L.mesh.n_vertices(); ++v)
-        for (int c = 0; c < 2; ++c)
-            if (const int d = L.dofs.u_dof(v, c); d >= 0)
-                b.component[static_cast<size_t>(b.compact[static_cast<size_t>(d)])] = c;
-    std::vector<Triplet> t;
-    for (Index i = 0; i < L.n_unknowns(); ++i)
-        for (SparseMatrix::InnerIterator it(L.elastic.K, i); it; ++it) {
-            const int r = b.compact[static_cast<size_t>(i)];
-            const int c = b.compact[static_cast<size_t>(it.col())];
-            if (r >= 0 && c >= 0) t.emplace_back(r, c, it.value());
-        }
-    b.K.resize(m, m);
-    b.K.setFromTriplets(t.begin(), t.end());
-    b.K.makeCompressed();
-    return b;
-}
-
 // Levels 0..2 of the square's elastic block with a V-cycle on top (LU on level 0).
 struct ElasticHierarchy {
     levels::Hierarchy h;
-    std::vector<Block> blocks;
+    std::vector<levels::ElasticBlock> blocks;
     std::vector<SparseMatrix> P, R;
     std::unique_ptr<solvers::SparseLUPreconditioner> lu;
     std::vector<std::unique_ptr<solvers::MultigridCycle>> cycle;
@@ -66,7 +34,7 @@ struct ElasticHierarchy {
         problem.levels = levels;
         h = levels::build_hierarchy(problem);
         for (const auto& L : h.levels)
-            blocks.push_back(block_of(L));
+            blocks.push_back(levels::elastic_block(L));
         const size_t n = blocks.size();
         P.resize(n);
         R.resize(n);
@@ -74,16 +42,8 @@ struct ElasticHierarchy {
         lu = std::make_unique<solvers::SparseLUPreconditioner>();
         lu->setup(blocks[0].K);
         for (size_t l = 1; l < n; ++l) {
-            std::vector<Triplet> t;
-            const SparseMatrix& T = h.transfers[l - 1].T;
-            for (Index i = 0; i < T.rows(); ++i)
-                for (SparseMatrix::InnerIterator it(T, i); it; ++it) {
-                    const int r = blocks[l].compact[static_cast<size_t>(i)];
-                    const int c = blocks[l - 1].compact[static_cast<size_t>(it.col())];
-                    if (r >= 0 && c >= 0) t.emplace_back(r, c, it.value());
-                }
-            P[l].resize(blocks[l].K.rows(), blocks[l - 1].K.rows());
-            P[l].setFromTriplets(t.begin(), t.end());
+            P[l] =
+                levels::displacement_prolongation(h.transfers[l - 1].T, blocks[l], blocks[l - 1]);
             R[l] = P[l].transpose();
             const Preconditioner* below =
                 l == 1 ? static_cast<const Preconditioner*>(lu.get()) : cycle[l - 1].get();
@@ -92,10 +52,7 @@ struct ElasticHierarchy {
                 solvers::vertex_block_starts(blocks[l].vertex));
             cycle[l]->setup(blocks[l].K);
         }
-        const auto& f = h.finest().elastic.f;
-        b.resize(blocks.back().K.rows());
-        for (Index i = 0; i < f.size(); ++i)
-            if (const int c = blocks.back().compact[static_cast<size_t>(i)]; c >= 0) b[c] = f[i];
+        b = blocks.back().restrict(h.finest().elastic.f);
     }
     const SparseMatrix& K() const { return blocks.back().K; }
 };
@@ -165,7 +122,8 @@ TEST(BoomerAMG, PCGSolvesTheElasticBlockLikeADirectSolve) {
     if (!solvers::have_hypre()) GTEST_SKIP() << "built without hypre";
     ElasticHierarchy e(2);
     Vector x;
-    const SolveResult r = solvers::boomeramg_pcg(e.K(), e.b, x, 1e-8, 200, {}, e.blocks.back().component);
+    const SolveResult r =
+        solvers::boomeramg_pcg(e.K(), e.b, x, 1e-8, 200, {}, e.blocks.back().component);
     ASSERT_TRUE(r.converged) << r;
     EXPECT_LE(r.relative_residual, 1e-8 * 1.01);
     EXPECT_LE(r.iterations, 30);
