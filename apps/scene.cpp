@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -501,9 +500,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
     // body governs the compliance of a contact pair; scaling r with the stiffer one makes r many
     // times the soft body's stiffness when the moduli differ (extremes study, contrast 1e6: the
     // statuses cycle and Newton does not converge), while a smaller r only costs iterations.
-    double Emin = std::numeric_limits<double>::infinity();
-    for (const auto& b : p.bodies)
-        Emin = std::min(Emin, b.material.E);
+    const double Emin = p.min_young_modulus();
     for (const toml::table* ct : rd.tables(root, "contact", "the scene")) {
         const std::string w = "[[contact]]";
         rd.check_keys(*ct,

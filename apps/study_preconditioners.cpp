@@ -42,7 +42,7 @@ std::string run_combination(const levels::Problem& base, const PreconditionerStu
     if (opt.load_steps > 0) p.load_steps = opt.load_steps;
     for (auto& c : p.contacts) {
         c.mu = mu;
-        c.r = rf * p.max_young_modulus();
+        c.r = rf * p.min_young_modulus(); // as the scene default r_over_E
     }
     levels::SolveOptions so;
     so.coarse_to_fine = true;

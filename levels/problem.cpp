@@ -4,7 +4,9 @@
 
 #include "core/check.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mlc::levels {
 
@@ -109,6 +111,13 @@ std::string_view to_string(ContactElementKind k) {
         return "node_on_node";
     }
     return "?";
+}
+
+double Problem::min_young_modulus() const {
+    double e = std::numeric_limits<double>::infinity();
+    for (const auto& b : bodies)
+        e = std::min(e, b.material.E);
+    return e;
 }
 
 double Problem::max_young_modulus() const {

@@ -134,6 +134,9 @@ struct Problem {
     void validate() const;
     /// Characteristic Young's modulus (the largest), for defaults such as r = 0.1 E.
     double max_young_modulus() const;
+    /// Smallest Young's modulus of the bodies (the scale of the default augmentation r: the
+    /// softer body governs the compliance of a contact pair).
+    double min_young_modulus() const;
 
     /// Number K of points of the loading path: the common length of the per-point lists of
     /// loads (`factors`) and supports (`ux_path`, `uy_path`), or 1 when there is none

@@ -51,8 +51,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     const auto& levels = res.hierarchy.levels;
     const int n_levels = res.hierarchy.n_levels();
     const int finest = n_levels - 1;
-    const bool all_levels = options.coarse_to_fine || options.solve_all_levels ||
-                            needs_coarse_level(options.linear);
+    const bool all_levels =
+        options.coarse_to_fine || options.solve_all_levels || needs_coarse_level(options.linear);
     const int first = all_levels ? 0 : finest;
 
     // Solvers, Newton drivers and coarse contexts per level (contexts are updated every step).
@@ -80,9 +80,11 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         u_now(static_cast<size_t>(n_levels));
     for (int l = 0; l < n_levels; ++l) {
         x[static_cast<size_t>(l)] = Vector::Zero(levels[static_cast<size_t>(l)].n_unknowns());
-        u_prev[static_cast<size_t>(l)] = Vector::Zero(2 * levels[static_cast<size_t>(l)].mesh.n_vertices());
+        u_prev[static_cast<size_t>(l)] =
+            Vector::Zero(2 * levels[static_cast<size_t>(l)].mesh.n_vertices());
     }
-    std::vector<Vector> x_before(static_cast<size_t>(n_levels)); // each level's state before its solve
+    std::vector<Vector> x_before(
+        static_cast<size_t>(n_levels)); // each level's state before its solve
     res.level_steps.resize(static_cast<size_t>(n_levels));
     res.converged = true;
     for (int step = 1; step <= problem.load_steps && res.converged; ++step) {
@@ -93,7 +95,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             ContactNewton& nw = *newton[li];
             LevelStep ls;
             ls.level = l;
-            x_before[li] = x[li];
+            if (options.transfer_increment) x_before[li] = x[li]; // step - 1, for the level above
             if (options.coarse_to_fine && l > first) {
                 // Initial guess (P u_H, Q lambda_H): displacements through the full nodal vectors
                 // (prescribed values included), multipliers through Q.
@@ -103,7 +105,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 // level's own previous state (x[li] still holds step - 1).
                 const bool inc = options.transfer_increment && step > 1;
                 Vector uf;
-                T.interpolate_nodal(inc ? Vector(u_now[li - 1] - u_prev[li - 1]) : u_now[li - 1], uf);
+                T.interpolate_nodal(inc ? Vector(u_now[li - 1] - u_prev[li - 1]) : u_now[li - 1],
+                                    uf);
                 const Vector q = T.Q * (inc ? Vector(x[li - 1] - x_before[li - 1]) : x[li - 1]);
                 Vector& xl = x[li];
                 for (int v = 0; v < L.mesh.n_vertices(); ++v)
@@ -125,7 +128,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 for (size_t e = 0; e < ls.final_statuses.size(); ++e)
                     ++ls.confusion[static_cast<size_t>(ls.predicted_statuses[e])]
                                   [static_cast<size_t>(ls.final_statuses[e])];
-            if (options.progress) print_progress(*options.progress, l, n_levels, step, problem.load_steps, ls);
+            if (options.progress)
+                print_progress(*options.progress, l, n_levels, step, problem.load_steps, ls);
             const bool ok = ls.report.converged;
             if (l == finest) res.steps.push_back(ls.report);
             res.level_steps[li].push_back(std::move(ls));
@@ -135,14 +139,16 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 os << "load step " << step << " (load factor " << s << ")";
                 if (n_levels > 1) os << " on level " << l;
                 os << " did not converge: " << rep.message << "; residual history:";
-                for (double r : rep.residuals) os << " " << std::scientific << std::setprecision(2) << r;
+                for (double r : rep.residuals)
+                    os << " " << std::scientific << std::setprecision(2) << r;
                 res.failure = os.str();
                 res.converged = false;
                 break;
             }
             L.dofs.expand(x[li], L.u_fixed_at(s), u_now[li]);
             if (l + 1 < n_levels) {
-                // The level above needs this level's converged statuses (two-level preconditioners).
+                // The level above needs this level's converged statuses (two-level
+                // preconditioners).
                 Vector R(x[li].size());
                 nw.residual(s, u_prev[li], x[li], R, nullptr, &context[li + 1].coarse_M, nullptr);
             }
@@ -154,7 +160,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             res.step_u_full.push_back(res.u_full);
             res.step_nodes.push_back(res.nodes);
         }
-        for (int l = first; l < n_levels; ++l) u_prev[static_cast<size_t>(l)] = u_now[static_cast<size_t>(l)];
+        for (int l = first; l < n_levels; ++l)
+            u_prev[static_cast<size_t>(l)] = u_now[static_cast<size_t>(l)];
     }
     res.x = x.back();
     return res;
