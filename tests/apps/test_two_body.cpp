@@ -6,6 +6,7 @@
 #include "apps/study_accuracy.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"
+#include "tests/common/scene_text.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,21 +20,8 @@ using namespace mlc;
 
 namespace {
 
-std::string replace(std::string s, const std::string& from, const std::string& to) {
-    const auto pos = s.find(from);
-    EXPECT_NE(pos, std::string::npos) << from;
-    if (pos != std::string::npos) s.replace(pos, from.size(), to);
-    return s;
-}
-
-std::string error_of(const std::string& text) {
-    try {
-        apps::parse_scene(text, "test.toml");
-    } catch (const InvalidInput& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::error_of;
+using test::replace;
 
 /// Body of each vertex (attribute of a triangle using it).
 std::vector<int> vertex_body(const mesh::Mesh& m) {
@@ -429,5 +417,30 @@ TEST(TwoBodyMesh, ContactNodesNestOnACurvedTarget) {
                       F.contact_of_vertex[static_cast<size_t>(v)] >= 0)
                 << "vertex " << v << " on level " << l;
         EXPECT_GT(F.not_found[0].size(), 0u); // the radius leaves the far block top out
+    }
+}
+
+TEST(PatchTest, StiffnessContrastOfAMillionIsExactWithTheDefaultAugmentation) {
+    // The lower block 1e6 times softer than the upper one (nu = 0, E = 2 and 2e6): springs in
+    // series, uniform stress s = 0.1 / (1/2 + 1/2e6), interface u_y = -s / 2. The default r is
+    // 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, Newton cycles).
+    const auto p0 = apps::parse_scene(
+        replace(apps::builtin_scene_text("patch"), "E = 2.0e6", "E = 2.0"), "patch_contrast.toml");
+    ASSERT_EQ(p0.bodies.size(), 2u);
+    EXPECT_DOUBLE_EQ(p0.bodies[0].material.E, 2.0);
+    EXPECT_DOUBLE_EQ(p0.bodies[1].material.E, 2.0e6);
+    EXPECT_DOUBLE_EQ(p0.contacts[0].r, 0.1 * 2.0);
+    const double s = 0.1 / (1.0 / 2.0 + 1.0 / 2.0e6);
+    for (int level : {0, 2}) {
+        auto p = p0;
+        p.levels = level;
+        const auto r = levels::solve(p);
+        ASSERT_TRUE(r.converged) << r.failure;
+        double resultant = 0;
+        for (const auto& n : r.nodes) {
+            EXPECT_NEAR(n.u.y(), -s / 2.0, 1e-8 * s) << "level " << level;
+            resultant -= n.lambda_n;
+        }
+        EXPECT_NEAR(resultant, s * 1.0, 1e-8 * s) << "level " << level;
     }
 }

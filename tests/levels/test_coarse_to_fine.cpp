@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 using namespace mlc;
 
 namespace {
@@ -13,7 +15,8 @@ namespace {
 double mean_newton(const levels::RunResult& r, int level) {
     const auto& s = r.level_steps[static_cast<size_t>(level)];
     double sum = 0;
-    for (const auto& x : s) sum += x.report.iterations;
+    for (const auto& x : s)
+        sum += x.report.iterations;
     return sum / static_cast<double>(s.size());
 }
 
@@ -41,7 +44,8 @@ TEST(CoarseToFine, SquareMatchesColdStartWithHalfTheNewtonIterations) {
             EXPECT_GE(st.agreement(), 0.95) << "level " << l << " step " << st.report.step;
             int total = 0;
             for (const auto& row : st.confusion)
-                for (int n : row) total += n;
+                for (int n : row)
+                    total += n;
             EXPECT_EQ(total, static_cast<int>(st.final_statuses.size()));
         }
     }
@@ -107,6 +111,7 @@ TEST(CoarseToFine, IncrementTransferGivesTheSameSolutionAndPredictsAtLeastAsWell
     const auto rb = levels::solve(p, b);
     ASSERT_TRUE(ra.converged && rb.converged);
     EXPECT_LT((ra.x - rb.x).norm(), 1e-9 * ra.x.norm());
+    double total_a = 0, total_b = 0;
     for (int l = 1; l <= 3; ++l) {
         const auto& sa = ra.level_steps[static_cast<size_t>(l)];
         const auto& sb = rb.level_steps[static_cast<size_t>(l)];
@@ -119,5 +124,12 @@ TEST(CoarseToFine, IncrementTransferGivesTheSameSolutionAndPredictsAtLeastAsWell
             agree_b += sb[k].agreement();
         }
         EXPECT_GE(agree_b, agree_a - 1e-12) << "level " << l;
+        std::cout << "[ increment ] level " << l << ": agreement over steps 2.. " << agree_a
+                  << " (state) vs " << agree_b << " (increment)\n";
+        total_a += agree_a;
+        total_b += agree_b;
     }
+    // Measured: 11.72 vs 11.89 (levels 1..3, steps 2..5): the increment start predicts strictly
+    // better; a start that ignored the option would give the same sum.
+    EXPECT_GT(total_b, total_a + 0.1);
 }
