@@ -15,11 +15,13 @@
 #include "apps/study_preconditioners.hpp"
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
+#include "core/memory.hpp"
 
 #include <CLI/CLI.hpp>
 #include <iostream>
 
 int main(int argc, char** argv) {
+    mlc::keep_freed_memory();
     CLI::App app{"mlcontact: multilevel frictional contact in 2D linear elasticity"};
     app.require_subcommand(1);
     mlc::apps::RunOptions ro;
@@ -36,8 +38,11 @@ int main(int argc, char** argv) {
     run->add_option("--linear", ro.linear,
                     "Newton system solver: schur (exact, condensed; default), lu, or krylov")
         ->check(CLI::IsMember({"schur", "lu", "krylov"}));
-    run->add_option("--krylov", ro.krylov, "Krylov method with --linear krylov: cgs, bicg, bicgstab, gmres");
-    run->add_option("--pc", ro.pc, "preconditioner with --linear krylov, e.g. diag, ilu:1, cf, sorcf:omega=1.2, ebe");
+    run->add_option("--krylov", ro.krylov,
+                    "Krylov method with --linear krylov: cgs, bicg, bicgstab, gmres");
+    run->add_option(
+        "--pc", ro.pc,
+        "preconditioner with --linear krylov, e.g. diag, ilu:1, cf, sorcf:omega=1.2, ebe");
     run->add_option("--linear-tol", ro.linear_rel_tol, "relative tolerance of each Krylov solve");
     auto* study = app.add_subcommand("study", "run a study (see README: Studies)");
     study->require_subcommand(1);
@@ -63,20 +68,23 @@ int main(int argc, char** argv) {
     ex->add_option("--out,-o", exo_out, "output folder (default out/studies/extremes)");
     mlc::apps::ErrorVsTimeOptions evo;
     std::string evo_scene = "square", evo_out;
-    auto* ev = study->add_subcommand("error-vs-time", "error against wall time over levels and solvers");
+    auto* ev =
+        study->add_subcommand("error-vs-time", "error against wall time over levels and solvers");
     ev->add_option("scene", evo_scene, "scene file or built-in name (default square)");
     ev->add_option("--levels,-l", evo.max_level, "configurations on levels 0..L (default 3)");
-    ev->add_option("--out,-o", evo_out, "output folder (default out/studies/<scene>_error_vs_time)");
+    ev->add_option("--out,-o", evo_out,
+                   "output folder (default out/studies/<scene>_error_vs_time)");
     ev->add_flag("!--no-plot", evo.plot, "do not draw the PNG");
     mlc::apps::PreconditionerStudyOptions pso;
     std::string pso_scene = "square", pso_out;
-    auto* ps = study->add_subcommand("preconditioners",
-                                     "Krylov iterations and times per Newton step per preconditioner");
+    auto* ps = study->add_subcommand(
+        "preconditioners", "Krylov iterations and times per Newton step per preconditioner");
     ps->add_option("scene", pso_scene, "scene file or built-in name (default square)");
     ps->add_option("--levels,-l", pso.levels, "finest level (default 2)");
     ps->add_option("--mu", pso.mu, "friction coefficients (list)")->delimiter(',');
     ps->add_option("--r", pso.r_over_E, "penalty factors r/E (list)")->delimiter(',');
-    ps->add_option("--pc", pso.pcs, "preconditioners (list; default diag ilu:0 cf sorcf ebe ebe:variant=c5)");
+    ps->add_option("--pc", pso.pcs,
+                   "preconditioners (list; default diag ilu:0 cf sorcf ebe ebe:variant=c5)");
     ps->add_option("--krylov", pso.krylovs, "Krylov methods (list; default cgs)")->delimiter(',');
     ps->add_option("--steps", pso.load_steps, "load steps (default: the scene's)");
     ps->add_option("--tol", pso.rel_tol, "Krylov relative tolerance (default 1e-8)");
@@ -86,23 +94,26 @@ int main(int argc, char** argv) {
     ps->add_flag("!--no-plot", pso.plot, "do not draw the PNG");
     mlc::apps::AccuracyOptions aco;
     std::string aco_scene = "hertz", aco_out;
-    auto* ac = study->add_subcommand("accuracy",
-                                     "closed-form errors per level and observed orders (hertz, mindlin, patch)");
+    auto* ac = study->add_subcommand(
+        "accuracy", "closed-form errors per level and observed orders (hertz, mindlin, patch)");
     ac->add_option("scene", aco_scene, "scene file or built-in name (default hertz)");
     ac->add_option("--levels,-l", aco.levels, "levels 0..L (default 3)");
     ac->add_option("--out,-o", aco_out, "output folder (default out/<scene>/accuracy)");
     ac->add_flag("!--no-plot", aco.plot, "do not draw the PNG");
     ac->add_flag("!--no-compare", aco.compare_integration,
                  "node-on-facet scenes: do not also solve with the other integration variants");
-    auto* bench = app.add_subcommand("bench", "scaling benchmarks (see README: Multilevel preconditioner)");
+    auto* bench =
+        app.add_subcommand("bench", "scaling benchmarks (see README: Multilevel preconditioner)");
     bench->require_subcommand(1);
     mlc::apps::BenchSquareOptions bso;
     std::string bso_out;
-    auto* bsq = bench->add_subcommand("square", "full coarse-to-fine solve per solver: JSON per level");
+    auto* bsq =
+        bench->add_subcommand("square", "full coarse-to-fine solve per solver: JSON per level");
     bsq->add_option("scene", bso.scene, "scene file or built-in name (default square)");
     bsq->add_option("--levels,-l", bso.levels, "finest level (default 3)");
-    bsq->add_option("--pc", bso.pcs,
-                    "solvers (space-separated list): schur, lu, or preconditioner specs (default mg)");
+    bsq->add_option(
+        "--pc", bso.pcs,
+        "solvers (space-separated list): schur, lu, or preconditioner specs (default mg)");
     bsq->add_option("--krylov", bso.krylov, "Krylov method for the preconditioners (default cgs)");
     bsq->add_option("--tol", bso.rel_tol, "Krylov relative tolerance (default 1e-8)");
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
@@ -146,7 +157,8 @@ int main(int argc, char** argv) {
         }
         if (*ps) {
             pso.out = pso_out;
-            return mlc::apps::study_preconditioners(mlc::apps::load_scene(pso_scene), pso, std::cout);
+            return mlc::apps::study_preconditioners(mlc::apps::load_scene(pso_scene), pso,
+                                                    std::cout);
         }
         if (*ex) {
             exo.out = exo_out;
@@ -154,8 +166,10 @@ int main(int argc, char** argv) {
         }
         if (*st) {
             sto.out = sto_out;
-            sto.q_rule = sto_q == "paper" ? mlc::transfer::QRule::paper : mlc::transfer::QRule::conservative;
-            return mlc::apps::study_status_transfer(mlc::apps::load_scene(sto_scene), sto, std::cout);
+            sto.q_rule =
+                sto_q == "paper" ? mlc::transfer::QRule::paper : mlc::transfer::QRule::conservative;
+            return mlc::apps::study_status_transfer(mlc::apps::load_scene(sto_scene), sto,
+                                                    std::cout);
         }
         if (*scenes) {
             for (const auto& n : mlc::apps::builtin_scene_names())

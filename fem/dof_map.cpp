@@ -6,14 +6,26 @@
 
 namespace mlc::fem {
 
-DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra) {
+DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra,
+               const std::vector<int>& order) {
     MLC_CHECK(fixed.size() == n_extra.size(),
               "DofMap: " << fixed.size() << " fixed flags for " << n_extra.size() << " vertices");
     const size_t nv = fixed.size();
+    if (!order.empty()) {
+        MLC_CHECK(order.size() == nv, "DofMap: the vertex order has "
+                                          << order.size() << " entries for " << nv << " vertices");
+        std::vector<char> seen(nv, 0);
+        for (const int v : order) {
+            MLC_CHECK(v >= 0 && static_cast<size_t>(v) < nv && !seen[static_cast<size_t>(v)],
+                      "DofMap: the vertex order is not a permutation (entry " << v << ")");
+            seen[static_cast<size_t>(v)] = 1;
+        }
+    }
     u_dof_.resize(nv);
     extra_.assign(nv, -1);
     int next = 0;
-    for (size_t v = 0; v < nv; ++v) {
+    for (size_t pos = 0; pos < nv; ++pos) {
+        const size_t v = order.empty() ? pos : static_cast<size_t>(order[pos]);
         for (size_t c = 0; c < 2; ++c) {
             if (fixed[v][c]) {
                 u_dof_[v][c] = -1;

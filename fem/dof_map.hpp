@@ -12,7 +12,8 @@ namespace mlc::fem {
 
 /// Unknown numbering of one level.
 ///
-/// Vertex v contributes, in this order: its free displacement components (x then y; a component
+/// Vertices are visited in a given order (default: index order); vertex v contributes, in this
+/// order: its free displacement components (x then y; a component
 /// fixed by a Dirichlet condition is not an unknown, `u_dof` is -1 there), then `n_extra(v)`
 /// extra unknowns (the contact multipliers (lambda_t, lambda_n), or lambda_n alone). Keeping a
 /// contact node's multipliers next to its displacements gives ILU nonzero pivots and lets block
@@ -22,7 +23,10 @@ public:
     DofMap() = default;
     /// @param fixed  fixed[v][c] true when component c of vertex v is prescribed
     /// @param n_extra number of extra unknowns per vertex (0, 1 or 2)
-    DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra);
+    /// @param order  the order in which vertices are numbered (a permutation of the vertices,
+    ///               e.g. mesh::hilbert_order); empty: vertex index order
+    DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra,
+           const std::vector<int>& order = {});
 
     Index n_dofs() const { return n_dofs_; }
     int n_vertices() const { return static_cast<int>(u_dof_.size()); }

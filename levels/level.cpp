@@ -38,7 +38,11 @@ Vector Level::f_nodal_at(double s) const {
 }
 
 Level build_level(const Problem& problem, mesh::Mesh m) {
-    mesh::check_quality(m);
+    // A refined mesh (of a checked one, as the hierarchy builds them) only needs its areas checked.
+    if (m.n_coarse_vertices > 0)
+        mesh::check_refined_quality(m);
+    else
+        mesh::check_quality(m);
     Level L;
     L.mesh = std::move(m);
     const auto& mesh = L.mesh;
@@ -135,7 +139,10 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
         }
     }
 
-    L.dofs = fem::DofMap(L.fixed, n_extra);
+    // Unknowns numbered along a Hilbert curve: refinement appends the new vertices after the
+    // coarse ones, and in that order the mat-vecs and sweeps of the large levels gather x from
+    // all over memory (at level 6 of the square one mat-vec took 1.4 times as long).
+    L.dofs = fem::DofMap(L.fixed, n_extra, mesh::hilbert_order(L.mesh.vertices));
     L.lambda_dof.reserve(L.contacts.size());
     for (const auto& e : L.contacts)
         L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));

@@ -56,7 +56,8 @@ struct Level {
 /// the pair's integration, nodal, segment or dual, computed on this level's meshes, or
 /// contact::node_on_node_search); contactor nodes that find nothing are left out and listed in
 /// `not_found`. Throws InvalidInput for an unknown tag, a support point that is not a vertex, or
-/// a pair with no contact node.
+/// a pair with no contact node. The mesh is checked with mesh::check_quality, or, when it was
+/// made by mesh::refine (of a checked mesh), with mesh::check_refined_quality.
 Level build_level(const Problem& problem, mesh::Mesh m);
 
 } // namespace mlc::levels

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <unordered_map>
 
 namespace mlc::mesh {
@@ -111,16 +112,9 @@ std::uint64_t edge_key(int a, int b) {
 
 } // namespace
 
-void check_quality(const Mesh& m) {
-    MLC_CHECK(m.n_triangles() > 0, "the mesh has no triangles");
+namespace {
+void check_triangle_areas(const Mesh& m, double diam) {
     const int nv = m.n_vertices();
-    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.triangles.size(),
-              "the mesh has " << m.attribute.size() << " triangle attributes for "
-                              << m.triangles.size() << " triangles");
-    for (const auto& v : m.vertices)
-        MLC_CHECK(std::isfinite(v.x()) && std::isfinite(v.y()), "a mesh vertex is not finite");
-    const double diam = m.diameter();
-    MLC_CHECK(diam > 0, "the mesh has zero extent");
     for (int t = 0; t < m.n_triangles(); ++t) {
         const auto& tri = m.triangles[static_cast<size_t>(t)];
         for (int k = 0; k < 3; ++k)
@@ -136,6 +130,25 @@ void check_quality(const Mesh& m) {
                                                << "; triangles must be counter-clockwise "
                                                   "with positive area");
     }
+}
+} // namespace
+
+void check_refined_quality(const Mesh& m) {
+    MLC_CHECK(m.n_triangles() > 0, "the mesh has no triangles");
+    check_triangle_areas(m, m.diameter());
+}
+
+void check_quality(const Mesh& m) {
+    MLC_CHECK(m.n_triangles() > 0, "the mesh has no triangles");
+    const int nv = m.n_vertices();
+    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.triangles.size(),
+              "the mesh has " << m.attribute.size() << " triangle attributes for "
+                              << m.triangles.size() << " triangles");
+    for (const auto& v : m.vertices)
+        MLC_CHECK(std::isfinite(v.x()) && std::isfinite(v.y()), "a mesh vertex is not finite");
+    const double diam = m.diameter();
+    MLC_CHECK(diam > 0, "the mesh has zero extent");
+    check_triangle_areas(m, diam);
     // Duplicate vertices: pairs of one body closer than tol. Two bodies (triangle attributes) may
     // touch: their vertices may coincide (a matching interface).
     std::vector<int> body(static_cast<size_t>(nv), -1);
@@ -198,6 +211,48 @@ void check_quality(const Mesh& m) {
                   "boundary edge (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
                                     << "' is not a boundary edge of the triangulation");
     }
+}
+
+std::vector<int> hilbert_order(const std::vector<Vec2>& points) {
+    const size_t n = points.size();
+    std::vector<int> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    if (n < 2) return order;
+    Vec2 lo = points[0], hi = points[0];
+    for (const Vec2& p : points) {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    const double span = std::max(hi.x() - lo.x(), hi.y() - lo.y());
+    constexpr std::uint32_t side = 1u << 16;
+    std::vector<std::uint64_t> key(n, 0);
+    if (span > 0.0) {
+        for (size_t i = 0; i < n; ++i) {
+            // Cell of the point, then its distance along the curve (the classic xy -> d walk).
+            auto cell = [&](double t) {
+                const double c = std::floor(t / span * (side - 1));
+                return static_cast<std::uint32_t>(std::clamp(c, 0.0, double(side - 1)));
+            };
+            std::uint32_t x = cell(points[i].x() - lo.x()), y = cell(points[i].y() - lo.y());
+            std::uint64_t d = 0;
+            for (std::uint32_t s = side / 2; s > 0; s /= 2) {
+                const std::uint32_t rx = (x & s) ? 1 : 0, ry = (y & s) ? 1 : 0;
+                d += static_cast<std::uint64_t>(s) * s * ((3 * rx) ^ ry);
+                if (ry == 0) {
+                    if (rx == 1) {
+                        x = side - 1 - x;
+                        y = side - 1 - y;
+                    }
+                    std::swap(x, y);
+                }
+            }
+            key[i] = d;
+        }
+    }
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+        return key[static_cast<size_t>(a)] < key[static_cast<size_t>(b)];
+    });
+    return order;
 }
 
 Mesh refine(const Mesh& coarse) {

@@ -79,10 +79,21 @@ struct Mesh {
 /// Throws InvalidInput naming the first defect (triangle or vertex index and coordinates).
 void check_quality(const Mesh& m);
 
+/// The part of check_quality a refinement of a checked mesh still needs: every triangle with
+/// positive area (a midpoint moved onto a circular boundary can fold a thin triangle). Its
+/// vertices are distinct and its boundary edges are halves of checked ones by construction.
+void check_refined_quality(const Mesh& m);
+
 /// Uniform refinement: every triangle split into four by its edge midpoints. Boundary edges are
 /// split in two with the tag and curve inherited; a midpoint on a circular boundary edge is moved
 /// onto the circle. Coarse vertex indices are kept; `parents` is filled.
 Mesh refine(const Mesh& coarse);
+
+/// The vertices in the order of a Hilbert curve through their bounding box (2^16 cells a side;
+/// ties keep index order): neighbours in the mesh get nearby positions, so vectors indexed in
+/// this order are read with few cache misses by the sparse mat-vecs and sweeps of a level.
+/// Returns a permutation of 0..n-1 (position -> vertex).
+std::vector<int> hilbert_order(const std::vector<Vec2>& points);
 
 /// How a structured rectangle's squares are cut into two triangles.
 enum class Diagonal {

@@ -145,3 +145,29 @@ TEST(Assembly, PressureIsANormalTractionIntoTheBody) {
     EXPECT_NEAR(fx, 0.0, 1e-14);
     EXPECT_NEAR(fy, -5.0, 1e-14);
 }
+
+TEST(DofMap, NumbersVerticesInTheGivenOrderWithMultipliersAfterTheirDisplacements) {
+    // Vertex 0: x fixed; vertex 1: free with 2 multipliers; vertex 2: free.
+    const std::vector<std::array<bool, 2>> fixed = {{true, false}, {false, false}, {false, false}};
+    const std::vector<int> extra = {0, 2, 0};
+    const fem::DofMap natural(fixed, extra);
+    EXPECT_EQ(natural.u_dof(0, 0), -1);
+    EXPECT_EQ(natural.u_dof(0, 1), 0);
+    EXPECT_EQ(natural.u_dof(1, 0), 1);
+    EXPECT_EQ(natural.extra_dof(1), 3);
+    EXPECT_EQ(natural.u_dof(2, 1), 6);
+    const fem::DofMap ordered(fixed, extra, {2, 1, 0});
+    EXPECT_EQ(ordered.n_dofs(), 7);
+    EXPECT_EQ(ordered.u_dof(2, 0), 0);
+    EXPECT_EQ(ordered.u_dof(2, 1), 1);
+    EXPECT_EQ(ordered.u_dof(1, 0), 2);
+    EXPECT_EQ(ordered.u_dof(1, 1), 3);
+    EXPECT_EQ(ordered.extra_dof(1), 4);
+    EXPECT_FALSE(ordered.is_displacement(5));
+    EXPECT_EQ(ordered.vertex_of(5), 1);
+    EXPECT_EQ(ordered.u_dof(0, 1), 6);
+    EXPECT_EQ(ordered.u_dof(0, 0), -1);
+    EXPECT_THROW(fem::DofMap(fixed, extra, {0, 1}), InvalidInput);    // too short
+    EXPECT_THROW(fem::DofMap(fixed, extra, {0, 1, 1}), InvalidInput); // not a permutation
+    EXPECT_THROW(fem::DofMap(fixed, extra, {0, 1, 3}), InvalidInput); // out of range
+}

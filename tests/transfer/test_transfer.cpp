@@ -491,6 +491,10 @@ TEST(MultiplierTransfer, ConservativeRulePreservesTheResultantPaperOnlyWithUnloa
 
             for (unsigned seed : {7u, 8u, 9u}) {
                 Vector xc = random_field(C.n_unknowns(), seed);
+                // Loaded ends whatever the random draw gave them (so `lost` below is not ~0).
+                for (size_t e = 0; e < ends.vertex.size(); ++e)
+                    for (int q = 0; q < ends.n_multipliers[e]; ++q)
+                        xc[ends.lambda_dof[e] + q] = (q == 0 ? 1.0 : -0.5) * (1.0 + seed % 3);
                 const Eigen::Vector2d Rc = transfer::multiplier_resultant(cn, xc);
                 double scale = 0.0; // sum of |lambda| over the coarse multipliers
                 for (size_t i = 0; i < cn.vertex.size(); ++i)

@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: MIT
+// Process-wide memory policy.
+#include "core/memory.hpp"
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+namespace mlc {
+
+void keep_freed_memory() {
+#if defined(__GLIBC__)
+    // 32 MiB is the largest mmap threshold glibc accepts on 64-bit systems: vectors up to that
+    // size (4 million doubles) come from the heap and are reused.
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
+}
+
+} // namespace mlc
