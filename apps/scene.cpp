@@ -615,9 +615,10 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
     }
     if (const toml::node* nn = root.get("newton")) {
         const toml::table& nt = rd.table(nn, "[newton]");
-        rd.check_keys(nt, {"rel_tol", "max_iter"}, "[newton]");
+        rd.check_keys(nt, {"rel_tol", "max_iter", "forcing"}, "[newton]");
         p.newton.rel_tol = rd.number_or(nt, "rel_tol", p.newton.rel_tol, "[newton]");
         p.newton.max_iter = rd.integer_or(nt, "max_iter", p.newton.max_iter, "[newton]");
+        p.newton.forcing = rd.number_or(nt, "forcing", p.newton.forcing, "[newton]");
         at(rd, nn, [&] {
             p.newton.validate();
             return 0;

@@ -84,10 +84,11 @@ public:
         else if (parsed.name == "mg")
             build_mg(parsed, context);
         else if (parsed.name == "amg" && !level.contacts.empty())
-            MLC_CHECK(false, "amg (hypre BoomerAMG) preconditions the elastic block only (symmetric "
-                             "positive definite); the contact Jacobian has zero multiplier "
-                             "diagonals: use --pc mg, or compare on the elastic block with "
-                             "`mlcontact bench elastic`");
+            MLC_CHECK(false,
+                      "amg (hypre BoomerAMG) preconditions the elastic block only (symmetric "
+                      "positive definite); the contact Jacobian has zero multiplier "
+                      "diagonals: use --pc mg, or compare on the elastic block with "
+                      "`mlcontact bench elastic`");
         else
             pc_ = solvers::make_preconditioner(spec.pc);
     }
@@ -102,13 +103,19 @@ public:
         if (dx.size() != b.size()) dx = Vector::Zero(b.size());
         // mg: the unrolled mat-vec (solvers::CsrOperator); the others keep Eigen's, so
         // their published iteration counts stay bit-for-bit reproducible.
+        solvers::KrylovParams params = params_;
+        params.rel_tol = std::max(params_.rel_tol, forcing_);
         SolveResult r =
-            mg_ ? solvers::solve(method_, solvers::CsrOperator(jac_.matrix()), *pc_, b, dx, params_)
-                : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params_);
+            mg_ ? solvers::solve(method_, solvers::CsrOperator(jac_.matrix()), *pc_, b, dx, params)
+                : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params);
         r.setup_seconds = t1 - t0;
         return r;
     }
     std::string name() const override { return spec_.krylov + "+" + pc_->name(); }
+    void set_forcing(double eta) override {
+        MLC_CHECK(eta >= 0 && eta < 1, "forcing term must lie in [0, 1), found " << eta);
+        forcing_ = eta;
+    }
 
     const Preconditioner* preconditioner_for(const std::vector<Eigen::Matrix2d>& M) override {
         MLC_CHECK(M.size() == level_.contacts.size(),
@@ -240,8 +247,7 @@ private:
             owner[static_cast<size_t>(i)] = level_.dofs.vertex_of(i);
         mg_ = true;
         pc_ = std::make_unique<solvers::MultigridCycle>(
-            T, ctx_->transfer->R,
-            [this](const Vector& r, Vector& z) { mg_coarse_->apply(r, z); },
+            T, ctx_->transfer->R, [this](const Vector& r, Vector& z) { mg_coarse_->apply(r, z); },
             solvers::vertex_block_starts(owner), p);
     }
 
@@ -267,6 +273,7 @@ private:
     solvers::Krylov method_;
     std::unique_ptr<Preconditioner> pc_;
     solvers::KrylovParams params_;
+    double forcing_ = 0.0; // inexact Newton: looser tolerance of the next solves (set_forcing)
     bool first_ = true;
     std::vector<Eigen::Matrix2d> last_M_; // statuses of the last assembly
     // CF / SORCF

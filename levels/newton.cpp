@@ -82,6 +82,15 @@ std::vector<contact::Status> ContactNewton::statuses(double s, const Vector& u_p
     return st;
 }
 
+double ContactNewton::forcing_term(int k, double norm, double scale) const {
+    if (params_.forcing <= 0.0) return 0.0;
+    if (k == 0) return params_.forcing;
+    // Enough to reach the tolerance if the statuses stay (a margin of 10 for the Krylov norm,
+    // which weights the multiplier rows differently from ||R||), never looser than 0.5.
+    const double target = norm > 0.0 ? 0.1 * params_.rel_tol * scale / norm : 0.0;
+    return std::min(0.5, target);
+}
+
 StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) {
     const double t_start = wall_seconds();
     StepReport rep;
@@ -157,7 +166,9 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
             ScopedTimer t(timings_, "newton/linear_solve");
             R = -R;
             dx.setZero();
+            solver_->set_forcing(forcing_term(k, norm, scale));
             lin = solver_->solve(M, R, dx);
+            solver_->set_forcing(0.0); // others may call this solver (CF's coarse=solver)
         }
         rep.linear_iterations += lin.iterations;
         rep.linear_iterations_per_newton.push_back(lin.iterations);

@@ -34,11 +34,11 @@ struct StepReport {
     StatusCounts counts;             ///< final statuses (reported, see node_statuses)
     int linear_iterations = 0;       ///< Krylov iterations summed over the step (0 if direct)
     std::vector<int> linear_iterations_per_newton; ///< Krylov iterations of each Newton system
-    double linear_seconds = 0.0;     ///< time in the Newton-system solves (setup + solve)
+    double linear_seconds = 0.0;       ///< time in the Newton-system solves (setup + solve)
     double linear_setup_seconds = 0.0; ///< of which preconditioner/factorization setup
-    int inexact_steps = 0;           ///< steps taken from a Krylov solve stopped at max_iter
-    int cycling_detected_at = -1;    ///< iterate at which statuses returned to an earlier set
-    int damped_steps = 0;            ///< steps taken with backtracking on ||R|| after cycling
+    int inexact_steps = 0;             ///< steps taken from a Krylov solve stopped at max_iter
+    int cycling_detected_at = -1;      ///< iterate at which statuses returned to an earlier set
+    int damped_steps = 0;              ///< steps taken with backtracking on ||R|| after cycling
     double seconds = 0.0;
     std::string message; ///< diagnosis when not converged
 };
@@ -73,6 +73,10 @@ public:
     /// slip_forward/backward by the sign of its slip increment, or stick if it did not move).
     std::vector<ContactNodeState> node_states(double s, const Vector& u_prev_full,
                                               const Vector& x) const;
+
+    /// The relative tolerance asked of the iterative solver at Newton iteration k with residual
+    /// norm `norm` (NewtonParams::forcing); 0: the solver's own.
+    double forcing_term(int k, double norm, double scale) const;
 
     /// Residual R(x) at load factor s and its scaled norm (force units); also returns statuses.
     double residual(double s, const Vector& u_prev_full, const Vector& x, Vector& R,

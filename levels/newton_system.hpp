@@ -54,6 +54,9 @@ public:
                               Vector& dx) = 0;
     /// "lu", "schur", or the Krylov/preconditioner pair.
     virtual std::string name() const = 0;
+    /// Inexact Newton: the relative tolerance of the following solves is max(eta, the solver's
+    /// own rel_tol); 0 restores the solver's own. Direct solvers ignore it (they are exact).
+    virtual void set_forcing(double eta) { (void)eta; }
     /// For the multilevel preconditioner of the level above: this solver's preconditioner set
     /// up on J(M) (assembled, and refreshed only when M differs from the last call's), or null
     /// when it has none (direct solvers). Valid until the next `solve` or call of this function.
@@ -87,13 +90,13 @@ struct LinearSolverSpec {
     /// "schur" (exact, condensed on the contact set; default), "lu" (SparseLU on the assembled
     /// Jacobian) or "krylov" (the `krylov` method with the `pc` preconditioner).
     std::string method = "schur";
-    std::string krylov = "cgs";  ///< cgs | bicg | bicgstab | gmres (method "krylov")
-    std::string pc = "ilu:0";    ///< preconditioner spec, e.g. "ilu:1", "cf", "sorcf:omega=1.2", "ebe"
+    std::string krylov = "cgs"; ///< cgs | bicg | bicgstab | gmres (method "krylov")
+    std::string pc = "ilu:0"; ///< preconditioner spec, e.g. "ilu:1", "cf", "sorcf:omega=1.2", "ebe"
     /// Relative tolerance of the linear solve, ||b - J dx|| <= rel_tol ||b||. 1e-10 keeps the
     /// Newton iterates as exact as the papers' (they solve to near round-off).
     double rel_tol = 1e-10;
-    int max_iter = 5000;         ///< Krylov iterations per Newton step
-    int restart = 50;            ///< GMRES restart length
+    int max_iter = 5000; ///< Krylov iterations per Newton step
+    int restart = 50;    ///< GMRES restart length
     void validate() const;
 };
 
@@ -101,18 +104,18 @@ std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s);
 
 /// What multilevel preconditioners may use from the level below; all null/empty on level 0.
 struct CoarseContext {
-    const Level* coarse = nullptr;                    ///< the level below
+    const Level* coarse = nullptr;                     ///< the level below
     const transfer::LevelTransfer* transfer = nullptr; ///< coarse -> this level
-    NewtonSystemSolver* coarse_solver = nullptr;      ///< exact solver of the coarse Jacobian
-    std::vector<Eigen::Matrix2d> coarse_M;            ///< converged coarse statuses (per element)
+    NewtonSystemSolver* coarse_solver = nullptr;       ///< exact solver of the coarse Jacobian
+    std::vector<Eigen::Matrix2d> coarse_M;             ///< converged coarse statuses (per element)
     bool available() const { return coarse && transfer && coarse_solver; }
 };
 
 /// Builds the Newton system solver of `spec` for a level. `context` (may be null) gives
 /// two-level preconditioners what they need; they throw InvalidInput without it. The context's
 /// pointees must outlive the returned object.
-std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level,
-                                                              const LinearSolverSpec& spec,
-                                                              const CoarseContext* context = nullptr);
+std::unique_ptr<NewtonSystemSolver>
+make_newton_system_solver(const Level& level, const LinearSolverSpec& spec,
+                          const CoarseContext* context = nullptr);
 
 } // namespace mlc::levels

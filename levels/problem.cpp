@@ -13,10 +13,12 @@ namespace mlc::levels {
 void NewtonParams::validate() const {
     MLC_CHECK(rel_tol > 0 && rel_tol < 1, "newton.rel_tol must lie in (0, 1), found " << rel_tol);
     MLC_CHECK(max_iter >= 1, "newton.max_iter must be at least 1, found " << max_iter);
+    MLC_CHECK(forcing >= 0 && forcing < 1, "newton.forcing must lie in [0, 1), found " << forcing);
 }
 
 std::ostream& operator<<(std::ostream& os, const NewtonParams& p) {
-    return os << "rel_tol = " << p.rel_tol << ", max_iter = " << p.max_iter;
+    return os << "rel_tol = " << p.rel_tol << ", max_iter = " << p.max_iter
+              << ", forcing = " << p.forcing;
 }
 
 void Problem::validate() const {

@@ -107,6 +107,14 @@ struct NewtonParams {
     /// Iterations per load step before the step is declared not converged. The papers converge
     /// in 3-10; 50 leaves room for cycling detection to act.
     int max_iter = 50;
+    /// Inexact Newton (forcing terms) for iterative Newton-system solvers; direct solvers are
+    /// exact whatever it says. The first iteration of a load step solves its system only to the
+    /// relative tolerance `forcing` (its statuses are a prediction, usually corrected by that
+    /// step: solving it to round-off would be wasted), and every later one to
+    /// 0.1 rel_tol scale / ||R||, what reaches the Newton tolerance if the statuses stay, capped
+    /// at 0.5; never tighter than the linear solver's own rel_tol. 0 solves every system to the
+    /// linear solver's rel_tol (exact Newton). In [0, 1).
+    double forcing = 1e-3;
     void validate() const;
 };
 

@@ -22,7 +22,8 @@ std::vector<int> max_iterations(const RunResult& r) {
     for (size_t l = 1; l < r.level_steps.size(); ++l) {
         int m = 0;
         for (const auto& st : r.level_steps[l])
-            for (int i : st.report.linear_iterations_per_newton) m = std::max(m, i);
+            for (int i : st.report.linear_iterations_per_newton)
+                m = std::max(m, i);
         out.push_back(m);
     }
     return out;
@@ -38,6 +39,12 @@ RunResult run_square(int levels, const std::string& krylov, const std::string& p
     return solve(p, so);
 }
 
+RunResult run_square_problem(const Problem& p) {
+    SolveOptions so;
+    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-8, .max_iter = 200};
+    return solve(p, so);
+}
+
 } // namespace
 
 TEST(MultilevelPreconditioner, WorksInsideCgsBicgstabAndGmres) {
@@ -50,7 +57,8 @@ TEST(MultilevelPreconditioner, WorksInsideCgsBicgstabAndGmres) {
          {std::pair<std::string, int>{"cgs", 12}, {"bicgstab", 12}, {"gmres", 18}}) {
         const RunResult r = run_square(2, krylov, "mg");
         ASSERT_TRUE(r.converged) << krylov << ": " << r.failure;
-        for (int m : max_iterations(r)) EXPECT_LE(m, bound) << krylov;
+        for (int m : max_iterations(r))
+            EXPECT_LE(m, bound) << krylov;
         EXPECT_LT((r.x - ref.x).norm(), 1e-7 * ref.x.norm()) << krylov;
     }
 }
@@ -75,4 +83,36 @@ TEST(MultilevelPreconditioner, NeedsTheLevelBelowAndValidOptions) {
     EXPECT_THROW(solve(p, so), InvalidInput);
     so.linear.pc = "mg:sweeps=2";
     EXPECT_THROW(solve(p, so), InvalidInput);
+}
+
+TEST(InexactNewton, ForcingTermsSaveKrylovIterationsAndGiveTheSameSolution) {
+    // The first Newton iteration of each load step solves to 1e-3 (its statuses are a coarse
+    // prediction, corrected by that step), the later ones just to what reaches the Newton
+    // tolerance: measured on levels 1..2, 105 instead of 156 CGS iterations in all.
+    auto p = apps::load_scene("square");
+    p.levels = 2;
+    const RunResult ref = solve(p, {}); // the exact condensed solver
+    ASSERT_TRUE(ref.converged);
+    auto total_krylov = [](const RunResult& r) {
+        int n = 0;
+        for (const auto& steps : r.level_steps)
+            for (const auto& st : steps)
+                n += st.report.linear_iterations;
+        return n;
+    };
+    p.newton.forcing = 0.0;
+    const RunResult exact = run_square_problem(p);
+    p.newton.forcing = 1e-3;
+    const RunResult inexact = run_square_problem(p);
+    ASSERT_TRUE(exact.converged) << exact.failure;
+    ASSERT_TRUE(inexact.converged) << inexact.failure;
+    EXPECT_LT(total_krylov(inexact), 0.8 * total_krylov(exact));
+    // Same Newton tolerance (1e-10), so the same solution to far below discretization error.
+    EXPECT_LT((inexact.x - ref.x).norm(), 1e-8 * ref.x.norm());
+    EXPECT_LT((exact.x - ref.x).norm(), 1e-8 * ref.x.norm());
+    // Out of range.
+    p.newton.forcing = 1.0;
+    EXPECT_THROW(p.newton.validate(), InvalidInput);
+    p.newton.forcing = -0.1;
+    EXPECT_THROW(p.newton.validate(), InvalidInput);
 }
