@@ -173,8 +173,10 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     for (int k = 1; k < K; ++k) {
         // f_k = F_k,free - K_(free,fixed) u_fixed,k, the lifting from element-wise K u.
         const Vector F = nodal_loads_at(k);
-        const Vector Ku =
-            fem::internal_forces(mesh, L.materials, L.path_u_fixed[static_cast<size_t>(k - 1)]);
+        // (No element loop when every prescribed value is zero at this point, as for the square.)
+        const Vector& uk = L.path_u_fixed[static_cast<size_t>(k - 1)];
+        const Vector Ku = uk.isZero(0.0) ? Vector::Zero(uk.size())
+                                         : fem::internal_forces(mesh, L.materials, uk);
         Vector f = Vector::Zero(L.dofs.n_dofs());
         for (int v = 0; v < nv; ++v)
             for (int c = 0; c < 2; ++c)
