@@ -11,6 +11,10 @@
 #include <cmath>
 #include <sstream>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace mlc::solvers {
 
 namespace {
@@ -32,13 +36,70 @@ inline double row_dot(const int* inner, const double* val, const double* x, int 
         a0 += val[k] * x[inner[k]];
     return (a0 + a1) + (a2 + a3);
 }
+int max_threads() {
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+}
+
+// Threads for a row-parallel loop over n rows (one per kMinRowsPerPart rows at most).
+int threads_for(Index n) {
+    return static_cast<int>(
+        std::clamp<Index>(n / BlockGaussSeidel::kMinRowsPerPart, 1, max_threads()));
+}
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
-BlockGaussSeidel::BlockGaussSeidel(std::vector<Index> block_starts, double omega)
-    : starts_(std::move(block_starts)), omega_(omega) {
+BlockGaussSeidel::BlockGaussSeidel(std::vector<Index> block_starts, double omega, int parts)
+    : starts_(std::move(block_starts)), omega_(omega), parts_requested_(parts) {
     MLC_CHECK(omega > 0.0 && omega < 2.0,
               "BlockGaussSeidel: omega must be in (0, 2), found " << omega);
+    MLC_CHECK(parts >= 0, "BlockGaussSeidel: parts must be >= 0, found " << parts);
+}
+
+void BlockGaussSeidel::split_parts() {
+    const SparseMatrix& A = *A_;
+    const Index n = A.rows();
+    const Index nb = static_cast<Index>(starts_.size()) - 1;
+    const Index want = parts_requested_ > 0 ? parts_requested_ : max_threads();
+    const Index P =
+        std::clamp<Index>(std::min(want, n / kMinRowsPerPart), 1, std::max<Index>(nb, 1));
+    part_block_.assign(1, 0);
+    const int* outer = A.outerIndexPtr();
+    const double per_part = static_cast<double>(A.nonZeros()) / static_cast<double>(P);
+    for (Index I = 0, p = 1; I < nb && p < P; ++I)
+        if (static_cast<double>(outer[starts_[static_cast<size_t>(I) + 1]]) >= per_part * p) {
+            part_block_.push_back(I + 1);
+            ++p;
+        }
+    part_block_.push_back(nb);
+    // Own-part entry range of every row, and the columns read across a cut.
+    const int* inner = A.innerIndexPtr();
+    own_begin_.resize(static_cast<size_t>(n));
+    own_end_.resize(static_cast<size_t>(n));
+    std::vector<char> across(static_cast<size_t>(n), 0);
+    for (size_t p = 0; p + 1 < part_block_.size(); ++p) {
+        const Index r0 = starts_[static_cast<size_t>(part_block_[p])];
+        const Index r1 = starts_[static_cast<size_t>(part_block_[p + 1])];
+        for (Index i = r0; i < r1; ++i) {
+            const int* b = inner + outer[i];
+            const int* e = inner + outer[i + 1];
+            const int* lo = std::lower_bound(b, e, static_cast<int>(r0));
+            const int* hi = std::lower_bound(lo, e, static_cast<int>(r1));
+            own_begin_[static_cast<size_t>(i)] = static_cast<int>(lo - inner);
+            own_end_[static_cast<size_t>(i)] = static_cast<int>(hi - inner);
+            for (const int* c = b; c < lo; ++c)
+                across[static_cast<size_t>(*c)] = 1;
+            for (const int* c = hi; c < e; ++c)
+                across[static_cast<size_t>(*c)] = 1;
+        }
+    }
+    interface_.clear();
+    for (Index j = 0; j < n; ++j)
+        if (across[static_cast<size_t>(j)]) interface_.push_back(static_cast<int>(j));
+    snap_.setZero(n);
 }
 
 void BlockGaussSeidel::setup(const SparseMatrix& A) {
@@ -54,14 +115,15 @@ void BlockGaussSeidel::setup(const SparseMatrix& A) {
     Index total = 0;
     for (size_t I = 0; I + 1 < starts_.size(); ++I) {
         const Index b = starts_[I + 1] - starts_[I];
-        MLC_CHECK(b >= 1 && b <= kMaxBlock, "BlockGaussSeidel: block " << I << " has " << b
-                                                << " rows (valid 1.." << kMaxBlock
-                                                << ", increasing starts within the matrix)");
+        MLC_CHECK(b >= 1 && b <= kMaxBlock,
+                  "BlockGaussSeidel: block " << I << " has " << b << " rows (valid 1.." << kMaxBlock
+                                             << ", increasing starts within the matrix)");
         offset_[I] = total;
         total += b * b;
     }
     dinv_.assign(static_cast<size_t>(total), 0.0);
     A_ = &A;
+    split_parts();
     invert_blocks();
 }
 
@@ -89,9 +151,38 @@ void BlockGaussSeidel::forward_from_zero(const Vector& b, Vector& x, Vector& res
     double* xp = x.data();
     double* rp = res.data();
     const double* bp = b.data();
+    if (parts() > 1) {
+        // Each part from zero with its own lower entries (the other parts' x count as 0, as
+        // they are at the start of the sweep); then the whole residual with the final x.
+        const int P = parts();
+#pragma omp parallel for num_threads(P) schedule(static, 1)
+        for (int p = 0; p < P; ++p) {
+            for (Index I = part_block_[static_cast<size_t>(p)];
+                 I < part_block_[static_cast<size_t>(p) + 1]; ++I) {
+                const Index s = starts_[static_cast<size_t>(I)],
+                            bs = starts_[static_cast<size_t>(I) + 1] - s;
+                for (Index i = s; i < s + bs; ++i)
+                    rp[i] = bp[i] -
+                            row_dot(inner, val, xp, own_begin_[static_cast<size_t>(i)], dbeg[i]);
+                const double* d = dinv_.data() + offset_[static_cast<size_t>(I)];
+                for (Index i = 0; i < bs; ++i) {
+                    double acc = 0.0;
+                    for (Index j = 0; j < bs; ++j)
+                        acc += d[i * bs + j] * rp[s + j];
+                    xp[s + i] = acc;
+                }
+            }
+        }
+#pragma omp parallel for num_threads(P) schedule(static)
+        for (Index i = 0; i < n; ++i)
+            rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
+                     row_dot(inner, val, xp, outer[i], own_begin_[static_cast<size_t>(i)]);
+        return;
+    }
     // Sweep: only the strictly lower entries see non-zero x (x_J = 0 for blocks J >= I).
     for (Index I = 0; I < nb; ++I) {
-        const Index s = starts_[static_cast<size_t>(I)], bs = starts_[static_cast<size_t>(I) + 1] - s;
+        const Index s = starts_[static_cast<size_t>(I)],
+                    bs = starts_[static_cast<size_t>(I) + 1] - s;
         for (Index i = s; i < s + bs; ++i)
             rp[i] = bp[i] - row_dot(inner, val, xp, outer[i], dbeg[i]);
         const double* d = dinv_.data() + offset_[static_cast<size_t>(I)];
@@ -116,6 +207,7 @@ void BlockGaussSeidel::update_values(const SparseMatrix& A) {
                                               << A.rows() << " rows, the blocks cover "
                                               << starts_.back() << " (call setup)");
     A_ = &A;
+    split_parts(); // the pattern may differ from the last setup's
     invert_blocks();
 }
 
@@ -153,9 +245,9 @@ void BlockGaussSeidel::invert_blocks() {
         }
         Eigen::FullPivLU<Eigen::MatrixXd> lu(D);
         lu.setThreshold(1e-14);
-        MLC_CHECK(scale > 0.0 && lu.isInvertible(),
-                  "BlockGaussSeidel: diagonal block " << I << " (rows " << s << ".." << s + b - 1
-                                                      << ") is singular");
+        MLC_CHECK(scale > 0.0 && lu.isInvertible(), "BlockGaussSeidel: diagonal block "
+                                                        << I << " (rows " << s << ".." << s + b - 1
+                                                        << ") is singular");
         const Eigen::MatrixXd inv = omega_ * lu.inverse();
         for (Index i = 0; i < b; ++i)
             for (Index j = 0; j < b; ++j)
@@ -163,8 +255,46 @@ void BlockGaussSeidel::invert_blocks() {
     }
 }
 
+void BlockGaussSeidel::sweep_part(const double* bp, double* xp, Index b0, Index b1,
+                                  bool forward) const {
+    const int* outer = A_->outerIndexPtr();
+    const int* inner = A_->innerIndexPtr();
+    const double* val = A_->valuePtr();
+    const double* sp = snap_.data();
+    double res[kMaxBlock];
+    for (Index step = b0; step < b1; ++step) {
+        const auto I = static_cast<size_t>(forward ? step : b1 - 1 - (step - b0));
+        const Index s = starts_[I], bs = starts_[I + 1] - s;
+        for (Index i = 0; i < bs; ++i) {
+            const auto r = static_cast<size_t>(s + i);
+            res[i] = bp[s + i] - row_dot(inner, val, xp, own_begin_[r], own_end_[r]) -
+                     row_dot(inner, val, sp, outer[s + i], own_begin_[r]) -
+                     row_dot(inner, val, sp, own_end_[r], outer[s + i + 1]);
+        }
+        const double* d = dinv_.data() + offset_[I];
+        for (Index i = 0; i < bs; ++i) {
+            double acc = 0.0;
+            for (Index j = 0; j < bs; ++j)
+                acc += d[i * bs + j] * res[j];
+            xp[s + i] += acc;
+        }
+    }
+}
+
 void BlockGaussSeidel::sweep(const Vector& b, Vector& x, bool forward) const {
     MLC_CHECK(A_ != nullptr, "BlockGaussSeidel: call setup first");
+    if (parts() > 1) {
+        double* xp = x.data();
+        double* sp = snap_.data();
+        for (const int j : interface_)
+            sp[j] = xp[j];
+        const int P = parts();
+#pragma omp parallel for num_threads(P) schedule(static, 1)
+        for (int p = 0; p < P; ++p)
+            sweep_part(b.data(), xp, part_block_[static_cast<size_t>(p)],
+                       part_block_[static_cast<size_t>(p) + 1], forward);
+        return;
+    }
     const Index nb = static_cast<Index>(starts_.size()) - 1;
     const int* outer = A_->outerIndexPtr();
     const int* inner = A_->innerIndexPtr();
@@ -213,8 +343,8 @@ std::ostream& operator<<(std::ostream& os, const MultigridParams& p) {
 
 MultigridCycle::MultigridCycle(const SparseMatrix& T, const SparseMatrix& R, CoarseSolve coarse,
                                std::vector<Index> block_starts, MultigridParams params)
-    : T_(T), R_(R), coarse_(std::move(coarse)),
-      smoother_(std::move(block_starts), params.omega), params_(params) {
+    : T_(T), R_(R), coarse_(std::move(coarse)), smoother_(std::move(block_starts), params.omega),
+      params_(params) {
     params_.validate();
     MLC_CHECK(R.rows() == T.cols() && R.cols() == T.rows(),
               "MultigridCycle: R is " << R.rows() << " x " << R.cols() << ", T is " << T.rows()
@@ -256,9 +386,9 @@ void MultigridCycle::apply(const Vector& r, Vector& z) const {
             res_.noalias() -= *A_ * z;
         }
     }
-    rc_.noalias() = R_ * res_;
+    csr_multiply(R_, res_, rc_);
     coarse_(rc_, ec_);
-    z.noalias() += T_ * ec_;
+    csr_multiply(T_, ec_, z, true);
     for (int k = 0; k < params_.post_sweeps; ++k)
         smoother_.sweep(r, z, false);
 }
@@ -273,15 +403,31 @@ std::string MultigridCycle::name() const {
 // ---------------------------------------------------------------------------------------------
 void CsrOperator::apply(const Vector& x, Vector& y) const {
     smoothers::check_size(x, A_.cols(), "CsrOperator::apply", "x");
-    const Index n = A_.rows();
-    y.resize(n);
-    const int* outer = A_.outerIndexPtr();
-    const int* inner = A_.innerIndexPtr();
-    const double* val = A_.valuePtr();
+    csr_multiply(A_, x, y);
+}
+
+void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add) {
+    MLC_CHECK(x.size() == A.cols() && (!add || y.size() == A.rows()),
+              "csr_multiply: A is " << A.rows() << " x " << A.cols() << ", x has " << x.size()
+                                    << ", y has " << y.size());
+    MLC_CHECK(A.isCompressed(), "csr_multiply: A must be compressed");
+    const Index n = A.rows();
+    if (!add) y.resize(n);
+    const int* outer = A.outerIndexPtr();
+    const int* inner = A.innerIndexPtr();
+    const double* val = A.valuePtr();
     const double* xp = x.data();
     double* yp = y.data();
-    for (Index i = 0; i < n; ++i)
-        yp[i] = row_dot(inner, val, xp, outer[i], outer[i + 1]);
+    const int threads = threads_for(n);
+    if (add) {
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+        for (Index i = 0; i < n; ++i)
+            yp[i] += row_dot(inner, val, xp, outer[i], outer[i + 1]);
+    } else {
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
+        for (Index i = 0; i < n; ++i)
+            yp[i] = row_dot(inner, val, xp, outer[i], outer[i + 1]);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -34,11 +34,32 @@ namespace mlc::solvers {
 /// `setup` stores a reference to A (A must outlive it) and inverts the blocks; `update_values`
 /// re-inverts them (same blocks). The sweeps do not allocate. A singular block throws
 /// mlc::InvalidInput naming it.
+///
+/// Parts (hybrid Gauss–Seidel, as in hypre's threaded relaxation): the blocks are cut into P
+/// contiguous runs of about equal nonzeros, one per OpenMP thread. Each part sweeps its own
+/// blocks in order with the newest values of its own unknowns, and reads the unknowns of the
+/// other parts as they were when the sweep began (Jacobi across the cuts). So every sweep is the
+/// same linear map whatever the threads do, and with P = 1 it is plain block Gauss–Seidel. With
+/// the unknowns numbered along a space-filling curve the parts are compact pieces of the domain
+/// and only their few interface rows differ from a sequential sweep.
 class BlockGaussSeidel final : public Smoother {
 public:
     /// `block_starts`: first row of every block, strictly increasing from 0 (a trailing n is
-    /// allowed); empty: blocks of 2 rows. omega in (0, 2).
-    explicit BlockGaussSeidel(std::vector<Index> block_starts = {}, double omega = 1.0);
+    /// allowed); empty: blocks of 2 rows. omega in (0, 2). `parts`: 0 takes the number of OpenMP
+    /// threads; at most one part per kMinRowsPerPart rows (small levels stay sequential).
+    explicit BlockGaussSeidel(std::vector<Index> block_starts = {}, double omega = 1.0,
+                              int parts = 0);
+    /// Rows per part below which fewer parts are used.
+    static constexpr Index kMinRowsPerPart = 4096;
+    /// Number of parts of the last setup.
+    int parts() const { return static_cast<int>(part_block_.size()) - 1; }
+    /// First row of every part, then the number of rows.
+    std::vector<Index> part_rows() const {
+        std::vector<Index> rows;
+        for (const Index I : part_block_)
+            rows.push_back(starts_[static_cast<size_t>(I)]);
+        return rows;
+    }
     void setup(const SparseMatrix& A) override;
     void update_values(const SparseMatrix& A) override;
     /// z = one forward sweep from z = 0.
@@ -55,13 +76,21 @@ public:
 private:
     void invert_blocks();
     void find_diagonal_starts();
+    void split_parts();
+    // One part's sweep from x (other parts' unknowns read from snap_), blocks [b0, b1).
+    void sweep_part(const double* bp, double* xp, Index b0, Index b1, bool forward) const;
 
     std::vector<Index> starts_; // block starts followed by n
     double omega_;
+    int parts_requested_;
     const SparseMatrix* A_ = nullptr;
-    std::vector<Index> offset_; // offset of block I's inverse (row-major) in dinv_
-    std::vector<int> diag_begin_; // per row: first stored entry in or right of its block
-    std::vector<double> dinv_;  // omega * D_I^{-1}
+    std::vector<Index> offset_;            // offset of block I's inverse (row-major) in dinv_
+    std::vector<int> diag_begin_;          // per row: first stored entry in or right of its block
+    std::vector<int> own_begin_, own_end_; // per row: its entries with columns in its own part
+    std::vector<Index> part_block_;        // first block of each part, then the block count
+    std::vector<int> interface_;           // columns read across a cut (copied into snap_)
+    mutable Vector snap_;                  // other parts' unknowns at the start of a sweep
+    std::vector<double> dinv_;             // omega * D_I^{-1}
 };
 
 /// Parameters of `MultigridCycle`.
@@ -108,16 +137,18 @@ private:
 };
 
 /// y = A x for a CSR matrix, each row summed with four independent accumulators (the
-/// single-accumulator loop is bound by the latency of the chained multiply-adds). Sequential:
-/// splitting the rows over OpenMP threads did not pay on the shared 2-core machine (see the
-/// README). The transpose goes to MatrixOperator. A must outlive this object.
+/// single-accumulator loop is bound by the latency of the chained multiply-adds), rows split
+/// over the OpenMP threads for matrices of at least BlockGaussSeidel::kMinRowsPerPart rows
+/// per thread. The transpose goes to MatrixOperator. A must outlive this object.
 class CsrOperator final : public LinearOperator {
 public:
     explicit CsrOperator(const SparseMatrix& A) : A_(A), plain_(A) {}
     Index rows() const override { return A_.rows(); }
     Index cols() const override { return A_.cols(); }
     void apply(const Vector& x, Vector& y) const override;
-    void apply_transpose(const Vector& x, Vector& y) const override { plain_.apply_transpose(x, y); }
+    void apply_transpose(const Vector& x, Vector& y) const override {
+        plain_.apply_transpose(x, y);
+    }
 
 private:
     const SparseMatrix& A_;
@@ -130,6 +161,9 @@ private:
 /// initial guess on entry (resized to zero if empty).
 SolveResult pcg(const SparseMatrix& A, const Preconditioner& M, const Vector& b, Vector& x,
                 double rel_tol, int max_iter);
+
+/// y = A x (or y += A x with `add`) for a CSR matrix, over the OpenMP threads like CsrOperator.
+void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = false);
 
 /// The vertex blocks of a dof numbering in which each vertex's unknowns are contiguous:
 /// `vertex_of_dof[i]` is the owner of unknown i; returns the first unknown of each run.

@@ -143,3 +143,84 @@ TEST(BoomerAMG, AsPreconditionerFromTheFactory) {
     EXPECT_LE(r.iterations, 30);
     EXPECT_THROW(solvers::make_preconditioner("amg:theta=1.5"), InvalidInput);
 }
+
+namespace {
+
+// Which part each row belongs to, from the block starts and the parts' first rows.
+std::vector<int> part_of_rows(Index n, const std::vector<Index>& part_first_row) {
+    std::vector<int> part(static_cast<size_t>(n), 0);
+    for (size_t p = 0; p < part_first_row.size(); ++p)
+        for (Index i = part_first_row[p]; i < n; ++i)
+            part[static_cast<size_t>(i)] = static_cast<int>(p);
+    return part;
+}
+
+} // namespace
+
+TEST(BlockGaussSeidel, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
+    // The elastic block of level 3 (33152 unknowns, 2x2 vertex blocks): two parts. Every row i
+    // of part p must satisfy, after a forward sweep from x_old,
+    //   sum_{j in p, block(j) <= block(i)} a_ij x_new_j + sum_{other j} a_ij x_old_j = b_i,
+    // which is the hybrid Gauss–Seidel definition (and from zero, x_old = 0 everywhere).
+    const ElasticHierarchy eh(3);
+    const SparseMatrix& K = eh.K();
+    const Index n = K.rows();
+    const auto starts = solvers::vertex_block_starts(eh.blocks.back().vertex);
+    solvers::BlockGaussSeidel two(starts, 1.0, 2), one(starts, 1.0, 1);
+    two.setup(K);
+    one.setup(K);
+    ASSERT_EQ(two.parts(), 2);
+    ASSERT_EQ(one.parts(), 1);
+    std::vector<int> block(static_cast<size_t>(n));
+    for (size_t I = 0; I < starts.size(); ++I)
+        for (Index i = starts[I]; i < (I + 1 < starts.size() ? starts[I + 1] : n); ++i)
+            block[static_cast<size_t>(i)] = static_cast<int>(I);
+    Vector x0, res;
+    two.forward_from_zero(eh.b, x0, res);
+    Vector check = eh.b;
+    check.noalias() -= K * x0;
+    EXPECT_LT((res - check).norm(), 1e-12 * eh.b.norm()); // the residual it returns is exact
+    // The cut: at a block start, with about half the nonzeros on each side.
+    const auto rows = two.part_rows();
+    ASSERT_EQ(rows.size(), 3u);
+    EXPECT_EQ(rows[0], 0);
+    EXPECT_EQ(rows[2], n);
+    const Index cut = rows[1];
+    EXPECT_TRUE(std::binary_search(starts.begin(), starts.end(), cut));
+    const double half = K.outerIndexPtr()[cut] / static_cast<double>(K.nonZeros());
+    EXPECT_NEAR(half, 0.5, 0.01);
+    const auto part = part_of_rows(n, {0, cut});
+    auto hybrid_defect = [&](const Vector& x_old, const Vector& x_new, bool forward) {
+        double worst = 0.0;
+        for (Index i = 0; i < n; ++i) {
+            double s = 0.0;
+            for (SparseMatrix::InnerIterator it(K, i); it; ++it) {
+                const auto j = static_cast<size_t>(it.col());
+                const bool same = part[j] == part[static_cast<size_t>(i)];
+                const bool done = forward ? block[j] <= block[static_cast<size_t>(i)]
+                                          : block[j] >= block[static_cast<size_t>(i)];
+                s += it.value() * (same && done ? x_new[it.col()] : x_old[it.col()]);
+            }
+            worst = std::max(worst, std::abs(s - eh.b[i]));
+        }
+        return worst / eh.b.lpNorm<Eigen::Infinity>();
+    };
+    EXPECT_LT(hybrid_defect(Vector::Zero(n), x0, true), 1e-10);
+    for (bool forward : {true, false}) {
+        Vector x_old = Vector::Random(n) * x0.lpNorm<Eigen::Infinity>();
+        Vector x = x_old;
+        two.sweep(eh.b, x, forward);
+        EXPECT_LT(hybrid_defect(x_old, x, forward), 1e-10) << (forward ? "forward" : "backward");
+        // The same linear map every time, and not the sequential sweep (the cut is real).
+        Vector x2 = x_old;
+        two.sweep(eh.b, x2, forward);
+        EXPECT_EQ((x2 - x).norm(), 0.0);
+        Vector xs = x_old;
+        one.sweep(eh.b, xs, forward);
+        EXPECT_GT((xs - x).norm(), 1e-12 * x.norm());
+    }
+    // Smaller than two parts' worth of rows: one part whatever is asked.
+    solvers::BlockGaussSeidel small(solvers::vertex_block_starts(eh.blocks[1].vertex), 1.0, 2);
+    small.setup(eh.blocks[1].K);
+    EXPECT_EQ(small.parts(), 1);
+}
