@@ -136,6 +136,7 @@ private:
             if (!ebe_elements_.empty())
                 for (size_t e = 0; e < level_.contacts.size(); ++e)
                     contact_element_matrix(level_, e, M[e], ebe_elements_[ebe_n_elastic_ + e]);
+            if (!galerkin_.empty()) build_galerkin(); // the coarse operators from this J
             if (first_)
                 pc_->setup(jac_.matrix());
             else
@@ -149,6 +150,7 @@ private:
     // after each coarse load step); with coarse=lu the coarse Jacobian is refactored when they
     // changed.
     void refresh_coarse() {
+        if (!galerkin_.empty()) return; // the coarse operators come from this level's J
         const auto& cM = ctx_->coarse_M;
         MLC_CHECK(cM.size() == ctx_->coarse->contacts.size(),
                   "CF: the coarse context has " << cM.size() << " status matrices for "
@@ -236,6 +238,9 @@ private:
         p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
         p.post_sweeps = o.get_int("post", p.post_sweeps);
         p.omega = o.get_double("omega", p.omega);
+        const std::string coarse = o.get_string("coarse", "rediscretize");
+        MLC_CHECK(coarse == "rediscretize" || coarse == "galerkin",
+                  "option coarse=" << coarse << " of mg: valid rediscretize, galerkin");
         o.finish();
         const auto& T = ctx_->transfer->T;
         MLC_CHECK(T.rows() == level_.n_unknowns() && T.cols() == ctx_->coarse->n_unknowns(),
@@ -249,6 +254,59 @@ private:
         pc_ = std::make_unique<solvers::MultigridCycle>(
             T, ctx_->transfer->R, [this](const Vector& r, Vector& z) { mg_coarse_->apply(r, z); },
             solvers::vertex_block_starts(owner), p);
+        if (coarse == "galerkin") {
+            // One entry per level below, down to level 0: the level, its transfer from the
+            // level under it, its Galerkin operator and (above level 0) its cycle.
+            for (const CoarseContext* c = ctx_; c != nullptr; c = c->below) {
+                GalerkinLevel g;
+                g.level = c->coarse;
+                g.R = &c->transfer->R;
+                g.T = &c->transfer->T;
+                galerkin_.push_back(std::move(g));
+            }
+            MLC_CHECK(galerkin_.back().level->mesh.n_coarse_vertices == 0,
+                      "mg:coarse=galerkin needs every level below in the coarse-to-fine solve");
+            // galerkin_[k] is level l-1-k with T from it to level l-k; the cycle of level l-1-k
+            // thus prolongates with galerkin_[k+1].T.
+            for (size_t k = 0; k + 1 < galerkin_.size(); ++k) {
+                const Level& Lk = *galerkin_[k].level;
+                std::vector<int> own(static_cast<size_t>(Lk.n_unknowns()));
+                for (Index i = 0; i < Lk.n_unknowns(); ++i)
+                    own[static_cast<size_t>(i)] = Lk.dofs.vertex_of(i);
+                const GalerkinLevel& under = galerkin_[k + 1];
+                galerkin_[k].cycle = std::make_unique<solvers::MultigridCycle>(
+                    *under.T, *under.R,
+                    [this, k](const Vector& r, Vector& z) {
+                        if (k + 2 < galerkin_.size())
+                            galerkin_[k + 1].cycle->apply(r, z);
+                        else
+                            galerkin_lu_.apply(r, z);
+                    },
+                    solvers::vertex_block_starts(own), p);
+            }
+            mg_coarse_ = galerkin_.size() > 1
+                             ? static_cast<const Preconditioner*>(galerkin_[0].cycle.get())
+                             : &galerkin_lu_;
+        }
+    }
+
+    // Galerkin coarse operators down the chain from this level's J (A of galerkin_[0] is R J T
+    // with this level's transfer, then R A T level by level); the cycles are set up on them
+    // and level 0's is factored.
+    void build_galerkin() {
+        const SparseMatrix* A = &jac_.matrix();
+        for (size_t k = 0; k < galerkin_.size(); ++k) {
+            const SparseMatrix RA = *galerkin_[k].R * (*A);
+            galerkin_[k].A = RA * *galerkin_[k].T;
+            galerkin_[k].A.makeCompressed();
+            A = &galerkin_[k].A;
+        }
+        for (size_t k = galerkin_.size(); k-- > 0;) {
+            if (k + 1 == galerkin_.size())
+                galerkin_lu_.setup(galerkin_[k].A);
+            else
+                galerkin_[k].cycle->setup(galerkin_[k].A);
+        }
     }
 
     void build_ebe(const solvers::PreconditionerSpec& parsed) {
@@ -285,6 +343,16 @@ private:
     // MG: the coarse correction (the level below's cycle, or coarse_lu_), set at every solve.
     bool mg_ = false;
     const Preconditioner* mg_coarse_ = nullptr;
+    // MG with coarse=galerkin: one entry per level below (the level below first).
+    struct GalerkinLevel {
+        const Level* level = nullptr;
+        const SparseMatrix* R = nullptr; // restriction to this level from the one above
+        const SparseMatrix* T = nullptr; // prolongation from this level to the one above
+        SparseMatrix A;                  // its Galerkin operator
+        std::unique_ptr<solvers::MultigridCycle> cycle; // above level 0
+    };
+    std::vector<GalerkinLevel> galerkin_;
+    solvers::SparseLUPreconditioner galerkin_lu_;
     // EBE: elastic element matrices first, then one per contact element (refreshed per solve).
     std::vector<smoothers::ElementMatrix> ebe_elements_;
     size_t ebe_n_elastic_ = 0;

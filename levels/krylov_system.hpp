@@ -44,7 +44,8 @@ namespace mlc::levels {
 ///   statuses (default c1); unit: where W~ = 1 (default multipliers; "contact", formulation.md's
 ///   reading, diverges with c1 on the square).
 ///
-/// - "mg[:pre=N,post=N,omega=W]": one V-cycle over all levels (solvers/mg.hpp): N forward /
+/// - "mg[:pre=N,post=N,omega=W,coarse=C]": one V-cycle over all levels (solvers/mg.hpp): N forward
+/// /
 ///   backward vertex-block Gauss–Seidel sweeps before / after the coarse correction (defaults
 ///   1, 1; relaxation W, default 1), restriction R = T^T and prolongation T of the context's
 ///   transfer, and as coarse correction the level below's own cycle, set up on its Jacobian at
@@ -52,6 +53,10 @@ namespace mlc::levels {
 ///   cycle recurses down to level 1), or, when the level below has no cycle (level 0, solved by
 ///   "schur"), a sparse LU of its Jacobian at those statuses. A fixed linear operator per
 ///   Newton system: CGS, BiCGStab and GMRES apply. Its mat-vecs use solvers::CsrOperator.
+///   coarse: "rediscretize" (default, the above) or "galerkin": the coarse operators are
+///   R J T of this Newton system's J, then R A T level by level down to level 0 (factored by
+///   sparse LU), recomputed for every Newton system; they carry the fine statuses down through
+///   the products (it needs the context chain, CoarseContext::below, down to level 0).
 ///
 /// "cf", "sorcf" and "mg" need `context` with the level below (context->available()); without
 /// it they throw mlc::InvalidInput ("cf needs the level below: use with --levels >= 1 and the

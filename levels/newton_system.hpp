@@ -108,6 +108,9 @@ struct CoarseContext {
     const transfer::LevelTransfer* transfer = nullptr; ///< coarse -> this level
     NewtonSystemSolver* coarse_solver = nullptr;       ///< exact solver of the coarse Jacobian
     std::vector<Eigen::Matrix2d> coarse_M;             ///< converged coarse statuses (per element)
+    /// The level below's own context (null on level 0 or when the level below has none): the
+    /// chain down to level 0, for operators built over all levels (mg:coarse=galerkin).
+    const CoarseContext* below = nullptr;
     bool available() const { return coarse && transfer && coarse_solver; }
 };
 

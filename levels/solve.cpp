@@ -69,6 +69,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             ctx.coarse = &levels[static_cast<size_t>(l - 1)];
             ctx.transfer = &res.hierarchy.transfers[static_cast<size_t>(l - 1)];
             ctx.coarse_solver = system[static_cast<size_t>(l - 1)];
+            if (l - 1 > first) ctx.below = &context[static_cast<size_t>(l - 1)];
         }
         auto sys = make_newton_system_solver(L, spec, &ctx);
         system[static_cast<size_t>(l)] = sys.get();

@@ -224,3 +224,20 @@ TEST(BlockGaussSeidel, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
     small.setup(eh.blocks[1].K);
     EXPECT_EQ(small.parts(), 1);
 }
+
+TEST(Multigrid, GalerkinElasticOperatorIsTheRediscretizedOne) {
+    // Nested P1 spaces and P the exact interpolation: P^T K_l P = K_{l-1} (the same bilinear form
+    // on the coarse space), so for the elastic block the Galerkin and rediscretized coarse
+    // operators coincide; only the contact rows can differ.
+    const ElasticHierarchy eh(2);
+    for (size_t l = 1; l < eh.blocks.size(); ++l) {
+        const SparseMatrix RKP = SparseMatrix(eh.R[l] * eh.blocks[l].K) * eh.P[l];
+        const SparseMatrix diff = RKP - eh.blocks[l - 1].K;
+        double dmax = 0.0, kmax = 0.0;
+        for (int k = 0; k < diff.nonZeros(); ++k)
+            dmax = std::max(dmax, std::abs(diff.valuePtr()[k]));
+        for (int k = 0; k < eh.blocks[l - 1].K.nonZeros(); ++k)
+            kmax = std::max(kmax, std::abs(eh.blocks[l - 1].K.valuePtr()[k]));
+        EXPECT_LT(dmax, 1e-12 * kmax) << "level " << l;
+    }
+}
