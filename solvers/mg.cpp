@@ -140,7 +140,6 @@ void BlockGaussSeidel::find_diagonal_starts() {
 
 void BlockGaussSeidel::forward_from_zero(const Vector& b, Vector& x, Vector& res) const {
     MLC_CHECK(A_ != nullptr, "BlockGaussSeidel: call setup first");
-    const Index nb = static_cast<Index>(starts_.size()) - 1;
     const Index n = A_->rows();
     x.resize(n);
     res.resize(n);
@@ -151,51 +150,32 @@ void BlockGaussSeidel::forward_from_zero(const Vector& b, Vector& x, Vector& res
     double* xp = x.data();
     double* rp = res.data();
     const double* bp = b.data();
-    if (parts() > 1) {
-        // Each part from zero with its own lower entries (the other parts' x count as 0, as
-        // they are at the start of the sweep); then the whole residual with the final x.
-        const int P = parts();
-#pragma omp parallel for num_threads(P) schedule(static, 1)
-        for (int p = 0; p < P; ++p) {
-            for (Index I = part_block_[static_cast<size_t>(p)];
-                 I < part_block_[static_cast<size_t>(p) + 1]; ++I) {
-                const Index s = starts_[static_cast<size_t>(I)],
-                            bs = starts_[static_cast<size_t>(I) + 1] - s;
-                for (Index i = s; i < s + bs; ++i)
-                    rp[i] = bp[i] -
-                            row_dot(inner, val, xp, own_begin_[static_cast<size_t>(i)], dbeg[i]);
-                const double* d = dinv_.data() + offset_[static_cast<size_t>(I)];
-                for (Index i = 0; i < bs; ++i) {
-                    double acc = 0.0;
-                    for (Index j = 0; j < bs; ++j)
-                        acc += d[i * bs + j] * rp[s + j];
-                    xp[s + i] = acc;
-                }
+    // Each part from zero with its own lower entries (the other parts' x count as 0, as they
+    // are at the start of the sweep); then the whole residual with the final x: the diagonal
+    // and upper entries, and the lower ones of other parts. One part: plain Gauss–Seidel.
+    const int P = parts();
+#pragma omp parallel for num_threads(P) schedule(static, 1) if (P > 1)
+    for (int p = 0; p < P; ++p) {
+        for (Index I = part_block_[static_cast<size_t>(p)];
+             I < part_block_[static_cast<size_t>(p) + 1]; ++I) {
+            const Index s = starts_[static_cast<size_t>(I)],
+                        bs = starts_[static_cast<size_t>(I) + 1] - s;
+            for (Index i = s; i < s + bs; ++i)
+                rp[i] =
+                    bp[i] - row_dot(inner, val, xp, own_begin_[static_cast<size_t>(i)], dbeg[i]);
+            const double* d = dinv_.data() + offset_[static_cast<size_t>(I)];
+            for (Index i = 0; i < bs; ++i) {
+                double acc = 0.0;
+                for (Index j = 0; j < bs; ++j)
+                    acc += d[i * bs + j] * rp[s + j];
+                xp[s + i] = acc;
             }
         }
-#pragma omp parallel for num_threads(P) schedule(static)
-        for (Index i = 0; i < n; ++i)
-            rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
-                     row_dot(inner, val, xp, outer[i], own_begin_[static_cast<size_t>(i)]);
-        return;
     }
-    // Sweep: only the strictly lower entries see non-zero x (x_J = 0 for blocks J >= I).
-    for (Index I = 0; I < nb; ++I) {
-        const Index s = starts_[static_cast<size_t>(I)],
-                    bs = starts_[static_cast<size_t>(I) + 1] - s;
-        for (Index i = s; i < s + bs; ++i)
-            rp[i] = bp[i] - row_dot(inner, val, xp, outer[i], dbeg[i]);
-        const double* d = dinv_.data() + offset_[static_cast<size_t>(I)];
-        for (Index i = 0; i < bs; ++i) {
-            double acc = 0.0;
-            for (Index j = 0; j < bs; ++j)
-                acc += d[i * bs + j] * rp[s + j];
-            xp[s + i] = acc;
-        }
-    }
-    // Residual: subtract the block-diagonal and upper entries with the final x.
+#pragma omp parallel for num_threads(P) schedule(static) if (P > 1)
     for (Index i = 0; i < n; ++i)
-        rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]);
+        rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
+                 row_dot(inner, val, xp, outer[i], own_begin_[static_cast<size_t>(i)]);
 }
 
 void BlockGaussSeidel::update_values(const SparseMatrix& A) {
@@ -283,38 +263,15 @@ void BlockGaussSeidel::sweep_part(const double* bp, double* xp, Index b0, Index 
 
 void BlockGaussSeidel::sweep(const Vector& b, Vector& x, bool forward) const {
     MLC_CHECK(A_ != nullptr, "BlockGaussSeidel: call setup first");
-    if (parts() > 1) {
-        double* xp = x.data();
-        double* sp = snap_.data();
-        for (const int j : interface_)
-            sp[j] = xp[j];
-        const int P = parts();
-#pragma omp parallel for num_threads(P) schedule(static, 1)
-        for (int p = 0; p < P; ++p)
-            sweep_part(b.data(), xp, part_block_[static_cast<size_t>(p)],
-                       part_block_[static_cast<size_t>(p) + 1], forward);
-        return;
-    }
-    const Index nb = static_cast<Index>(starts_.size()) - 1;
-    const int* outer = A_->outerIndexPtr();
-    const int* inner = A_->innerIndexPtr();
-    const double* val = A_->valuePtr();
     double* xp = x.data();
-    const double* bp = b.data();
-    double res[kMaxBlock];
-    for (Index step = 0; step < nb; ++step) {
-        const auto I = static_cast<size_t>(forward ? step : nb - 1 - step);
-        const Index s = starts_[I], bs = starts_[I + 1] - s;
-        for (Index i = 0; i < bs; ++i)
-            res[i] = bp[s + i] - row_dot(inner, val, xp, outer[s + i], outer[s + i + 1]);
-        const double* d = dinv_.data() + offset_[I];
-        for (Index i = 0; i < bs; ++i) {
-            double acc = 0.0;
-            for (Index j = 0; j < bs; ++j)
-                acc += d[i * bs + j] * res[j];
-            xp[s + i] += acc;
-        }
-    }
+    double* sp = snap_.data();
+    for (const int j : interface_) // empty with one part
+        sp[j] = xp[j];
+    const int P = parts();
+#pragma omp parallel for num_threads(P) schedule(static, 1) if (P > 1)
+    for (int p = 0; p < P; ++p)
+        sweep_part(b.data(), xp, part_block_[static_cast<size_t>(p)],
+                   part_block_[static_cast<size_t>(p) + 1], forward);
 }
 
 void BlockGaussSeidel::apply(const Vector& r, Vector& z) const {
