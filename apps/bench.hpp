@@ -3,7 +3,7 @@
 ///
 /// - `bench square`: the full coarse-to-fine solve of a scene (all levels, all load steps) with
 ///   each requested Newton-system solver; per level: unknowns, Jacobian nonzeros, Newton steps,
-///   Krylov iterations per Newton step, setup (assembly + preconditioner) and solve seconds,
+///   Krylov iterations per Newton step, Jacobian assembly, preconditioner setup and solve seconds,
 ///   and per run the wall time and peak resident memory (getrusage ru_maxrss).
 /// - `bench elastic`: the elastic block alone (K on the free displacement unknowns of the finest
 ///   level, right-hand side the full load) solved to the same relative tolerance by hypre
@@ -22,13 +22,13 @@ namespace mlc::apps {
 /// Options of `bench square`.
 struct BenchSquareOptions {
     std::string scene = "square";
-    int levels = 3;                       ///< finest level L (levels 0..L are all solved)
+    int levels = 3;                        ///< finest level L (levels 0..L are all solved)
     std::vector<std::string> pcs = {"mg"}; ///< "schur", "lu", or Krylov preconditioner specs
-    std::string krylov = "cgs";           ///< Krylov method for the preconditioner specs
-    double rel_tol = 1e-8;                ///< Krylov relative tolerance
-    int max_iter = 5000;                  ///< Krylov iterations per Newton step
-    int repeat = 1;                       ///< runs per solver; times are medians over them
-    std::filesystem::path out;            ///< JSON file (default out/bench/square_L<L>.json)
+    std::string krylov = "cgs";            ///< Krylov method for the preconditioner specs
+    double rel_tol = 1e-8;                 ///< Krylov relative tolerance
+    int max_iter = 5000;                   ///< Krylov iterations per Newton step
+    int repeat = 1;                        ///< runs per solver; times are medians over them
+    std::filesystem::path out;             ///< JSON file (default out/bench/square_L<L>.json)
 };
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every run converged).
@@ -37,10 +37,10 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os);
 /// Options of `bench elastic`.
 struct BenchElasticOptions {
     std::string scene = "square";
-    int levels = 3;             ///< the elastic block of level L
-    double rel_tol = 1e-8;      ///< relative tolerance of every solve
-    int max_iter = 1000;        ///< iterations of every solve
-    int repeat = 1;             ///< runs per solver; times are medians over them
+    int levels = 3;            ///< the elastic block of level L
+    double rel_tol = 1e-8;     ///< relative tolerance of every solve
+    int max_iter = 1000;       ///< iterations of every solve
+    int repeat = 1;            ///< runs per solver; times are medians over them
     std::filesystem::path out; ///< JSON file (default out/bench/elastic_L<L>.json)
 };
 

@@ -88,14 +88,15 @@ struct SolveResult {
     int iterations = 0;
     bool converged = false;
     StopReason reason = StopReason::max_iter;
-    std::string message;             ///< detail for breakdown/divergence, empty otherwise
-    double initial_residual = 0.0;   ///< ||b - A x0||
-    double final_residual = 0.0;     ///< true ||b - A x|| at exit (recomputed, not recursive)
-    double relative_residual = 0.0;  ///< final_residual / ||b|| (or / initial if b = 0)
-    double average_rate = 0.0;       ///< (final/initial)^(1/iterations)
-    double setup_seconds = 0.0;
+    std::string message;            ///< detail for breakdown/divergence, empty otherwise
+    double initial_residual = 0.0;  ///< ||b - A x0||
+    double final_residual = 0.0;    ///< true ||b - A x|| at exit (recomputed, not recursive)
+    double relative_residual = 0.0; ///< final_residual / ||b|| (or / initial if b = 0)
+    double average_rate = 0.0;      ///< (final/initial)^(1/iterations)
+    double setup_seconds = 0.0;     ///< matrix assembly (if any) and preconditioner/factorization
+    double assembly_seconds = 0.0;  ///< of setup_seconds: assembling the matrix (Newton systems)
     double solve_seconds = 0.0;
-    std::vector<double> history;     ///< residual norms per iteration when recording was asked for
+    std::vector<double> history; ///< residual norms per iteration when recording was asked for
 };
 
 /// One line: "converged in 12 it, rel. residual 3.1e-09, rate 0.21, setup 0.01 s, solve 0.03 s".

@@ -41,7 +41,8 @@ Hierarchy build_hierarchy(const Problem& problem, transfer::QRule rule, Timings*
 
 void Hierarchy::report(std::ostream& os) const {
     long total = 0;
-    for (const auto& L : levels) total += L.elastic.K.nonZeros();
+    for (const auto& L : levels)
+        total += L.elastic.K.nonZeros();
     os << "  level  vertices  triangles  unknowns  contact nodes  nnz(K)\n";
     for (size_t l = 0; l < levels.size(); ++l) {
         const auto& L = levels[l];

@@ -109,6 +109,7 @@ public:
             mg_ ? solvers::solve(method_, solvers::CsrOperator(jac_.matrix()), *pc_, b, dx, params)
                 : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params);
         r.setup_seconds = t1 - t0;
+        r.assembly_seconds = assembly_seconds_;
         return r;
     }
     std::string name() const override { return spec_.krylov + "+" + pc_->name(); }
@@ -131,8 +132,11 @@ private:
         if (ctx_ != nullptr) refresh_coarse();
         // The same statuses as the last call (e.g. this solver serving as the coarse solve of
         // the level above, once per preconditioner application): J and C are unchanged.
+        assembly_seconds_ = 0.0;
         if (first_ || M != last_M_) {
+            const double t0 = wall_seconds();
             jac_.assemble(M);
+            assembly_seconds_ = wall_seconds() - t0;
             if (!ebe_elements_.empty())
                 for (size_t e = 0; e < level_.contacts.size(); ++e)
                     contact_element_matrix(level_, e, M[e], ebe_elements_[ebe_n_elastic_ + e]);
@@ -334,6 +338,7 @@ private:
     double forcing_ = 0.0; // inexact Newton: looser tolerance of the next solves (set_forcing)
     bool first_ = true;
     std::vector<Eigen::Matrix2d> last_M_; // statuses of the last assembly
+    double assembly_seconds_ = 0.0;       // of the last prepare
     // CF / SORCF
     const CoarseContext* ctx_ = nullptr; // borrowed, read at every solve
     std::unique_ptr<JacobianAssembler> coarse_jac_;

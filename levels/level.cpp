@@ -175,8 +175,8 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
         const Vector F = nodal_loads_at(k);
         // (No element loop when every prescribed value is zero at this point, as for the square.)
         const Vector& uk = L.path_u_fixed[static_cast<size_t>(k - 1)];
-        const Vector Ku = uk.isZero(0.0) ? Vector::Zero(uk.size())
-                                         : fem::internal_forces(mesh, L.materials, uk);
+        const Vector Ku =
+            uk.isZero(0.0) ? Vector::Zero(uk.size()) : fem::internal_forces(mesh, L.materials, uk);
         Vector f = Vector::Zero(L.dofs.n_dofs());
         for (int v = 0; v < nv; ++v)
             for (int c = 0; c < 2; ++c)

@@ -174,6 +174,7 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
         rep.linear_iterations_per_newton.push_back(lin.iterations);
         rep.linear_seconds += lin.setup_seconds + lin.solve_seconds;
         rep.linear_setup_seconds += lin.setup_seconds;
+        rep.linear_assembly_seconds += lin.assembly_seconds;
         // Inexact Newton: a Krylov solve that hit its iteration limit but reduced the linear
         // residual by at least half still gives a descent-quality step; the Newton test decides.
         const bool usable = !lin.converged && lin.reason == StopReason::max_iter &&

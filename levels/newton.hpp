@@ -34,11 +34,12 @@ struct StepReport {
     StatusCounts counts;             ///< final statuses (reported, see node_statuses)
     int linear_iterations = 0;       ///< Krylov iterations summed over the step (0 if direct)
     std::vector<int> linear_iterations_per_newton; ///< Krylov iterations of each Newton system
-    double linear_seconds = 0.0;       ///< time in the Newton-system solves (setup + solve)
-    double linear_setup_seconds = 0.0; ///< of which preconditioner/factorization setup
-    int inexact_steps = 0;             ///< steps taken from a Krylov solve stopped at max_iter
-    int cycling_detected_at = -1;      ///< iterate at which statuses returned to an earlier set
-    int damped_steps = 0;              ///< steps taken with backtracking on ||R|| after cycling
+    double linear_seconds = 0.0;          ///< time in the Newton-system solves (setup + solve)
+    double linear_setup_seconds = 0.0;    ///< of which Jacobian assembly and preconditioner setup
+    double linear_assembly_seconds = 0.0; ///< of which Jacobian assembly
+    int inexact_steps = 0;                ///< steps taken from a Krylov solve stopped at max_iter
+    int cycling_detected_at = -1;         ///< iterate at which statuses returned to an earlier set
+    int damped_steps = 0;                 ///< steps taken with backtracking on ||R|| after cycling
     double seconds = 0.0;
     std::string message; ///< diagnosis when not converged
 };

@@ -113,9 +113,14 @@ public:
         MLC_CHECK(solver_ != nullptr, "no linear solver given");
     }
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) override {
+        const double t0 = wall_seconds();
         jac_.assemble(M);
+        const double assembly = wall_seconds() - t0;
         if (dx.size() != b.size()) dx = Vector::Zero(b.size());
-        return solver_->solve(jac_.matrix(), b, dx);
+        SolveResult r = solver_->solve(jac_.matrix(), b, dx);
+        r.assembly_seconds = assembly;
+        r.setup_seconds += assembly;
+        return r;
     }
     std::string name() const override { return solver_->name(); }
 
@@ -159,9 +164,9 @@ public:
         B_.resize(m_, nu);
         B_.setFromTriplets(bt.begin(), bt.end());
         // K0 = K_uu + B^T diag(r) B, factored with the unknowns B touches ("c") ordered last and
-        // the others by nested dissection. Then P K0 P^T = L L^T with L = [L_ii 0; L_ci L_cc] and, as B only
-        // touches c, S = B K0^{-1} B^T = X^T X with X = L_cc^{-1} B_c^T: the factorization gives
-        // S without a solve per contact component.
+        // the others by nested dissection. Then P K0 P^T = L L^T with L = [L_ii 0; L_ci L_cc] and,
+        // as B only touches c, S = B K0^{-1} B^T = X^T X with X = L_cc^{-1} B_c^T: the
+        // factorization gives S without a solve per contact component.
         std::vector<Triplet> kt;
         const SparseMatrix& K = level.elastic.K;
         kt.reserve(static_cast<size_t>(K.nonZeros()));
@@ -175,7 +180,8 @@ public:
         K0 += SparseMatrixCol(B_.transpose() * r.asDiagonal() * B_);
         std::vector<char> is_c(static_cast<size_t>(nu), 0);
         for (int i = 0; i < B_.outerSize(); ++i)
-            for (SparseMatrix::InnerIterator it(B_, i); it; ++it) is_c[static_cast<size_t>(it.col())] = 1;
+            for (SparseMatrix::InnerIterator it(B_, i); it; ++it)
+                is_c[static_cast<size_t>(it.col())] = 1;
         std::vector<int> interior, local(static_cast<size_t>(nu), -1);
         for (Index k = 0; k < nu; ++k)
             if (!is_c[static_cast<size_t>(k)]) {
@@ -194,27 +200,31 @@ public:
         const std::vector<int> order = solvers::SparseCholesky::fill_reducing_order(Aii);
         newpos_.assign(static_cast<size_t>(nu), -1);
         for (Index k = 0; k < ni; ++k)
-            newpos_[static_cast<size_t>(interior[static_cast<size_t>(order[static_cast<size_t>(k)])])] =
+            newpos_[static_cast<size_t>(
+                interior[static_cast<size_t>(order[static_cast<size_t>(k)])])] =
                 static_cast<int>(k);
         Index next = ni;
         for (Index k = 0; k < nu; ++k)
-            if (is_c[static_cast<size_t>(k)]) newpos_[static_cast<size_t>(k)] = static_cast<int>(next++);
+            if (is_c[static_cast<size_t>(k)])
+                newpos_[static_cast<size_t>(k)] = static_cast<int>(next++);
         const Index nc = nu - ni;
         std::vector<Triplet> pt;
         pt.reserve(static_cast<size_t>(K0.nonZeros()));
         for (int j = 0; j < K0.outerSize(); ++j)
             for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it)
-                pt.emplace_back(newpos_[static_cast<size_t>(it.row())], newpos_[static_cast<size_t>(j)],
-                                it.value());
+                pt.emplace_back(newpos_[static_cast<size_t>(it.row())],
+                                newpos_[static_cast<size_t>(j)], it.value());
         SparseMatrixCol K0p(nu, nu);
         K0p.setFromTriplets(pt.begin(), pt.end());
         try {
             chol_.factor(K0p);
         } catch (const InvalidInput& e) {
-            throw InvalidInput(std::string("the elastic operator regularized by the contact penalty "
-                                           "is singular: some rigid-body motion is held neither by "
-                                           "supports nor by the contact candidates (add a support, "
-                                           "or widen the contact region); ") + e.what());
+            throw InvalidInput(
+                std::string("the elastic operator regularized by the contact penalty "
+                            "is singular: some rigid-body motion is held neither by "
+                            "supports nor by the contact candidates (add a support, "
+                            "or widen the contact region); ") +
+                e.what());
         }
         const Eigen::MatrixXd Lcc = chol_.trailing_block(nc);
         Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nc, m_);
@@ -255,7 +265,8 @@ public:
             const int me = el.n_multipliers(), c = comp_[e], q0 = me == 2 ? 0 : 1;
             const Eigen::MatrixXd Me = M[e].block(q0, q0, me, me);
             sys_.block(c, c, me, me) -= (Eigen::MatrixXd::Identity(me, me) - Me) / el.r;
-            for (int q = 0; q < me; ++q) bl_[c + q] = b[L.lambda_dof[e] + q];
+            for (int q = 0; q < me; ++q)
+                bl_[c + q] = b[L.lambda_dof[e] + q];
             rhs_.segment(c, me) = w.segment(c, me) - Me * bl_.segment(c, me);
         }
         lu_.compute(sys_);
@@ -285,7 +296,7 @@ public:
 private:
     const Level& level_;
     std::vector<int> u_of_dof_, dof_of_u_;
-    std::vector<int> newpos_;     ///< compact displacement index -> position in the factor
+    std::vector<int> newpos_;   ///< compact displacement index -> position in the factor
     std::vector<int> comp_;     ///< first contact component of each element
     std::vector<double> rdiag_; ///< r per component
     Index m_ = 0;               ///< number of contact components

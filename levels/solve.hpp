@@ -59,15 +59,15 @@ struct RunResult {
     Hierarchy hierarchy;
     /// level_steps[l][k]: load step k+1 on level l (empty for levels not solved).
     std::vector<std::vector<LevelStep>> level_steps;
-    std::vector<StepReport> steps;         ///< finest level, one per load step
-    Vector x;                              ///< final unknowns of the finest level
-    Vector u_full;                         ///< final nodal displacements (2 per vertex)
-    std::vector<ContactNodeState> nodes;   ///< final contact node states (finest)
-    std::vector<Vector> step_u_full;       ///< finest, per step, when keep_step_states
+    std::vector<StepReport> steps;       ///< finest level, one per load step
+    Vector x;                            ///< final unknowns of the finest level
+    Vector u_full;                       ///< final nodal displacements (2 per vertex)
+    std::vector<ContactNodeState> nodes; ///< final contact node states (finest)
+    std::vector<Vector> step_u_full;     ///< finest, per step, when keep_step_states
     std::vector<std::vector<ContactNodeState>> step_nodes; ///< per step, when keep_step_states
     Timings timings;
     bool converged = false;
-    std::string failure;                   ///< diagnosis of the first step that failed
+    std::string failure; ///< diagnosis of the first step that failed
     const Level& finest() const { return hierarchy.finest(); }
     const std::vector<Level>& levels() const { return hierarchy.levels; }
 };
