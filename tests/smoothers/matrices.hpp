@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 /// @file Small test matrices for the smoother and solver tests: Laplacians, a non-symmetric
-/// convection-diffusion matrix and an interleaved contact saddle-point Jacobian.
+/// convection-diffusion matrix and an interleaved contact saddle-point Jacobian; the explicit
+/// matrix of a preconditioner.
 #pragma once
 
+#include "core/linear_operator.hpp"
 #include "core/types.hpp"
 
 #include <Eigen/Dense>
@@ -10,6 +12,20 @@
 #include <vector>
 
 namespace mlc::testmat {
+
+/// The n x n matrix of a preconditioner (or of its transpose), column j = P e_j.
+inline Eigen::MatrixXd probe(const Preconditioner& P, Index n, bool transpose = false) {
+    Eigen::MatrixXd C(n, n);
+    for (Index j = 0; j < n; ++j) {
+        Vector z;
+        if (transpose)
+            P.apply_transpose(Vector::Unit(n, j), z);
+        else
+            P.apply(Vector::Unit(n, j), z);
+        C.col(j) = z;
+    }
+    return C;
+}
 
 /// Builds a compressed CSR matrix from triplets (duplicates summed).
 inline SparseMatrix from_triplets(Index n, const std::vector<Triplet>& t) {

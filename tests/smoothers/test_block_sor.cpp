@@ -11,6 +11,7 @@
 #include <sstream>
 
 using namespace mlc;
+using testmat::probe;
 using namespace mlc::smoothers;
 
 namespace {
@@ -51,18 +52,6 @@ Eigen::MatrixXd explicit_inverse(const SparseMatrix& A, const std::vector<Index>
     return C.inverse();
 }
 
-Eigen::MatrixXd probe(const BlockSOR& S, Index n, bool transpose) {
-    Eigen::MatrixXd C(n, n);
-    for (Index j = 0; j < n; ++j) {
-        Vector z;
-        if (transpose)
-            S.apply_transpose(Vector::Unit(n, j), z);
-        else
-            S.apply(Vector::Unit(n, j), z);
-        C.col(j) = z;
-    }
-    return C;
-}
 
 struct Case {
     const char* name;

@@ -13,6 +13,7 @@
 #include <algorithm>
 
 using namespace mlc;
+using testmat::probe;
 using namespace mlc::smoothers;
 
 namespace {
@@ -46,18 +47,6 @@ SparseMatrix assemble(Index n, const std::vector<ElementMatrix>& els) {
     return testmat::from_triplets(n, t);
 }
 
-Eigen::MatrixXd probe(const EBE& P, Index n, bool transpose = false) {
-    Eigen::MatrixXd C(n, n);
-    for (Index j = 0; j < n; ++j) {
-        Vector z;
-        if (transpose)
-            P.apply_transpose(Vector::Unit(n, j), z);
-        else
-            P.apply(Vector::Unit(n, j), z);
-        C.col(j) = z;
-    }
-    return C;
-}
 
 // Two triangles (0,1,2), (0,2,3) of the unit square; vertex 3 fixed, vertex 2 fixed in y, a
 // node-on-rigid contact element at vertex 0 with the given status. Unknowns: vertex 0: u 0,1 and

@@ -12,6 +12,7 @@
 #include <Eigen/LU>
 
 using namespace mlc;
+using testmat::probe;
 using namespace mlc::solvers;
 
 namespace {
@@ -76,15 +77,6 @@ Eigen::MatrixXd explicit_cf(const Fixture& f, const Eigen::MatrixXd& Aff,
     return C;
 }
 
-Eigen::MatrixXd probe(const Preconditioner& P, Index n) {
-    Eigen::MatrixXd C(n, n);
-    for (Index j = 0; j < n; ++j) {
-        Vector z;
-        P.apply(Vector::Unit(n, j), z);
-        C.col(j) = z;
-    }
-    return C;
-}
 
 CoarseSolve dense_solver(const Eigen::MatrixXd& AH) {
     auto lu = std::make_shared<Eigen::PartialPivLU<Eigen::MatrixXd>>(AH);

@@ -10,6 +10,7 @@
 #include <Eigen/LU>
 
 using namespace mlc;
+using testmat::probe;
 using namespace mlc::solvers;
 
 namespace {
@@ -37,15 +38,6 @@ SparseMatrix paper_pattern(bool stick, double eps = 1.0) {
     return testmat::from_triplets(4, t);
 }
 
-Eigen::MatrixXd probe(const Preconditioner& P, Index n) {
-    Eigen::MatrixXd C(n, n);
-    for (Index j = 0; j < n; ++j) {
-        Vector z;
-        P.apply(Vector::Unit(n, j), z);
-        C.col(j) = z;
-    }
-    return C;
-}
 
 // P_omega = (D* + w L) D*^{-1} (D* + w U) / (w (2 - w)) with the splitting by `block_of`.
 Eigen::MatrixXd explicit_p(const SparseMatrix& A, const Eigen::MatrixXd& Dstar,
