@@ -227,7 +227,6 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
     const double th0 = wall_seconds();
     const levels::Hierarchy h = levels::build_hierarchy(problem);
     const double hierarchy_s = wall_seconds() - th0;
-    const int nl = h.n_levels();
     std::vector<levels::ElasticBlock> blocks;
     for (const auto& L : h.levels)
         blocks.push_back(levels::elastic_block(L));
@@ -264,32 +263,17 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
         r.name = method;
         for (int rep = 0; rep < opt.repeat; ++rep) {
             const double t0 = wall_seconds();
-            std::vector<SparseMatrix> P(static_cast<size_t>(nl)), R(static_cast<size_t>(nl));
-            auto lu = std::make_unique<solvers::SparseLUPreconditioner>();
-            lu->setup(blocks[0].K);
-            std::vector<std::unique_ptr<solvers::MultigridCycle>> cycle(static_cast<size_t>(nl));
-            for (int l = 1; l < nl; ++l) {
-                const auto li = static_cast<size_t>(l);
-                P[li] = levels::displacement_prolongation(h.transfers[li - 1].T, blocks[li],
-                                                          blocks[li - 1]);
-                R[li] = P[li].transpose();
-                const Preconditioner* below =
-                    l == 1 ? static_cast<const Preconditioner*>(lu.get()) : cycle[li - 1].get();
-                cycle[li] = std::make_unique<solvers::MultigridCycle>(
-                    P[li], R[li], [below](const Vector& rc, Vector& zc) { below->apply(rc, zc); },
-                    solvers::vertex_block_starts(blocks[li].vertex));
-                cycle[li]->setup(blocks[li].K);
-            }
+            const levels::ElasticMultigrid mg(h, blocks);
             const double t1 = wall_seconds();
             x_mg = Vector::Zero(n);
             SolveResult s;
             if (method == std::string("mg-cg")) {
-                s = solvers::pcg(fine.K, *cycle.back(), b, x_mg, opt.rel_tol, opt.max_iter);
+                s = solvers::pcg(fine.K, mg.finest(), b, x_mg, opt.rel_tol, opt.max_iter);
             } else {
                 solvers::KrylovParams kp;
                 kp.rel_tol = opt.rel_tol;
                 kp.max_iter = opt.max_iter;
-                s = solvers::solve(solvers::Krylov::gmres, fine.K, *cycle.back(), b, x_mg, kp);
+                s = solvers::solve(solvers::Krylov::gmres, fine.K, mg.finest(), b, x_mg, kp);
             }
             r.setup.push_back(t1 - t0);
             r.solve.push_back(s.solve_seconds);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "levels/elastic_block.hpp"
 
+#include "core/check.hpp"
+
 namespace mlc::levels {
 
 Vector ElasticBlock::restrict(const Vector& full) const {
@@ -52,6 +54,29 @@ SparseMatrix displacement_prolongation(const SparseMatrix& T, const ElasticBlock
     P.setFromTriplets(t.begin(), t.end());
     P.makeCompressed();
     return P;
+}
+
+ElasticMultigrid::ElasticMultigrid(const Hierarchy& h, const std::vector<ElasticBlock>& blocks,
+                                   solvers::MultigridParams params) {
+    const size_t n = blocks.size();
+    MLC_CHECK(n >= 2 && n == static_cast<size_t>(h.n_levels()),
+              "ElasticMultigrid: " << n << " elastic blocks for " << h.n_levels()
+                                   << " levels (at least two needed)");
+    P.resize(n);
+    R.resize(n);
+    cycle.resize(n);
+    lu = std::make_unique<solvers::SparseLUPreconditioner>();
+    lu->setup(blocks[0].K);
+    for (size_t l = 1; l < n; ++l) {
+        P[l] = displacement_prolongation(h.transfers[l - 1].T, blocks[l], blocks[l - 1]);
+        R[l] = P[l].transpose();
+        const Preconditioner* below =
+            l == 1 ? static_cast<const Preconditioner*>(lu.get()) : cycle[l - 1].get();
+        cycle[l] = std::make_unique<solvers::MultigridCycle>(
+            P[l], R[l], [below](const Vector& r, Vector& z) { below->apply(r, z); },
+            solvers::vertex_block_starts(blocks[l].vertex), params);
+        cycle[l]->setup(blocks[l].K);
+    }
 }
 
 } // namespace mlc::levels

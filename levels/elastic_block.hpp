@@ -4,8 +4,12 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "levels/hierarchy.hpp"
 #include "levels/level.hpp"
+#include "solvers/direct.hpp"
+#include "solvers/mg.hpp"
 
+#include <memory>
 #include <vector>
 
 namespace mlc::levels {
@@ -28,5 +32,19 @@ ElasticBlock elastic_block(const Level& L);
 /// unknowns of the two blocks: P (fine compact x coarse compact).
 SparseMatrix displacement_prolongation(const SparseMatrix& T, const ElasticBlock& fine,
                                        const ElasticBlock& coarse);
+
+/// The geometric V-cycle on the elastic blocks of all levels: P = displacement_prolongation of
+/// each transfer, R = P^T, vertex-block Gauss–Seidel, sparse LU on level 0. `blocks[l]` is the
+/// elastic block of h.levels[l]; both must outlive this object (the cycles keep references).
+struct ElasticMultigrid {
+    std::vector<SparseMatrix> P, R; ///< per level >= 1: from / to the level below
+    std::unique_ptr<solvers::SparseLUPreconditioner> lu;
+    std::vector<std::unique_ptr<solvers::MultigridCycle>> cycle; ///< per level >= 1
+    /// Builds and sets up the cycles of levels 1..L (at least two levels).
+    ElasticMultigrid(const Hierarchy& h, const std::vector<ElasticBlock>& blocks,
+                     solvers::MultigridParams params = {});
+    /// The finest level's cycle.
+    const solvers::MultigridCycle& finest() const { return *cycle.back(); }
+};
 
 } // namespace mlc::levels

@@ -24,9 +24,7 @@ namespace {
 struct ElasticHierarchy {
     levels::Hierarchy h;
     std::vector<levels::ElasticBlock> blocks;
-    std::vector<SparseMatrix> P, R;
-    std::unique_ptr<solvers::SparseLUPreconditioner> lu;
-    std::vector<std::unique_ptr<solvers::MultigridCycle>> cycle;
+    std::unique_ptr<levels::ElasticMultigrid> mg;
     Vector b;
 
     explicit ElasticHierarchy(int levels) {
@@ -35,23 +33,7 @@ struct ElasticHierarchy {
         h = levels::build_hierarchy(problem);
         for (const auto& L : h.levels)
             blocks.push_back(levels::elastic_block(L));
-        const size_t n = blocks.size();
-        P.resize(n);
-        R.resize(n);
-        cycle.resize(n);
-        lu = std::make_unique<solvers::SparseLUPreconditioner>();
-        lu->setup(blocks[0].K);
-        for (size_t l = 1; l < n; ++l) {
-            P[l] =
-                levels::displacement_prolongation(h.transfers[l - 1].T, blocks[l], blocks[l - 1]);
-            R[l] = P[l].transpose();
-            const Preconditioner* below =
-                l == 1 ? static_cast<const Preconditioner*>(lu.get()) : cycle[l - 1].get();
-            cycle[l] = std::make_unique<solvers::MultigridCycle>(
-                P[l], R[l], [below](const Vector& r, Vector& z) { below->apply(r, z); },
-                solvers::vertex_block_starts(blocks[l].vertex));
-            cycle[l]->setup(blocks[l].K);
-        }
+        mg = std::make_unique<levels::ElasticMultigrid>(h, blocks);
         b = blocks.back().restrict(h.finest().elastic.f);
     }
     const SparseMatrix& K() const { return blocks.back().K; }
@@ -79,7 +61,7 @@ TEST(Multigrid, TwoLevelCycleContractsTheElasticError) {
     const double first = prev;
     for (int k = 0; k < 10; ++k) {
         const Vector r = e.b - K * x;
-        e.cycle.back()->apply(r, z);
+        e.mg->finest().apply(r, z);
         x += z;
         const double now = energy(xd - x);
         EXPECT_LT(now, 0.5 * prev) << "cycle " << k; // measured 0.16, then 0.40 .. 0.46
@@ -92,7 +74,7 @@ TEST(Multigrid, VCycleIsLevelIndependentAsCGPreconditioner) {
     for (int levels : {1, 2, 3}) {
         ElasticHierarchy e(levels);
         Vector x;
-        const SolveResult r = solvers::pcg(e.K(), *e.cycle.back(), e.b, x, 1e-8, 100);
+        const SolveResult r = solvers::pcg(e.K(), e.mg->finest(), e.b, x, 1e-8, 100);
         ASSERT_TRUE(r.converged) << "levels " << levels << ": " << r;
         EXPECT_LE(r.iterations, 16) << "levels " << levels;
         EXPECT_LE(r.relative_residual, 1e-8);
@@ -231,7 +213,7 @@ TEST(Multigrid, GalerkinElasticOperatorIsTheRediscretizedOne) {
     // operators coincide; only the contact rows can differ.
     const ElasticHierarchy eh(2);
     for (size_t l = 1; l < eh.blocks.size(); ++l) {
-        const SparseMatrix RKP = SparseMatrix(eh.R[l] * eh.blocks[l].K) * eh.P[l];
+        const SparseMatrix RKP = SparseMatrix(eh.mg->R[l] * eh.blocks[l].K) * eh.mg->P[l];
         const SparseMatrix diff = RKP - eh.blocks[l - 1].K;
         double dmax = 0.0, kmax = 0.0;
         for (int k = 0; k < diff.nonZeros(); ++k)
