@@ -124,6 +124,8 @@ void BlockGaussSeidel::setup(const SparseMatrix& A) {
     dinv_.assign(static_cast<size_t>(total), 0.0);
     A_ = &A;
     split_parts();
+    find_diagonal_starts();
+    nonzeros_ = A.nonZeros();
     invert_blocks();
 }
 
@@ -186,13 +188,19 @@ void BlockGaussSeidel::update_values(const SparseMatrix& A) {
     MLC_CHECK(A.rows() == starts_.back(), "BlockGaussSeidel::update_values: the matrix has "
                                               << A.rows() << " rows, the blocks cover "
                                               << starts_.back() << " (call setup)");
+    // The matrix of the last setup, refreshed in place (as JacobianAssembler does): its pattern,
+    // parts and diagonal positions stand; any other matrix has them derived anew.
+    const bool same_pattern = &A == A_ && A.nonZeros() == nonzeros_;
     A_ = &A;
-    split_parts(); // the pattern may differ from the last setup's
+    if (!same_pattern) {
+        split_parts();
+        find_diagonal_starts();
+        nonzeros_ = A.nonZeros();
+    }
     invert_blocks();
 }
 
 void BlockGaussSeidel::invert_blocks() {
-    find_diagonal_starts();
     const SparseMatrix& A = *A_;
     const int* outer = A.outerIndexPtr();
     const int* inner = A.innerIndexPtr();

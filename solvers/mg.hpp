@@ -32,8 +32,10 @@ namespace mlc::solvers {
 /// and slip rows sit inside a nonsingular 3x3/4x4 block), with relaxation omega.
 ///
 /// `setup` stores a reference to A (A must outlive it) and inverts the blocks; `update_values`
-/// re-inverts them (same blocks). The sweeps do not allocate. A singular block throws
-/// mlc::InvalidInput naming it.
+/// re-inverts them (same blocks): for the matrix of the last setup refreshed in place (same
+/// object and nonzero count: the pattern is taken as unchanged) that is all it does, for another
+/// matrix it also redoes the parts and diagonal positions. The sweeps do not allocate. A singular
+/// block throws mlc::InvalidInput naming it.
 ///
 /// Parts (hybrid Gauss–Seidel, as in hypre's threaded relaxation): the blocks are cut into P
 /// contiguous runs of about equal nonzeros, one per OpenMP thread. Each part sweeps its own
@@ -84,8 +86,9 @@ private:
     double omega_;
     int parts_requested_;
     const SparseMatrix* A_ = nullptr;
-    std::vector<Index> offset_;            // offset of block I's inverse (row-major) in dinv_
-    std::vector<int> diag_begin_;          // per row: first stored entry in or right of its block
+    Index nonzeros_ = 0;          // of A at the last setup (pattern check of update_values)
+    std::vector<Index> offset_;   // offset of block I's inverse (row-major) in dinv_
+    std::vector<int> diag_begin_; // per row: first stored entry in or right of its block
     std::vector<int> own_begin_, own_end_; // per row: its entries with columns in its own part
     std::vector<Index> part_block_;        // first block of each part, then the block count
     std::vector<int> interface_;           // columns read across a cut (copied into snap_)

@@ -201,6 +201,25 @@ TEST(BlockGaussSeidel, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
         one.sweep(eh.b, xs, forward);
         EXPECT_GT((xs - x).norm(), 1e-12 * x.norm());
     }
+    // update_values: values refreshed in place (K doubled: the sweep from zero halves), and
+    // another matrix (the same as a fresh setup on it).
+    SparseMatrix K2 = K;
+    solvers::BlockGaussSeidel mine(starts, 1.0, 2);
+    mine.setup(K2);
+    Vector xa, ra, xb, rb;
+    mine.forward_from_zero(eh.b, xa, ra);
+    K2 *= 2.0;
+    mine.update_values(K2);
+    mine.forward_from_zero(eh.b, xb, rb);
+    EXPECT_LT((2.0 * xb - xa).norm(), 1e-12 * xa.norm());
+    SparseMatrix K3 = K;
+    K3.coeffRef(0, 0) *= 3.0;
+    mine.update_values(K3);
+    solvers::BlockGaussSeidel fresh(starts, 1.0, 2);
+    fresh.setup(K3);
+    mine.forward_from_zero(eh.b, xa, ra);
+    fresh.forward_from_zero(eh.b, xb, rb);
+    EXPECT_EQ((xa - xb).norm(), 0.0);
     // Smaller than two parts' worth of rows: one part whatever is asked.
     solvers::BlockGaussSeidel small(solvers::vertex_block_starts(eh.blocks[1].vertex), 1.0, 2);
     small.setup(eh.blocks[1].K);
