@@ -22,6 +22,14 @@ namespace mlc::levels {
 
 namespace {
 
+// The smoother blocks of a level: one per vertex, its displacements and multipliers.
+std::vector<Index> level_vertex_blocks(const Level& L) {
+    std::vector<int> owner(static_cast<size_t>(L.n_unknowns()));
+    for (Index i = 0; i < L.n_unknowns(); ++i)
+        owner[static_cast<size_t>(i)] = L.dofs.vertex_of(i);
+    return solvers::vertex_block_starts(owner);
+}
+
 // Typed access to the options of a level-aware spec; unknown keys are errors.
 class Options {
 public:
@@ -251,13 +259,10 @@ private:
                   "mg: the transfer is " << T.rows() << " x " << T.cols() << ", expected "
                                          << level_.n_unknowns() << " x "
                                          << ctx_->coarse->n_unknowns());
-        std::vector<int> owner(static_cast<size_t>(level_.n_unknowns()));
-        for (Index i = 0; i < level_.n_unknowns(); ++i)
-            owner[static_cast<size_t>(i)] = level_.dofs.vertex_of(i);
         mg_ = true;
         pc_ = std::make_unique<solvers::MultigridCycle>(
             T, ctx_->transfer->R, [this](const Vector& r, Vector& z) { mg_coarse_->apply(r, z); },
-            solvers::vertex_block_starts(owner), p);
+            level_vertex_blocks(level_), p);
         if (coarse == "galerkin") {
             // One entry per level below, down to level 0: the level, its transfer from the
             // level under it, its Galerkin operator and (above level 0) its cycle.
@@ -273,10 +278,6 @@ private:
             // galerkin_[k] is level l-1-k with T from it to level l-k; the cycle of level l-1-k
             // thus prolongates with galerkin_[k+1].T.
             for (size_t k = 0; k + 1 < galerkin_.size(); ++k) {
-                const Level& Lk = *galerkin_[k].level;
-                std::vector<int> own(static_cast<size_t>(Lk.n_unknowns()));
-                for (Index i = 0; i < Lk.n_unknowns(); ++i)
-                    own[static_cast<size_t>(i)] = Lk.dofs.vertex_of(i);
                 const GalerkinLevel& under = galerkin_[k + 1];
                 galerkin_[k].cycle = std::make_unique<solvers::MultigridCycle>(
                     *under.T, *under.R,
@@ -286,7 +287,7 @@ private:
                         else
                             galerkin_lu_.apply(r, z);
                     },
-                    solvers::vertex_block_starts(own), p);
+                    level_vertex_blocks(*galerkin_[k].level), p);
             }
             mg_coarse_ = galerkin_.size() > 1
                              ? static_cast<const Preconditioner*>(galerkin_[0].cycle.get())
