@@ -4,6 +4,7 @@
 // against the exact condensed ("schur") solve.
 #include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "levels/hierarchy.hpp"
 #include "levels/krylov_system.hpp"
 #include "levels/level.hpp"
 #include "levels/newton.hpp"
@@ -18,16 +19,6 @@ using namespace mlc;
 using namespace mlc::levels;
 
 namespace {
-
-transfer::ContactNodes nodes_of(const Level& L) {
-    transfer::ContactNodes c;
-    for (size_t e = 0; e < L.contacts.size(); ++e) {
-        c.vertex.push_back(L.contacts[e].vertex[0]);
-        c.lambda_dof.push_back(L.lambda_dof[e]);
-        c.n_multipliers.push_back(L.contacts[e].n_multipliers());
-    }
-    return c;
-}
 
 // Levels 0 and 1 of the built-in square (mu = 1, five load steps). The coarse level is solved
 // through every load step by Newton with the exact "schur" solver; the fine Newton system is the
@@ -46,8 +37,9 @@ struct TwoLevels {
         problem = apps::load_scene("square");
         coarse = build_level(problem, problem.mesh0);
         fine = build_level(problem, mesh::refine(problem.mesh0));
-        transfer = transfer::build_transfer(fine.mesh, coarse.dofs, fine.dofs, nodes_of(coarse),
-                                            nodes_of(fine));
+        transfer =
+            transfer::build_transfer(fine.mesh, coarse.dofs, fine.dofs,
+                                     levels::contact_nodes(coarse), levels::contact_nodes(fine));
         ContactNewton newton_c(coarse, problem.newton,
                                make_newton_system_solver(coarse, {.method = "schur"}));
         Vector x = Vector::Zero(coarse.n_unknowns());

@@ -4,6 +4,7 @@
 // transfer of Q at the ends of the contact boundary.
 #include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "levels/hierarchy.hpp"
 #include "levels/level.hpp"
 #include "levels/solve.hpp"
 #include "transfer/transfer.hpp"
@@ -22,16 +23,6 @@ using transfer::QRule;
 
 namespace {
 
-ContactNodes nodes_of(const levels::Level& L) {
-    ContactNodes c;
-    for (size_t i = 0; i < L.contacts.size(); ++i) {
-        c.vertex.push_back(L.contacts[i].vertex[0]);
-        c.lambda_dof.push_back(L.lambda_dof[i]);
-        c.n_multipliers.push_back(L.contacts[i].n_multipliers());
-    }
-    return c;
-}
-
 /// Levels 0..n_levels-1 of a scene by uniform refinement of its level-0 mesh.
 std::vector<levels::Level> ladder(const levels::Problem& p, int n_levels) {
     std::vector<levels::Level> out;
@@ -45,8 +36,9 @@ std::vector<levels::Level> ladder(const levels::Problem& p, int n_levels) {
 
 LevelTransfer make_transfer(const levels::Level& coarse, const levels::Level& fine,
                             QRule rule = QRule::paper) {
-    return transfer::build_transfer(fine.mesh, coarse.dofs, fine.dofs, nodes_of(coarse),
-                                    nodes_of(fine), rule);
+    return transfer::build_transfer(fine.mesh, coarse.dofs, fine.dofs,
+                                    levels::contact_nodes(coarse), levels::contact_nodes(fine),
+                                    rule);
 }
 
 const std::vector<levels::Level>& square_levels() {
@@ -441,9 +433,9 @@ TEST(MultiplierTransfer, UniformPressureIsReproducedAwayFromTheEnds) {
         EXPECT_EQ(n_checked, F.n_contact_nodes() - 2);
         // Resultants (p = 1): coarse 40 - H/2, fine 40 - h/2 (the corner's share shrinks), and
         // the paper's Q gives the coarse one less a quarter of the left end's H/2.
-        const Eigen::Vector2d Rc = transfer::multiplier_resultant(nodes_of(C), xc);
-        const Eigen::Vector2d Rq = transfer::multiplier_resultant(nodes_of(F), got);
-        const Eigen::Vector2d Rf = transfer::multiplier_resultant(nodes_of(F), want);
+        const Eigen::Vector2d Rc = transfer::multiplier_resultant(levels::contact_nodes(C), xc);
+        const Eigen::Vector2d Rq = transfer::multiplier_resultant(levels::contact_nodes(F), got);
+        const Eigen::Vector2d Rf = transfer::multiplier_resultant(levels::contact_nodes(F), want);
         EXPECT_NEAR(Rc.y(), -p * (40.0 - H / 2), 1e-12 * p * 40);
         EXPECT_NEAR(Rf.y(), -p * (40.0 - h / 2), 1e-12 * p * 40);
         EXPECT_NEAR(Rq.y(), -p * (40.0 - H / 2 - H / 8), 1e-12 * p * 40);
@@ -460,7 +452,7 @@ TEST(MultiplierTransfer, ConservativeRulePreservesTheResultantPaperOnlyWithUnloa
         for (int l = 0; l + 1 < 3; ++l) {
             const auto& C = (*levs)[static_cast<size_t>(l)];
             const auto& F = (*levs)[static_cast<size_t>(l) + 1];
-            const ContactNodes cn = nodes_of(C), fn = nodes_of(F);
+            const ContactNodes cn = levels::contact_nodes(C), fn = levels::contact_nodes(F);
             const auto paper = make_transfer(C, F, QRule::paper);
             const auto cons = make_transfer(C, F, QRule::conservative);
             // The paper's rule keeps 1/2 + k/4 of lambda_H(i), k = contact midpoints fed by i.
@@ -540,11 +532,11 @@ TEST(MultiplierTransfer, PaperRuleIsExactOnTheSolvedSquareBecauseTheLeftEndLifts
     const int end = C.contact_of_vertex[0]; // vertex 0 is (0, 0), the left end
     ASSERT_GE(end, 0);
     const int d = C.lambda_dof[static_cast<size_t>(end)];
-    const Eigen::Vector2d Rc = transfer::multiplier_resultant(nodes_of(C), r.x);
+    const Eigen::Vector2d Rc = transfer::multiplier_resultant(levels::contact_nodes(C), r.x);
     EXPECT_LT(std::abs(r.x[d]) + std::abs(r.x[d + 1]), 1e-12 * Rc.norm());
     Vector xf;
     tr.prolongate(r.x, xf);
-    const Eigen::Vector2d Rq = transfer::multiplier_resultant(nodes_of(F), xf);
+    const Eigen::Vector2d Rq = transfer::multiplier_resultant(levels::contact_nodes(F), xf);
     EXPECT_LT((Rq - Rc).norm(), 1e-12 * Rc.norm());
 }
 
@@ -612,7 +604,7 @@ TEST(Transfer, RejectsLevelsThatDoNotNest) {
     const auto& L = square_levels();
     const auto& C = L[0];
     const auto& F = L[1];
-    const ContactNodes cn = nodes_of(C), fn = nodes_of(F);
+    const ContactNodes cn = levels::contact_nodes(C), fn = levels::contact_nodes(F);
     // Not a refined mesh / wrong numberings.
     EXPECT_THROW(transfer::build_transfer(C.mesh, C.dofs, F.dofs, cn, fn), InvalidInput);
     EXPECT_THROW(transfer::build_transfer(F.mesh, F.dofs, F.dofs, cn, fn), InvalidInput);
@@ -630,7 +622,8 @@ TEST(Transfer, RejectsLevelsThatDoNotNest) {
     auto p = apps::load_scene("square");
     p.contacts[0].mu = 0.0;
     const auto F0 = levels::build_level(p, F.mesh);
-    EXPECT_THROW(transfer::build_transfer(F.mesh, C.dofs, F0.dofs, cn, nodes_of(F0)), InvalidInput);
+    EXPECT_THROW(transfer::build_transfer(F.mesh, C.dofs, F0.dofs, cn, levels::contact_nodes(F0)),
+                 InvalidInput);
     // lambda_dof that does not match the numbering; ragged lists.
     ContactNodes bad = fn;
     bad.lambda_dof[0] += 1;
