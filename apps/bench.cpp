@@ -4,6 +4,7 @@
 
 #include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "core/memory.hpp"
 #include "core/timer.hpp"
 #include "levels/elastic_block.hpp"
 #include "levels/hierarchy.hpp"
@@ -27,9 +28,7 @@ namespace mlc::apps {
 namespace {
 
 double peak_rss_mib() {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return static_cast<double>(u.ru_maxrss) / 1024.0; // ru_maxrss is in KiB on Linux
+    return peak_rss_bytes() / (1024.0 * 1024.0);
 }
 
 double median(std::vector<double> v) {
@@ -121,6 +120,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
                          .max_iter = opt.max_iter};
         std::vector<SquareRow> rows;
         std::vector<double> walls;
+        double estimate_mib = 0;
         bool converged = true;
         std::string failure;
         for (int rep = 0; rep < opt.repeat && converged; ++rep) {
@@ -129,6 +129,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
             walls.push_back(wall_seconds() - t0);
             converged = r.converged;
             failure = r.failure;
+            estimate_mib = r.memory.bytes / (1024.0 * 1024.0);
             if (rows.empty()) {
                 rows.resize(r.level_steps.size());
                 for (size_t l = 0; l < rows.size(); ++l) {
@@ -167,7 +168,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         if (!converged) code = 2;
         js << (ip ? "," : "") << "\n    {\"solver\": " << json_string(pc)
            << ", \"converged\": " << (converged ? "true" : "false")
-           << ", \"wall_seconds\": " << median(walls) << ", \"peak_rss_mib\": " << rss;
+           << ", \"wall_seconds\": " << median(walls) << ", \"peak_rss_mib\": " << rss
+           << ", \"memory_estimate_mib\": " << estimate_mib;
         if (!converged) js << ", \"failure\": " << json_string(failure);
         js << ",\n     \"levels\": [";
         for (size_t l = 0; l < rows.size(); ++l) {
@@ -196,8 +198,9 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         }
         js << "\n     ]}";
         os << std::setw(14) << pc << "  total wall " << std::fixed << std::setprecision(2)
-           << median(walls) << " s (median), peak RSS " << std::setprecision(0) << rss << " MiB"
-           << std::defaultfloat << (converged ? "" : "  FAILED: " + failure) << "\n";
+           << median(walls) << " s (median), peak RSS " << std::setprecision(0) << rss
+           << " MiB (estimate " << estimate_mib << " MiB)" << std::defaultfloat
+           << (converged ? "" : "  FAILED: " + failure) << "\n";
     }
     js << "\n  ]\n}\n";
     os << "wrote " << out.string() << "\n";

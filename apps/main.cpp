@@ -36,14 +36,17 @@ int main(int argc, char** argv) {
     run->add_flag("--cold", ro.cold,
                   "solve the finest level from the previous step alone (default: coarse-to-fine)");
     run->add_option("--linear", ro.linear,
-                    "Newton system solver: schur (exact, condensed; default), lu, or krylov")
+                    "Newton system solver: schur (exact, condensed), lu, or krylov (default: "
+                    "chosen by size, see the report)")
         ->check(CLI::IsMember({"schur", "lu", "krylov"}));
     run->add_option("--krylov", ro.krylov,
-                    "Krylov method with --linear krylov: cgs, bicg, bicgstab, gmres");
-    run->add_option(
-        "--pc", ro.pc,
-        "preconditioner with --linear krylov, e.g. diag, ilu:1, cf, sorcf:omega=1.2, ebe");
-    run->add_option("--linear-tol", ro.linear_rel_tol, "relative tolerance of each Krylov solve");
+                    "Krylov method (implies a Krylov solve): cgs (default), bicg, bicgstab, gmres");
+    run->add_option("--pc", ro.pc,
+                    "preconditioner (implies a Krylov solve), e.g. mg (default with levels), "
+                    "diag, ilu:1, cf, sorcf:omega=1.2, ebe");
+    run->add_option("--linear-tol", ro.linear_rel_tol,
+                    "relative tolerance of each Krylov solve (implies a Krylov solve; default "
+                    "1e-10)");
     auto* study = app.add_subcommand("study", "run a study (see README: Studies)");
     study->require_subcommand(1);
     mlc::apps::StatusTransferOptions sto;
@@ -66,6 +69,14 @@ int main(int argc, char** argv) {
     ex->add_option("--seconds", exo.seconds_per_case, "time bound per case (default 120)");
     ex->add_option("--only", exo.only, "run only cases whose name contains this text");
     ex->add_option("--out,-o", exo_out, "output folder (default out/studies/extremes)");
+    ex->add_option("--linear", exo.linear,
+                   "Newton-system solver of every case: schur, lu or krylov (default: each "
+                   "solver the run default may choose, one table each)")
+        ->check(CLI::IsMember({"schur", "lu", "krylov"}));
+    ex->add_option("--krylov", exo.krylov, "Krylov method (implies a Krylov solve)");
+    ex->add_option("--pc", exo.pc, "preconditioner (implies a Krylov solve), e.g. mg");
+    ex->add_option("--linear-tol", exo.linear_rel_tol,
+                   "relative tolerance of each Krylov solve (implies a Krylov solve)");
     mlc::apps::ErrorVsTimeOptions evo;
     std::string evo_scene = "square", evo_out;
     auto* ev =

@@ -3,6 +3,7 @@
 #include "apps/output.hpp"
 
 #include "core/check.hpp"
+#include "core/memory.hpp"
 #include "mesh/io/vtu.hpp"
 
 #include <cmath>
@@ -255,6 +256,28 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             ct.insert("complementarity", c.complementarity);
             ct.insert("penetration", c.penetration);
             root.insert("checks", ct);
+        }
+        {
+            const auto& sp = r.solver.spec;
+            toml::table sv;
+            sv.insert("method", sp.method);
+            if (sp.method == "krylov") {
+                sv.insert("krylov", sp.krylov);
+                sv.insert("pc", sp.pc);
+                sv.insert("rel_tol", sp.rel_tol);
+            }
+            sv.insert("automatic", r.solver.automatic);
+            sv.insert("reason", r.solver.reason);
+            root.insert("solver", sv);
+            toml::table mt;
+            mt.insert("estimate_bytes", r.memory.bytes);
+            mt.insert("estimate_hierarchy_bytes", r.memory.hierarchy_bytes);
+            mt.insert("estimate_solver_bytes", r.memory.solver_bytes);
+            mt.insert("limit_bytes",
+                      std::isfinite(r.memory_limit.bytes) ? r.memory_limit.bytes : -1.0);
+            mt.insert("limit_source", r.memory_limit.source);
+            mt.insert("peak_rss_bytes", peak_rss_bytes());
+            root.insert("memory", mt);
         }
         toml::table tt;
         for (const auto& [name, e] : r.timings.table())

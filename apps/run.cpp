@@ -5,6 +5,7 @@
 #include "apps/output.hpp"
 #include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "core/memory.hpp"
 #include "levels/solve.hpp"
 
 #include <cmath>
@@ -34,16 +35,19 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
         }
     }
     p.validate();
+    const levels::SolverChoice choice =
+        levels::choose_solver(p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol});
     levels::SolveOptions so;
     so.progress = opt.quiet ? nullptr : &os;
     so.coarse_to_fine = !opt.cold;
-    so.linear.method = opt.linear;
-    so.linear.krylov = opt.krylov;
-    so.linear.pc = opt.pc;
-    so.linear.rel_tol = opt.linear_rel_tol;
-    so.linear.validate();
+    so.linear = choice.spec;
     os << "mlcontact: solving '" << p.name << "'\n";
+    os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
     levels::RunResult r = levels::solve(p, so);
+    r.solver = choice;
+    os << "memory: estimated peak " << levels::format_bytes(r.memory.bytes) << " of "
+       << levels::format_bytes(r.memory_limit.bytes) << " available (" << r.memory_limit.source
+       << "); measured peak " << levels::format_bytes(peak_rss_bytes()) << "\n";
     os << "\n";
     print_header(os, p, r);
     print_summary(os, p, r);

@@ -19,10 +19,12 @@ struct RunOptions {
     std::string out;               ///< output folder; empty: out/<scene name>
     bool quiet = false;            ///< no per-step progress
     bool cold = false;             ///< finest level from the previous step only (no coarse-to-fine)
-    std::string linear = "schur";  ///< Newton system solver: schur | lu | krylov
-    std::string krylov = "cgs";    ///< Krylov method when linear == krylov
-    std::string pc = "ilu:0";      ///< preconditioner spec when linear == krylov
-    double linear_rel_tol = 1e-10; ///< relative tolerance of each Krylov solve
+    /// Newton-system solver: schur | lu | krylov; unset with no Krylov option: chosen by size
+    /// (levels::choose_solver).
+    std::optional<std::string> linear;
+    std::optional<std::string> krylov;    ///< Krylov method (implies a Krylov solve)
+    std::optional<std::string> pc;        ///< preconditioner spec (implies a Krylov solve)
+    std::optional<double> linear_rel_tol; ///< relative tolerance of each Krylov solve
 };
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not

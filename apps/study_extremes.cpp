@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <fstream>
 #include <functional>
 #include <iomanip>
@@ -18,7 +19,6 @@
 #include <sstream>
 #include <sys/wait.h>
 #include <toml++/toml.h>
-#include <fcntl.h>
 #include <unistd.h>
 #include <vector>
 
@@ -32,7 +32,7 @@ using Fields = std::map<std::string, std::string>;
 struct Case {
     std::string name;
     std::string what;
-    std::function<Fields(int levels)> run;
+    std::function<Fields(int levels, const levels::LinearSolverSpec& solver)> run;
 };
 
 std::string num(double v, int digits = 3) {
@@ -42,21 +42,27 @@ std::string num(double v, int digits = 3) {
 }
 
 /// Solves a problem and summarizes it.
-Fields solve_case(levels::Problem p, int levels) {
+Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec& solver) {
     p.levels = levels;
     Fields f;
     const double t0 = wall_seconds();
-    const auto r = levels::solve(p);
+    levels::SolveOptions so;
+    so.linear = solver;
+    const auto r = levels::solve(p, so);
     f["seconds"] = num(wall_seconds() - t0);
-    int newton = 0, krylov = 0, cycling = -1;
+    int newton = 0, krylov = 0, cycling = -1, krylov_systems = 0;
     for (const auto& ls : r.level_steps)
         for (const auto& st : ls) {
             newton += st.report.iterations;
             krylov += st.report.linear_iterations;
+            krylov_systems += static_cast<int>(st.report.linear_iterations_per_newton.size());
             if (st.report.cycling_detected_at >= 0) cycling = st.report.cycling_detected_at;
         }
     f["newton"] = std::to_string(newton);
     f["krylov"] = std::to_string(krylov);
+    // Krylov iterations per Krylov-solved Newton system (levels >= 1; level 0 is exact).
+    if (krylov_systems > 0)
+        f["krylov_per_newton"] = num(static_cast<double>(krylov) / krylov_systems);
     if (cycling >= 0) f["cycling"] = "damped";
     if (!r.converged) {
         f["status"] = "no conv";
@@ -64,7 +70,8 @@ Fields solve_case(levels::Problem p, int levels) {
         return f;
     }
     double res = 0;
-    for (const auto& s : r.steps) res = std::max(res, s.residuals.back());
+    for (const auto& s : r.steps)
+        res = std::max(res, s.residuals.back());
     f["residual"] = num(res);
     const StateChecks c = check_state(p, r);
     f["penetration"] = num(c.penetration);
@@ -83,42 +90,49 @@ Fields solve_case(levels::Problem p, int levels) {
     return f;
 }
 
-levels::Problem square() { return load_scene("square"); }
+levels::Problem square() {
+    return load_scene("square");
+}
 
 std::vector<Case> make_cases() {
     std::vector<Case> cs;
     for (double mu : {0.0, 0.01, 1.0, 2.0})
-        cs.push_back({"mu=" + num(mu), "square, friction coefficient", [mu](int l) {
+        cs.push_back({"mu=" + num(mu), "square, friction coefficient",
+                      [mu](int l, const levels::LinearSolverSpec& solver) {
                           auto p = square();
                           p.contacts[0].mu = mu;
-                          return solve_case(p, l);
+                          return solve_case(p, l, solver);
                       }});
     for (double rf : {1e-4, 1e-2, 10.0, 1e4})
-        cs.push_back({"r=" + num(rf) + "E", "square, augmentation parameter", [rf](int l) {
+        cs.push_back({"r=" + num(rf) + "E", "square, augmentation parameter",
+                      [rf](int l, const levels::LinearSolverSpec& solver) {
                           auto p = square();
                           p.contacts[0].r = rf * p.bodies[0].material.E;
-                          return solve_case(p, l);
+                          return solve_case(p, l, solver);
                       }});
     for (double nu : {0.45, 0.49, 0.4999})
-        cs.push_back({"nu=" + num(nu, 6), "square, near-incompressible", [nu](int l) {
+        cs.push_back({"nu=" + num(nu, 6), "square, near-incompressible",
+                      [nu](int l, const levels::LinearSolverSpec& solver) {
                           auto p = square();
                           p.bodies[0].material.nu = nu;
-                          return solve_case(p, l);
+                          return solve_case(p, l, solver);
                       }});
     for (double f : {1e-8, 1e-4, 1e3})
-        cs.push_back({"load x" + num(f), "square, loads scaled", [f](int l) {
+        cs.push_back({"load x" + num(f), "square, loads scaled",
+                      [f](int l, const levels::LinearSolverSpec& solver) {
                           auto p = square();
                           for (auto& ld : p.loads) {
                               ld.pressure *= f;
                               ld.traction *= f;
                           }
-                          return solve_case(p, l);
+                          return solve_case(p, l, solver);
                       }});
-    cs.push_back({"lift-off", "square with suction on top: every node opens", [](int l) {
+    cs.push_back({"lift-off", "square with suction on top: every node opens",
+                  [](int l, const levels::LinearSolverSpec& solver) {
                       auto p = square();
                       p.loads[0].pressure = -50.0;
                       p.loads[1].pressure = 0.0;
-                      auto f = solve_case(p, l);
+                      auto f = solve_case(p, l, solver);
                       const std::string& st = f["statuses"];
                       if (f["status"] == "converged" &&
                           (st.size() < 6 || st.compare(st.size() - 6, 6, "/0/0/0") != 0)) {
@@ -128,13 +142,14 @@ std::vector<Case> make_cases() {
                       return f;
                   }});
     cs.push_back({"gross slip", "square, side load 20 x mu P, mu = 0.1, held by the symmetry plane",
-                  [](int l) {
+                  [](int l, const levels::LinearSolverSpec& solver) {
                       auto p = square();
                       p.contacts[0].mu = 0.1;
                       p.loads[1].pressure = 150.0 * 10;
-                      return solve_case(p, l);
+                      return solve_case(p, l, solver);
                   }});
-    cs.push_back({"slender 100:1", "strip 100 x 1 on a plane, pressed and pushed", [](int l) {
+    cs.push_back({"slender 100:1", "strip 100 x 1 on a plane, pressed and pushed",
+                  [](int l, const levels::LinearSolverSpec& solver) {
                       const std::string text = R"(
 [scene]
 name = "slender"
@@ -157,16 +172,19 @@ contactor = "bottom"
 mu = 0.3
 obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
 )";
-                      return solve_case(parse_scene(text, "extremes:slender"), std::min(l, 1));
+                      return solve_case(parse_scene(text, "extremes:slender"), std::min(l, 1),
+                                        solver);
                   }});
     // Two bodies, Young's moduli 1e6 apart, node on facet with friction, the default
     // r = 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, the statuses cycle
-    // and Newton fails). Both ways round: a soft block on a stiff base, a stiff block on a soft one.
+    // and Newton fails). Both ways round: a soft block on a stiff base, a stiff block on a soft
+    // one.
     for (const bool soft_on_stiff : {true, false})
         cs.push_back({soft_on_stiff ? "contrast 1e6 soft/stiff" : "contrast 1e6 stiff/soft",
-                      soft_on_stiff ? "two bodies: block E = 1 pressed on a base E = 1e6, side load"
-                                    : "two bodies: block E = 1e6 pressed on a base E = 1, side load",
-                      [soft_on_stiff](int l) {
+                      soft_on_stiff
+                          ? "two bodies: block E = 1 pressed on a base E = 1e6, side load"
+                          : "two bodies: block E = 1e6 pressed on a base E = 1, side load",
+                      [soft_on_stiff](int l, const levels::LinearSolverSpec& solver) {
                           const double Eb = soft_on_stiff ? 1.0 : 1e6;
                           const double Ebase = soft_on_stiff ? 1e6 : 1.0;
                           std::ostringstream t;
@@ -204,21 +222,26 @@ target = "base_top"
 element = "node_on_facet"
 mu = 0.3
 )";
-                          return solve_case(parse_scene(t.str(), "extremes:contrast"), l);
+                          return solve_case(parse_scene(t.str(), "extremes:contrast"), l, solver);
                       }});
-    cs.push_back({"units N/m/Pa vs N/mm/MPa", "square in SI and in mm units; compare", [](int l) {
+    cs.push_back({"units N/m/Pa vs N/mm/MPa", "square in SI and in mm units; compare",
+                  [](int l, const levels::LinearSolverSpec& solver) {
                       auto mm = square();
                       auto si = square();
                       const double L = 1e-3, P = 1e6; // mm -> m, MPa -> Pa
-                      for (auto& v : si.mesh0.vertices) v *= L;
+                      for (auto& v : si.mesh0.vertices)
+                          v *= L;
                       si.bodies[0].material.E *= P;
-                      for (auto& ld : si.loads) ld.pressure *= P;
+                      for (auto& ld : si.loads)
+                          ld.pressure *= P;
                       for (auto& s : si.supports)
                           if (s.point) *s.point *= L;
                       si.contacts[0].r *= P; // r = 0.1 E in both
                       mm.levels = si.levels = l;
-                      const auto a = levels::solve(mm);
-                      const auto b = levels::solve(si);
+                      levels::SolveOptions so;
+                      so.linear = solver;
+                      const auto a = levels::solve(mm, so);
+                      const auto b = levels::solve(si, so);
                       Fields f;
                       if (!a.converged || !b.converged) {
                           f["status"] = "no conv";
@@ -230,25 +253,30 @@ mu = 0.3
                       const double du = (b.u_full - L * a.u_full).norm() / (L * a.u_full.norm());
                       double dl = 0, lmax = 0;
                       for (size_t e = 0; e < a.nodes.size(); ++e) {
-                          dl = std::max({dl, std::abs(b.nodes[e].lambda_n - P * L * a.nodes[e].lambda_n),
-                                         std::abs(b.nodes[e].lambda_t - P * L * a.nodes[e].lambda_t)});
+                          dl = std::max(
+                              {dl, std::abs(b.nodes[e].lambda_n - P * L * a.nodes[e].lambda_n),
+                               std::abs(b.nodes[e].lambda_t - P * L * a.nodes[e].lambda_t)});
                           lmax = std::max(lmax, std::abs(P * L * a.nodes[e].lambda_n));
                       }
                       f["unit_diff_u"] = num(du);
                       f["unit_diff_lambda"] = num(dl / lmax);
                       int na = 0, nb = 0;
-                      for (const auto& st : a.steps) na += st.iterations;
-                      for (const auto& st : b.steps) nb += st.iterations;
+                      for (const auto& st : a.steps)
+                          na += st.iterations;
+                      for (const auto& st : b.steps)
+                          nb += st.iterations;
                       f["newton"] = std::to_string(na) + "|" + std::to_string(nb);
                       f["status"] = du <= 1e-8 && dl / lmax <= 1e-8 ? "converged" : "mismatch";
-                      if (f["status"] == "mismatch") f["diagnosis"] = "results differ after unit conversion";
+                      if (f["status"] == "mismatch")
+                          f["diagnosis"] = "results differ after unit conversion";
                       return f;
                   }});
     return cs;
 }
 
 /// Runs one case in a child process with a wall-clock bound.
-Fields run_isolated(const Case& c, int levels, double seconds) {
+Fields run_isolated(const Case& c, int levels, const levels::LinearSolverSpec& solver,
+                    double seconds) {
     std::fflush(nullptr); // nothing buffered may be written twice by the child
     int fd[2];
     if (pipe(fd) != 0) return {{"status", "error"}, {"diagnosis", "pipe failed"}};
@@ -257,7 +285,7 @@ Fields run_isolated(const Case& c, int levels, double seconds) {
         close(fd[0]);
         Fields f;
         try {
-            f = c.run(levels);
+            f = c.run(levels, solver);
         } catch (const std::exception& e) {
             f["status"] = "error";
             f["diagnosis"] = e.what();
@@ -331,41 +359,68 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     MLC_CHECK(opt.seconds_per_case > 0, "--seconds must be positive");
     const auto dir = opt.out.empty() ? std::filesystem::path("out/studies/extremes") : opt.out;
     std::filesystem::create_directories(dir);
-    os << "stability study: square-based cases on levels 0.." << opt.levels
-       << " (coarse-to-fine, exact Newton systems), " << opt.seconds_per_case << " s per case\n\n";
-    os << std::left << std::setw(26) << "case" << std::setw(11) << "result" << std::setw(6) << "exit"
-       << std::setw(9) << "newton" << std::setw(11) << "residual" << std::setw(12) << "penetration"
-       << std::setw(10) << "Coulomb" << std::setw(10) << "balance" << std::setw(9) << "seconds"
-       << "notes\n" << std::right << std::flush;
+    // The solvers: the one asked for, or each the default may choose.
+    std::vector<levels::SolverChoice> solvers;
+    levels::Problem sq = square();
+    sq.levels = opt.levels;
+    if (opt.linear || opt.krylov || opt.pc || opt.linear_rel_tol) {
+        solvers.push_back(
+            levels::choose_solver(sq, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}));
+    } else {
+        solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}}));
+        if (opt.levels >= 1)
+            solvers.push_back(levels::choose_solver(sq, {{}, {}, std::string("mg"), {}}));
+    }
+    os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "
+       << opt.seconds_per_case << " s per case, " << solvers.size() << " Newton-system solver(s)\n";
     std::ofstream csv(dir / "extremes.csv");
-    csv << "case,description,result,exit,newton,krylov,residual,penetration,coulomb,balance,seconds,notes\n";
+    csv << "solver,case,description,result,exit,newton,krylov,krylov_per_newton,residual,"
+           "penetration,coulomb,balance,seconds,notes\n";
     toml::array jrows;
     bool bad = false;
-    for (const auto& c : make_cases()) {
-        if (!opt.only.empty() && c.name.find(opt.only) == std::string::npos) continue;
-        Fields f = run_isolated(c, opt.levels, opt.seconds_per_case);
-        auto get = [&](const std::string& k) { return f.count(k) ? f[k] : std::string("-"); };
-        std::string notes = get("diagnosis") == "-" ? "" : get("diagnosis");
-        if (f.count("statuses")) notes += (notes.empty() ? "" : "; ") + std::string("g/st/s+/s- ") + f["statuses"];
-        if (f.count("cycling")) notes += (notes.empty() ? "" : "; ") + std::string("status cycling, damped");
-        if (f.count("unit_diff_u"))
-            notes += "rel. diff u " + f["unit_diff_u"] + ", lambda " + f["unit_diff_lambda"];
-        os << std::left << std::setw(26) << c.name << std::setw(11) << get("status") << std::setw(6)
-           << get("exit") << std::setw(9) << get("newton") << std::setw(11) << get("residual")
-           << std::setw(12) << get("penetration") << std::setw(10) << get("coulomb") << std::setw(10)
-           << get("balance") << std::setw(9) << get("seconds") << notes << std::right << "\n"
-           << std::flush;
-        csv << '"' << c.name << "\",\"" << c.what << "\"," << get("status") << "," << get("exit") << ","
-            << get("newton") << "," << get("krylov") << "," << get("residual") << ","
-            << get("penetration") << "," << get("coulomb") << "," << get("balance") << ","
-            << get("seconds") << ",\"" << notes << "\"\n";
-        toml::table row;
-        row.insert("case", c.name);
-        row.insert("description", c.what);
-        for (const auto& [k, v] : f) row.insert(k, v);
-        jrows.push_back(row);
-        const std::string st = get("status");
-        bad = bad || st == "crash" || st == "timeout" || st == "NaN" || st == "error";
+    for (const auto& solver : solvers) {
+        std::ostringstream sname;
+        sname << solver.spec;
+        os << "\nsolver: " << sname.str() << "\n";
+        os << std::left << std::setw(26) << "case" << std::setw(11) << "result" << std::setw(6)
+           << "exit" << std::setw(9) << "newton" << std::setw(11) << "residual" << std::setw(12)
+           << "penetration" << std::setw(10) << "Coulomb" << std::setw(10) << "balance"
+           << std::setw(9) << "seconds" << std::setw(12) << "krylov/newt"
+           << "notes\n"
+           << std::right << std::flush;
+        for (const auto& c : make_cases()) {
+            if (!opt.only.empty() && c.name.find(opt.only) == std::string::npos) continue;
+            Fields f = run_isolated(c, opt.levels, solver.spec, opt.seconds_per_case);
+            auto get = [&](const std::string& k) { return f.count(k) ? f[k] : std::string("-"); };
+            std::string notes = get("diagnosis") == "-" ? "" : get("diagnosis");
+            if (f.count("statuses"))
+                notes += (notes.empty() ? "" : "; ") + std::string("g/st/s+/s- ") + f["statuses"];
+            if (f.count("cycling"))
+                notes += (notes.empty() ? "" : "; ") + std::string("status cycling, damped");
+            if (f.count("unit_diff_u"))
+                notes += "rel. diff u " + f["unit_diff_u"] + ", lambda " + f["unit_diff_lambda"];
+            os << std::left << std::setw(26) << c.name << std::setw(11) << get("status")
+               << std::setw(6) << get("exit") << std::setw(9) << get("newton") << std::setw(11)
+               << get("residual") << std::setw(12) << get("penetration") << std::setw(10)
+               << get("coulomb") << std::setw(10) << get("balance") << std::setw(9)
+               << get("seconds") << std::setw(12) << get("krylov_per_newton") << notes << std::right
+               << "\n"
+               << std::flush;
+            csv << '"' << sname.str() << "\",\"" << c.name << "\",\"" << c.what << "\","
+                << get("status") << "," << get("exit") << "," << get("newton") << ","
+                << get("krylov") << "," << get("krylov_per_newton") << "," << get("residual") << ","
+                << get("penetration") << "," << get("coulomb") << "," << get("balance") << ","
+                << get("seconds") << ",\"" << notes << "\"\n";
+            toml::table row;
+            row.insert("solver", sname.str());
+            row.insert("case", c.name);
+            row.insert("description", c.what);
+            for (const auto& [k, v] : f)
+                row.insert(k, v);
+            jrows.push_back(row);
+            const std::string st = get("status");
+            bad = bad || st == "crash" || st == "timeout" || st == "NaN" || st == "error";
+        }
     }
     toml::table root;
     root.insert("levels", static_cast<int64_t>(opt.levels));

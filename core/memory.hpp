@@ -12,4 +12,7 @@ namespace mlc {
 /// main. Elsewhere than glibc it does nothing.
 void keep_freed_memory();
 
+/// Peak resident memory of this process so far, in bytes (getrusage ru_maxrss).
+double peak_rss_bytes();
+
 } // namespace mlc

@@ -47,6 +47,14 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     problem.validate();
     options.linear.validate();
     RunResult res;
+    res.solver.spec = options.linear;
+    res.solver.reason = "as given";
+    res.predicted_sizes = predict_level_sizes(problem);
+    res.memory = estimate_memory(res.predicted_sizes, options.linear,
+                                 options.coarse_to_fine || options.solve_all_levels ||
+                                     needs_coarse_level(options.linear));
+    res.memory_limit = process_memory_limit();
+    check_memory_fits(res.memory, res.memory_limit, res.predicted_sizes);
     res.hierarchy = build_hierarchy(problem, options.q_rule, &res.timings);
     const auto& levels = res.hierarchy.levels;
     const int n_levels = res.hierarchy.n_levels();

@@ -9,6 +9,7 @@
 #include "levels/newton.hpp"
 #include "levels/newton_system.hpp"
 #include "levels/problem.hpp"
+#include "levels/resources.hpp"
 
 #include <array>
 #include <ostream>
@@ -66,6 +67,14 @@ struct RunResult {
     std::vector<Vector> step_u_full;     ///< finest, per step, when keep_step_states
     std::vector<std::vector<ContactNodeState>> step_nodes; ///< per step, when keep_step_states
     Timings timings;
+    /// Predicted sizes, the peak-memory estimate for this run's solver and what the process may
+    /// use, all computed before the hierarchy was built.
+    std::vector<LevelSize> predicted_sizes;
+    /// The Newton-system solver of levels >= 1 (SolveOptions::linear); the driver that chose
+    /// it (choose_solver) fills `automatic` and `reason`.
+    SolverChoice solver;
+    MemoryEstimate memory;
+    MemoryLimit memory_limit;
     bool converged = false;
     std::string failure; ///< diagnosis of the first step that failed
     const Level& finest() const { return hierarchy.finest(); }
@@ -73,7 +82,9 @@ struct RunResult {
 };
 
 /// Builds the hierarchy and solves every load step (see SolveOptions). Stops at the first level
-/// and step that does not converge (RunResult::converged false, failure set).
+/// and step that does not converge (RunResult::converged false, failure set). Before building
+/// anything it estimates the peak memory of the run (estimate_memory) and throws InvalidInput
+/// when that exceeds what the process may use (process_memory_limit), naming both.
 RunResult solve(const Problem& problem, const SolveOptions& options = {});
 
 /// Relative global force balance: |resultant of loads, contact forces and support reactions| /

@@ -1,0 +1,272 @@
+// SPDX-License-Identifier: MIT
+// Level sizes predicted from level 0, the default Newton-system solver, the memory estimate and
+// the memory this process may use.
+#include "levels/resources.hpp"
+
+#include "core/check.hpp"
+#include "levels/level.hpp"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <unordered_set>
+
+namespace mlc::levels {
+
+std::vector<LevelSize> predict_level_sizes(const Problem& problem) {
+    problem.validate();
+    const Level L0 = build_level(problem, problem.mesh0);
+    std::unordered_set<std::uint64_t> edges;
+    for (const auto& t : L0.mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const auto a = static_cast<std::uint64_t>(t[static_cast<size_t>(k)]);
+            const auto b = static_cast<std::uint64_t>(t[static_cast<size_t>((k + 1) % 3)]);
+            edges.insert(std::min(a, b) << 32 | std::max(a, b));
+        }
+    LevelSize s;
+    s.vertices = L0.mesh.n_vertices();
+    s.edges = static_cast<double>(edges.size());
+    s.triangles = L0.mesh.n_triangles();
+    s.contact_nodes = L0.n_contact_nodes();
+    for (const auto& c : L0.contacts)
+        s.multipliers += c.n_multipliers();
+    s.unknowns = static_cast<double>(L0.n_unknowns());
+    s.k_nonzeros = static_cast<double>(L0.elastic.K.nonZeros());
+    // Fixed displacement components: on the boundary (doubling per level).
+    const double fixed0 = 2 * s.vertices - (s.unknowns - s.multipliers);
+    // Nonzeros of K: 2 x 2 blocks for every vertex and each of its neighbours, less those of
+    // fixed components (on the boundary, so their share doubles per level like the boundary).
+    const double deficit0 = 4 * (s.vertices + 2 * s.edges) - s.k_nonzeros;
+    std::vector<LevelSize> out{s};
+    for (int l = 1; l <= problem.levels; ++l) {
+        const LevelSize& c = out.back();
+        LevelSize f;
+        f.level = l;
+        f.vertices = c.vertices + c.edges;
+        f.edges = 2 * c.edges + 3 * c.triangles;
+        f.triangles = 4 * c.triangles;
+        const double grow = std::ldexp(1.0, l); // boundary quantities
+        f.contact_nodes = s.contact_nodes * grow;
+        f.multipliers = s.multipliers * grow;
+        f.unknowns = std::max(0.0, 2 * f.vertices - fixed0 * grow) + f.multipliers;
+        f.k_nonzeros = std::max(0.0, 4 * (f.vertices + 2 * f.edges) - deficit0 * grow);
+        out.push_back(f);
+    }
+    return out;
+}
+
+// ------------------------------------------------------------------------------------------
+SolverChoice choose_solver(const Problem& problem, const SolverRequest& req) {
+    SolverChoice c;
+    LinearSolverSpec& s = c.spec;
+    const bool krylov_option = req.pc || req.krylov || req.rel_tol;
+    if (req.linear && *req.linear != "krylov" && krylov_option) {
+        std::ostringstream os;
+        os << "--linear " << *req.linear << " is a direct solve, but ";
+        if (req.pc)
+            os << "--pc " << *req.pc;
+        else if (req.krylov)
+            os << "--krylov " << *req.krylov;
+        else
+            os << "--linear-tol";
+        os << " applies to Krylov solves only: drop --linear " << *req.linear
+           << " (a preconditioner alone means --linear krylov) or the Krylov option";
+        throw InvalidInput(os.str());
+    }
+    if (req.krylov) s.krylov = *req.krylov;
+    if (req.rel_tol) s.rel_tol = *req.rel_tol;
+    const bool has_levels = problem.levels >= 1;
+    if (req.linear && *req.linear != "krylov") {
+        s.method = *req.linear;
+        c.reason = "--linear " + s.method + " as requested";
+    } else if (req.linear || krylov_option) {
+        s.method = "krylov";
+        if (req.pc) {
+            s.pc = *req.pc;
+            c.reason = "Krylov solve with --pc " + s.pc + " as requested";
+        } else {
+            s.pc = has_levels ? "mg" : "ilu:0";
+            c.reason = has_levels ? "--linear krylov: multilevel mg over the levels"
+                                  : "--linear krylov on a single level (no level below for mg): "
+                                    "ilu:0";
+        }
+    } else {
+        c.automatic = true;
+        const auto sizes = predict_level_sizes(problem);
+        const double n = sizes.back().unknowns;
+        std::ostringstream os;
+        os << std::setprecision(3);
+        if (has_levels && n > kKrylovCrossoverUnknowns) {
+            s.method = "krylov";
+            s.pc = "mg";
+            os << "default: " << n << " unknowns on the finest level exceed the crossover "
+               << kKrylovCrossoverUnknowns << ": CGS + mg (faster and smaller than schur there)";
+        } else {
+            s.method = "schur";
+            if (!has_levels && n > kKrylovCrossoverUnknowns)
+                os << "default: " << n << " unknowns but a single level (no hierarchy for mg): "
+                   << "exact schur";
+            else
+                os << "default: " << n << " unknowns on the finest level, at most the crossover "
+                   << kKrylovCrossoverUnknowns << ": exact schur (faster there)";
+        }
+        c.reason = os.str();
+    }
+    s.validate();
+    return c;
+}
+
+// ------------------------------------------------------------------------------------------
+namespace {
+
+// Fitted on measured peaks (README "Memory"): bytes per nonzero of K and per unknown over all
+// levels, for the hierarchy and for each solver, plus the process baseline.
+constexpr double kBaseline = 40.0 * (1 << 20);
+constexpr double kHierarchyPerNonzero = 30.0;
+constexpr double kHierarchyPerUnknown = 120.0;
+constexpr double kKrylovPerNonzero = 28.0;
+constexpr double kKrylovPerUnknown = 150.0;
+constexpr double kLuPerNonzero = 120.0;
+constexpr double kCholeskyPerNonzero = 60.0;
+
+} // namespace
+
+MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const LinearSolverSpec& spec,
+                               bool coarse_to_fine) {
+    MLC_CHECK(!sizes.empty(), "estimate_memory: no levels");
+    MemoryEstimate e;
+    const int finest = static_cast<int>(sizes.size()) - 1;
+    double worst = 0;
+    for (const LevelSize& s : sizes) {
+        e.hierarchy_bytes +=
+            kHierarchyPerNonzero * s.k_nonzeros + kHierarchyPerUnknown * s.unknowns;
+        // The finest level's solver, and every level's in coarse-to-fine (level 0 by schur).
+        const bool solved = coarse_to_fine || s.level == finest || spec.method == "krylov";
+        if (!solved) continue;
+        double b = 0;
+        const std::string method = s.level == 0 && finest > 0 ? "schur" : spec.method;
+        const double m = s.multipliers;
+        if (method == "krylov")
+            b = kKrylovPerNonzero * s.k_nonzeros + kKrylovPerUnknown * s.unknowns;
+        else if (method == "lu")
+            b = kLuPerNonzero * s.k_nonzeros * std::max(1.0, std::log2(s.unknowns) / 4);
+        else // schur: Cholesky of K0, S (m x m) and the dense m x m LU of every Newton step
+            b = kCholeskyPerNonzero * s.k_nonzeros * std::max(1.0, std::log2(s.unknowns) / 4) +
+                3 * 8.0 * m * m;
+        e.solver_bytes += b;
+        if (b >= worst) {
+            worst = b;
+            e.largest_level = s.level;
+        }
+    }
+    e.bytes = kBaseline + e.hierarchy_bytes + e.solver_bytes;
+    return e;
+}
+
+namespace {
+
+double read_meminfo_available() {
+    std::ifstream in("/proc/meminfo");
+    std::string key;
+    double kib = 0;
+    std::string unit;
+    while (in >> key >> kib) {
+        std::getline(in, unit);
+        if (key == "MemAvailable:") return kib * 1024.0;
+    }
+    return std::numeric_limits<double>::infinity();
+}
+
+// A number from a one-line file; "max" or a missing file give infinity.
+double read_number_file(const std::string& path) {
+    std::ifstream in(path);
+    std::string v;
+    if (!(in >> v) || v == "max") return std::numeric_limits<double>::infinity();
+    try {
+        return std::stod(v);
+    } catch (...) {
+        return std::numeric_limits<double>::infinity();
+    }
+}
+
+// The cgroup of this process: the v2 path, or v1's memory controller path.
+double cgroup_room() {
+    std::ifstream in("/proc/self/cgroup");
+    std::string line;
+    double room = std::numeric_limits<double>::infinity();
+    while (std::getline(in, line)) {
+        // "0::/path" (v2) or "N:memory:/path" (v1)
+        const auto a = line.find(':'), b = line.find(':', a + 1);
+        if (a == std::string::npos || b == std::string::npos) continue;
+        const std::string ctl = line.substr(a + 1, b - a - 1), path = line.substr(b + 1);
+        if (ctl.empty()) {
+            for (std::string p = path;; p = p.substr(0, p.rfind('/'))) {
+                const std::string dir = "/sys/fs/cgroup" + (p == "/" ? std::string() : p);
+                const double max = read_number_file(dir + "/memory.max");
+                if (std::isfinite(max))
+                    room = std::min(room, max - read_number_file(dir + "/memory.current"));
+                if (p.empty() || p == "/") break;
+            }
+        } else if (ctl.find("memory") != std::string::npos) {
+            const std::string dir = "/sys/fs/cgroup/memory" + (path == "/" ? std::string() : path);
+            const double max = read_number_file(dir + "/memory.limit_in_bytes");
+            if (std::isfinite(max) && max < 1e18)
+                room = std::min(room, max - read_number_file(dir + "/memory.usage_in_bytes"));
+        }
+    }
+    return room;
+}
+
+double address_space_room() {
+    rlimit rl{};
+    if (getrlimit(RLIMIT_AS, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY)
+        return std::numeric_limits<double>::infinity();
+    // Address space already mapped: VmSize in /proc/self/status.
+    std::ifstream in("/proc/self/status");
+    std::string key;
+    double used = 0;
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind("VmSize:", 0) == 0) used = std::stod(line.substr(7)) * 1024.0;
+    return static_cast<double>(rl.rlim_cur) - used;
+}
+
+} // namespace
+
+MemoryLimit process_memory_limit() {
+    MemoryLimit m{read_meminfo_available(), "MemAvailable (/proc/meminfo)"};
+    if (const double c = cgroup_room(); c < m.bytes) m = {c, "the cgroup memory limit"};
+    if (const double a = address_space_room(); a < m.bytes) m = {a, "RLIMIT_AS (ulimit -v)"};
+    return m;
+}
+
+std::string format_bytes(double bytes) {
+    std::ostringstream os;
+    os << std::fixed;
+    if (!std::isfinite(bytes))
+        os << "unlimited";
+    else if (bytes >= 1024.0 * 1024 * 1024)
+        os << std::setprecision(1) << bytes / (1024.0 * 1024 * 1024) << " GiB";
+    else
+        os << std::setprecision(0) << bytes / (1024.0 * 1024) << " MiB";
+    return os.str();
+}
+
+void check_memory_fits(const MemoryEstimate& estimate, const MemoryLimit& limit,
+                       const std::vector<LevelSize>& sizes) {
+    if (estimate.bytes <= limit.bytes) return;
+    const LevelSize& f = sizes.back();
+    std::ostringstream os;
+    os << std::setprecision(3) << "the run needs an estimated " << format_bytes(estimate.bytes)
+       << " (finest level " << f.level << ": " << f.unknowns << " unknowns, " << f.contact_nodes
+       << " contact nodes; largest solver on level " << estimate.largest_level
+       << ") but this process may use " << format_bytes(std::max(0.0, limit.bytes)) << " ("
+       << limit.source << "): use fewer --levels";
+    throw InvalidInput(os.str());
+}
+
+} // namespace mlc::levels

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: MIT
+/// @file What a run will need before it is built: the sizes of every level predicted from level
+/// 0, the Newton-system solver the driver chooses for them (the default picks by size), the peak
+/// memory that run is estimated to need, and the memory this process may use.
+#pragma once
+
+#include "levels/newton_system.hpp"
+#include "levels/problem.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace mlc::levels {
+
+/// Predicted size of one level (exact on level 0; refinement counts for vertices, edges and
+/// triangles; boundary quantities doubled per level).
+struct LevelSize {
+    int level = 0;
+    double vertices = 0, edges = 0, triangles = 0;
+    double unknowns = 0;      ///< displacements and multipliers
+    double contact_nodes = 0; ///< contact elements
+    double multipliers = 0;   ///< contact multiplier unknowns
+    double k_nonzeros = 0;    ///< of the elastic operator K on the unknowns
+};
+
+/// Sizes of levels 0..problem.levels from problem.mesh0 alone (level 0 is built to count its
+/// unknowns and contact nodes; nothing finer is allocated). Vertices, edges and triangles follow
+/// the 1 -> 4 refinement exactly (V' = V + E, E' = 2 E + 3 T, T' = 4 T); unknowns and the
+/// nonzeros of K scale with V + 2 E (a vertex row couples to itself and its neighbours),
+/// fixed components and contact nodes with the boundary, which doubles per level.
+std::vector<LevelSize> predict_level_sizes(const Problem& problem);
+
+/// Finest-level unknowns above which the default Newton-system solver is Krylov + mg rather
+/// than the exact `schur` (measured, see the README: "Choosing the Newton-system solver").
+inline constexpr double kKrylovCrossoverUnknowns = 30000;
+
+/// What the user asked for; unset fields take the driver's defaults.
+struct SolverRequest {
+    std::optional<std::string> linear; ///< schur | lu | krylov
+    std::optional<std::string> krylov; ///< cgs | bicg | bicgstab | gmres
+    std::optional<std::string> pc;     ///< preconditioner spec
+    std::optional<double> rel_tol;     ///< Krylov relative tolerance
+};
+
+/// The Newton-system solver of a run and why it was chosen.
+struct SolverChoice {
+    LinearSolverSpec spec;
+    bool automatic = false; ///< chosen by size (no solver flag given)
+    std::string reason;     ///< one sentence, for the report and summary.json
+};
+
+/// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
+/// without `pc` uses `mg` where a level below exists (problem.levels >= 1) and `ilu:0` on a
+/// single level; nothing at all chooses by size: `schur` up to kKrylovCrossoverUnknowns
+/// unknowns on the finest level, Krylov (CGS) + `mg` above it when levels exist. A Krylov
+/// option next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying
+/// so.
+SolverChoice choose_solver(const Problem& problem, const SolverRequest& request);
+
+/// Peak resident memory a run is estimated to need, and its parts.
+struct MemoryEstimate {
+    double bytes = 0;           ///< total
+    double hierarchy_bytes = 0; ///< meshes, K, transfers, vectors of all levels
+    double solver_bytes = 0;    ///< Jacobians, smoothers, factors of the Newton-system solvers
+    int largest_level = 0;      ///< the level whose solver dominates
+};
+
+/// Estimates the peak resident memory of `levels::solve` for these sizes and solver (a fit of
+/// measured peaks on the square, hertz and dovetail ladders; README: "Memory").
+MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const LinearSolverSpec& spec,
+                               bool coarse_to_fine);
+
+/// The memory this process may use: the smallest of MemAvailable (/proc/meminfo), the cgroup
+/// limit less its current usage (v2 memory.max / v1 memory.limit_in_bytes) and RLIMIT_AS less the
+/// address space already mapped.
+struct MemoryLimit {
+    double bytes = 0;
+    std::string source; ///< which of the three it is, e.g. "RLIMIT_AS (ulimit -v)"
+};
+MemoryLimit process_memory_limit();
+
+/// Throws InvalidInput when `estimate` does not fit in `limit`, naming the level, the estimate
+/// and the limit.
+void check_memory_fits(const MemoryEstimate& estimate, const MemoryLimit& limit,
+                       const std::vector<LevelSize>& sizes);
+
+/// "123 MiB" / "4.5 GiB".
+std::string format_bytes(double bytes);
+
+} // namespace mlc::levels

@@ -1,0 +1,154 @@
+// SPDX-License-Identifier: MIT
+// What a run needs before it is built: predicted level sizes against the built hierarchy, the
+// driver's solver choice, the memory estimate and the refusal of a run that cannot fit.
+#include "apps/scene.hpp"
+#include "core/check.hpp"
+#include "levels/hierarchy.hpp"
+#include "levels/resources.hpp"
+#include "levels/solve.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace mlc;
+
+TEST(PredictLevelSizes, RefinementCountsAreExactAndUnknownsClose) {
+    for (const char* name : {"square", "hertz", "dovetail", "mindlin"}) {
+        SCOPED_TRACE(name);
+        auto p = apps::load_scene(name);
+        p.levels = 3;
+        const auto sizes = levels::predict_level_sizes(p);
+        const auto h = levels::build_hierarchy(p);
+        ASSERT_EQ(sizes.size(), h.levels.size());
+        for (size_t l = 0; l < sizes.size(); ++l) {
+            SCOPED_TRACE(l);
+            const auto& L = h.levels[l];
+            EXPECT_EQ(sizes[l].vertices, L.mesh.n_vertices());
+            EXPECT_EQ(sizes[l].triangles, L.mesh.n_triangles());
+            // Boundary terms are doubled per level, so the finer counts are estimates: within
+            // 3 % for the unknowns and nonzeros, within a factor for the contact nodes.
+            EXPECT_NEAR(sizes[l].unknowns / L.n_unknowns(), 1.0, 0.03);
+            EXPECT_NEAR(sizes[l].k_nonzeros / L.elastic.K.nonZeros(), 1.0, 0.03);
+            EXPECT_GE(sizes[l].contact_nodes, 0.9 * L.n_contact_nodes());
+            EXPECT_LE(sizes[l].contact_nodes, 1.6 * L.n_contact_nodes() + 4);
+        }
+        // Level 0 is counted, not predicted.
+        EXPECT_EQ(sizes[0].unknowns, h.levels[0].n_unknowns());
+        EXPECT_EQ(sizes[0].contact_nodes, h.levels[0].n_contact_nodes());
+    }
+}
+
+TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
+    auto p = apps::load_scene("square");
+    p.levels = 2;
+    const auto c = levels::choose_solver(p, {{}, {}, std::string("mg"), {}});
+    EXPECT_EQ(c.spec.method, "krylov");
+    EXPECT_EQ(c.spec.pc, "mg");
+    EXPECT_EQ(c.spec.krylov, "cgs");
+    EXPECT_FALSE(c.automatic);
+    // A Krylov method or tolerance alone too, with mg where there is a level below.
+    const auto k = levels::choose_solver(p, {{}, std::string("gmres"), {}, {}});
+    EXPECT_EQ(k.spec.method, "krylov");
+    EXPECT_EQ(k.spec.krylov, "gmres");
+    EXPECT_EQ(k.spec.pc, "mg");
+    const auto t = levels::choose_solver(p, {{}, {}, {}, 1e-6});
+    EXPECT_EQ(t.spec.method, "krylov");
+    EXPECT_EQ(t.spec.rel_tol, 1e-6);
+}
+
+TEST(ChooseSolver, LinearKrylovUsesMgWhereLevelsExistAndIluOnOneLevel) {
+    auto p = apps::load_scene("square");
+    p.levels = 1;
+    EXPECT_EQ(levels::choose_solver(p, {std::string("krylov"), {}, {}, {}}).spec.pc, "mg");
+    p.levels = 0;
+    EXPECT_EQ(levels::choose_solver(p, {std::string("krylov"), {}, {}, {}}).spec.pc, "ilu:0");
+}
+
+TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
+    auto p = apps::load_scene("square");
+    p.levels = 2;
+    for (const char* direct : {"schur", "lu"}) {
+        try {
+            levels::choose_solver(p, {std::string(direct), {}, std::string("mg"), {}});
+            ADD_FAILURE() << "no error for --linear " << direct << " --pc mg";
+        } catch (const InvalidInput& e) {
+            EXPECT_NE(std::string(e.what()).find("--pc mg applies to Krylov solves only"),
+                      std::string::npos)
+                << e.what();
+        }
+        EXPECT_THROW(levels::choose_solver(p, {std::string(direct), std::string("cgs"), {}, {}}),
+                     InvalidInput);
+        EXPECT_THROW(levels::choose_solver(p, {std::string(direct), {}, {}, 1e-8}), InvalidInput);
+        EXPECT_EQ(levels::choose_solver(p, {std::string(direct), {}, {}, {}}).spec.method, direct);
+    }
+}
+
+TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
+    auto p = apps::load_scene("square");
+    for (int L = 0; L <= 6; ++L) {
+        SCOPED_TRACE(L);
+        p.levels = L;
+        const double n = levels::predict_level_sizes(p).back().unknowns;
+        const auto c = levels::choose_solver(p, {});
+        EXPECT_TRUE(c.automatic);
+        EXPECT_FALSE(c.reason.empty());
+        if (L >= 1 && n > levels::kKrylovCrossoverUnknowns) {
+            EXPECT_EQ(c.spec.method, "krylov");
+            EXPECT_EQ(c.spec.pc, "mg");
+        } else {
+            EXPECT_EQ(c.spec.method, "schur");
+        }
+    }
+    // The square ladder crosses over between levels 2 and 3 (8 512 and 33 408 unknowns).
+    p.levels = 2;
+    EXPECT_EQ(levels::choose_solver(p, {}).spec.method, "schur");
+    p.levels = 3;
+    EXPECT_EQ(levels::choose_solver(p, {}).spec.method, "krylov");
+}
+
+TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
+    auto p = apps::load_scene("square");
+    p.levels = 5;
+    const auto sizes = levels::predict_level_sizes(p);
+    levels::LinearSolverSpec mg;
+    mg.method = "krylov";
+    mg.pc = "mg";
+    levels::LinearSolverSpec schur;
+    const auto e5 = levels::estimate_memory(sizes, mg, true);
+    const auto e4 = levels::estimate_memory({sizes.begin(), sizes.end() - 1}, mg, true);
+    EXPECT_GT(e5.bytes, 3.0 * (e4.bytes - 40 * 1048576.0));
+    EXPECT_LT(e5.bytes, 5.0 * e4.bytes);
+    EXPECT_EQ(e5.largest_level, 5);
+    EXPECT_GT(levels::estimate_memory(sizes, schur, true).bytes, e5.bytes);
+    EXPECT_DOUBLE_EQ(e5.bytes, e5.hierarchy_bytes + e5.solver_bytes + 40 * 1048576.0);
+}
+
+TEST(MemoryEstimate, ARunThatCannotFitIsRefusedBeforeAllocatingNamingLevelAndLimit) {
+    auto p = apps::load_scene("square");
+    p.levels = 3;
+    const auto sizes = levels::predict_level_sizes(p);
+    const auto e = levels::estimate_memory(sizes, levels::LinearSolverSpec{}, true);
+    EXPECT_NO_THROW(levels::check_memory_fits(e, {1e15, "test"}, sizes));
+    try {
+        levels::check_memory_fits(e, {0.5 * e.bytes, "a test limit"}, sizes);
+        ADD_FAILURE() << "not refused";
+    } catch (const InvalidInput& ex) {
+        const std::string m = ex.what();
+        EXPECT_NE(m.find("finest level 3"), std::string::npos) << m;
+        EXPECT_NE(m.find("a test limit"), std::string::npos) << m;
+        EXPECT_NE(m.find(levels::format_bytes(e.bytes)), std::string::npos) << m;
+    }
+    // levels::solve refuses too: level 12 of the square (1.1e9 unknowns) fits nowhere here.
+    p.levels = 12;
+    EXPECT_THROW(levels::solve(p), InvalidInput);
+}
+
+TEST(MemoryLimit, IsPositiveAndNamesItsSource) {
+    const auto m = levels::process_memory_limit();
+    EXPECT_GT(m.bytes, 0.0);
+    EXPECT_FALSE(m.source.empty());
+    EXPECT_EQ(levels::format_bytes(3.0 * 1024 * 1024 * 1024), "3.0 GiB");
+    EXPECT_EQ(levels::format_bytes(5.0 * 1024 * 1024), "5 MiB");
+}
