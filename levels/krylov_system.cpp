@@ -75,6 +75,27 @@ private:
     std::set<std::string> used_;
 };
 
+// A Newton-system solver (at fixed statuses) used as a preconditioner: the exact coarse solve
+// when the coarse Jacobian cannot be factored by sparse LU.
+class CoarseSolverAsPreconditioner final : public Preconditioner {
+public:
+    CoarseSolverAsPreconditioner(NewtonSystemSolver& solver, const std::vector<Eigen::Matrix2d>& M)
+        : solver_(&solver), M_(M) {}
+    void setup(const SparseMatrix&) override {}
+    void apply(const Vector& r, Vector& z) const override {
+        z.setZero(r.size());
+        const SolveResult res = solver_->solve(M_, r, z);
+        if (!res.converged)
+            throw SolverBreakdown("the coarse solve (" + solver_->name() +
+                                  ") did not converge: " + res.message);
+    }
+    std::string name() const override { return solver_->name(); }
+
+private:
+    NewtonSystemSolver* solver_;
+    const std::vector<Eigen::Matrix2d>& M_; // the context's coarse statuses, read at each apply
+};
+
 class KrylovSystemSolver final : public NewtonSystemSolver {
 public:
     KrylovSystemSolver(const Level& level, const LinearSolverSpec& spec,
@@ -120,7 +141,12 @@ public:
         r.assembly_seconds = assembly_seconds_;
         return r;
     }
-    std::string name() const override { return spec_.krylov + "+" + pc_->name(); }
+    std::string name() const override {
+        return spec_.krylov + "+" + pc_->name() +
+               (coarse_exact_ ? " (coarse LU singular, coarse solve by the level below's " +
+                                    coarse_exact_->name() + ")"
+                              : "");
+    }
     void set_forcing(double eta) override {
         MLC_CHECK(eta >= 0 && eta < 1, "forcing term must lie in [0, 1), found " << eta);
         forcing_ = eta;
@@ -184,15 +210,36 @@ private:
                 mg_coarse_ = coarse_lu_.get();
             }
         }
-        if (coarse_lu_ && (!coarse_factored_ || cM != coarse_M_used_)) {
+        if (coarse_lu_ && !coarse_exact_ && (!coarse_factored_ || cM != coarse_M_used_)) {
             coarse_jac_->assemble(cM);
-            if (!coarse_factored_)
-                coarse_lu_->setup(coarse_jac_->matrix());
-            else
-                coarse_lu_->update_values(coarse_jac_->matrix());
-            coarse_factored_ = true;
-            coarse_M_used_ = cM;
+            try {
+                if (!coarse_factored_)
+                    coarse_lu_->setup(coarse_jac_->matrix());
+                else
+                    coarse_lu_->update_values(coarse_jac_->matrix());
+                coarse_factored_ = true;
+                coarse_M_used_ = cM;
+            } catch (const SolverBreakdown& e) {
+                // The coarse Jacobian is singular at these statuses (for instance the
+                // tangential multiplier of a stuck node whose tangential displacement is
+                // prescribed: a zero row and column). The level below's own exact solver
+                // (schur) copes with it: from now on it is the coarse solve, and the name
+                // says so.
+                coarse_exact_ = std::make_unique<CoarseSolverAsPreconditioner>(*ctx_->coarse_solver,
+                                                                               ctx_->coarse_M);
+                coarse_fallback_ = e.what();
+            }
         }
+        if (mg_ && coarse_exact_ && mg_coarse_ == coarse_lu_.get())
+            mg_coarse_ = coarse_exact_.get();
+    }
+
+    // The coarse correction of CF/SORCF with coarse=lu: the LU, or the fallback above.
+    void coarse_lu_apply(const Vector& r, Vector& z) const {
+        if (coarse_exact_)
+            coarse_exact_->apply(r, z);
+        else
+            coarse_lu_->apply(r, z);
     }
 
     void build_coarse_fine(const solvers::PreconditionerSpec& parsed,
@@ -210,7 +257,7 @@ private:
         if (coarse == "lu") {
             coarse_jac_ = std::make_unique<JacobianAssembler>(*ctx_->coarse);
             coarse_lu_ = std::make_unique<solvers::SparseLUPreconditioner>();
-            coarse_solve = [this](const Vector& r, Vector& z) { coarse_lu_->apply(r, z); };
+            coarse_solve = [this](const Vector& r, Vector& z) { coarse_lu_apply(r, z); };
         } else {
             coarse_solve = [this](const Vector& r, Vector& z) {
                 z.setZero(r.size());
@@ -345,6 +392,9 @@ private:
     std::unique_ptr<JacobianAssembler> coarse_jac_;
     std::unique_ptr<solvers::SparseLUPreconditioner> coarse_lu_;
     bool coarse_factored_ = false;
+    // When the coarse LU broke down: the level below's exact solver as coarse solve.
+    std::unique_ptr<Preconditioner> coarse_exact_;
+    std::string coarse_fallback_;
     std::vector<Eigen::Matrix2d> coarse_M_used_;
     // MG: the coarse correction (the level below's cycle, or coarse_lu_), set at every solve.
     bool mg_ = false;

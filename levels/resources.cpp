@@ -126,13 +126,13 @@ namespace {
 
 // Fitted on measured peaks (README "Memory"): bytes per nonzero of K and per unknown over all
 // levels, for the hierarchy and for each solver, plus the process baseline.
-constexpr double kBaseline = 40.0 * (1 << 20);
-constexpr double kHierarchyPerNonzero = 30.0;
-constexpr double kHierarchyPerUnknown = 120.0;
-constexpr double kKrylovPerNonzero = 28.0;
-constexpr double kKrylovPerUnknown = 150.0;
+constexpr double kBaseline = 12.0 * (1 << 20);
+constexpr double kHierarchyPerNonzero = 26.0;
+constexpr double kHierarchyPerUnknown = 104.0;
+constexpr double kKrylovPerNonzero = 24.4;
+constexpr double kKrylovPerUnknown = 130.0;
 constexpr double kLuPerNonzero = 120.0;
-constexpr double kCholeskyPerNonzero = 60.0;
+constexpr double kCholeskyPerNonzero = 50.0;
 
 } // namespace
 

@@ -118,11 +118,11 @@ TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
     levels::LinearSolverSpec schur;
     const auto e5 = levels::estimate_memory(sizes, mg, true);
     const auto e4 = levels::estimate_memory({sizes.begin(), sizes.end() - 1}, mg, true);
-    EXPECT_GT(e5.bytes, 3.0 * (e4.bytes - 40 * 1048576.0));
+    EXPECT_GT(e5.bytes, 3.0 * (e4.bytes - 12 * 1048576.0));
     EXPECT_LT(e5.bytes, 5.0 * e4.bytes);
     EXPECT_EQ(e5.largest_level, 5);
     EXPECT_GT(levels::estimate_memory(sizes, schur, true).bytes, e5.bytes);
-    EXPECT_DOUBLE_EQ(e5.bytes, e5.hierarchy_bytes + e5.solver_bytes + 40 * 1048576.0);
+    EXPECT_DOUBLE_EQ(e5.bytes, e5.hierarchy_bytes + e5.solver_bytes + 12 * 1048576.0);
 }
 
 TEST(MemoryEstimate, ARunThatCannotFitIsRefusedBeforeAllocatingNamingLevelAndLimit) {
