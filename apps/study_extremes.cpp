@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <fstream>
 #include <functional>
 #include <iomanip>
@@ -18,7 +19,6 @@
 #include <sstream>
 #include <sys/wait.h>
 #include <toml++/toml.h>
-#include <fcntl.h>
 #include <unistd.h>
 #include <vector>
 
@@ -64,7 +64,8 @@ Fields solve_case(levels::Problem p, int levels) {
         return f;
     }
     double res = 0;
-    for (const auto& s : r.steps) res = std::max(res, s.residuals.back());
+    for (const auto& s : r.steps)
+        res = std::max(res, s.residuals.back());
     f["residual"] = num(res);
     const StateChecks c = check_state(p, r);
     f["penetration"] = num(c.penetration);
@@ -83,7 +84,9 @@ Fields solve_case(levels::Problem p, int levels) {
     return f;
 }
 
-levels::Problem square() { return load_scene("square"); }
+levels::Problem square() {
+    return load_scene("square");
+}
 
 std::vector<Case> make_cases() {
     std::vector<Case> cs;
@@ -161,11 +164,13 @@ obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
                   }});
     // Two bodies, Young's moduli 1e6 apart, node on facet with friction, the default
     // r = 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, the statuses cycle
-    // and Newton fails). Both ways round: a soft block on a stiff base, a stiff block on a soft one.
+    // and Newton fails). Both ways round: a soft block on a stiff base, a stiff block on a soft
+    // one.
     for (const bool soft_on_stiff : {true, false})
         cs.push_back({soft_on_stiff ? "contrast 1e6 soft/stiff" : "contrast 1e6 stiff/soft",
-                      soft_on_stiff ? "two bodies: block E = 1 pressed on a base E = 1e6, side load"
-                                    : "two bodies: block E = 1e6 pressed on a base E = 1, side load",
+                      soft_on_stiff
+                          ? "two bodies: block E = 1 pressed on a base E = 1e6, side load"
+                          : "two bodies: block E = 1e6 pressed on a base E = 1, side load",
                       [soft_on_stiff](int l) {
                           const double Eb = soft_on_stiff ? 1.0 : 1e6;
                           const double Ebase = soft_on_stiff ? 1e6 : 1.0;
@@ -210,9 +215,11 @@ mu = 0.3
                       auto mm = square();
                       auto si = square();
                       const double L = 1e-3, P = 1e6; // mm -> m, MPa -> Pa
-                      for (auto& v : si.mesh0.vertices) v *= L;
+                      for (auto& v : si.mesh0.vertices)
+                          v *= L;
                       si.bodies[0].material.E *= P;
-                      for (auto& ld : si.loads) ld.pressure *= P;
+                      for (auto& ld : si.loads)
+                          ld.pressure *= P;
                       for (auto& s : si.supports)
                           if (s.point) *s.point *= L;
                       si.contacts[0].r *= P; // r = 0.1 E in both
@@ -230,18 +237,22 @@ mu = 0.3
                       const double du = (b.u_full - L * a.u_full).norm() / (L * a.u_full.norm());
                       double dl = 0, lmax = 0;
                       for (size_t e = 0; e < a.nodes.size(); ++e) {
-                          dl = std::max({dl, std::abs(b.nodes[e].lambda_n - P * L * a.nodes[e].lambda_n),
-                                         std::abs(b.nodes[e].lambda_t - P * L * a.nodes[e].lambda_t)});
+                          dl = std::max(
+                              {dl, std::abs(b.nodes[e].lambda_n - P * L * a.nodes[e].lambda_n),
+                               std::abs(b.nodes[e].lambda_t - P * L * a.nodes[e].lambda_t)});
                           lmax = std::max(lmax, std::abs(P * L * a.nodes[e].lambda_n));
                       }
                       f["unit_diff_u"] = num(du);
                       f["unit_diff_lambda"] = num(dl / lmax);
                       int na = 0, nb = 0;
-                      for (const auto& st : a.steps) na += st.iterations;
-                      for (const auto& st : b.steps) nb += st.iterations;
+                      for (const auto& st : a.steps)
+                          na += st.iterations;
+                      for (const auto& st : b.steps)
+                          nb += st.iterations;
                       f["newton"] = std::to_string(na) + "|" + std::to_string(nb);
                       f["status"] = du <= 1e-8 && dl / lmax <= 1e-8 ? "converged" : "mismatch";
-                      if (f["status"] == "mismatch") f["diagnosis"] = "results differ after unit conversion";
+                      if (f["status"] == "mismatch")
+                          f["diagnosis"] = "results differ after unit conversion";
                       return f;
                   }});
     return cs;
@@ -333,12 +344,15 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     std::filesystem::create_directories(dir);
     os << "stability study: square-based cases on levels 0.." << opt.levels
        << " (coarse-to-fine, exact Newton systems), " << opt.seconds_per_case << " s per case\n\n";
-    os << std::left << std::setw(26) << "case" << std::setw(11) << "result" << std::setw(6) << "exit"
-       << std::setw(9) << "newton" << std::setw(11) << "residual" << std::setw(12) << "penetration"
-       << std::setw(10) << "Coulomb" << std::setw(10) << "balance" << std::setw(9) << "seconds"
-       << "notes\n" << std::right << std::flush;
+    os << std::left << std::setw(26) << "case" << std::setw(11) << "result" << std::setw(6)
+       << "exit" << std::setw(9) << "newton" << std::setw(11) << "residual" << std::setw(12)
+       << "penetration" << std::setw(10) << "Coulomb" << std::setw(10) << "balance" << std::setw(9)
+       << "seconds"
+       << "notes\n"
+       << std::right << std::flush;
     std::ofstream csv(dir / "extremes.csv");
-    csv << "case,description,result,exit,newton,krylov,residual,penetration,coulomb,balance,seconds,notes\n";
+    csv << "case,description,result,exit,newton,krylov,residual,penetration,coulomb,balance,"
+           "seconds,notes\n";
     toml::array jrows;
     bool bad = false;
     for (const auto& c : make_cases()) {
@@ -346,23 +360,27 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
         Fields f = run_isolated(c, opt.levels, opt.seconds_per_case);
         auto get = [&](const std::string& k) { return f.count(k) ? f[k] : std::string("-"); };
         std::string notes = get("diagnosis") == "-" ? "" : get("diagnosis");
-        if (f.count("statuses")) notes += (notes.empty() ? "" : "; ") + std::string("g/st/s+/s- ") + f["statuses"];
-        if (f.count("cycling")) notes += (notes.empty() ? "" : "; ") + std::string("status cycling, damped");
+        if (f.count("statuses"))
+            notes += (notes.empty() ? "" : "; ") + std::string("g/st/s+/s- ") + f["statuses"];
+        if (f.count("cycling"))
+            notes += (notes.empty() ? "" : "; ") + std::string("status cycling, damped");
         if (f.count("unit_diff_u"))
             notes += "rel. diff u " + f["unit_diff_u"] + ", lambda " + f["unit_diff_lambda"];
         os << std::left << std::setw(26) << c.name << std::setw(11) << get("status") << std::setw(6)
            << get("exit") << std::setw(9) << get("newton") << std::setw(11) << get("residual")
-           << std::setw(12) << get("penetration") << std::setw(10) << get("coulomb") << std::setw(10)
-           << get("balance") << std::setw(9) << get("seconds") << notes << std::right << "\n"
+           << std::setw(12) << get("penetration") << std::setw(10) << get("coulomb")
+           << std::setw(10) << get("balance") << std::setw(9) << get("seconds") << notes
+           << std::right << "\n"
            << std::flush;
-        csv << '"' << c.name << "\",\"" << c.what << "\"," << get("status") << "," << get("exit") << ","
-            << get("newton") << "," << get("krylov") << "," << get("residual") << ","
+        csv << '"' << c.name << "\",\"" << c.what << "\"," << get("status") << "," << get("exit")
+            << "," << get("newton") << "," << get("krylov") << "," << get("residual") << ","
             << get("penetration") << "," << get("coulomb") << "," << get("balance") << ","
             << get("seconds") << ",\"" << notes << "\"\n";
         toml::table row;
         row.insert("case", c.name);
         row.insert("description", c.what);
-        for (const auto& [k, v] : f) row.insert(k, v);
+        for (const auto& [k, v] : f)
+            row.insert(k, v);
         jrows.push_back(row);
         const std::string st = get("status");
         bad = bad || st == "crash" || st == "timeout" || st == "NaN" || st == "error";
