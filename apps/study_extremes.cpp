@@ -3,9 +3,9 @@
 #include "apps/study_extremes.hpp"
 
 #include "apps/output.hpp"
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <cmath>
 #include <csignal>
@@ -85,7 +85,7 @@ Fields solve_case(levels::Problem p, int levels) {
 }
 
 levels::Problem square() {
-    return load_scene("square");
+    return scene::load_scene("square");
 }
 
 std::vector<Case> make_cases() {
@@ -160,7 +160,8 @@ contactor = "bottom"
 mu = 0.3
 obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
 )";
-                      return solve_case(parse_scene(text, "extremes:slender"), std::min(l, 1));
+                      return solve_case(scene::parse_scene(text, "extremes:slender"),
+                                        std::min(l, 1));
                   }});
     // Two bodies, Young's moduli 1e6 apart, node on facet with friction, the default
     // r = 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, the statuses cycle
@@ -209,7 +210,7 @@ target = "base_top"
 element = "node_on_facet"
 mu = 0.3
 )";
-                          return solve_case(parse_scene(t.str(), "extremes:contrast"), l);
+                          return solve_case(scene::parse_scene(t.str(), "extremes:contrast"), l);
                       }});
     cs.push_back({"units N/m/Pa vs N/mm/MPa", "square in SI and in mm units; compare", [](int l) {
                       auto mm = square();

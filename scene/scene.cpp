@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Scene parsing with toml++; every key is checked against the schema documented in README.md.
-#include "apps/scene.hpp"
+#include "scene/scene.hpp"
 
 #include "core/check.hpp"
 #include "mesh/mesh.hpp"
@@ -17,7 +17,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-namespace mlc::apps {
+namespace mlc::scene {
 
 namespace detail {
 const std::map<std::string, std::string>& builtin_scenes(); // generated
@@ -668,4 +668,4 @@ levels::Problem load_scene(const std::string& name_or_path) {
     return parse_scene(ss.str(), path.string(), path.parent_path());
 }
 
-} // namespace mlc::apps
+} // namespace mlc::scene
