@@ -2,8 +2,8 @@
 // Stability study over stiff and extreme cases (benchmarks.md, "Stiff and extreme cases").
 #include "apps/study_extremes.hpp"
 
-#include "apps/output.hpp"
 #include "core/check.hpp"
+#include "levels/checks.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 
@@ -67,7 +67,7 @@ Fields solve_case(levels::Problem p, int levels) {
     for (const auto& s : r.steps)
         res = std::max(res, s.residuals.back());
     f["residual"] = num(res);
-    const StateChecks c = check_state(p, r);
+    const levels::StateChecks c = levels::check_state(p, r);
     f["penetration"] = num(c.penetration);
     f["coulomb"] = num(std::max(c.coulomb_excess, c.slip_equality));
     f["balance"] = num(c.force_balance);

@@ -76,9 +76,4 @@ struct RunResult {
 /// and step that does not converge (RunResult::converged false, failure set).
 RunResult solve(const Problem& problem, const SolveOptions& options = {});
 
-/// Relative global force balance: |resultant of loads, contact forces and support reactions| /
-/// sum of their magnitudes, per axis, the worse of the two.
-double force_balance_error(const Level& level, double s, const Vector& u_full,
-                           const std::vector<ContactNodeState>& nodes);
-
 } // namespace mlc::levels

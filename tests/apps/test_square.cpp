@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The square test (benchmarks.md): equilibrium, Signorini/Coulomb identities and the expected
 // picture of lift-off, slip and stick.
-#include "apps/output.hpp"
+#include "levels/checks.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 
@@ -40,7 +40,7 @@ TEST(Square, ConvergedStateSatisfiesEquilibriumAndTheContactLaws) {
         p.levels = level;
         const auto r = levels::solve(p);
         ASSERT_TRUE(r.converged) << r.failure;
-        const auto c = apps::check_state(p, r);
+        const auto c = levels::check_state(p, r);
         EXPECT_LT(c.force_balance, 1e-8);
         EXPECT_LT(c.coulomb_excess, 1e-8);
         EXPECT_LT(c.slip_equality, 1e-8);

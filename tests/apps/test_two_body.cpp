@@ -4,6 +4,7 @@
 #include "apps/output.hpp"
 #include "apps/study_accuracy.hpp"
 #include "core/check.hpp"
+#include "levels/checks.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 #include "tests/common/scene_text.hpp"
@@ -278,7 +279,7 @@ TEST(Dovetail, EquilibriumMirrorSymmetryAndCoulombOnLevels0To2) {
             ++slipping;
         }
     EXPECT_GT(slipping, 0);
-    const auto c = apps::check_state(p, r);
+    const auto c = levels::check_state(p, r);
     EXPECT_LT(c.force_balance, 1e-10);
     EXPECT_LT(c.penetration, 1e-10);
     // Contactor vertices of level 0 stay contactor nodes on every level; coarse-to-fine predicts
@@ -319,7 +320,7 @@ TEST(Calumet, RingHeldOnlyByContactConvergesOnLevels0To3) {
         f -= r.nodes[e].lambda_t * L.contacts[e].t + r.nodes[e].lambda_n * L.contacts[e].n;
     EXPECT_NEAR(f.y(), 1000.0, 1e-3); // arc polygon vs chord: the mesh resultant is 1000 to 1e-7
     EXPECT_NEAR(f.x(), 0.0, 1e-8 * 1000.0);
-    EXPECT_LT(apps::check_state(p, r).force_balance, 1e-10);
+    EXPECT_LT(levels::check_state(p, r).force_balance, 1e-10);
 }
 
 // ---------------------------------------------------------------------------------------------

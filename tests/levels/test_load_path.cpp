@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Loading paths: proportional loading unchanged, per-step prescribed values and load factors
 // interpolated between path points.
+#include "levels/checks.hpp"
 #include "levels/level.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
