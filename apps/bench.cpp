@@ -2,13 +2,13 @@
 // `mlcontact bench square` and `mlcontact bench elastic`.
 #include "apps/bench.hpp"
 
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/timer.hpp"
 #include "levels/elastic_block.hpp"
 #include "levels/hierarchy.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/hypre/boomeramg.hpp"
 #include "solvers/krylov.hpp"
@@ -86,7 +86,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
               "bench square: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench square: --repeat must be >= 1, found " << opt.repeat);
     MLC_CHECK(!opt.pcs.empty(), "bench square: no --pc given");
-    levels::Problem base = load_scene(opt.scene);
+    levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
     const std::filesystem::path out =
         opt.out.empty() ? std::filesystem::path("out/bench/" + opt.scene + "_L" +
@@ -225,7 +225,7 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
     MLC_CHECK(opt.repeat >= 1, "bench elastic: --repeat must be >= 1, found " << opt.repeat);
     MLC_CHECK(opt.rel_tol > 0 && opt.rel_tol < 1,
               "bench elastic: --tol must be in (0, 1), found " << opt.rel_tol);
-    levels::Problem problem = load_scene(opt.scene);
+    levels::Problem problem = scene::load_scene(opt.scene);
     problem.levels = opt.levels;
     const double th0 = wall_seconds();
     const levels::Hierarchy h = levels::build_hierarchy(problem);

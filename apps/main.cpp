@@ -8,7 +8,6 @@
 // breakdown.
 #include "apps/bench.hpp"
 #include "apps/run.hpp"
-#include "apps/scene.hpp"
 #include "apps/study_accuracy.hpp"
 #include "apps/study_error_vs_time.hpp"
 #include "apps/study_extremes.hpp"
@@ -16,6 +15,7 @@
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
+#include "scene/scene.hpp"
 
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -160,15 +160,16 @@ int main(int argc, char** argv) {
         }
         if (*ev) {
             evo.out = evo_out;
-            return mlc::apps::study_error_vs_time(mlc::apps::load_scene(evo_scene), evo, std::cout);
+            return mlc::apps::study_error_vs_time(mlc::scene::load_scene(evo_scene), evo,
+                                                  std::cout);
         }
         if (*ac) {
             aco.out = aco_out;
-            return mlc::apps::study_accuracy(mlc::apps::load_scene(aco_scene), aco, std::cout);
+            return mlc::apps::study_accuracy(mlc::scene::load_scene(aco_scene), aco, std::cout);
         }
         if (*ps) {
             pso.out = pso_out;
-            return mlc::apps::study_preconditioners(mlc::apps::load_scene(pso_scene), pso,
+            return mlc::apps::study_preconditioners(mlc::scene::load_scene(pso_scene), pso,
                                                     std::cout);
         }
         if (*ex) {
@@ -179,16 +180,16 @@ int main(int argc, char** argv) {
             sto.out = sto_out;
             sto.q_rule =
                 sto_q == "paper" ? mlc::transfer::QRule::paper : mlc::transfer::QRule::conservative;
-            return mlc::apps::study_status_transfer(mlc::apps::load_scene(sto_scene), sto,
+            return mlc::apps::study_status_transfer(mlc::scene::load_scene(sto_scene), sto,
                                                     std::cout);
         }
         if (*scenes) {
-            for (const auto& n : mlc::apps::builtin_scene_names())
+            for (const auto& n : mlc::scene::builtin_scene_names())
                 std::cout << n << "\n";
             return 0;
         }
         if (*show) {
-            const std::string t = mlc::apps::builtin_scene_text(show_name);
+            const std::string t = mlc::scene::builtin_scene_text(show_name);
             if (t.empty()) throw mlc::InvalidInput("no built-in scene named '" + show_name + "'");
             std::cout << t;
             return 0;

@@ -4,6 +4,7 @@
 
 #include "core/check.hpp"
 #include "core/memory.hpp"
+#include "levels/checks.hpp"
 #include "mesh/io/vtu.hpp"
 
 #include <cmath>
@@ -88,38 +89,6 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
     os << "; Newton " << p.newton << "\n";
 }
 
-StateChecks check_state(const levels::Problem& p, const levels::RunResult& r) {
-    StateChecks c;
-    const auto& L = r.finest();
-    c.force_balance = levels::force_balance_error(L, 1.0, r.u_full, r.nodes);
-    double lmax = 0.0;
-    for (const auto& n : r.nodes)
-        lmax = std::max(lmax, std::abs(n.lambda_n));
-    const double umax = r.u_full.size() ? r.u_full.cwiseAbs().maxCoeff() : 0.0;
-    for (size_t e = 0; e < r.nodes.size(); ++e) {
-        const auto& n = r.nodes[e];
-        const double mu = p.contacts[static_cast<size_t>(L.contacts[e].pair)].mu;
-        const double excess = std::abs(n.lambda_t) - mu * std::abs(n.lambda_n);
-        // At open nodes lambda = 0 up to round-off: the cone test is meaningful in contact only.
-        if (n.status != contact::Status::gap)
-            c.coulomb_excess = std::max(c.coulomb_excess, std::max(excess, 0.0));
-        if (L.contacts[e].frictional() && (n.status == contact::Status::slip_forward ||
-                                           n.status == contact::Status::slip_backward))
-            c.slip_equality = std::max(c.slip_equality, std::abs(excess));
-        c.complementarity = std::max(c.complementarity, std::abs(n.lambda_n * n.d_n));
-        c.penetration = std::max(c.penetration, std::max(-n.d_n, 0.0));
-        c.tension = std::max(c.tension, std::max(n.lambda_n, 0.0));
-    }
-    if (lmax > 0) {
-        c.coulomb_excess /= lmax;
-        c.slip_equality /= lmax;
-        c.tension /= lmax;
-        if (umax > 0) c.complementarity /= lmax * umax;
-    }
-    if (umax > 0) c.penetration /= umax;
-    return c;
-}
-
 void print_summary(std::ostream& os, const levels::Problem& p, const levels::RunResult& r) {
     os << "\n step   load  newton  lin.it  residual    gap  stick  slip+  slip-   time[s]\n";
     for (const auto& s : r.steps)
@@ -132,7 +101,7 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
            << "\n";
     os << std::defaultfloat;
     if (r.converged) {
-        const StateChecks c = check_state(p, r);
+        const levels::StateChecks c = levels::check_state(p, r);
         os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1)
            << c.force_balance << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| "
            << c.slip_equality << "  complementarity " << c.complementarity << "  penetration "
@@ -248,7 +217,7 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
         root.insert("levels", lv);
         root.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
         if (r.converged) {
-            const StateChecks c = check_state(p, r);
+            const levels::StateChecks c = levels::check_state(p, r);
             toml::table ct;
             ct.insert("force_balance", c.force_balance);
             ct.insert("coulomb_excess", c.coulomb_excess);

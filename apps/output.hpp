@@ -24,19 +24,6 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
 /// Prints the per-step table, checks (force balance, Coulomb, complementarity) and timings.
 void print_summary(std::ostream& os, const levels::Problem& p, const levels::RunResult& r);
 
-/// Quality figures of a converged state, all relative (see the README).
-struct StateChecks {
-    double force_balance =
-        0.0; ///< |resultant of loads, contact forces, reactions| / sum of magnitudes
-    double coulomb_excess = 0.0; ///< max (|lambda_t| - mu |lambda_n|)+ / max |lambda_n|
-    double slip_equality =
-        0.0; ///< max | |lambda_t| - mu |lambda_n| | at slipping nodes / max |lambda_n|
-    double complementarity = 0.0; ///< max |lambda_n d_n| / (max |lambda_n| * max |u|)
-    double penetration = 0.0;     ///< max (-d_n)+ / max |u|
-    double tension = 0.0;         ///< max (lambda_n)+ / max |lambda_n|
-};
-StateChecks check_state(const levels::Problem& p, const levels::RunResult& r);
-
 /// Writes contact.csv, summary.json and solution.vtu into dir (created if needed).
 void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
                    const levels::RunResult& r);

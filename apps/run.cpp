@@ -3,17 +3,17 @@
 #include "apps/run.hpp"
 
 #include "apps/output.hpp"
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <cmath>
 
 namespace mlc::apps {
 
 int run_scene(const RunOptions& opt, std::ostream& os) {
-    levels::Problem p = load_scene(opt.scene);
+    levels::Problem p = scene::load_scene(opt.scene);
     if (opt.levels) {
         MLC_CHECK(*opt.levels >= 0 && *opt.levels <= 12,
                   "--levels must lie in [0, 12], found " << *opt.levels);

@@ -2,10 +2,10 @@
 // Stability study over stiff and extreme cases (benchmarks.md, "Stiff and extreme cases").
 #include "apps/study_extremes.hpp"
 
-#include "apps/output.hpp"
-#include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "levels/checks.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <cmath>
 #include <csignal>
@@ -73,7 +73,7 @@ Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec&
     for (const auto& s : r.steps)
         res = std::max(res, s.residuals.back());
     f["residual"] = num(res);
-    const StateChecks c = check_state(p, r);
+    const levels::StateChecks c = levels::check_state(p, r);
     f["penetration"] = num(c.penetration);
     f["coulomb"] = num(std::max(c.coulomb_excess, c.slip_equality));
     f["balance"] = num(c.force_balance);
@@ -91,7 +91,7 @@ Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec&
 }
 
 levels::Problem square() {
-    return load_scene("square");
+    return scene::load_scene("square");
 }
 
 std::vector<Case> make_cases() {
@@ -172,23 +172,23 @@ contactor = "bottom"
 mu = 0.3
 obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
 )";
-                      return solve_case(parse_scene(text, "extremes:slender"), std::min(l, 1),
-                                        solver);
+                      return solve_case(scene::parse_scene(text, "extremes:slender"),
+                                        std::min(l, 1), solver);
                   }});
     // Two bodies, Young's moduli 1e6 apart, node on facet with friction, the default
     // r = 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, the statuses cycle
     // and Newton fails). Both ways round: a soft block on a stiff base, a stiff block on a soft
     // one.
     for (const bool soft_on_stiff : {true, false})
-        cs.push_back({soft_on_stiff ? "contrast 1e6 soft/stiff" : "contrast 1e6 stiff/soft",
-                      soft_on_stiff
-                          ? "two bodies: block E = 1 pressed on a base E = 1e6, side load"
-                          : "two bodies: block E = 1e6 pressed on a base E = 1, side load",
-                      [soft_on_stiff](int l, const levels::LinearSolverSpec& solver) {
-                          const double Eb = soft_on_stiff ? 1.0 : 1e6;
-                          const double Ebase = soft_on_stiff ? 1e6 : 1.0;
-                          std::ostringstream t;
-                          t << std::setprecision(17) << R"(
+        cs.push_back(
+            {soft_on_stiff ? "contrast 1e6 soft/stiff" : "contrast 1e6 stiff/soft",
+             soft_on_stiff ? "two bodies: block E = 1 pressed on a base E = 1e6, side load"
+                           : "two bodies: block E = 1e6 pressed on a base E = 1, side load",
+             [soft_on_stiff](int l, const levels::LinearSolverSpec& solver) {
+                 const double Eb = soft_on_stiff ? 1.0 : 1e6;
+                 const double Ebase = soft_on_stiff ? 1e6 : 1.0;
+                 std::ostringstream t;
+                 t << std::setprecision(17) << R"(
 [scene]
 name = "contrast"
 load_steps = 3
@@ -214,7 +214,8 @@ ux = 0.0
 uy = -0.01
 [[load]]
 tag = "block_left"
-pressure = )" << 2e-3 * Eb << R"(
+pressure = )" << 2e-3 * Eb
+                   << R"(
 [[contact]]
 name = "interface"
 contactor = "block_bottom"
@@ -222,8 +223,8 @@ target = "base_top"
 element = "node_on_facet"
 mu = 0.3
 )";
-                          return solve_case(parse_scene(t.str(), "extremes:contrast"), l, solver);
-                      }});
+                 return solve_case(scene::parse_scene(t.str(), "extremes:contrast"), l, solver);
+             }});
     cs.push_back({"units N/m/Pa vs N/mm/MPa", "square in SI and in mm units; compare",
                   [](int l, const levels::LinearSolverSpec& solver) {
                       auto mm = square();

@@ -1,99 +1,17 @@
 // SPDX-License-Identifier: MIT
 // Contact search on the reference configuration: closest facets (node on facet) and coincident
-// vertices (node on node), with a CGAL Kd-tree (Orthogonal_k_neighbor_search, Fuzzy_sphere).
+// vertices (node on node), with the point search of mesh/cgal/point_search.hpp (a CGAL Kd-tree).
 #include "contact/search.hpp"
 
 #include "core/check.hpp"
+#include "mesh/cgal/point_search.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 
-#ifdef MLC_HAVE_CGAL
-#include <CGAL/Fuzzy_sphere.h>
-#include <CGAL/Orthogonal_k_neighbor_search.h>
-#include <CGAL/Search_traits_2.h>
-#include <CGAL/Search_traits_adapter.h>
-#include <CGAL/Simple_cartesian.h>
-#include <CGAL/property_map.h>
-#include <boost/tuple/tuple.hpp>
-#endif
-
 namespace mlc::contact {
-
-namespace {
-
-/// Indexed points with nearest-point and range queries.
-class PointIndex {
-public:
-    explicit PointIndex(const std::vector<Vec2>& pts);
-    /// Index of the point nearest to x.
-    int nearest(const Vec2& x) const;
-    /// Indices of the points within distance `radius` of x (unordered).
-    std::vector<int> within(const Vec2& x, double radius) const;
-
-private:
-#ifdef MLC_HAVE_CGAL
-    using K = CGAL::Simple_cartesian<double>;
-    using Point = K::Point_2;
-    using PointAndIndex = boost::tuple<Point, int>;
-    using Traits = CGAL::Search_traits_adapter<
-        PointAndIndex, CGAL::Nth_of_tuple_property_map<0, PointAndIndex>, CGAL::Search_traits_2<K>>;
-    using KNN = CGAL::Orthogonal_k_neighbor_search<Traits>;
-    using Tree = KNN::Tree;
-    Tree tree_;
-#else
-    std::vector<Vec2> pts_;
-#endif
-};
-
-#ifdef MLC_HAVE_CGAL
-PointIndex::PointIndex(const std::vector<Vec2>& pts) {
-    std::vector<PointAndIndex> data;
-    data.reserve(pts.size());
-    for (size_t i = 0; i < pts.size(); ++i)
-        data.emplace_back(Point(pts[i].x(), pts[i].y()), static_cast<int>(i));
-    tree_.insert(data.begin(), data.end());
-    tree_.build();
-}
-
-int PointIndex::nearest(const Vec2& x) const {
-    KNN search(tree_, Point(x.x(), x.y()), 1);
-    return boost::get<1>(search.begin()->first);
-}
-
-std::vector<int> PointIndex::within(const Vec2& x, double radius) const {
-    std::vector<PointAndIndex> found;
-    CGAL::Fuzzy_sphere<Traits> sphere(Point(x.x(), x.y()), radius, 0.0);
-    tree_.search(std::back_inserter(found), sphere);
-    std::vector<int> out;
-    out.reserve(found.size());
-    for (const auto& p : found)
-        out.push_back(boost::get<1>(p));
-    return out;
-}
-#else
-// Without CGAL: linear scans (O(n) per query; fine for the contact boundaries of test meshes).
-PointIndex::PointIndex(const std::vector<Vec2>& pts) : pts_(pts) {}
-
-int PointIndex::nearest(const Vec2& x) const {
-    int best = 0;
-    for (size_t i = 1; i < pts_.size(); ++i)
-        if ((pts_[i] - x).squaredNorm() < (pts_[static_cast<size_t>(best)] - x).squaredNorm())
-            best = static_cast<int>(i);
-    return best;
-}
-
-std::vector<int> PointIndex::within(const Vec2& x, double radius) const {
-    std::vector<int> out;
-    for (size_t i = 0; i < pts_.size(); ++i)
-        if ((pts_[i] - x).norm() <= radius) out.push_back(static_cast<int>(i));
-    return out;
-}
-#endif
-
-} // namespace
 
 std::vector<Facet> target_facets(const mesh::Mesh& m, int tag) {
     std::vector<Facet> out;
@@ -122,7 +40,7 @@ struct FacetIndex::Impl {
     std::vector<std::array<Vec2, 2>> ends;
     double max_length = 0.0;
     std::vector<double> length;
-    PointIndex midpoints;
+    mesh::PointSearch midpoints;
     Impl(std::vector<Facet> f, std::vector<std::array<Vec2, 2>> e, std::vector<Vec2> mid)
         : facets(std::move(f)), ends(std::move(e)), midpoints(mid) {
         for (const auto& p : ends) {
@@ -396,7 +314,7 @@ SearchResult node_on_node_search(const mesh::Mesh& m, const std::vector<int>& co
             ++n_facets[it->second];
         }
     }
-    const PointIndex index(pos);
+    const mesh::PointSearch index(pos);
     SearchResult res;
     for (int c : contactors) {
         const Vec2& x = m.vertices[static_cast<size_t>(c)];

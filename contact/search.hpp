@@ -40,8 +40,9 @@ struct FacetProjection {
 /// zero length.
 FacetProjection project_on_facet(const Vec2& x, const Vec2& xa, const Vec2& xb);
 
-/// Spatial index over a set of facets: a CGAL Kd-tree on the facet midpoints (a linear scan when
-/// the build has no CGAL). Holds copies of the end points; `vertices` need not outlive it.
+/// Spatial index over a set of facets: a mesh::PointSearch on the facet midpoints (a CGAL Kd-tree,
+/// or a linear scan when the build has no CGAL). Holds copies of the end points; `vertices` need
+/// not outlive it.
 class FacetIndex {
 public:
     /// Throws InvalidInput for an empty facet list, an index out of range or a facet of zero

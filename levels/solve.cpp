@@ -176,37 +176,4 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     return res;
 }
 
-double force_balance_error(const Level& level, double s, const Vector& u_full,
-                           const std::vector<ContactNodeState>& nodes) {
-    // External forces on the body: loads F, contact forces -C (C = sum_j w_j (lambda_t t +
-    // lambda_n n), the multiplier being the force the body exerts), and support reactions
-    // Rs = K u - F + C on the fixed components (nodal equilibrium K u = F - C + Rs). The
-    // resultant F - C + Rs must vanish per axis; K u is recomputed element by element.
-    const Vector Ku = fem::internal_forces(level.mesh, level.materials, u_full);
-    const Vector F = level.f_nodal_at(s);
-    Vector C = Vector::Zero(Ku.size());
-    for (size_t e = 0; e < level.contacts.size(); ++e) {
-        const auto& el = level.contacts[e];
-        const Vec2 f = nodes[e].lambda_t * el.t + nodes[e].lambda_n * el.n;
-        for (int j = 0; j < el.n_nodes; ++j)
-            C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
-                el.weight[static_cast<size_t>(j)] * f;
-    }
-    double err = 0.0, total = 0.0;
-    for (int a = 0; a < 2; ++a) {
-        double resultant = 0.0, magnitude = 0.0;
-        for (int v = 0; v < level.mesh.n_vertices(); ++v) {
-            const int i = 2 * v + a;
-            const double Rs = level.fixed[static_cast<size_t>(v)][static_cast<size_t>(a)]
-                                  ? Ku[i] - F[i] + C[i]
-                                  : 0.0;
-            resultant += F[i] - C[i] + Rs;
-            magnitude += std::abs(F[i]) + std::abs(C[i]) + std::abs(Rs);
-        }
-        err = std::max(err, std::abs(resultant));
-        total = std::max(total, magnitude);
-    }
-    return total > 0 ? err / total : err;
-}
-
 } // namespace mlc::levels

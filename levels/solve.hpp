@@ -87,9 +87,4 @@ struct RunResult {
 /// when that exceeds what the process may use (process_memory_limit), naming both.
 RunResult solve(const Problem& problem, const SolveOptions& options = {});
 
-/// Relative global force balance: |resultant of loads, contact forces and support reactions| /
-/// sum of their magnitudes, per axis, the worse of the two.
-double force_balance_error(const Level& level, double s, const Vector& u_full,
-                           const std::vector<ContactNodeState>& nodes);
-
 } // namespace mlc::levels

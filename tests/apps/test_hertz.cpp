@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Hertz contact (benchmarks.md `hertz`): half-width and pressure against the closed form.
 #include "apps/closed_form.hpp"
-#include "apps/scene.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@ TEST(Hertz, ClosedFormValuesOfTheScene) {
     EXPECT_NEAR(h.half_width(), 0.1, 1e-5);
     EXPECT_NEAR(h.peak_pressure(), 0.054945, 1e-5);
     // The scene's top traction carries P / 2 on the half model.
-    const auto p = apps::load_scene("hertz");
+    const auto p = scene::load_scene("hertz");
     const auto L = levels::build_level(p, p.mesh0);
     double fy = 0;
     for (int v = 0; v < L.mesh.n_vertices(); ++v)
@@ -23,7 +23,7 @@ TEST(Hertz, ClosedFormValuesOfTheScene) {
 
 TEST(Hertz, HalfWidthAndPeakPressureConvergeToTheClosedForm) {
     const apps::Hertz h{.P = 8.6307e-3, .R = 1.0, .E_star = 1.0 / (1.0 - 0.09)};
-    auto p = apps::load_scene("hertz");
+    auto p = scene::load_scene("hertz");
     std::vector<apps::HertzErrors> err;
     for (int level : {0, 1, 2}) {
         p.levels = level;

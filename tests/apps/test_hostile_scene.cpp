@@ -2,8 +2,8 @@
 // Hostile input (issue 7): scenes that once crashed, hung or invoked undefined behaviour in the
 // parser (found while fuzzing it with tests/fuzz, or by review), inlined as they were found; each
 // must now give an InvalidInput, or parse in reasonable time when it is valid.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +22,7 @@ E = 1.0
 nu = 0.3
 mesh = { type = "rectangle", corner = [0, 0], size = [1, 1], divisions = [100000, 100000] }
 )";
-    EXPECT_THROW(apps::parse_scene(text, "hostile.toml"), InvalidInput);
+    EXPECT_THROW(scene::parse_scene(text, "hostile.toml"), InvalidInput);
 }
 
 // Found while bounding the fuzz target: a scene naming a device as its Gmsh file made the parser
@@ -36,7 +36,7 @@ nu = 0.3
 mesh = { type = "gmsh", file = "/dev/zero" }
 )";
     try {
-        apps::parse_scene(text, "hostile.toml");
+        scene::parse_scene(text, "hostile.toml");
         ADD_FAILURE() << "no exception";
     } catch (const InvalidInput& e) {
         EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
@@ -55,7 +55,7 @@ nu = 0.3
 mesh = { type = "rectangle", corner = [0, 0], size = [0.01, 1000], divisions = [1, 100000] }
 )";
     const auto t0 = std::chrono::steady_clock::now();
-    const auto p = apps::parse_scene(text, "strip.toml");
+    const auto p = scene::parse_scene(text, "strip.toml");
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_EQ(p.mesh0.n_triangles(), 200000);

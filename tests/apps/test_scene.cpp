@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Scene parsing: every bad input of the foundation issue gets an InvalidInput naming it.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "scene/scene.hpp"
 #include "tests/common/scene_text.hpp"
 
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@ using namespace mlc;
 namespace {
 
 std::string square_text() {
-    return apps::builtin_scene_text("square");
+    return scene::builtin_scene_text("square");
 }
 
 using test::error_of;
@@ -21,7 +21,7 @@ using test::replace;
 } // namespace
 
 TEST(Scene, BuiltinSquareParses) {
-    const auto p = apps::load_scene("square");
+    const auto p = scene::load_scene("square");
     EXPECT_EQ(p.name, "square");
     EXPECT_EQ(p.load_steps, 5);
     ASSERT_EQ(p.contacts.size(), 1u);
@@ -90,6 +90,6 @@ TEST(Scene, UnknownTagIsRejected) {
 }
 
 TEST(Scene, MissingFileAndUnknownBuiltinAreRejected) {
-    EXPECT_THROW(apps::load_scene("/nonexistent/scene.toml"), InvalidInput);
-    EXPECT_THROW(apps::load_scene("no_such_scene"), InvalidInput);
+    EXPECT_THROW(scene::load_scene("/nonexistent/scene.toml"), InvalidInput);
+    EXPECT_THROW(scene::load_scene("no_such_scene"), InvalidInput);
 }

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The square test (benchmarks.md): equilibrium, Signorini/Coulomb identities and the expected
 // picture of lift-off, slip and stick.
-#include "apps/output.hpp"
-#include "apps/scene.hpp"
+#include "levels/checks.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@ using namespace mlc;
 namespace {
 
 levels::RunResult solve_square(int level, double mu) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = level;
     for (auto& c : p.contacts)
         c.mu = mu;
@@ -22,7 +22,7 @@ levels::RunResult solve_square(int level, double mu) {
 } // namespace
 
 TEST(Square, UnknownCountsMatchTheBenchmarkLadder) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     for (auto [level, n] : {std::pair{0, 592}, {1, 2208}}) {
         p.levels = level;
         mesh::Mesh m = p.mesh0;
@@ -36,11 +36,11 @@ TEST(Square, UnknownCountsMatchTheBenchmarkLadder) {
 
 TEST(Square, ConvergedStateSatisfiesEquilibriumAndTheContactLaws) {
     for (int level : {0, 1}) {
-        auto p = apps::load_scene("square");
+        auto p = scene::load_scene("square");
         p.levels = level;
         const auto r = levels::solve(p);
         ASSERT_TRUE(r.converged) << r.failure;
-        const auto c = apps::check_state(p, r);
+        const auto c = levels::check_state(p, r);
         EXPECT_LT(c.force_balance, 1e-8);
         EXPECT_LT(c.coulomb_excess, 1e-8);
         EXPECT_LT(c.slip_equality, 1e-8);

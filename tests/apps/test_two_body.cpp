@@ -2,10 +2,11 @@
 // Two-body contact (node on node, node on facet) on the benchmark scenes patch, patch_matching,
 // mindlin and dovetail, the ring scene calumet, and the scene keys of two-body pairs.
 #include "apps/output.hpp"
-#include "apps/scene.hpp"
 #include "apps/study_accuracy.hpp"
 #include "core/check.hpp"
+#include "levels/checks.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 #include "tests/common/scene_text.hpp"
 
 #include <gtest/gtest.h>
@@ -36,7 +37,7 @@ std::vector<int> vertex_body(const mesh::Mesh& m) {
 
 // ---------------------------------------------------------------------------------------------
 TEST(PatchTest, NodeOnNodeOnMatchingMeshesIsExactToRoundOff) {
-    auto p = apps::load_scene("patch_matching");
+    auto p = scene::load_scene("patch_matching");
     for (int level : {0, 1, 2}) {
         p.levels = level;
         const auto r = levels::solve(p);
@@ -60,9 +61,9 @@ TEST(PatchTest, NodalNodeOnFacetOnNonMatchingMeshesMissesByMoreThanTwoPerCent) {
     // target vertex hands its whole force to that vertex and carries about 7% less than p h.
     // The interface displacement and the resultant converge; the nodal pressure error does not
     // shrink with h. This documents why the scene uses integration = "segment".
-    auto p = apps::parse_scene(replace(apps::builtin_scene_text("patch"),
-                                       "integration = \"segment\"", "integration = \"nodal\""),
-                               "patch_nodal.toml");
+    auto p = scene::parse_scene(replace(scene::builtin_scene_text("patch"),
+                                        "integration = \"segment\"", "integration = \"nodal\""),
+                                "patch_nodal.toml");
     ASSERT_EQ(p.contacts[0].integration, contact::FacetIntegration::nodal);
     for (int level : {0, 1}) {
         p.levels = level;
@@ -89,9 +90,9 @@ TEST(PatchTest, SegmentAndDualIntegrationAreExactOnNonMatchingMeshes) {
     // Segment-integrated weights give the consistent load of a uniform pressure on the target:
     // the exact linear field is the discrete solution on every level (each solved
     // coarse-to-fine from level 0). Exact case: fails if the weights are wrong.
-    const std::string text = apps::builtin_scene_text("patch");
+    const std::string text = scene::builtin_scene_text("patch");
     for (const std::string variant : {"segment", "dual"}) {
-        auto p = apps::parse_scene(
+        auto p = scene::parse_scene(
             replace(text, "integration = \"segment\"", "integration = \"" + variant + "\""),
             "patch_" + variant + ".toml");
         for (int level : {0, 1, 2}) {
@@ -129,7 +130,7 @@ TEST(PatchTest, SegmentAndDualIntegrationAreExactOnNonMatchingMeshes) {
 
 // ---------------------------------------------------------------------------------------------
 TEST(Mindlin, PartialSlipStickZoneMatchesCattaneoMindlin) {
-    auto p = apps::load_scene("mindlin");
+    auto p = scene::load_scene("mindlin");
     ASSERT_EQ(p.n_path_points(), 2);
     std::vector<apps::MindlinMeasures> ms;
     std::vector<double> bound;
@@ -202,7 +203,7 @@ TEST(Mindlin, StepOneTractionIsAFiniteGeometryEffectThatShrinksWithTheContactWid
     // (a / R) mu p0 that the closed form does not have. Measured on level 1: rms q / (mu p0) =
     // 0.086 at the scene's a = 0.1 R, 0.032 with the platen displacements divided by 16
     // (a = 0.021 R); on level 2, 0.080 and 0.024. A discretization artefact would not scale so.
-    auto p = apps::load_scene("mindlin");
+    auto p = scene::load_scene("mindlin");
     p.levels = 1;
     std::vector<apps::MindlinMeasures> ms;
     for (const double scale : {1.0, 1.0 / 16.0}) {
@@ -230,7 +231,7 @@ TEST(Mindlin, StepOneTractionIsAFiniteGeometryEffectThatShrinksWithTheContactWid
 
 // ---------------------------------------------------------------------------------------------
 TEST(Dovetail, EquilibriumMirrorSymmetryAndCoulombOnLevels0To2) {
-    auto p = apps::load_scene("dovetail");
+    auto p = scene::load_scene("dovetail");
     p.levels = 2;
     const auto r = levels::solve(p);
     ASSERT_TRUE(r.converged) << r.failure;
@@ -278,7 +279,7 @@ TEST(Dovetail, EquilibriumMirrorSymmetryAndCoulombOnLevels0To2) {
             ++slipping;
         }
     EXPECT_GT(slipping, 0);
-    const auto c = apps::check_state(p, r);
+    const auto c = levels::check_state(p, r);
     EXPECT_LT(c.force_balance, 1e-10);
     EXPECT_LT(c.penetration, 1e-10);
     // Contactor vertices of level 0 stay contactor nodes on every level; coarse-to-fine predicts
@@ -298,7 +299,7 @@ TEST(Dovetail, EquilibriumMirrorSymmetryAndCoulombOnLevels0To2) {
 
 // ---------------------------------------------------------------------------------------------
 TEST(Calumet, RingHeldOnlyByContactConvergesOnLevels0To3) {
-    auto p = apps::load_scene("calumet");
+    auto p = scene::load_scene("calumet");
     p.levels = 3;
     const auto r = levels::solve(p);
     ASSERT_TRUE(r.converged) << r.failure;
@@ -319,12 +320,12 @@ TEST(Calumet, RingHeldOnlyByContactConvergesOnLevels0To3) {
         f -= r.nodes[e].lambda_t * L.contacts[e].t + r.nodes[e].lambda_n * L.contacts[e].n;
     EXPECT_NEAR(f.y(), 1000.0, 1e-3); // arc polygon vs chord: the mesh resultant is 1000 to 1e-7
     EXPECT_NEAR(f.x(), 0.0, 1e-8 * 1000.0);
-    EXPECT_LT(apps::check_state(p, r).force_balance, 1e-10);
+    EXPECT_LT(levels::check_state(p, r).force_balance, 1e-10);
 }
 
 // ---------------------------------------------------------------------------------------------
 TEST(TwoBodyMesh, RefinementKeepsTheBodiesApart) {
-    auto p = apps::load_scene("patch_matching");
+    auto p = scene::load_scene("patch_matching");
     p.levels = 2;
     const auto h = levels::build_hierarchy(p);
     for (int l = 1; l <= 2; ++l) {
@@ -351,10 +352,10 @@ TEST(TwoBodyMesh, RefinementKeepsTheBodiesApart) {
 TEST(TwoBodyScene, ContactorNodesBeyondTheTargetAreReported) {
     // The upper block overhangs the lower one by half a unit: its bottom nodes beyond x = 1 face
     // no target facet.
-    std::string text = apps::builtin_scene_text("patch");
+    std::string text = scene::builtin_scene_text("patch");
     text = replace(text, "corner = [0.0, 1.0], size = [1.0, 1.0], divisions = [5, 5]",
                    "corner = [0.0, 1.0], size = [1.5, 1.0], divisions = [6, 4]");
-    const auto p = apps::parse_scene(text, "overhang.toml");
+    const auto p = scene::parse_scene(text, "overhang.toml");
     const auto L = levels::build_level(p, p.mesh0);
     ASSERT_EQ(L.not_found.size(), 1u);
     ASSERT_EQ(L.not_found[0].size(), 2u); // x = 1.25 and 1.5 (x = 1 is the target's end)
@@ -366,7 +367,7 @@ TEST(TwoBodyScene, ContactorNodesBeyondTheTargetAreReported) {
 }
 
 TEST(TwoBodyScene, KeysAreCheckedAndNamed) {
-    const std::string patch = apps::builtin_scene_text("patch");
+    const std::string patch = scene::builtin_scene_text("patch");
     auto msg = error_of(replace(patch, "target = \"lower_top\"",
                                 "target = \"lower_top\"\nobstacle = { type = \"line\", point = "
                                 "[0, 0], normal = [0, 1] }"));
@@ -400,18 +401,18 @@ TEST(TwoBodyScene, KeysAreCheckedAndNamed) {
     EXPECT_NE(msg.find("has no tag 'roof'"), std::string::npos) << msg;
     // A rigid pair takes no two-body keys.
     msg = error_of(
-        replace(apps::builtin_scene_text("square"), "mu = 1.0", "mu = 1.0\nsearch_radius = 2"));
+        replace(scene::builtin_scene_text("square"), "mu = 1.0", "mu = 1.0\nsearch_radius = 2"));
     EXPECT_NE(msg.find("applies to two-body pairs"), std::string::npos) << msg;
     // Per-step lists: every list has the same length.
-    msg = error_of(replace(apps::builtin_scene_text("mindlin"), "ux = [0.0, 4.35e-3]",
+    msg = error_of(replace(scene::builtin_scene_text("mindlin"), "ux = [0.0, 4.35e-3]",
                            "ux = [0.0, 1e-3, 4.35e-3]"));
     EXPECT_NE(msg.find("every per-step list must have the same length"), std::string::npos) << msg;
-    msg = error_of(replace(apps::builtin_scene_text("mindlin"), "ux = [0.0, 4.35e-3]", "ux = []"));
+    msg = error_of(replace(scene::builtin_scene_text("mindlin"), "ux = [0.0, 4.35e-3]", "ux = []"));
     EXPECT_NE(msg.find("non-empty array of numbers"), std::string::npos) << msg;
 }
 
 TEST(TwoBodyScene, MirroredDomainIsExactlySymmetric) {
-    const auto p = apps::load_scene("dovetail");
+    const auto p = scene::load_scene("dovetail");
     const auto& m = p.mesh0;
     std::map<std::pair<long, long>, int> at;
     for (int v = 0; v < m.n_vertices(); ++v)
@@ -434,12 +435,12 @@ TEST(TwoBodyMesh, ContactNodesNestOnACurvedTarget) {
     // The half-disc's arc as the target (its polygon moves toward the circle under refinement)
     // and the block top as the contactor: whether a node is a contact node is decided on the
     // level-0 facets, so every level-0 contact node stays one and the transfers build.
-    std::string text = apps::builtin_scene_text("mindlin");
+    std::string text = scene::builtin_scene_text("mindlin");
     text = replace(text, "contactor = \"surface\"\ntarget = \"block_top\"",
                    "contactor = \"block_top\"\ntarget = \"surface\"");
     text = replace(text, "region = { min = [-0.25, -1.0], max = [0.25, 0.1] }",
                    "region = { min = [-0.25, -1.0], max = [0.25, 0.1] }\nsearch_radius = 1.0");
-    auto p = apps::parse_scene(text, "swapped.toml");
+    auto p = scene::parse_scene(text, "swapped.toml");
     p.levels = 2;
     const auto h = levels::build_hierarchy(p);
     for (int l = 1; l <= 2; ++l) {
@@ -457,8 +458,8 @@ TEST(PatchTest, StiffnessContrastOfAMillionIsExactWithTheDefaultAugmentation) {
     // The lower block 1e6 times softer than the upper one (nu = 0, E = 2 and 2e6): springs in
     // series, uniform stress s = 0.1 / (1/2 + 1/2e6), interface u_y = -s / 2. The default r is
     // 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, Newton cycles).
-    const auto p0 = apps::parse_scene(
-        replace(apps::builtin_scene_text("patch"), "E = 2.0e6", "E = 2.0"), "patch_contrast.toml");
+    const auto p0 = scene::parse_scene(
+        replace(scene::builtin_scene_text("patch"), "E = 2.0e6", "E = 2.0"), "patch_contrast.toml");
     ASSERT_EQ(p0.bodies.size(), 2u);
     EXPECT_DOUBLE_EQ(p0.bodies[0].material.E, 2.0);
     EXPECT_DOUBLE_EQ(p0.bodies[1].material.E, 2.0e6);

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "tests/common/scene_text.hpp"
 
-#include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@ std::string replace(std::string s, const std::string& from, const std::string& t
 
 std::string error_of(const std::string& text) {
     try {
-        apps::parse_scene(text, "test.toml");
+        scene::parse_scene(text, "test.toml");
     } catch (const InvalidInput& e) {
         return e.what();
     }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// libFuzzer target: the input bytes as scene TOML text for apps::parse_scene. mlc::InvalidInput is
+// libFuzzer target: the input bytes as scene TOML text for scene::parse_scene. mlc::InvalidInput is
 // the expected answer to bad input; any other exception, a crash, a sanitizer report or a hang is
 // a finding.
 //
@@ -9,8 +9,8 @@
 // target estimates the triangle count from the TOML before calling the parser and skips inputs
 // above a budget. The estimate only skips inputs; it never replaces a check of the library, which
 // still sees every input under the budget, including every invalid size.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
+#include "scene/scene.hpp"
 
 #include <toml++/toml.h>
 
@@ -135,7 +135,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::string text(reinterpret_cast<const char*>(data), size);
     if (estimate_scene(text) > max_triangles) return -1; // skipped; not added to the corpus
     try {
-        mlc::apps::parse_scene(text, "fuzz.toml", MLC_FUZZ_DATA_DIR);
+        mlc::scene::parse_scene(text, "fuzz.toml", MLC_FUZZ_DATA_DIR);
     } catch (const mlc::InvalidInput&) {
         // The expected answer to bad input. Anything else propagates: libFuzzer reports it.
     }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Coarse-to-fine Newton: same discrete solution as the cold start, far fewer Newton iterations,
 // and statuses predicted by the interpolated state.
-#include "apps/scene.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -23,7 +23,7 @@ double mean_newton(const levels::RunResult& r, int level) {
 } // namespace
 
 TEST(CoarseToFine, SquareMatchesColdStartWithHalfTheNewtonIterations) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 3;
     levels::SolveOptions warm_opt, cold_opt;
     cold_opt.coarse_to_fine = false;
@@ -53,7 +53,7 @@ TEST(CoarseToFine, SquareMatchesColdStartWithHalfTheNewtonIterations) {
 }
 
 TEST(CoarseToFine, ConservativeQGivesTheSameSolution) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 2;
     levels::SolveOptions a, b;
     b.q_rule = transfer::QRule::conservative;
@@ -64,7 +64,7 @@ TEST(CoarseToFine, ConservativeQGivesTheSameSolution) {
 }
 
 TEST(CoarseToFine, HertzConvergesOnEveryLevelWithPredictedStatuses) {
-    auto p = apps::load_scene("hertz");
+    auto p = scene::load_scene("hertz");
     p.levels = 2;
     const auto r = levels::solve(p);
     ASSERT_TRUE(r.converged) << r.failure;
@@ -76,7 +76,7 @@ TEST(CoarseToFine, HertzConvergesOnEveryLevelWithPredictedStatuses) {
 }
 
 TEST(CoarseToFine, FailureNamesTheLevelAndStep) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 1;
     p.newton.max_iter = 1;
     const auto r = levels::solve(p);
@@ -89,7 +89,7 @@ TEST(CoarseToFine, FailureNamesTheLevelAndStep) {
 TEST(Newton, SolutionDoesNotDependOnTheAugmentationParameter) {
     // The discrete solution of the Alart-Curnier equations is independent of r; a very large r
     // makes the generalized Newton cycle between status sets, which must be detected and damped.
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 2;
     const auto ref = levels::solve(p);
     ASSERT_TRUE(ref.converged) << ref.failure;
@@ -103,7 +103,7 @@ TEST(Newton, SolutionDoesNotDependOnTheAugmentationParameter) {
 }
 
 TEST(CoarseToFine, IncrementTransferGivesTheSameSolutionAndPredictsAtLeastAsWell) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 3;
     levels::SolveOptions a, b;
     b.transfer_increment = true;

@@ -2,13 +2,13 @@
 // Krylov Newton-system solvers with the papers' preconditioners on two levels of the square:
 // one fine Newton system of the multilevel Newton, solved by CGS with ILU(0), CF, SORCF and EBE,
 // against the exact condensed ("schur") solve.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "levels/hierarchy.hpp"
 #include "levels/krylov_system.hpp"
 #include "levels/level.hpp"
 #include "levels/newton.hpp"
 #include "mesh/mesh.hpp"
+#include "scene/scene.hpp"
 #include "transfer/transfer.hpp"
 
 #include <gtest/gtest.h>
@@ -34,7 +34,7 @@ struct TwoLevels {
     std::unique_ptr<JacobianAssembler> J;
 
     TwoLevels() {
-        problem = apps::load_scene("square");
+        problem = scene::load_scene("square");
         coarse = build_level(problem, problem.mesh0);
         fine = build_level(problem, mesh::refine(problem.mesh0));
         transfer =

@@ -1,16 +1,17 @@
 // SPDX-License-Identifier: MIT
 // Loading paths: proportional loading unchanged, per-step prescribed values and load factors
 // interpolated between path points.
-#include "apps/scene.hpp"
+#include "levels/checks.hpp"
 #include "levels/level.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
 using namespace mlc;
 
 TEST(LoadPath, ProportionalLoadingIsTheLoadFactorTimesTheFullLoad) {
-    const auto p = apps::load_scene("square");
+    const auto p = scene::load_scene("square");
     ASSERT_EQ(p.n_path_points(), 1);
     const auto L = levels::build_level(p, p.mesh0);
     for (double s : {0.0, 0.2, 0.6, 1.0}) {
@@ -23,7 +24,7 @@ TEST(LoadPath, ProportionalLoadingIsTheLoadFactorTimesTheFullLoad) {
 
 TEST(LoadPath, PerStepValuesAreReachedAtTheirPathPoints) {
     // mindlin: platen u = (0, -d_n) at step 1, (d_t, -d_n) at step 2.
-    const auto p = apps::load_scene("mindlin");
+    const auto p = scene::load_scene("mindlin");
     ASSERT_EQ(p.n_path_points(), 2);
     const auto L = levels::build_level(p, p.mesh0);
     const int v = L.mesh.nearest_vertex(Vec2(0.5, 1.0)); // on the platen
@@ -45,7 +46,7 @@ TEST(LoadPath, PerStepValuesAreReachedAtTheirPathPoints) {
 TEST(LoadPath, LoadFactorsScaleTractionsPerStep) {
     // square with the top pressure applied in the first step only and the side pressure in
     // the second: factors [1, 1] and [0, 1].
-    std::string text = apps::builtin_scene_text("square");
+    std::string text = scene::builtin_scene_text("square");
     auto put = [&](const std::string& from, const std::string& to) {
         const auto pos = text.find(from);
         ASSERT_NE(pos, std::string::npos) << from;
@@ -54,7 +55,7 @@ TEST(LoadPath, LoadFactorsScaleTractionsPerStep) {
     put("load_steps = 5", "load_steps = 2");
     put("pressure = 50.0", "pressure = 50.0\nfactors = [1.0, 1.0]");
     put("pressure = 150.0", "pressure = 150.0\nfactors = [0.0, 1.0]");
-    auto p = apps::parse_scene(text, "staged.toml");
+    auto p = scene::parse_scene(text, "staged.toml");
     ASSERT_EQ(p.n_path_points(), 2);
     const auto L = levels::build_level(p, p.mesh0);
     double fx = 0, fy = 0;

@@ -2,10 +2,10 @@
 // `--pc mg` on the square (mu = 1, five load steps, coarse-to-fine): the V-cycle over all
 // levels preconditions the non-symmetric contact Jacobian inside CGS, BiCGStab and GMRES with a
 // small iteration count that does not grow from level 1 to level 3.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "levels/krylov_system.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -31,7 +31,7 @@ std::vector<int> max_iterations(const RunResult& r) {
 
 RunResult run_square(int levels, const std::string& krylov, const std::string& pc,
                      int load_steps = 0) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = levels;
     if (load_steps > 0) p.load_steps = load_steps;
     SolveOptions so;
@@ -49,7 +49,7 @@ RunResult run_square_problem(const Problem& p) {
 
 TEST(MultilevelPreconditioner, WorksInsideCgsBicgstabAndGmres) {
     // Measured on level 2: CGS 8-9, BiCGStab 7-8, GMRES 13 iterations per Newton step.
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 2;
     const RunResult ref = solve(p, {}); // the exact condensed solver
     ASSERT_TRUE(ref.converged);
@@ -73,7 +73,7 @@ TEST(MultilevelPreconditioner, IterationsDoNotGrowWithTheLevel) {
 }
 
 TEST(MultilevelPreconditioner, NeedsTheLevelBelowAndValidOptions) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 0;
     SolveOptions so;
     so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg"};
@@ -89,7 +89,7 @@ TEST(InexactNewton, ForcingTermsSaveKrylovIterationsAndGiveTheSameSolution) {
     // The first Newton iteration of each load step solves to 1e-3 (its statuses are a coarse
     // prediction, corrected by that step), the later ones just to what reaches the Newton
     // tolerance: measured on levels 1..2, 105 instead of 156 CGS iterations in all.
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 2;
     const RunResult ref = solve(p, {}); // the exact condensed solver
     ASSERT_TRUE(ref.converged);
@@ -121,7 +121,7 @@ TEST(MultilevelPreconditioner, GalerkinCoarseOperatorsConvergeLikeRediscretizati
     // mg:coarse=galerkin builds R J T down to level 0 from each Newton system (statuses of the
     // fine level carried down by the products); the default rediscretizes (the level below's
     // Jacobian at its converged statuses). Same solution, similar iterations on levels 1..2.
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 2;
     p.load_steps = 2;
     const RunResult ref = solve(p, {});

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
 // What a run needs before it is built: predicted level sizes against the built hierarchy, the
 // driver's solver choice, the memory estimate and the refusal of a run that cannot fit.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "levels/hierarchy.hpp"
 #include "levels/resources.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@ using namespace mlc;
 TEST(PredictLevelSizes, RefinementCountsAreExactAndUnknownsClose) {
     for (const char* name : {"square", "hertz", "dovetail", "mindlin"}) {
         SCOPED_TRACE(name);
-        auto p = apps::load_scene(name);
+        auto p = scene::load_scene(name);
         p.levels = 3;
         const auto sizes = levels::predict_level_sizes(p);
         const auto h = levels::build_hierarchy(p);
@@ -41,7 +41,7 @@ TEST(PredictLevelSizes, RefinementCountsAreExactAndUnknownsClose) {
 }
 
 TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 2;
     const auto c = levels::choose_solver(p, {{}, {}, std::string("mg"), {}});
     EXPECT_EQ(c.spec.method, "krylov");
@@ -59,7 +59,7 @@ TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
 }
 
 TEST(ChooseSolver, LinearKrylovUsesMgWhereLevelsExistAndIluOnOneLevel) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 1;
     EXPECT_EQ(levels::choose_solver(p, {std::string("krylov"), {}, {}, {}}).spec.pc, "mg");
     p.levels = 0;
@@ -67,7 +67,7 @@ TEST(ChooseSolver, LinearKrylovUsesMgWhereLevelsExistAndIluOnOneLevel) {
 }
 
 TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 2;
     for (const char* direct : {"schur", "lu"}) {
         try {
@@ -86,7 +86,7 @@ TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
 }
 
 TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     for (int L = 0; L <= 6; ++L) {
         SCOPED_TRACE(L);
         p.levels = L;
@@ -109,7 +109,7 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
 }
 
 TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 5;
     const auto sizes = levels::predict_level_sizes(p);
     levels::LinearSolverSpec mg;
@@ -126,7 +126,7 @@ TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
 }
 
 TEST(MemoryEstimate, ARunThatCannotFitIsRefusedBeforeAllocatingNamingLevelAndLimit) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 3;
     const auto sizes = levels::predict_level_sizes(p);
     const auto e = levels::estimate_memory(sizes, levels::LinearSolverSpec{}, true);

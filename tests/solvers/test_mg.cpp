@@ -2,10 +2,10 @@
 // The geometric V-cycle (solvers/mg.hpp) and hypre BoomerAMG on the elastic block of the square:
 // the cycle as a stationary iteration contracts the residual by a fixed factor per cycle, and
 // mg-CG and BoomerAMG-PCG both reach the tolerance and agree with a sparse direct solve.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "levels/elastic_block.hpp"
 #include "levels/hierarchy.hpp"
+#include "scene/scene.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/hypre/boomeramg.hpp"
@@ -28,7 +28,7 @@ struct ElasticHierarchy {
     Vector b;
 
     explicit ElasticHierarchy(int levels) {
-        auto problem = apps::load_scene("square");
+        auto problem = scene::load_scene("square");
         problem.levels = levels;
         h = levels::build_hierarchy(problem);
         for (const auto& L : h.levels)

@@ -2,11 +2,11 @@
 // Two-level interpolation P and Q (formulation.md §3) on the square ladder and the CGAL-meshed
 // Hertz scene: reproduction of linear fields, nesting, the coarse/fine split, and the force
 // transfer of Q at the ends of the contact boundary.
-#include "apps/scene.hpp"
 #include "core/check.hpp"
 #include "levels/hierarchy.hpp"
 #include "levels/level.hpp"
 #include "levels/solve.hpp"
+#include "scene/scene.hpp"
 #include "transfer/transfer.hpp"
 
 #include <gtest/gtest.h>
@@ -42,12 +42,12 @@ LevelTransfer make_transfer(const levels::Level& coarse, const levels::Level& fi
 }
 
 const std::vector<levels::Level>& square_levels() {
-    static const auto L = ladder(apps::load_scene("square"), 3);
+    static const auto L = ladder(scene::load_scene("square"), 3);
     return L;
 }
 
 const std::vector<levels::Level>& hertz_levels() {
-    static const auto L = ladder(apps::load_scene("hertz"), 3);
+    static const auto L = ladder(scene::load_scene("hertz"), 3);
     return L;
 }
 
@@ -522,7 +522,7 @@ TEST(MultiplierTransfer, ConservativeRulePreservesTheResultantPaperOnlyWithUnloa
 // load step) the left end of the contact edge has lifted off, so Q loses nothing there and the
 // resultant of (lambda_t, lambda_n) survives the transfer to level 1 exactly.
 TEST(MultiplierTransfer, PaperRuleIsExactOnTheSolvedSquareBecauseTheLeftEndLiftsOff) {
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 0;
     const auto r = levels::solve(p);
     ASSERT_TRUE(r.converged) << r.failure;
@@ -576,7 +576,7 @@ TEST(MultiplierTransfer, MidpointsAtTheEdgeOfTheContactRegionTakeOneParent) {
 }
 
 TEST(Transfer, SquareLadderUnknownCounts) {
-    const auto p = apps::load_scene("square");
+    const auto p = scene::load_scene("square");
     // (N+1)^2 vertices with N = 16 * 2^l: 2 (N+1)^2 components, less u_x on the N+1 vertices of
     // the symmetry plane and u_y at the corner, plus (lambda_t, lambda_n) at the N contact nodes
     // (the corner is no contact node). Level 2: 8450 - 66 + 128 = 8512.
@@ -619,7 +619,7 @@ TEST(Transfer, RejectsLevelsThatDoNotNest) {
     fewer.n_multipliers.erase(fewer.n_multipliers.begin() + k);
     EXPECT_THROW(transfer::build_transfer(F.mesh, C.dofs, F.dofs, cn, fewer), InvalidInput);
     // A different multiplier count (frictionless on the fine level only).
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.contacts[0].mu = 0.0;
     const auto F0 = levels::build_level(p, F.mesh);
     EXPECT_THROW(transfer::build_transfer(F.mesh, C.dofs, F0.dofs, cn, levels::contact_nodes(F0)),

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace mlc::apps {
+namespace mlc::scene {
 
 /// Parses a scene from TOML text. `origin` names the source in messages (a file path or
 /// "builtin:square"); relative mesh file paths are resolved against `base_dir`.
@@ -27,4 +27,4 @@ std::vector<std::string> builtin_scene_names();
 /// TOML text of a built-in scene, or empty if there is none with that name.
 std::string builtin_scene_text(const std::string& name);
 
-} // namespace mlc::apps
+} // namespace mlc::scene

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The BoomerAMG entry points when built without hypre (MLC_WITH_HYPRE=OFF): they say so.
+// solvers/CMakeLists.txt builds this file instead of boomeramg.cpp in that case.
 #include "solvers/hypre/boomeramg.hpp"
 
-#ifndef MLC_HAVE_HYPRE
 #include "core/check.hpp"
 
 namespace mlc::solvers {
@@ -17,20 +17,31 @@ namespace {
 struct BoomerAMGPreconditioner::Impl {};
 
 void BoomerAMGParams::validate() const {}
-std::ostream& operator<<(std::ostream& os, const BoomerAMGParams&) { return os << "BoomerAMGParams{}"; }
-bool have_hypre() { return false; }
-void ensure_hypre_initialized() { no_hypre(); }
+std::ostream& operator<<(std::ostream& os, const BoomerAMGParams&) {
+    return os << "BoomerAMGParams{}";
+}
+bool have_hypre() {
+    return false;
+}
+void ensure_hypre_initialized() {
+    no_hypre();
+}
 BoomerAMGPreconditioner::BoomerAMGPreconditioner(BoomerAMGParams params) : params_(params) {
     no_hypre();
 }
 BoomerAMGPreconditioner::~BoomerAMGPreconditioner() = default;
-void BoomerAMGPreconditioner::setup(const SparseMatrix&) { no_hypre(); }
-void BoomerAMGPreconditioner::apply(const Vector&, Vector&) const { no_hypre(); }
-std::string BoomerAMGPreconditioner::name() const { return "amg"; }
+void BoomerAMGPreconditioner::setup(const SparseMatrix&) {
+    no_hypre();
+}
+void BoomerAMGPreconditioner::apply(const Vector&, Vector&) const {
+    no_hypre();
+}
+std::string BoomerAMGPreconditioner::name() const {
+    return "amg";
+}
 SolveResult boomeramg_pcg(const SparseMatrix&, const Vector&, Vector&, double, int,
                           const BoomerAMGParams&, const std::vector<int>&) {
     no_hypre();
 }
 
 } // namespace mlc::solvers
-#endif

@@ -1,7 +1,7 @@
 # Generates a C++ source holding every scenes/*.toml as a string (the built-in scenes).
 file(GLOB scenes ${SRC_DIR}/scenes/*.toml)
 list(SORT scenes)
-set(body "// Generated from scenes/*.toml by apps/embed_scenes.cmake; do not edit.\n#include <map>\n#include <string>\nnamespace mlc::apps::detail {\nconst std::map<std::string, std::string>& builtin_scenes() {\n  static const std::map<std::string, std::string> s = {\n")
+set(body "// Generated from scenes/*.toml by scene/embed_scenes.cmake; do not edit.\n#include <map>\n#include <string>\nnamespace mlc::scene::detail {\nconst std::map<std::string, std::string>& builtin_scenes() {\n  static const std::map<std::string, std::string> s = {\n")
 foreach(f ${scenes})
   get_filename_component(name ${f} NAME_WE)
   file(READ ${f} content)

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Scene parsing with toml++; every key is checked against the schema documented in README.md.
-#include "apps/scene.hpp"
+#include "scene/scene.hpp"
 
 #include "core/check.hpp"
 #include "mesh/mesh.hpp"
@@ -8,6 +8,7 @@
 #include "mesh/cgal/domain_mesher.hpp"
 #endif
 #include "mesh/io/gmsh.hpp"
+#include "mesh/transform.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-namespace mlc::apps {
+namespace mlc::scene {
 
 namespace detail {
 const std::map<std::string, std::string>& builtin_scenes(); // generated
@@ -188,55 +189,6 @@ template <class F> auto at(const Reader& rd, const toml::node* n, F&& f) {
     }
 }
 
-/// The mesh of a half domain (every vertex on one side of the line x = x0, some on it) reflected
-/// about that line and glued to itself: vertices on the line are shared, the straight boundary
-/// edges lying on it disappear (they become interior), everything else is doubled with
-/// orientations restored (triangles and boundary edges counter-clockwise). An exactly mirror-
-/// symmetric mesh gives an exactly mirror-symmetric discrete problem.
-mesh::Mesh mirror_about_x(const mesh::Mesh& h, double x0) {
-    const double tol = 1e-10 * h.diameter();
-    const int nv = h.n_vertices();
-    mesh::Mesh m = h;
-    m.boundary.clear();
-    std::vector<int> image(static_cast<size_t>(nv));
-    int side = 0;
-    bool on_line = false;
-    for (int v = 0; v < nv; ++v) {
-        const Vec2 p = h.vertices[static_cast<size_t>(v)];
-        if (std::abs(p.x() - x0) <= tol) {
-            image[static_cast<size_t>(v)] = v;
-            on_line = true;
-            continue;
-        }
-        const int sv = p.x() > x0 ? 1 : -1;
-        MLC_CHECK(side == 0 || sv == side, "mirror_x = " << x0 << ": the domain has vertices on "
-                                                         << "both sides of the mirror line; "
-                                                         << "describe one half only");
-        side = sv;
-        image[static_cast<size_t>(v)] = m.n_vertices();
-        m.vertices.emplace_back(2.0 * x0 - p.x(), p.y());
-    }
-    MLC_CHECK(on_line, "mirror_x = " << x0 << ": no boundary vertex lies on the mirror line; the "
-                                     << "half domain must have an edge on it");
-    for (const auto& t : h.triangles)
-        m.triangles.push_back({image[static_cast<size_t>(t[0])], image[static_cast<size_t>(t[2])],
-                               image[static_cast<size_t>(t[1])]});
-    if (!h.attribute.empty())
-        m.attribute.insert(m.attribute.end(), h.attribute.begin(), h.attribute.end());
-    const int coff = static_cast<int>(h.circles.size());
-    for (const auto& c : h.circles)
-        m.circles.push_back({Vec2(2.0 * x0 - c.center.x(), c.center.y()), c.radius});
-    auto on = [&](int v) { return image[static_cast<size_t>(v)] == v; };
-    for (const auto& e : h.boundary) {
-        if (e.curve < 0 && on(e.v0) && on(e.v1)) continue; // on the mirror line: now interior
-        m.boundary.push_back(e);
-        m.boundary.push_back({image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)],
-                              e.tag, e.curve >= 0 ? e.curve + coff : -1});
-    }
-    mesh::check_quality(m);
-    return m;
-}
-
 #ifdef MLC_HAVE_CGAL
 mesh::Segment parse_segment(const Reader& rd, const toml::table& t, const std::string& where) {
     rd.check_keys(t, {"type", "from", "to", "center", "ccw", "tag"}, where);
@@ -317,7 +269,8 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
         }
         if (const toml::node* mx = t.get("mirror_x")) {
             const double x0 = rd.number(mx, where + ".mirror_x");
-            return at(rd, mx, [&] { return mirror_about_x(mesh::mesh_domain(loops, sf), x0); });
+            return at(rd, mx,
+                      [&] { return mesh::mirror_about_x(mesh::mesh_domain(loops, sf), x0); });
         }
         return at(rd, &t, [&] { return mesh::mesh_domain(loops, sf); });
 #else
@@ -333,21 +286,6 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
     }
     rd.fail(t.get("type"),
             where + ".type must be \"rectangle\", \"domain\" or \"gmsh\", found \"" + type + "\"");
-}
-
-/// Appends mesh b (body index `body`) to the merged mesh: vertices renumbered, tags merged by
-/// name, circles appended.
-void merge_into(mesh::Mesh& all, const mesh::Mesh& b, int body) {
-    const int voff = all.n_vertices();
-    const int coff = static_cast<int>(all.circles.size());
-    all.vertices.insert(all.vertices.end(), b.vertices.begin(), b.vertices.end());
-    all.circles.insert(all.circles.end(), b.circles.begin(), b.circles.end());
-    for (const auto& t : b.triangles)
-        all.triangles.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
-    all.attribute.resize(all.triangles.size(), body);
-    for (const auto& e : b.boundary)
-        all.boundary.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)),
-                                e.curve >= 0 ? e.curve + coff : -1});
 }
 
 } // namespace
@@ -436,7 +374,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
                 if (const auto it = merged.find(e.tag); it != merged.end()) e.tag = it->second;
             m.tag_names = std::move(names);
         }
-        merge_into(p.mesh0, m, static_cast<int>(i));
+        mesh::merge_into(p.mesh0, m, static_cast<int>(i));
         p.bodies.push_back(body);
     }
     at(rd, &root, [&] {
@@ -668,4 +606,4 @@ levels::Problem load_scene(const std::string& name_or_path) {
     return parse_scene(ss.str(), path.string(), path.parent_path());
 }
 
-} // namespace mlc::apps
+} // namespace mlc::scene

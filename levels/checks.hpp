@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: MIT
+/// @file Physics checks of a converged state: global force balance, the Coulomb cone, slip,
+/// complementarity, penetration and tension, each relative to the scale of the solution.
+#pragma once
+
+#include "core/types.hpp"
+#include "levels/level.hpp"
+#include "levels/newton.hpp"
+#include "levels/problem.hpp"
+#include "levels/solve.hpp"
+
+#include <vector>
+
+namespace mlc::levels {
+
+/// Relative global force balance: |resultant of loads, contact forces and support reactions| /
+/// sum of their magnitudes, per axis, the worse of the two.
+double force_balance_error(const Level& level, double s, const Vector& u_full,
+                           const std::vector<ContactNodeState>& nodes);
+
+/// Quality figures of a converged state, all relative (see the README).
+struct StateChecks {
+    double force_balance =
+        0.0; ///< |resultant of loads, contact forces, reactions| / sum of magnitudes
+    double coulomb_excess = 0.0; ///< max (|lambda_t| - mu |lambda_n|)+ / max |lambda_n|
+    double slip_equality =
+        0.0; ///< max | |lambda_t| - mu |lambda_n| | at slipping nodes / max |lambda_n|
+    double complementarity = 0.0; ///< max |lambda_n d_n| / (max |lambda_n| * max |u|)
+    double penetration = 0.0;     ///< max (-d_n)+ / max |u|
+    double tension = 0.0;         ///< max (lambda_n)+ / max |lambda_n|
+};
+
+/// The checks of the final state of a run (r.u_full and r.nodes on the finest level, full load):
+/// force balance as force_balance_error; the contact figures over all contact nodes, the Coulomb
+/// excess only at nodes in contact and the slip equality only at slipping frictional nodes.
+StateChecks check_state(const Problem& p, const RunResult& r);
+
+} // namespace mlc::levels

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: MIT
+// Mirroring a half-domain mesh and merging the meshes of several bodies.
+#include "mesh/transform.hpp"
+
+#include "core/check.hpp"
+
+#include <cmath>
+
+namespace mlc::mesh {
+
+Mesh mirror_about_x(const Mesh& h, double x0) {
+    const double tol = 1e-10 * h.diameter();
+    const int nv = h.n_vertices();
+    Mesh m = h;
+    m.boundary.clear();
+    std::vector<int> image(static_cast<size_t>(nv));
+    int side = 0;
+    bool on_line = false;
+    for (int v = 0; v < nv; ++v) {
+        const Vec2 p = h.vertices[static_cast<size_t>(v)];
+        if (std::abs(p.x() - x0) <= tol) {
+            image[static_cast<size_t>(v)] = v;
+            on_line = true;
+            continue;
+        }
+        const int sv = p.x() > x0 ? 1 : -1;
+        MLC_CHECK(side == 0 || sv == side, "mirror_x = " << x0 << ": the domain has vertices on "
+                                                         << "both sides of the mirror line; "
+                                                         << "describe one half only");
+        side = sv;
+        image[static_cast<size_t>(v)] = m.n_vertices();
+        m.vertices.emplace_back(2.0 * x0 - p.x(), p.y());
+    }
+    MLC_CHECK(on_line, "mirror_x = " << x0 << ": no boundary vertex lies on the mirror line; the "
+                                     << "half domain must have an edge on it");
+    for (const auto& t : h.triangles)
+        m.triangles.push_back({image[static_cast<size_t>(t[0])], image[static_cast<size_t>(t[2])],
+                               image[static_cast<size_t>(t[1])]});
+    if (!h.attribute.empty())
+        m.attribute.insert(m.attribute.end(), h.attribute.begin(), h.attribute.end());
+    const int coff = static_cast<int>(h.circles.size());
+    for (const auto& c : h.circles)
+        m.circles.push_back({Vec2(2.0 * x0 - c.center.x(), c.center.y()), c.radius});
+    auto on = [&](int v) { return image[static_cast<size_t>(v)] == v; };
+    for (const auto& e : h.boundary) {
+        if (e.curve < 0 && on(e.v0) && on(e.v1)) continue; // on the mirror line: now interior
+        m.boundary.push_back(e);
+        m.boundary.push_back({image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)],
+                              e.tag, e.curve >= 0 ? e.curve + coff : -1});
+    }
+    check_quality(m);
+    return m;
+}
+
+void merge_into(Mesh& all, const Mesh& b, int body) {
+    const int voff = all.n_vertices();
+    const int coff = static_cast<int>(all.circles.size());
+    all.vertices.insert(all.vertices.end(), b.vertices.begin(), b.vertices.end());
+    all.circles.insert(all.circles.end(), b.circles.begin(), b.circles.end());
+    for (const auto& t : b.triangles)
+        all.triangles.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
+    all.attribute.resize(all.triangles.size(), body);
+    for (const auto& e : b.boundary)
+        all.boundary.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)),
+                                e.curve >= 0 ? e.curve + coff : -1});
+}
+
+} // namespace mlc::mesh

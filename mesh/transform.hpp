@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: MIT
+/// @file Whole-mesh transformations used to build a scene's level-0 mesh: a half domain mirrored
+/// about a vertical line, and the meshes of several bodies merged into one.
+#pragma once
+
+#include "mesh/mesh.hpp"
+
+namespace mlc::mesh {
+
+/// The mesh of a half domain reflected about the vertical line x = x0 and glued to itself.
+///
+/// Every vertex of `half` must lie on one side of the line or on it (within a relative 1e-10 of
+/// the mesh diameter), and at least one must lie on it. The result keeps the vertices, triangles,
+/// attributes and circles of `half` with their indices and appends the mirror images:
+///  - a vertex v off the line gets an image at (2 x0 - x_v, y_v), appended in vertex order;
+///    vertices on the line are shared (they are their own image);
+///  - each triangle (a, b, c) gets an image (a', c', b') (reversed, so still counter-clockwise),
+///    with the same attribute;
+///  - each circle gets a mirrored circle (center reflected, same radius), appended after them;
+///  - each boundary edge (v0, v1) is kept and followed by its image (v1', v0') (reversed, so the
+///    body still lies to its left) with the same tag and the mirrored circle, except straight
+///    edges with both ends on the line: those become interior and are dropped.
+/// An exactly mirror-symmetric mesh gives an exactly mirror-symmetric discrete problem.
+/// The result passes check_quality (it is called). Throws InvalidInput when `half` has vertices
+/// on both sides of the line or none on it, or when the result fails check_quality.
+Mesh mirror_about_x(const Mesh& half, double x0);
+
+/// Appends mesh `b` to `all` as body number `body`: b's vertices and circles are appended, its
+/// triangles and boundary edges renumbered accordingly (vertex indices shifted by the former
+/// vertex count of `all`, circle indices by its former circle count), its boundary tags merged
+/// by name (a name already in `all` keeps its id, a new one gets the next free id), and every
+/// appended triangle gets attribute `body` (b's own attributes are not kept). `all` may be empty;
+/// its existing triangles without an attribute get `body` too. Coincident vertices of two bodies
+/// stay distinct. Nothing is checked.
+void merge_into(Mesh& all, const Mesh& b, int body);
+
+} // namespace mlc::mesh
