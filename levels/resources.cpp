@@ -61,6 +61,12 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem) {
 }
 
 // ------------------------------------------------------------------------------------------
+double mg_crossover_unknowns(const Problem& problem) {
+    for (const auto& c : problem.contacts)
+        if (c.two_body()) return kMgCrossoverTwoBody;
+    return kMgCrossoverOneBody;
+}
+
 SolverChoice choose_solver(const Problem& problem, const SolverRequest& req) {
     SolverChoice c;
     LinearSolverSpec& s = c.spec;
@@ -99,21 +105,22 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req) {
         c.automatic = true;
         const auto sizes = predict_level_sizes(problem);
         const double n = sizes.back().unknowns;
+        const double crossover = mg_crossover_unknowns(problem);
         std::ostringstream os;
         os << std::setprecision(3);
-        if (has_levels && n > kKrylovCrossoverUnknowns) {
+        if (has_levels && n > crossover) {
             s.method = "krylov";
             s.pc = "mg";
             os << "default: " << n << " unknowns on the finest level exceed the crossover "
-               << kKrylovCrossoverUnknowns << ": CGS + mg (faster and smaller than schur there)";
+               << crossover << ": CGS + mg (faster and smaller than schur there)";
         } else {
             s.method = "schur";
-            if (!has_levels && n > kKrylovCrossoverUnknowns)
+            if (!has_levels && n > crossover)
                 os << "default: " << n << " unknowns but a single level (no hierarchy for mg): "
                    << "exact schur";
             else
                 os << "default: " << n << " unknowns on the finest level, at most the crossover "
-                   << kKrylovCrossoverUnknowns << ": exact schur (faster there)";
+                   << crossover << ": exact schur (faster there)";
         }
         c.reason = os.str();
     }

@@ -34,8 +34,15 @@ struct LevelSize {
 std::vector<LevelSize> predict_level_sizes(const Problem& problem);
 
 /// Finest-level unknowns above which the default Newton-system solver is Krylov + mg rather
-/// than the exact `schur` (measured, see the README: "Choosing the Newton-system solver").
-inline constexpr double kKrylovCrossoverUnknowns = 30000;
+/// than the exact `schur` (measured, see the README: "Choosing the Newton-system solver"): with
+/// rigid obstacles only, mg is faster and smaller from the first refined level of the built-in
+/// scenes on (2 208 unknowns on the square); with a two-body pair (node on facet or node on
+/// node) mg needs about twice as many Krylov iterations and overtakes schur near 50 000.
+inline constexpr double kMgCrossoverOneBody = 2000;
+inline constexpr double kMgCrossoverTwoBody = 50000;
+
+/// The crossover that applies to `problem` (two-body pairs or not).
+double mg_crossover_unknowns(const Problem& problem);
 
 /// What the user asked for; unset fields take the driver's defaults.
 struct SolverRequest {
@@ -54,7 +61,7 @@ struct SolverChoice {
 
 /// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
 /// without `pc` uses `mg` where a level below exists (problem.levels >= 1) and `ilu:0` on a
-/// single level; nothing at all chooses by size: `schur` up to kKrylovCrossoverUnknowns
+/// single level; nothing at all chooses by size: `schur` up to mg_crossover_unknowns(problem)
 /// unknowns on the finest level, Krylov (CGS) + `mg` above it when levels exist. A Krylov
 /// option next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying
 /// so.

@@ -86,26 +86,39 @@ TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
 }
 
 TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
-    auto p = scene::load_scene("square");
-    for (int L = 0; L <= 6; ++L) {
-        SCOPED_TRACE(L);
-        p.levels = L;
-        const double n = levels::predict_level_sizes(p).back().unknowns;
-        const auto c = levels::choose_solver(p, {});
-        EXPECT_TRUE(c.automatic);
-        EXPECT_FALSE(c.reason.empty());
-        if (L >= 1 && n > levels::kKrylovCrossoverUnknowns) {
-            EXPECT_EQ(c.spec.method, "krylov");
-            EXPECT_EQ(c.spec.pc, "mg");
-        } else {
-            EXPECT_EQ(c.spec.method, "schur");
+    for (const char* name : {"square", "hertz", "dovetail"}) {
+        SCOPED_TRACE(name);
+        auto p = scene::load_scene(name);
+        const double crossover = levels::mg_crossover_unknowns(p);
+        for (int L = 0; L <= 6; ++L) {
+            SCOPED_TRACE(L);
+            p.levels = L;
+            const double n = levels::predict_level_sizes(p).back().unknowns;
+            const auto c = levels::choose_solver(p, {});
+            EXPECT_TRUE(c.automatic);
+            EXPECT_FALSE(c.reason.empty());
+            if (L >= 1 && n > crossover) {
+                EXPECT_EQ(c.spec.method, "krylov");
+                EXPECT_EQ(c.spec.pc, "mg");
+            } else {
+                EXPECT_EQ(c.spec.method, "schur");
+            }
         }
     }
-    // The square ladder crosses over between levels 2 and 3 (8 512 and 33 408 unknowns).
-    p.levels = 2;
-    EXPECT_EQ(levels::choose_solver(p, {}).spec.method, "schur");
-    p.levels = 3;
-    EXPECT_EQ(levels::choose_solver(p, {}).spec.method, "krylov");
+    // Rigid obstacles: mg from the first refined level (square: 2 208 unknowns); two bodies
+    // (dovetail: 14 341 and 56 181 unknowns on levels 1 and 2): from level 2.
+    auto sq = scene::load_scene("square");
+    EXPECT_EQ(levels::mg_crossover_unknowns(sq), levels::kMgCrossoverOneBody);
+    sq.levels = 0;
+    EXPECT_EQ(levels::choose_solver(sq, {}).spec.method, "schur");
+    sq.levels = 1;
+    EXPECT_EQ(levels::choose_solver(sq, {}).spec.pc, "mg");
+    auto dt = scene::load_scene("dovetail");
+    EXPECT_EQ(levels::mg_crossover_unknowns(dt), levels::kMgCrossoverTwoBody);
+    dt.levels = 1;
+    EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
+    dt.levels = 2;
+    EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg");
 }
 
 TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
