@@ -20,22 +20,6 @@ namespace mlc::solvers {
 namespace {
 constexpr Index kMaxBlock = 16; // largest diagonal block of the smoother (a vertex has <= 4)
 
-// sum_k val[k] x[inner[k]] for k in [k0, k1) with four independent accumulators: a single
-// accumulator chains every multiply-add on the previous one, and the sweeps (about 18 entries
-// per row) were bound by that latency rather than by memory bandwidth.
-inline double row_dot(const int* inner, const double* val, const double* x, int k0, int k1) {
-    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
-    int k = k0;
-    for (; k + 3 < k1; k += 4) {
-        a0 += val[k] * x[inner[k]];
-        a1 += val[k + 1] * x[inner[k + 1]];
-        a2 += val[k + 2] * x[inner[k + 2]];
-        a3 += val[k + 3] * x[inner[k + 3]];
-    }
-    for (; k < k1; ++k)
-        a0 += val[k] * x[inner[k]];
-    return (a0 + a1) + (a2 + a3);
-}
 int max_threads() {
 #ifdef _OPENMP
     return omp_get_max_threads();
@@ -44,11 +28,6 @@ int max_threads() {
 #endif
 }
 
-// Threads for a row-parallel loop over n rows (one per kMinRowsPerPart rows at most).
-int threads_for(Index n) {
-    return static_cast<int>(
-        std::clamp<Index>(n / BlockGaussSeidel::kMinRowsPerPart, 1, max_threads()));
-}
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -366,35 +345,6 @@ std::string MultigridCycle::name() const {
 }
 
 // ---------------------------------------------------------------------------------------------
-void CsrOperator::apply(const Vector& x, Vector& y) const {
-    smoothers::check_size(x, A_.cols(), "CsrOperator::apply", "x");
-    csr_multiply(A_, x, y);
-}
-
-void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add) {
-    MLC_CHECK(x.size() == A.cols() && (!add || y.size() == A.rows()),
-              "csr_multiply: A is " << A.rows() << " x " << A.cols() << ", x has " << x.size()
-                                    << ", y has " << y.size());
-    MLC_CHECK(A.isCompressed(), "csr_multiply: A must be compressed");
-    const Index n = A.rows();
-    if (!add) y.resize(n);
-    const int* outer = A.outerIndexPtr();
-    const int* inner = A.innerIndexPtr();
-    const double* val = A.valuePtr();
-    const double* xp = x.data();
-    double* yp = y.data();
-    const int threads = threads_for(n);
-    if (add) {
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
-        for (Index i = 0; i < n; ++i)
-            yp[i] += row_dot(inner, val, xp, outer[i], outer[i + 1]);
-    } else {
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
-        for (Index i = 0; i < n; ++i)
-            yp[i] = row_dot(inner, val, xp, outer[i], outer[i + 1]);
-    }
-}
-
 // ---------------------------------------------------------------------------------------------
 SolveResult pcg(const SparseMatrix& A, const Preconditioner& M, const Vector& b, Vector& x,
                 double rel_tol, int max_iter) {
@@ -408,7 +358,7 @@ SolveResult pcg(const SparseMatrix& A, const Preconditioner& M, const Vector& b,
     Vector r = b;
     r.noalias() -= A * x;
     Vector z(b.size()), p(b.size()), q(b.size());
-    const CsrOperator Aop(A);
+    const MatrixOperator Aop(A, MatVec::unrolled);
     const double bnorm = b.norm();
     const double target = rel_tol * (bnorm > 0 ? bnorm : r.norm());
     res.initial_residual = r.norm();

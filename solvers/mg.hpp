@@ -17,6 +17,7 @@
 /// so it also preconditions CG (`pcg` below) on the elastic block.
 #pragma once
 
+#include "core/csr.hpp"
 #include "core/linear_operator.hpp"
 #include "solvers/coarse_fine.hpp"
 
@@ -52,7 +53,7 @@ public:
     explicit BlockGaussSeidel(std::vector<Index> block_starts = {}, double omega = 1.0,
                               int parts = 0);
     /// Rows per part below which fewer parts are used.
-    static constexpr Index kMinRowsPerPart = 4096;
+    static constexpr Index kMinRowsPerPart = kMinRowsPerThread;
     /// Number of parts of the last setup.
     int parts() const { return static_cast<int>(part_block_.size()) - 1; }
     /// First row of every part, then the number of rows.
@@ -139,34 +140,12 @@ private:
     mutable Vector res_, rc_, ec_;
 };
 
-/// y = A x for a CSR matrix, each row summed with four independent accumulators (the
-/// single-accumulator loop is bound by the latency of the chained multiply-adds), rows split
-/// over the OpenMP threads for matrices of at least BlockGaussSeidel::kMinRowsPerPart rows
-/// per thread. The transpose goes to MatrixOperator. A must outlive this object.
-class CsrOperator final : public LinearOperator {
-public:
-    explicit CsrOperator(const SparseMatrix& A) : A_(A), plain_(A) {}
-    Index rows() const override { return A_.rows(); }
-    Index cols() const override { return A_.cols(); }
-    void apply(const Vector& x, Vector& y) const override;
-    void apply_transpose(const Vector& x, Vector& y) const override {
-        plain_.apply_transpose(x, y);
-    }
-
-private:
-    const SparseMatrix& A_;
-    MatrixOperator plain_;
-};
-
 /// Preconditioned conjugate gradients for a symmetric positive definite A with a symmetric
 /// positive definite preconditioner M: stops when ||b - A x|| <= rel_tol ||b|| (the recursive
 /// residual; the true one is recomputed at exit) or after max_iter iterations. x holds the
 /// initial guess on entry (resized to zero if empty).
 SolveResult pcg(const SparseMatrix& A, const Preconditioner& M, const Vector& b, Vector& x,
                 double rel_tol, int max_iter);
-
-/// y = A x (or y += A x with `add`) for a CSR matrix, over the OpenMP threads like CsrOperator.
-void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = false);
 
 /// The vertex blocks of a dof numbering in which each vertex's unknowns are contiguous:
 /// `vertex_of_dof[i]` is the owner of unknown i; returns the first unknown of each run.
