@@ -3,12 +3,19 @@
 #include "core/linear_operator.hpp"
 
 #include "core/check.hpp"
+#include "core/csr.hpp"
 
 #include <iomanip>
 
 namespace mlc {
 
-void MatrixOperator::apply(const Vector& x, Vector& y) const { y.noalias() = A_ * x; }
+void MatrixOperator::apply(const Vector& x, Vector& y) const {
+    if (kind_ == MatVec::unrolled) {
+        csr_multiply(A_, x, y);
+        return;
+    }
+    y.noalias() = A_ * x;
+}
 
 void MatrixOperator::apply_transpose(const Vector& x, Vector& y) const {
     y.noalias() = A_.transpose() * x;
@@ -27,19 +34,23 @@ void Preconditioner::apply_transpose(const Vector&, Vector&) const {
 
 std::string_view to_string(StopReason reason) {
     switch (reason) {
-    case StopReason::converged: return "converged";
-    case StopReason::max_iter: return "max_iter";
-    case StopReason::breakdown: return "breakdown";
-    case StopReason::diverged: return "diverged";
+    case StopReason::converged:
+        return "converged";
+    case StopReason::max_iter:
+        return "max_iter";
+    case StopReason::breakdown:
+        return "breakdown";
+    case StopReason::diverged:
+        return "diverged";
     }
     return "unknown";
 }
 
 std::ostream& operator<<(std::ostream& os, const SolveResult& r) {
-    os << to_string(r.reason) << " in " << r.iterations << " it, rel. residual "
-       << std::scientific << std::setprecision(2) << r.relative_residual << std::defaultfloat
-       << ", rate " << std::setprecision(3) << r.average_rate << ", setup " << r.setup_seconds
-       << " s, solve " << r.solve_seconds << " s";
+    os << to_string(r.reason) << " in " << r.iterations << " it, rel. residual " << std::scientific
+       << std::setprecision(2) << r.relative_residual << std::defaultfloat << ", rate "
+       << std::setprecision(3) << r.average_rate << ", setup " << r.setup_seconds << " s, solve "
+       << r.solve_seconds << " s";
     if (!r.message.empty()) os << " (" << r.message << ")";
     return os;
 }

@@ -130,12 +130,13 @@ public:
         prepare(M);
         const double t1 = wall_seconds();
         if (dx.size() != b.size()) dx = Vector::Zero(b.size());
-        // mg: the unrolled mat-vec (solvers::CsrOperator); the others keep Eigen's, so
-        // their published iteration counts stay bit-for-bit reproducible.
+        // mg: the unrolled mat-vec (MatVec::unrolled); the others keep Eigen's in-order one,
+        // so their published iteration counts stay bit-for-bit reproducible.
         solvers::KrylovParams params = params_;
         params.rel_tol = std::max(params_.rel_tol, forcing_);
         SolveResult r =
-            mg_ ? solvers::solve(method_, solvers::CsrOperator(jac_.matrix()), *pc_, b, dx, params)
+            mg_ ? solvers::solve(method_, MatrixOperator(jac_.matrix(), MatVec::unrolled), *pc_, b,
+                                 dx, params)
                 : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params);
         r.setup_seconds = t1 - t0;
         r.assembly_seconds = assembly_seconds_;

@@ -52,11 +52,11 @@ namespace mlc::levels {
 ///   the converged coarse statuses through `NewtonSystemSolver::preconditioner_for` (so the
 ///   cycle recurses down to level 1), or, when the level below has no cycle (level 0, solved by
 ///   "schur"), a sparse LU of its Jacobian at those statuses. A fixed linear operator per
-///   Newton system: CGS, BiCGStab and GMRES apply. Its mat-vecs use solvers::CsrOperator.
-///   coarse: "rediscretize" (default, the above) or "galerkin": the coarse operators are
-///   R J T of this Newton system's J, then R A T level by level down to level 0 (factored by
-///   sparse LU), recomputed for every Newton system; they carry the fine statuses down through
-///   the products (it needs the context chain, CoarseContext::below, down to level 0).
+///   Newton system: CGS, BiCGStab and GMRES apply. Its mat-vecs are MatrixOperator with
+///   MatVec::unrolled. coarse: "rediscretize" (default, the above) or "galerkin": the coarse
+///   operators are R J T of this Newton system's J, then R A T level by level down to level 0
+///   (factored by sparse LU), recomputed for every Newton system; they carry the fine statuses down
+///   through the products (it needs the context chain, CoarseContext::below, down to level 0).
 ///
 /// "cf", "sorcf" and "mg" need `context` with the level below (context->available()); without
 /// it they throw mlc::InvalidInput ("cf needs the level below: use with --levels >= 1 and the

@@ -6,9 +6,9 @@
 #include "core/timer.hpp"
 #include "levels/krylov_system.hpp"
 #include "solvers/cholesky.hpp"
+#include "solvers/direct.hpp"
 
 #include <Eigen/SparseCholesky>
-#include <Eigen/SparseLU>
 #include <algorithm>
 
 namespace mlc::levels {
@@ -64,24 +64,20 @@ void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
 // ---------------------------------------------------------------------------------------------
 namespace {
 
+// solvers::SparseLUPreconditioner as a LinearSolver: analysis on the first call, refactorization
+// only afterwards while J's pattern is unchanged (it is fixed per level).
 class SparseLUSolver final : public LinearSolver {
 public:
     SolveResult solve(const SparseMatrix& J, const Vector& b, Vector& x) override {
         SolveResult res;
         const double t0 = wall_seconds();
-        Jc_ = J; // column-major copy for SparseLU
-        if (!analyzed_ || !same_pattern(Jc_)) {
-            lu_.analyzePattern(Jc_);
-            outer_.assign(Jc_.outerIndexPtr(), Jc_.outerIndexPtr() + Jc_.outerSize() + 1);
-            inner_.assign(Jc_.innerIndexPtr(), Jc_.innerIndexPtr() + Jc_.nonZeros());
-            analyzed_ = true;
-        }
-        lu_.factorize(Jc_);
-        if (lu_.info() != Eigen::Success)
-            throw SolverBreakdown("SparseLU factorization failed (singular Jacobian): " +
-                                  lu_.lastErrorMessage());
+        if (first_)
+            lu_.setup(J);
+        else
+            lu_.update_values(J);
+        first_ = false;
         const double t1 = wall_seconds();
-        x = lu_.solve(b);
+        lu_.apply(b, x);
         res.setup_seconds = t1 - t0;
         res.solve_seconds = wall_seconds() - t1;
         res.converged = true;
@@ -92,18 +88,11 @@ public:
             res.initial_residual > 0 ? res.final_residual / res.initial_residual : 0.0;
         return res;
     }
-    std::string name() const override { return "lu"; }
+    std::string name() const override { return lu_.name(); }
 
 private:
-    bool same_pattern(const SparseMatrixCol& A) const {
-        return static_cast<size_t>(A.nonZeros()) == inner_.size() &&
-               std::equal(outer_.begin(), outer_.end(), A.outerIndexPtr()) &&
-               std::equal(inner_.begin(), inner_.end(), A.innerIndexPtr());
-    }
-    SparseMatrixCol Jc_;
-    Eigen::SparseLU<SparseMatrixCol, Eigen::COLAMDOrdering<int>> lu_;
-    bool analyzed_ = false;
-    std::vector<int> outer_, inner_;
+    solvers::SparseLUPreconditioner lu_;
+    bool first_ = true;
 };
 
 class AssembledSystemSolver final : public NewtonSystemSolver {

@@ -40,8 +40,9 @@ public:
     virtual std::string name() const = 0;
 };
 
-/// Eigen SparseLU on the assembled J; analyzes the pattern once and refactors numerically
-/// afterwards (the pattern of J is fixed per level).
+/// solvers::SparseLUPreconditioner (Eigen SparseLU) on the assembled J: analyzes the pattern
+/// once and refactors numerically afterwards while the pattern is unchanged (it is fixed per
+/// level). A singular J throws mlc::SolverBreakdown.
 std::unique_ptr<LinearSolver> make_sparse_lu_solver();
 
 /// Strategy for one Newton linear system J(M) dx = b on a level.

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Point and block SOR / SSOR sweeps on a CSR matrix, with dense-LU inverted diagonal blocks.
+// Point and block SOR / SSOR sweeps on a CSR matrix, with dense-LU inverted diagonal blocks and
+// threaded hybrid parts.
 #include "smoothers/block_sor.hpp"
 
 #include "core/check.hpp"
@@ -10,6 +11,10 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace mlc::smoothers {
 
@@ -29,6 +34,10 @@ std::ostream& operator<<(std::ostream& os, Sweep s) {
     return os << to_string(s);
 }
 
+std::string_view to_string(Kernel k) {
+    return k == Kernel::unrolled ? "unrolled" : "in_order";
+}
+
 void BlockSORParams::validate() const {
     MLC_CHECK(omega > 0.0 && omega < 2.0,
               "BlockSORParams::omega must be in (0, 2), found " << omega);
@@ -36,6 +45,7 @@ void BlockSORParams::validate() const {
     MLC_CHECK(singular_tol >= 0.0 && singular_tol < 1.0,
               "BlockSORParams::singular_tol must be in [0, 1), found " << singular_tol);
     MLC_CHECK(block_size >= 1, "BlockSORParams::block_size must be >= 1, found " << block_size);
+    MLC_CHECK(parts >= 0, "BlockSORParams::parts must be >= 0, found " << parts);
     MLC_CHECK(block_starts.empty() || block_starts.front() == 0,
               "BlockSORParams::block_starts must start at 0, found " << block_starts.front());
     for (size_t k = 1; k < block_starts.size(); ++k)
@@ -55,7 +65,8 @@ std::ostream& operator<<(std::ostream& os, const BlockSORParams& p) {
         os << "[]";
     else
         os << "[" << p.block_starts.size() << " starts, largest inner block " << largest << "]";
-    return os << ", singular_tol=" << p.singular_tol << "}";
+    return os << ", singular_tol=" << p.singular_tol << ", parts=" << p.parts
+              << ", kernel=" << to_string(p.kernel) << "}";
 }
 
 std::vector<Index> uniform_block_starts(Index n, Index block_size) {
@@ -97,21 +108,113 @@ void BlockSOR::setup(const SparseMatrix& A) {
         offset_[b + 1] = offset_[b] + s * s;
     }
     dinv_.assign(static_cast<size_t>(offset_[nb]), 0.0);
+    post_ = params_.kernel == Kernel::unrolled ? 1.0 : params_.omega;
+    A_ = &A;
+    derive_structure();
+    invert_blocks();
+    res_.resize(n);
+}
 
-    const int* ao = A.outerIndexPtr();
-    const int* ai = A.innerIndexPtr();
-    const double* av = A.valuePtr();
+void BlockSOR::update_values(const SparseMatrix& A) {
+    if (A_ == nullptr || A.rows() != starts_.back() || A.cols() != starts_.back()) {
+        setup(A);
+        return;
+    }
+    check_setup_matrix(A, "BlockSOR::update_values");
+    A_ = &A;
+    // A refreshed in place (as the Jacobian assembler does) keeps its parts and diagonal
+    // positions; any other pattern has them derived anew.
+    if (!pattern_.matches(A)) derive_structure();
+    invert_blocks();
+}
+
+void BlockSOR::derive_structure() {
+    const SparseMatrix& A = *A_;
+    const Index n = A.rows();
+    const Index nb = n_blocks();
+#ifdef _OPENMP
+    const Index threads = omp_get_max_threads();
+#else
+    const Index threads = 1;
+#endif
+    const Index want = params_.parts > 0 ? params_.parts : threads;
+    const Index P =
+        std::clamp<Index>(std::min(want, n / kMinRowsPerThread), 1, std::max<Index>(nb, 1));
+    part_block_.assign(1, 0);
+    const int* outer = A.outerIndexPtr();
+    const int* inner = A.innerIndexPtr();
+    const double per_part = static_cast<double>(A.nonZeros()) / static_cast<double>(P);
+    for (Index I = 0, p = 1; I < nb && p < P; ++I)
+        if (static_cast<double>(outer[starts_[static_cast<size_t>(I) + 1]]) >= per_part * p) {
+            part_block_.push_back(I + 1);
+            ++p;
+        }
+    part_block_.push_back(nb);
+    // Own-part entry range of every row, and the columns read across a cut.
+    own_begin_.resize(static_cast<size_t>(n));
+    own_end_.resize(static_cast<size_t>(n));
+    std::vector<char> across(static_cast<size_t>(n), 0);
+    for (size_t p = 0; p + 1 < part_block_.size(); ++p) {
+        const Index r0 = starts_[static_cast<size_t>(part_block_[p])];
+        const Index r1 = starts_[static_cast<size_t>(part_block_[p + 1])];
+        for (Index i = r0; i < r1; ++i) {
+            const int* b = inner + outer[i];
+            const int* e = inner + outer[i + 1];
+            const int* lo = std::lower_bound(b, e, static_cast<int>(r0));
+            const int* hi = std::lower_bound(lo, e, static_cast<int>(r1));
+            own_begin_[static_cast<size_t>(i)] = static_cast<int>(lo - inner);
+            own_end_[static_cast<size_t>(i)] = static_cast<int>(hi - inner);
+            for (const int* c = b; c < lo; ++c)
+                across[static_cast<size_t>(*c)] = 1;
+            for (const int* c = hi; c < e; ++c)
+                across[static_cast<size_t>(*c)] = 1;
+        }
+    }
+    interface_.clear();
+    for (Index j = 0; j < n; ++j)
+        if (across[static_cast<size_t>(j)]) interface_.push_back(static_cast<int>(j));
+    snap_.setZero(n);
+    // First entry of every row in or right of its own diagonal block.
+    diag_begin_.resize(static_cast<size_t>(n));
+    for (Index I = 0; I < nb; ++I)
+        for (Index i = starts_[I]; i < starts_[I + 1]; ++i)
+            diag_begin_[static_cast<size_t>(i)] = static_cast<int>(
+                std::lower_bound(inner + outer[i], inner + outer[i + 1], starts_[I]) - inner);
+    pattern_ = SparsityPattern(A);
+    work_.resize(max_block_ * P);
+}
+
+std::vector<Index> BlockSOR::part_rows() const {
+    std::vector<Index> rows;
+    for (const Index I : part_block_)
+        rows.push_back(starts_[static_cast<size_t>(I)]);
+    return rows;
+}
+
+void BlockSOR::invert_blocks() {
+    const int* ao = A_->outerIndexPtr();
+    const int* ai = A_->innerIndexPtr();
+    const double* av = A_->valuePtr();
+    const double omega = params_.omega;
+    const double tol = params_.singular_tol;
     Eigen::MatrixXd block;
-    for (Index b = 0; b < nb; ++b) {
+    for (Index b = 0; b < n_blocks(); ++b) {
         const Index s0 = starts_[b], s = starts_[b + 1] - s0;
         block.setZero(s, s);
         for (Index i = s0; i < s0 + s; ++i)
             for (int p = ao[i]; p < ao[i + 1]; ++p)
                 if (ai[p] >= s0 && ai[p] < s0 + s) block(i - s0, ai[p] - s0) = av[p];
-        const double scale = block.cwiseAbs().maxCoeff();
-        Eigen::PartialPivLU<Eigen::MatrixXd> lu(block);
-        const double min_pivot = lu.matrixLU().diagonal().cwiseAbs().minCoeff();
-        if (!(min_pivot > params_.singular_tol * scale) || min_pivot == 0.0) {
+        double* out = dinv_.data() + offset_[b];
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> inv(
+            out, s, s);
+        if (params_.kernel == Kernel::in_order) {
+            const double scale = block.cwiseAbs().maxCoeff();
+            Eigen::PartialPivLU<Eigen::MatrixXd> lu(block);
+            const double min_pivot = lu.matrixLU().diagonal().cwiseAbs().minCoeff();
+            if (min_pivot > tol * scale && min_pivot != 0.0) {
+                inv = lu.inverse();
+                continue;
+            }
             std::ostringstream os;
             if (s == 1)
                 os << "BlockSOR::setup: zero or missing diagonal in row " << s0
@@ -124,39 +227,65 @@ void BlockSOR::setup(const SparseMatrix& A) {
                    << "); group each contact node's multipliers with its vertex";
             MLC_CHECK(false, os.str());
         }
-        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> inv(
-            dinv_.data() + offset_[b], s, s);
-        inv = lu.inverse();
+        if (s == 2) {
+            // Closed form (the common vertex block without multipliers).
+            const double det = block(0, 0) * block(1, 1) - block(0, 1) * block(1, 0);
+            const double dscale =
+                std::abs(block(0, 0) * block(1, 1)) + std::abs(block(0, 1) * block(1, 0));
+            MLC_CHECK(dscale > 0.0 && std::abs(det) > tol * dscale,
+                      "BlockSOR::setup: diagonal block " << b << " (rows " << s0 << ".." << s0 + 1
+                                                         << ") is singular");
+            const double f = omega / det;
+            out[0] = f * block(1, 1);
+            out[1] = -f * block(0, 1);
+            out[2] = -f * block(1, 0);
+            out[3] = f * block(0, 0);
+            continue;
+        }
+        Eigen::FullPivLU<Eigen::MatrixXd> lu(block);
+        lu.setThreshold(tol);
+        MLC_CHECK(lu.isInvertible(), "BlockSOR::setup: diagonal block " << b << " (rows " << s0
+                                                                        << ".." << s0 + s - 1
+                                                                        << ") is singular");
+        inv = omega * lu.inverse();
     }
-    A_ = &A;
-    work_.resize(max_block_);
-    res_.resize(n);
 }
 
-// One half-sweep. With from_zero, x is zero on entry and only the already-visited part of each
-// row contributes (the lower part for forward, the upper part for backward sweeps).
-void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero) const {
+// One part's half-sweep over blocks [b0, b1) with scratch t (one block). The other parts'
+// unknowns are read from snap_ (their values when the sweep began). With from_zero (in_order
+// kernel only) x is zero on entry and only the already-visited own entries of each row count.
+void BlockSOR::sweep_part(const double* bp, double* xp, Index b0, Index b1, bool forward,
+                          bool from_zero, double* t) const {
     const int* ao = A_->outerIndexPtr();
     const int* ai = A_->innerIndexPtr();
     const double* av = A_->valuePtr();
-    const double w = params_.omega;
-    double* t = work_.data();
-    double* xv = x.data();
-    const Index nb = n_blocks();
-    for (Index k = 0; k < nb; ++k) {
-        const Index blk = forward ? k : nb - 1 - k;
+    const double* sp = snap_.data();
+    const bool unrolled = params_.kernel == Kernel::unrolled;
+    for (Index step = b0; step < b1; ++step) {
+        const Index blk = forward ? step : b1 - 1 - (step - b0);
         const Index s0 = starts_[blk], s1 = starts_[blk + 1], s = s1 - s0;
         for (Index i = s0; i < s1; ++i) {
-            double acc = b[i];
+            const auto r = static_cast<size_t>(i);
+            const int ob = own_begin_[r], oe = own_end_[r];
+            if (unrolled) {
+                t[i - s0] = bp[i] - row_dot(ai, av, xp, ob, oe) - row_dot(ai, av, sp, ao[i], ob) -
+                            row_dot(ai, av, sp, oe, ao[i + 1]);
+                continue;
+            }
+            double acc = bp[i];
             if (!from_zero) {
-                for (int p = ao[i]; p < ao[i + 1]; ++p)
-                    acc -= av[p] * xv[ai[p]];
+                for (int p = ob; p < oe; ++p)
+                    acc -= av[p] * xp[ai[p]];
+                for (int p = ao[i]; p < ob; ++p)
+                    acc -= av[p] * sp[ai[p]];
+                for (int p = oe; p < ao[i + 1]; ++p)
+                    acc -= av[p] * sp[ai[p]];
             } else if (forward) {
-                for (int p = ao[i]; p < ao[i + 1] && ai[p] < s0; ++p)
-                    acc -= av[p] * xv[ai[p]];
+                for (int p = ob; p < diag_begin_[r]; ++p)
+                    acc -= av[p] * xp[ai[p]];
             } else {
-                for (int p = ao[i + 1] - 1; p >= ao[i] && ai[p] >= s1; --p)
-                    acc -= av[p] * xv[ai[p]];
+                for (int p = oe - 1; p >= ob && ai[p] >= s1; --p)
+                    acc -= av[p] * xp[ai[p]];
             }
             t[i - s0] = acc;
         }
@@ -165,9 +294,84 @@ void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_ze
             double c = 0.0;
             for (Index q = 0; q < s; ++q)
                 c += D[a * s + q] * t[q];
-            xv[s0 + a] += w * c;
+            xp[s0 + a] += post_ * c;
         }
     }
+}
+
+void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero) const {
+    double* xp = x.data();
+    double* sp = snap_.data();
+    for (const int j : interface_) // empty with one part
+        sp[j] = xp[j];
+    const int P = parts();
+    const bool zero = from_zero && params_.kernel == Kernel::in_order;
+#pragma omp parallel for num_threads(P) schedule(static, 1) if (P > 1)
+    for (int p = 0; p < P; ++p)
+        sweep_part(b.data(), xp, part_block_[static_cast<size_t>(p)],
+                   part_block_[static_cast<size_t>(p) + 1], forward, zero,
+                   work_.data() + static_cast<Index>(p) * max_block_);
+}
+
+void BlockSOR::sweep(const Vector& b, Vector& x, Sweep direction) const {
+    MLC_CHECK(A_ != nullptr, "BlockSOR::sweep called before setup");
+    check_size(b, A_->rows(), "BlockSOR::sweep", "b");
+    check_size(x, A_->rows(), "BlockSOR::sweep", "x");
+    half_sweep(b, x, direction != Sweep::backward, false);
+    if (direction == Sweep::symmetric) half_sweep(b, x, false, false);
+}
+
+void BlockSOR::forward_from_zero(const Vector& b, Vector& x, Vector& res) const {
+    MLC_CHECK(A_ != nullptr, "BlockSOR::forward_from_zero called before setup");
+    check_size(b, A_->rows(), "BlockSOR::forward_from_zero", "b");
+    const Index n = A_->rows();
+    const int* outer = A_->outerIndexPtr();
+    const int* inner = A_->innerIndexPtr();
+    const double* val = A_->valuePtr();
+    if (params_.kernel == Kernel::in_order) {
+        x.setZero(n);
+        half_sweep(b, x, true, true);
+        res.resize(n);
+        for (Index i = 0; i < n; ++i) {
+            double acc = b[i];
+            for (int p = outer[i]; p < outer[i + 1]; ++p)
+                acc -= val[p] * x[inner[p]];
+            res[i] = acc;
+        }
+        return;
+    }
+    x.resize(n);
+    res.resize(n);
+    const int* dbeg = diag_begin_.data();
+    double* xp = x.data();
+    double* rp = res.data();
+    const double* bp = b.data();
+    // Each part from zero with its own lower entries (the other parts' x count as 0, as they
+    // are at the start of the sweep); then the whole residual with the final x: the diagonal
+    // and upper entries, and the lower ones of other parts. One part: plain Gauss–Seidel.
+    const int P = parts();
+#pragma omp parallel for num_threads(P) schedule(static, 1) if (P > 1)
+    for (int p = 0; p < P; ++p) {
+        for (Index I = part_block_[static_cast<size_t>(p)];
+             I < part_block_[static_cast<size_t>(p) + 1]; ++I) {
+            const Index s = starts_[static_cast<size_t>(I)],
+                        bs = starts_[static_cast<size_t>(I) + 1] - s;
+            for (Index i = s; i < s + bs; ++i)
+                rp[i] =
+                    bp[i] - row_dot(inner, val, xp, own_begin_[static_cast<size_t>(i)], dbeg[i]);
+            const double* d = dinv_.data() + offset_[static_cast<size_t>(I)];
+            for (Index i = 0; i < bs; ++i) {
+                double acc = 0.0;
+                for (Index j = 0; j < bs; ++j)
+                    acc += d[i * bs + j] * rp[s + j];
+                xp[s + i] = acc;
+            }
+        }
+    }
+#pragma omp parallel for num_threads(P) schedule(static) if (P > 1)
+    for (Index i = 0; i < n; ++i)
+        rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
+                 row_dot(inner, val, xp, outer[i], own_begin_[static_cast<size_t>(i)]);
 }
 
 void BlockSOR::apply(const Vector& r, Vector& z) const {
@@ -193,7 +397,6 @@ void BlockSOR::smooth(const Vector& b, Vector& x) const {
         if (sym) half_sweep(b, x, false, false);
     }
 }
-
 // (D/omega + L)^T t = w: blocks in reverse; each solved block scatters A_IJ^T t_I into w_J, J < I.
 void BlockSOR::solve_lower_transpose(Vector& wv) const {
     const int* ao = A_->outerIndexPtr();
@@ -208,7 +411,7 @@ void BlockSOR::solve_lower_transpose(Vector& wv) const {
             double c = 0.0;
             for (Index q = 0; q < s; ++q)
                 c += D[q * s + a] * w[s0 + q];
-            t[a] = params_.omega * c;
+            t[a] = post_ * c;
         }
         for (Index a = 0; a < s; ++a) {
             const Index i = s0 + a;
@@ -233,7 +436,7 @@ void BlockSOR::solve_upper_transpose(Vector& wv) const {
             double c = 0.0;
             for (Index q = 0; q < s; ++q)
                 c += D[q * s + a] * w[s0 + q];
-            t[a] = params_.omega * c;
+            t[a] = post_ * c;
         }
         for (Index a = 0; a < s; ++a) {
             const Index i = s0 + a;
@@ -248,6 +451,8 @@ void BlockSOR::solve_upper_transpose(Vector& wv) const {
 // reverse order with A^T and M_h^{-T}.
 void BlockSOR::apply_transpose(const Vector& r, Vector& z) const {
     MLC_CHECK(A_ != nullptr, "BlockSOR::apply_transpose called before setup");
+    MLC_CHECK(parts() == 1, "BlockSOR::apply_transpose: the hybrid sweep with "
+                                << parts() << " parts has no transpose here; use parts = 1");
     check_size(r, A_->rows(), "BlockSOR::apply_transpose", "r");
     z.setZero(r.size());
     const bool sym = params_.sweep == Sweep::symmetric;
@@ -283,6 +488,8 @@ std::string BlockSOR::name() const {
         os << ",blocks=var";
     else if (params_.block_size > 1)
         os << ",block=" << params_.block_size;
+    if (params_.parts != 1) os << ",parts=" << params_.parts;
+    if (params_.kernel == Kernel::unrolled) os << ",unrolled";
     os << ")";
     return os.str();
 }

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
 /// @file Point and block SOR / SSOR (Gauss–Seidel with relaxation) preconditioner and smoother,
-/// with variable block sizes so that 2x2 vertex and 4x4 vertex+multiplier blocks are handled.
+/// with variable block sizes so that 2x2 vertex and 4x4 vertex+multiplier blocks are handled, and
+/// threaded "hybrid" parts: the one block Gauss–Seidel of the code base (`--pc sor/ssor` and the
+/// multigrid smoother of solvers/mg).
 #pragma once
 
+#include "core/csr.hpp"
 #include "core/linear_operator.hpp"
 
 #include <ostream>
@@ -24,6 +27,22 @@ enum class Sweep {
 std::string_view to_string(Sweep s);
 /// Streams `to_string(s)`.
 std::ostream& operator<<(std::ostream& os, Sweep s);
+
+/// The arithmetic of a sweep. Both compute the same map in exact arithmetic; they differ in the
+/// last bits, and each reproduces the results of one of the two smoothers merged here.
+enum class Kernel {
+    /// Row residuals b_i - sum_j a_ij x_j subtracted one entry at a time in storage order; block
+    /// inverses by partial-pivoting LU, the correction scaled by omega after the block solve.
+    /// The default: the arithmetic of `--pc sor/ssor` (their published counts stay identical).
+    in_order,
+    /// Row residuals by core's `row_dot` (four accumulators); 2x2 blocks inverted in closed
+    /// form, larger ones by full-pivoting LU, omega folded into the inverses. About twice as
+    /// fast on the sweeps; the arithmetic of the multigrid smoother.
+    unrolled
+};
+
+/// "in_order" or "unrolled".
+std::string_view to_string(Kernel k);
 
 /// Parameters of `BlockSOR`.
 struct BlockSORParams {
@@ -47,6 +66,13 @@ struct BlockSORParams {
     /// |u_kk| <= singular_tol * max |block entry|, in [0, 1). Default 1e-14: exact zeros and
     /// round-off remnants only.
     double singular_tol = 1e-14;
+    /// Number of parts (hybrid Gauss–Seidel, see `BlockSOR`), >= 0: 0 takes the number of
+    /// OpenMP threads; at most one part per kMinRowsPerThread rows is used (small matrices stay
+    /// sequential). Default 1: plain sequential (block) Gauss–Seidel, the exact SOR map, which
+    /// `apply_transpose` needs.
+    int parts = 1;
+    /// Arithmetic of the sweeps. Default in_order (see `Kernel`).
+    Kernel kernel = Kernel::in_order;
 
     /// Throws mlc::InvalidInput naming the first field out of range (block_starts is checked
     /// against the matrix size in `BlockSOR::setup`).
@@ -67,53 +93,90 @@ std::vector<Index> uniform_block_starts(Index n, Index block_size);
 ///   C_SSOR = omega/(2 - omega) (D/omega + L) D^{-1} (D/omega + U),
 ///   C_SSOR^{-1} = omega (2 - omega) (D + omega U)^{-1} D (D + omega L)^{-1}.
 ///
-/// Each D_I is inverted once in `setup` by dense LU with partial pivoting, so zero scalar
-/// diagonals inside a block (contact multipliers in stick or slip-normal rows) are fine as long
-/// as the block is nonsingular. A singular block (for point blocks: a zero or missing diagonal)
-/// throws mlc::InvalidInput from `setup` naming the block and its rows: the blocking does not
-/// suit A, so group each contact node's multipliers with its vertex.
+/// Each D_I is inverted once in `setup` (and again in `update_values`) by dense LU, so zero
+/// scalar diagonals inside a block (contact multipliers in stick or slip-normal rows) are fine as
+/// long as the block is nonsingular. A singular block (for point blocks: a zero or missing
+/// diagonal) throws mlc::InvalidInput from `setup` naming the block and its rows: the blocking
+/// does not suit A, so group each contact node's multipliers with its vertex.
 ///
-/// `setup` stores a reference to A: A must outlive this object (or the next `setup`).
-/// `apply`, `apply_transpose` and `smooth` do not allocate once sizes are set; they use mutable
-/// work vectors, so one object must not be used from two threads at once. r and z (b and x)
-/// must be distinct objects.
+/// Parts (hybrid Gauss–Seidel, as in hypre's threaded relaxation): with `parts` != 1 the blocks
+/// are cut at setup into P contiguous runs of about equal nonzeros, one per OpenMP thread. Each
+/// part sweeps its own blocks in order with the newest values of its own unknowns, and reads the
+/// unknowns of the other parts as they were when the sweep began (Jacobi across the cuts). So
+/// every sweep is the same linear map whatever the threads do, and with P = 1 it is plain block
+/// Gauss–Seidel. With the unknowns numbered along a space-filling curve the parts are compact
+/// pieces of the domain and only their few interface rows differ from a sequential sweep.
+///
+/// `setup` stores a reference to A: A must outlive this object (or the next `setup` /
+/// `update_values`). `update_values` re-inverts the blocks; the parts and the positions of the
+/// diagonal blocks are derived anew only when A's pattern differs from the last one's
+/// (core's SparsityPattern). `apply`, `apply_transpose`, `smooth`, `sweep` and
+/// `forward_from_zero` do not allocate once sizes are set; they use mutable work vectors, so one
+/// object must not be used from two threads at once. r and z (b and x) must be distinct objects.
 class BlockSOR final : public Smoother {
 public:
     /// Validates `params`.
     explicit BlockSOR(BlockSORParams params = {});
 
-    /// Checks A and the blocking, inverts the diagonal blocks. Allocates.
+    /// Checks A and the blocking, splits the parts, inverts the diagonal blocks. Allocates.
     void setup(const SparseMatrix& A) override;
+    /// New values of A: re-inverts the blocks (parts and diagonal positions kept when the
+    /// pattern is the last one's; a different size means a full `setup`).
+    void update_values(const SparseMatrix& A) override;
     /// z = C^{-1} r: n_sweeps sweeps from z = 0 (the first one skips the zero part of z).
     void apply(const Vector& r, Vector& z) const override;
     /// z = C^{-T} r, the exact transpose of `apply` (half-sweeps on A^T in reverse order).
+    /// Needs one part (throws mlc::InvalidInput otherwise).
     void apply_transpose(const Vector& r, Vector& z) const override;
     /// n_sweeps sweeps on A x = b, x updated in place.
     void smooth(const Vector& b, Vector& x) const override;
+    /// One sweep on A x = b in the given direction (symmetric: forward then backward), in place,
+    /// whatever `params().sweep` and `params().n_sweeps` say.
+    void sweep(const Vector& b, Vector& x, Sweep direction) const;
+    /// x = one forward sweep from x = 0, and res = b - A x, in one pass over A (the lower part
+    /// during the sweep, the block-diagonal and upper part after it). x and res are resized.
+    void forward_from_zero(const Vector& b, Vector& x, Vector& res) const;
     /// "sor(omega=W)", "ssor(omega=W)", "backward-sor(omega=W)", with ",sweeps=N" when N > 1,
-    /// ",block=B" for uniform blocks B > 1 and ",blocks=var" for given block starts.
+    /// ",block=B" for uniform blocks B > 1, ",blocks=var" for given block starts, ",parts=P"
+    /// when P != 1 and ",unrolled" for that kernel.
     std::string name() const override;
 
     /// Number of diagonal blocks after the last `setup`.
     Index n_blocks() const { return static_cast<Index>(starts_.size()) - 1; }
     /// Largest block size after the last `setup`.
     Index max_block_size() const { return max_block_; }
+    /// Number of parts of the last setup.
+    int parts() const { return static_cast<int>(part_block_.size()) - 1; }
+    /// First row of every part, then the number of rows.
+    std::vector<Index> part_rows() const;
     /// The parameters in effect.
     const BlockSORParams& params() const { return params_; }
 
 private:
+    void derive_structure(); // parts and diagonal positions, from *A_'s pattern
+    void invert_blocks();
     void half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero) const;
+    // One part's sweep (blocks [b0, b1)), other parts' unknowns read from snap_.
+    void sweep_part(const double* bp, double* xp, Index b0, Index b1, bool forward, bool from_zero,
+                    double* t) const;
     void solve_lower_transpose(Vector& w) const; // (D/omega + L)^T t = w, t -> w
     void solve_upper_transpose(Vector& w) const; // (D/omega + U)^T t = w, t -> w
 
     BlockSORParams params_;
     const SparseMatrix* A_ = nullptr;
+    SparsityPattern pattern_;   // of A at the last derive_structure
     std::vector<Index> starts_; // block starts followed by n
     std::vector<Index> offset_; // offset of block I's inverse in dinv_
-    std::vector<double> dinv_;  // row-major inverses of the diagonal blocks
+    std::vector<double> dinv_;  // row-major inverses (times omega for `unrolled`)
+    double post_ = 1.0;         // factor of the block correction: omega or 1 (unrolled)
     Index max_block_ = 0;
-    mutable Vector work_; // one block's residual
-    mutable Vector res_;  // n-vector for apply_transpose
+    std::vector<int> diag_begin_;          // per row: first stored entry in or right of its block
+    std::vector<int> own_begin_, own_end_; // per row: its entries with columns in its own part
+    std::vector<Index> part_block_;        // first block of each part, then the block count
+    std::vector<int> interface_;           // columns read across a cut (copied into snap_)
+    mutable Vector snap_;                  // other parts' unknowns at the start of a sweep
+    mutable Vector work_;                  // one block's residual per part
+    mutable Vector res_;                   // n-vector for apply_transpose
 };
 
 } // namespace mlc::smoothers

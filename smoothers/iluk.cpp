@@ -33,11 +33,7 @@ void ILUK::setup(const SparseMatrix& A) {
 
 void ILUK::update_values(const SparseMatrix& A) {
     check_setup_matrix(A, "ILUK::update_values");
-    const bool same = n_ == A.rows() && a_outer_.size() == static_cast<size_t>(n_ + 1) &&
-                      a_inner_.size() == static_cast<size_t>(A.nonZeros()) &&
-                      std::equal(a_outer_.begin(), a_outer_.end(), A.outerIndexPtr()) &&
-                      std::equal(a_inner_.begin(), a_inner_.end(), A.innerIndexPtr());
-    if (!same) symbolic(A);
+    if (!a_pattern_.matches(A)) symbolic(A);
     numeric(A);
 }
 
@@ -50,8 +46,7 @@ void ILUK::symbolic(const SparseMatrix& A) {
     const int* ao = A.outerIndexPtr();
     const int* ai = A.innerIndexPtr();
     n_ = n;
-    a_outer_.assign(ao, ao + n + 1);
-    a_inner_.assign(ai, ai + A.nonZeros());
+    a_pattern_ = SparsityPattern(A);
 
     ptr_.assign(1, 0);
     cols_.clear();

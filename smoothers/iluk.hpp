@@ -4,6 +4,7 @@
 /// refactors values only.
 #pragma once
 
+#include "core/csr.hpp"
 #include "core/linear_operator.hpp"
 
 #include <ostream>
@@ -79,7 +80,7 @@ private:
     ILUKParams params_;
     Index n_ = 0;
     int n_symbolic_ = 0;
-    std::vector<int> a_outer_, a_inner_; // pattern of A at the last symbolic phase
+    SparsityPattern a_pattern_;          // pattern of A at the last symbolic phase
     std::vector<int> a_to_lu_;           // position in L\U of each stored entry of A
     std::vector<int> ptr_, cols_, diag_; // CSR of L\U; diag_[i] = position of (i, i)
     std::vector<double> vals_;

@@ -37,14 +37,4 @@ double row_max_abs(const SparseMatrix& A, Index i) {
     return m;
 }
 
-bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {
-    if (A.rows() != B.rows() || A.cols() != B.cols() || A.nonZeros() != B.nonZeros()) return false;
-    if (!A.isCompressed() || !B.isCompressed()) return false;
-    const int* ao = A.outerIndexPtr();
-    const int* bo = B.outerIndexPtr();
-    if (!std::equal(ao, ao + A.outerSize() + 1, bo)) return false;
-    const int* ai = A.innerIndexPtr();
-    return std::equal(ai, ai + A.nonZeros(), B.innerIndexPtr());
-}
-
 } // namespace mlc::smoothers

@@ -19,8 +19,4 @@ void check_size(const Vector& v, Index n, std::string_view who, std::string_view
 /// The largest |a_ij| over row i of A (0 for an empty row). A must be compressed.
 double row_max_abs(const SparseMatrix& A, Index i);
 
-/// True when A and B have identical sizes and identical compressed patterns (outer and inner
-/// index arrays compared entry by entry); values are ignored. Both must be compressed.
-bool same_pattern(const SparseMatrix& A, const SparseMatrix& B);
-
 } // namespace mlc::smoothers

@@ -3,6 +3,7 @@
 #include "solvers/direct.hpp"
 
 #include "core/check.hpp"
+#include "core/csr.hpp"
 #include "smoothers/matrix_checks.hpp"
 
 #include <Eigen/SparseLU>
@@ -24,8 +25,7 @@ std::ostream& operator<<(std::ostream& os, const SparseLUParams& p) {
 struct SparseLUPreconditioner::Impl {
     SparseMatrixCol Acol;
     Eigen::SparseLU<SparseMatrixCol, Eigen::COLAMDOrdering<int>> lu;
-    std::vector<int> outer, inner; // row-major pattern of the analysed A
-    bool analysed = false;
+    SparsityPattern pattern; // of the analysed A (empty before the first analysis)
     bool factorized = false;
     int n_analyses = 0;
 };
@@ -42,15 +42,13 @@ SparseLUPreconditioner::operator=(SparseLUPreconditioner&&) noexcept = default;
 void SparseLUPreconditioner::setup(const SparseMatrix& A) {
     smoothers::check_setup_matrix(A, "SparseLUPreconditioner::setup");
     Impl& m = *impl_;
-    m.analysed = false;
+    m.pattern = SparsityPattern();
     m.Acol = A;
     m.Acol.makeCompressed();
     m.lu.setPivotThreshold(params_.pivot_threshold);
     m.lu.analyzePattern(m.Acol);
     ++m.n_analyses;
-    m.outer.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
-    m.inner.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
-    m.analysed = true;
+    m.pattern = SparsityPattern(A);
     m.factorized = false;
     m.lu.factorize(m.Acol);
     if (m.lu.info() != Eigen::Success)
@@ -63,12 +61,7 @@ void SparseLUPreconditioner::setup(const SparseMatrix& A) {
 
 void SparseLUPreconditioner::update_values(const SparseMatrix& A) {
     Impl& m = *impl_;
-    const bool same = m.analysed && A.isCompressed() && A.rows() == m.Acol.rows() &&
-                      A.cols() == m.Acol.cols() &&
-                      m.inner.size() == static_cast<size_t>(A.nonZeros()) &&
-                      std::equal(m.outer.begin(), m.outer.end(), A.outerIndexPtr()) &&
-                      std::equal(m.inner.begin(), m.inner.end(), A.innerIndexPtr());
-    if (!same) {
+    if (!m.pattern.matches(A)) {
         setup(A);
         return;
     }

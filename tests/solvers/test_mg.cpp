@@ -6,6 +6,7 @@
 #include "levels/elastic_block.hpp"
 #include "levels/hierarchy.hpp"
 #include "scene/scene.hpp"
+#include "smoothers/block_sor.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/hypre/boomeramg.hpp"
@@ -47,6 +48,14 @@ Vector direct_solve(const SparseMatrix& K, const Vector& b) {
     return x;
 }
 
+// The multigrid cycle's smoother (vertex blocks, unrolled kernel) with `parts` parts.
+smoothers::BlockSOR mg_smoother(std::vector<Index> starts, int parts) {
+    return smoothers::BlockSOR(smoothers::BlockSORParams{.block_size = 2,
+                                                         .block_starts = std::move(starts),
+                                                         .parts = parts,
+                                                         .kernel = smoothers::Kernel::unrolled});
+}
+
 } // namespace
 
 TEST(Multigrid, TwoLevelCycleContractsTheElasticError) {
@@ -84,7 +93,7 @@ TEST(Multigrid, VCycleIsLevelIndependentAsCGPreconditioner) {
 }
 
 TEST(Multigrid, BadInputIsRejected) {
-    EXPECT_THROW(solvers::BlockGaussSeidel({}, 2.0), InvalidInput);
+    EXPECT_THROW(smoothers::BlockSOR(smoothers::BlockSORParams{.omega = 2.0}), InvalidInput);
     solvers::MultigridParams p;
     p.pre_sweeps = 0;
     p.post_sweeps = 0;
@@ -94,9 +103,9 @@ TEST(Multigrid, BadInputIsRejected) {
     A.insert(0, 1) = 1.0;
     A.insert(1, 0) = 1.0;
     A.makeCompressed();
-    solvers::BlockGaussSeidel point({0, 1});
+    auto point = mg_smoother({0, 1}, 1);
     EXPECT_THROW(point.setup(A), InvalidInput);
-    solvers::BlockGaussSeidel pair; // one 2x2 block: [[0, 1], [1, 0]] is fine
+    auto pair = mg_smoother({}, 1); // one 2x2 block: [[0, 1], [1, 0]] is fine
     EXPECT_NO_THROW(pair.setup(A));
 }
 
@@ -139,7 +148,7 @@ std::vector<int> part_of_rows(Index n, const std::vector<Index>& part_first_row)
 
 } // namespace
 
-TEST(BlockGaussSeidel, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
+TEST(BlockSORParts, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
     // The elastic block of level 3 (33152 unknowns, 2x2 vertex blocks): two parts. Every row i
     // of part p must satisfy, after a forward sweep from x_old,
     //   sum_{j in p, block(j) <= block(i)} a_ij x_new_j + sum_{other j} a_ij x_old_j = b_i,
@@ -148,7 +157,8 @@ TEST(BlockGaussSeidel, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
     const SparseMatrix& K = eh.K();
     const Index n = K.rows();
     const auto starts = solvers::vertex_block_starts(eh.blocks.back().vertex);
-    solvers::BlockGaussSeidel two(starts, 1.0, 2), one(starts, 1.0, 1);
+    auto two = mg_smoother(starts, 2);
+    auto one = mg_smoother(starts, 1);
     two.setup(K);
     one.setup(K);
     ASSERT_EQ(two.parts(), 2);
@@ -191,20 +201,20 @@ TEST(BlockGaussSeidel, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
     for (bool forward : {true, false}) {
         Vector x_old = Vector::Random(n) * x0.lpNorm<Eigen::Infinity>();
         Vector x = x_old;
-        two.sweep(eh.b, x, forward);
+        two.sweep(eh.b, x, forward ? smoothers::Sweep::forward : smoothers::Sweep::backward);
         EXPECT_LT(hybrid_defect(x_old, x, forward), 1e-10) << (forward ? "forward" : "backward");
         // The same linear map every time, and not the sequential sweep (the cut is real).
         Vector x2 = x_old;
-        two.sweep(eh.b, x2, forward);
+        two.sweep(eh.b, x2, forward ? smoothers::Sweep::forward : smoothers::Sweep::backward);
         EXPECT_EQ((x2 - x).norm(), 0.0);
         Vector xs = x_old;
-        one.sweep(eh.b, xs, forward);
+        one.sweep(eh.b, xs, forward ? smoothers::Sweep::forward : smoothers::Sweep::backward);
         EXPECT_GT((xs - x).norm(), 1e-12 * x.norm());
     }
     // update_values: values refreshed in place (K doubled: the sweep from zero halves), and
     // another matrix (the same as a fresh setup on it).
     SparseMatrix K2 = K;
-    solvers::BlockGaussSeidel mine(starts, 1.0, 2);
+    auto mine = mg_smoother(starts, 2);
     mine.setup(K2);
     Vector xa, ra, xb, rb;
     mine.forward_from_zero(eh.b, xa, ra);
@@ -215,13 +225,13 @@ TEST(BlockGaussSeidel, TwoPartsSweepTheirOwnRowsAndReadTheOtherPartAsItWas) {
     SparseMatrix K3 = K;
     K3.coeffRef(0, 0) *= 3.0;
     mine.update_values(K3);
-    solvers::BlockGaussSeidel fresh(starts, 1.0, 2);
+    auto fresh = mg_smoother(starts, 2);
     fresh.setup(K3);
     mine.forward_from_zero(eh.b, xa, ra);
     fresh.forward_from_zero(eh.b, xb, rb);
     EXPECT_EQ((xa - xb).norm(), 0.0);
     // Smaller than two parts' worth of rows: one part whatever is asked.
-    solvers::BlockGaussSeidel small(solvers::vertex_block_starts(eh.blocks[1].vertex), 1.0, 2);
+    auto small = mg_smoother(solvers::vertex_block_starts(eh.blocks[1].vertex), 2);
     small.setup(eh.blocks[1].K);
     EXPECT_EQ(small.parts(), 1);
 }

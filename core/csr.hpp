@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+/// @file Kernels on compressed CSR matrices shared by every folder: the row dot product with four
+/// accumulators, the row-parallel mat-vec `csr_multiply`, and the sparsity-pattern check that
+/// decides whether a preconditioner may only refresh its values.
+#pragma once
+
+#include "core/types.hpp"
+
+#include <algorithm>
+#include <vector>
+
+namespace mlc {
+
+/// Rows per OpenMP thread below which a row-parallel kernel (csr_multiply, the parts of the
+/// threaded block Gauss–Seidel) uses fewer threads: small levels stay sequential, where the
+/// fork/join would cost more than the rows.
+inline constexpr Index kMinRowsPerThread = 4096;
+
+/// Threads for a row-parallel loop over n rows: one per kMinRowsPerThread rows at most, at
+/// least 1, at most the OpenMP maximum (1 without OpenMP).
+int threads_for_rows(Index n);
+
+/// sum_k val[k] x[inner[k]] for k in [k0, k1) with four independent accumulators, returned as
+/// (a0 + a1) + (a2 + a3): accumulator j takes the entries k0 + j, k0 + j + 4, ... of the full
+/// groups of four, and a0 also the (k1 - k0) mod 4 remaining ones.
+///
+/// Why four: a single accumulator chains every multiply-add on the previous one, and the
+/// sweeps and mat-vecs (about 18 entries per row) were bound by that latency rather than by
+/// memory bandwidth. The summation order differs from a one-accumulator loop, so results differ
+/// from Eigen's product in the last bits.
+inline double row_dot(const int* inner, const double* val, const double* x, int k0, int k1) {
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    int k = k0;
+    for (; k + 3 < k1; k += 4) {
+        a0 += val[k] * x[inner[k]];
+        a1 += val[k + 1] * x[inner[k + 1]];
+        a2 += val[k + 2] * x[inner[k + 2]];
+        a3 += val[k + 3] * x[inner[k + 3]];
+    }
+    for (; k < k1; ++k)
+        a0 += val[k] * x[inner[k]];
+    return (a0 + a1) + (a2 + a3);
+}
+
+/// y = A x (or y += A x with `add`) for a compressed CSR matrix, each row by `row_dot`, rows
+/// split over `threads_for_rows(A.rows())` OpenMP threads (every row is summed the same way
+/// whatever the thread count, so the result does not depend on it). Without `add`, y is
+/// resized; with it, y must have A.rows() entries. Throws mlc::InvalidInput on a size mismatch
+/// or an uncompressed A. Does not allocate once y has its size.
+void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = false);
+
+/// True when A and B have identical sizes and identical compressed patterns (outer and inner
+/// index arrays compared entry by entry); values are ignored. False if either is uncompressed.
+bool same_pattern(const SparseMatrix& A, const SparseMatrix& B);
+
+/// A copy of the sparsity pattern of a compressed CSR matrix (its sizes and outer and inner
+/// index arrays), kept by preconditioners whose symbolic phase (analysis, fill pattern, parts)
+/// depends only on the pattern, so that `update_values` can tell a refreshed matrix from a
+/// different one. Memory: rows + 1 + nonzeros ints.
+class SparsityPattern {
+public:
+    /// The empty pattern: matches no matrix.
+    SparsityPattern() = default;
+    /// The pattern of A (A must be compressed; throws mlc::InvalidInput otherwise).
+    explicit SparsityPattern(const SparseMatrix& A);
+    /// True when A is compressed and has exactly this pattern (the same test as `same_pattern`).
+    bool matches(const SparseMatrix& A) const;
+    /// False for a default-constructed pattern.
+    bool empty() const { return outer_.empty(); }
+
+private:
+    Index rows_ = 0, cols_ = 0;
+    std::vector<int> outer_, inner_;
+};
+
+} // namespace mlc

@@ -1,0 +1,124 @@
+// SPDX-License-Identifier: MIT
+// CSR kernels of core/: the unrolled mat-vec, MatrixOperator's two summations, the pattern check.
+#include "core/check.hpp"
+#include "core/csr.hpp"
+#include "core/linear_operator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace mlc {
+namespace {
+
+// A random n x n CSR matrix with about `per_row` entries per row (at least the diagonal).
+SparseMatrix random_matrix(Index n, int per_row, unsigned seed) {
+    std::mt19937 gen(seed);
+    std::uniform_int_distribution<Index> col(0, n - 1);
+    std::uniform_real_distribution<double> val(-1.0, 1.0);
+    std::vector<Triplet> t;
+    for (Index i = 0; i < n; ++i) {
+        t.emplace_back(static_cast<int>(i), static_cast<int>(i), 4.0);
+        for (int k = 0; k < per_row; ++k)
+            t.emplace_back(static_cast<int>(i), static_cast<int>(col(gen)), val(gen));
+    }
+    SparseMatrix A(n, n);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    return A;
+}
+
+TEST(CsrMultiply, AgreesWithEigenToRoundOffAndAdds) {
+    // Large enough for several threads when OpenMP offers them.
+    for (const Index n : {Index{7}, Index{3 * kMinRowsPerThread + 5}}) {
+        const SparseMatrix A = random_matrix(n, 17, 3);
+        const Vector x = Vector::Random(n);
+        const Vector ref = A * x;
+        Vector y;
+        csr_multiply(A, x, y);
+        ASSERT_EQ(y.size(), n);
+        EXPECT_LT((y - ref).lpNorm<Eigen::Infinity>(), 1e-13 * ref.lpNorm<Eigen::Infinity>());
+        Vector z = Vector::Ones(n);
+        csr_multiply(A, x, z, true);
+        EXPECT_LT((z - ref - Vector::Ones(n)).lpNorm<Eigen::Infinity>(),
+                  1e-13 * ref.lpNorm<Eigen::Infinity>());
+    }
+    const SparseMatrix A = random_matrix(5, 2, 1);
+    Vector y;
+    EXPECT_THROW(csr_multiply(A, Vector::Ones(4), y), InvalidInput);
+    Vector short_y = Vector::Zero(3);
+    EXPECT_THROW(csr_multiply(A, Vector::Ones(5), short_y, true), InvalidInput);
+}
+
+TEST(RowDot, UsesFourAccumulatorsInAFixedOrder) {
+    const int inner[6] = {0, 1, 2, 3, 4, 5};
+    const double val[6] = {1e16, 1.0, -1e16, 1.0, 1.0, 1.0};
+    const double x[6] = {1, 1, 1, 1, 1, 1};
+    // Entries 0..3 go to a0..a3, the remainder (4, 5) to a0: a0 = (1e16 + 1) + 1 = 1e16 (each 1
+    // rounds away), a1 = 1, a2 = -1e16, a3 = 1, and (a0 + a1) + (a2 + a3) = 1e16 - 1e16 = 0,
+    // where the sum in storage order gives 3 (only the 1 next to 1e16 is lost).
+    EXPECT_EQ(row_dot(inner, val, x, 0, 6), 0.0);
+    double in_order = 0.0;
+    for (int k = 0; k < 6; ++k)
+        in_order += val[k] * x[inner[k]];
+    EXPECT_EQ(in_order, 3.0);
+    EXPECT_EQ(row_dot(inner, val, x, 2, 2), 0.0);
+}
+
+TEST(MatrixOperator, InOrderIsEigensProductBitForBitAndUnrolledIsCsrMultiply) {
+    const Index n = 2 * kMinRowsPerThread + 3;
+    const SparseMatrix A = random_matrix(n, 17, 5);
+    const Vector x = Vector::Random(n);
+    Vector y, u;
+    MatrixOperator(A).apply(x, y);
+    const Vector ref = A * x;
+    EXPECT_EQ((y - ref).norm(), 0.0);
+    MatrixOperator(A, MatVec::unrolled).apply(x, u);
+    Vector c;
+    csr_multiply(A, x, c);
+    EXPECT_EQ((u - c).norm(), 0.0);
+    Vector t;
+    MatrixOperator(A, MatVec::unrolled).apply_transpose(x, t);
+    const Vector tref = A.transpose() * x;
+    EXPECT_EQ((t - tref).norm(), 0.0);
+}
+
+TEST(SparsityPattern, MatchesTheSamePatternWhateverTheValues) {
+    const SparseMatrix A = random_matrix(50, 4, 7);
+    SparseMatrix B = 3.0 * A;
+    B.makeCompressed();
+    EXPECT_TRUE(same_pattern(A, B));
+    const SparsityPattern p(A);
+    EXPECT_TRUE(p.matches(B));
+    EXPECT_FALSE(SparsityPattern().matches(A));
+    // One entry moved within a row: same counts, different inner indices.
+    SparseMatrix C = A;
+    const int row = 10;
+    std::vector<Triplet> t;
+    for (int i = 0; i < C.outerSize(); ++i)
+        for (SparseMatrix::InnerIterator it(C, i); it; ++it)
+            t.emplace_back(i, static_cast<int>(it.col()), it.value());
+    SparseMatrix D(50, 50);
+    for (auto& e : t)
+        if (e.row() == row && e.col() != row) {
+            int c = e.col();
+            while (C.coeff(row, c) != 0.0 || c == row)
+                c = (c + 1) % 50;
+            e = Triplet(e.row(), c, e.value());
+            break;
+        }
+    D.setFromTriplets(t.begin(), t.end());
+    D.makeCompressed();
+    ASSERT_EQ(D.nonZeros(), A.nonZeros());
+    EXPECT_FALSE(same_pattern(A, D));
+    EXPECT_FALSE(p.matches(D));
+    // Different sizes, and an uncompressed matrix.
+    EXPECT_FALSE(p.matches(random_matrix(51, 4, 7)));
+    SparseMatrix U = A;
+    U.uncompress();
+    EXPECT_FALSE(p.matches(U));
+    EXPECT_FALSE(same_pattern(U, A));
+}
+
+} // namespace
+} // namespace mlc
