@@ -3,22 +3,11 @@
 #include "core/csr.hpp"
 
 #include "core/check.hpp"
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "core/parallel.hpp"
 
 namespace mlc {
 
 namespace {
-
-int max_threads() {
-#ifdef _OPENMP
-    return omp_get_max_threads();
-#else
-    return 1;
-#endif
-}
 
 // The one comparison behind same_pattern and SparsityPattern::matches.
 bool equal_pattern(Index rows, Index cols, const int* outer, const int* inner, Index nonzeros,
@@ -32,10 +21,6 @@ bool equal_pattern(Index rows, Index cols, const int* outer, const int* inner, I
 
 } // namespace
 
-int threads_for_rows(Index n) {
-    return static_cast<int>(std::clamp<Index>(n / kMinRowsPerThread, 1, max_threads()));
-}
-
 void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add) {
     MLC_CHECK(x.size() == A.cols() && (!add || y.size() == A.rows()),
               "csr_multiply: A is " << A.rows() << " x " << A.cols() << ", x has " << x.size()
@@ -48,16 +33,17 @@ void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add) {
     const double* val = A.valuePtr();
     const double* xp = x.data();
     double* yp = y.data();
-    const int threads = threads_for_rows(n);
-    if (add) {
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
-        for (Index i = 0; i < n; ++i)
-            yp[i] += row_dot(inner, val, xp, outer[i], outer[i + 1]);
-    } else {
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1)
-        for (Index i = 0; i < n; ++i)
-            yp[i] = row_dot(inner, val, xp, outer[i], outer[i + 1]);
-    }
+    // Chunks of at least kMinRowsPerThread rows claimed by the pool's threads (core/parallel):
+    // every row is summed the same way whoever runs it, and a loaded core only does fewer chunks.
+    parallel::for_rows(static_cast<size_t>(n), static_cast<size_t>(kMinRowsPerThread),
+                       [&](size_t b, size_t e) {
+                           if (add)
+                               for (size_t i = b; i < e; ++i)
+                                   yp[i] += row_dot(inner, val, xp, outer[i], outer[i + 1]);
+                           else
+                               for (size_t i = b; i < e; ++i)
+                                   yp[i] = row_dot(inner, val, xp, outer[i], outer[i + 1]);
+                       });
 }
 
 bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {

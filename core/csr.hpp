@@ -11,14 +11,10 @@
 
 namespace mlc {
 
-/// Rows per OpenMP thread below which a row-parallel kernel (csr_multiply, the parts of the
-/// threaded block Gauss–Seidel) uses fewer threads: small levels stay sequential, where the
-/// fork/join would cost more than the rows.
+/// Rows per chunk of a row-parallel kernel (csr_multiply, the parts of the hybrid block
+/// Gauss–Seidel) at least: small levels stay sequential, where handing rows to another thread
+/// would cost more than the rows.
 inline constexpr Index kMinRowsPerThread = 4096;
-
-/// Threads for a row-parallel loop over n rows: one per kMinRowsPerThread rows at most, at
-/// least 1, at most the OpenMP maximum (1 without OpenMP).
-int threads_for_rows(Index n);
 
 /// sum_k val[k] x[inner[k]] for k in [k0, k1) with four independent accumulators, returned as
 /// (a0 + a1) + (a2 + a3): accumulator j takes the entries k0 + j, k0 + j + 4, ... of the full
@@ -43,7 +39,8 @@ inline double row_dot(const int* inner, const double* val, const double* x, int 
 }
 
 /// y = A x (or y += A x with `add`) for a compressed CSR matrix, each row by `row_dot`, rows
-/// split over `threads_for_rows(A.rows())` OpenMP threads (every row is summed the same way
+/// split into chunks of at least kMinRowsPerThread rows run by core/parallel's threads (every
+/// row is summed the same way
 /// whatever the thread count, so the result does not depend on it). Without `add`, y is
 /// resized; with it, y must have A.rows() entries. Throws mlc::InvalidInput on a size mismatch
 /// or an uncompressed A. Does not allocate once y has its size.

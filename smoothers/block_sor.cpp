@@ -4,6 +4,7 @@
 #include "smoothers/block_sor.hpp"
 
 #include "core/check.hpp"
+#include "core/parallel.hpp"
 #include "smoothers/matrix_checks.hpp"
 
 #include <Eigen/LU>
@@ -11,10 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace mlc::smoothers {
 
@@ -132,12 +129,7 @@ void BlockSOR::derive_structure() {
     const SparseMatrix& A = *A_;
     const Index n = A.rows();
     const Index nb = n_blocks();
-#ifdef _OPENMP
-    const Index threads = omp_get_max_threads();
-#else
-    const Index threads = 1;
-#endif
-    const Index want = params_.parts > 0 ? params_.parts : threads;
+    const Index want = params_.parts > 0 ? params_.parts : kHybridParts;
     const Index P =
         std::clamp<Index>(std::min(want, n / kMinRowsPerThread), 1, std::max<Index>(nb, 1));
     part_block_.assign(1, 0);
@@ -306,11 +298,12 @@ void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_ze
         sp[j] = xp[j];
     const int P = parts();
     const bool zero = from_zero && params_.kernel == Kernel::in_order;
-#pragma omp parallel for num_threads(P) schedule(static, 1) if (P > 1)
-    for (int p = 0; p < P; ++p)
-        sweep_part(b.data(), xp, part_block_[static_cast<size_t>(p)],
-                   part_block_[static_cast<size_t>(p) + 1], forward, zero,
+    // The parts are claimed by whichever threads of core/parallel are free: with a loaded core
+    // the other thread sweeps both, and the map is the same.
+    parallel::for_chunks(static_cast<size_t>(P), [&](size_t p) {
+        sweep_part(b.data(), xp, part_block_[p], part_block_[p + 1], forward, zero,
                    work_.data() + static_cast<Index>(p) * max_block_);
+    });
 }
 
 void BlockSOR::sweep(const Vector& b, Vector& x, Sweep direction) const {
@@ -350,10 +343,8 @@ void BlockSOR::forward_from_zero(const Vector& b, Vector& x, Vector& res) const 
     // are at the start of the sweep); then the whole residual with the final x: the diagonal
     // and upper entries, and the lower ones of other parts. One part: plain Gauss–Seidel.
     const int P = parts();
-#pragma omp parallel for num_threads(P) schedule(static, 1) if (P > 1)
-    for (int p = 0; p < P; ++p) {
-        for (Index I = part_block_[static_cast<size_t>(p)];
-             I < part_block_[static_cast<size_t>(p) + 1]; ++I) {
+    parallel::for_chunks(static_cast<size_t>(P), [&](size_t p) {
+        for (Index I = part_block_[p]; I < part_block_[p + 1]; ++I) {
             const Index s = starts_[static_cast<size_t>(I)],
                         bs = starts_[static_cast<size_t>(I) + 1] - s;
             for (Index i = s; i < s + bs; ++i)
@@ -367,11 +358,13 @@ void BlockSOR::forward_from_zero(const Vector& b, Vector& x, Vector& res) const 
                 xp[s + i] = acc;
             }
         }
-    }
-#pragma omp parallel for num_threads(P) schedule(static) if (P > 1)
-    for (Index i = 0; i < n; ++i)
-        rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
-                 row_dot(inner, val, xp, outer[i], own_begin_[static_cast<size_t>(i)]);
+    });
+    parallel::for_rows(static_cast<size_t>(n), static_cast<size_t>(kMinRowsPerThread),
+                       [&](size_t i0, size_t i1) {
+                           for (size_t i = i0; i < i1; ++i)
+                               rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
+                                        row_dot(inner, val, xp, outer[i], own_begin_[i]);
+                       });
 }
 
 void BlockSOR::apply(const Vector& r, Vector& z) const {

@@ -15,6 +15,11 @@
 
 namespace mlc::smoothers {
 
+/// Parts of the hybrid block Gauss–Seidel when BlockSORParams::parts is 0 (the multigrid's
+/// smoother): two, as many as the cores of the machines this was tuned on. Fixed, so that the
+/// smoother is the same linear map with one thread, two, or a loaded core.
+inline constexpr int kHybridParts = 2;
+
 /// Order in which the blocks are visited by one sweep.
 enum class Sweep {
     forward,  ///< blocks 0, 1, ..., C = D/omega + L
@@ -66,10 +71,11 @@ struct BlockSORParams {
     /// |u_kk| <= singular_tol * max |block entry|, in [0, 1). Default 1e-14: exact zeros and
     /// round-off remnants only.
     double singular_tol = 1e-14;
-    /// Number of parts (hybrid Gauss–Seidel, see `BlockSOR`), >= 0: 0 takes the number of
-    /// OpenMP threads; at most one part per kMinRowsPerThread rows is used (small matrices stay
-    /// sequential). Default 1: plain sequential (block) Gauss–Seidel, the exact SOR map, which
-    /// `apply_transpose` needs.
+    /// Number of parts (hybrid Gauss–Seidel, see `BlockSOR`), >= 0: 0 takes kHybridParts; at
+    /// most one part per kMinRowsPerThread rows is used (small matrices stay sequential). The
+    /// parts never depend on the number of threads or on the load (core/parallel runs them on
+    /// whichever threads are free), so neither changes an iteration count. Default 1: plain
+    /// sequential (block) Gauss–Seidel, the exact SOR map, which `apply_transpose` needs.
     int parts = 1;
     /// Arithmetic of the sweeps. Default in_order (see `Kernel`).
     Kernel kernel = Kernel::in_order;
