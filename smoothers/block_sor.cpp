@@ -183,6 +183,86 @@ std::vector<Index> BlockSOR::part_rows() const {
     return rows;
 }
 
+namespace {
+
+// 2^round(log2(1/m)) for m > 0: a scaling factor that is exact in floating point.
+double inverse_power_of_two(double m) {
+    int e = 0;
+    std::frexp(m, &e); // m = f 2^e, f in [0.5, 1)
+    return std::ldexp(1.0, 1 - e);
+}
+
+void print_block(std::ostream& os, const Eigen::MatrixXd& D) {
+    const Eigen::IOFormat f(6, 0, ", ", "; ", "", "", "[", "]");
+    os << D.format(f);
+}
+
+} // namespace
+
+// The fallback inverse of a diagonal block that the kernel's fast path rejected. The fast paths
+// test pivots against the largest entry of the block, but a vertex + multiplier block mixes
+// displacement rows of size E (times the mesh's scale) with multiplier rows of size 1 and 1/r:
+// a stick block [[K, I], [I, 0]] has LU pivots of about |K| and 1/|K| (their product is det =
+// 1), a gap block [[K, 0], [0, -I/r]] has |K| and 1/r, and with large E/r or nu near 1/2 the
+// small pivot falls below singular_tol times the large one although the block is perfectly
+// invertible. So the block is equilibrated first, D_s = R D C with R, C diagonal powers of two
+// (exact; Ruiz's iteration: rows and columns scaled by 1/sqrt of their largest entry until all
+// are within a factor 2 of 1), D_s is inverted by full-pivoting LU with the threshold
+// singular_tol relative to its largest pivot, and D^{-1} = C D_s^{-1} R. A zero row or column of
+// the block is a blocking that does not suit A (mlc::InvalidInput, as a zero point diagonal);
+// an equilibrated block that is still singular is a numerical breakdown (mlc::SolverBreakdown,
+// with the block printed).
+void BlockSOR::robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, InverseMap inv) const {
+    const Index s = D.rows();
+    for (Index i = 0; i < s; ++i) {
+        if (D.row(i).cwiseAbs().maxCoeff() > 0.0 && D.col(i).cwiseAbs().maxCoeff() > 0.0) continue;
+        std::ostringstream os;
+        if (s == 1)
+            os << "BlockSOR::setup: zero or missing diagonal in row " << s0
+               << "; contact-multiplier rows have zero diagonals: use blocks that group each "
+                  "contact node's multipliers with its vertex, or ILU/LU";
+        else
+            os << "BlockSOR::setup: singular " << s << "x" << s << " diagonal block " << b
+               << " (rows " << s0 << ".." << s0 + s - 1 << "): its "
+               << (D.row(i).cwiseAbs().maxCoeff() > 0.0 ? "column " : "row ") << i
+               << " is zero; group each contact node's multipliers with its vertex";
+        MLC_CHECK(false, os.str());
+    }
+    Eigen::VectorXd r = Eigen::VectorXd::Ones(s), c = Eigen::VectorXd::Ones(s);
+    Eigen::MatrixXd Ds = D;
+    for (int it = 0; it < 20; ++it) {
+        bool balanced = true;
+        for (Index i = 0; i < s; ++i) {
+            const double m = Ds.row(i).cwiseAbs().maxCoeff();
+            if (m < 0.5 || m > 2.0) balanced = false;
+            const double f = inverse_power_of_two(std::sqrt(m));
+            Ds.row(i) *= f;
+            r[i] *= f;
+        }
+        for (Index j = 0; j < s; ++j) {
+            const double m = Ds.col(j).cwiseAbs().maxCoeff();
+            if (m < 0.5 || m > 2.0) balanced = false;
+            const double f = inverse_power_of_two(std::sqrt(m));
+            Ds.col(j) *= f;
+            c[j] *= f;
+        }
+        if (balanced) break;
+    }
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(Ds);
+    lu.setThreshold(params_.singular_tol);
+    if (!lu.isInvertible()) {
+        std::ostringstream os;
+        os << "BlockSOR::setup: diagonal block " << b << " (rows " << s0 << ".." << s0 + s - 1
+           << ") is singular even after equilibration (rank " << lu.rank() << " of " << s
+           << " at relative pivot threshold " << params_.singular_tol << "); block ";
+        print_block(os, D);
+        os << "; the Jacobian is singular at this node: check its supports and contact "
+              "statuses, or solve with --linear schur/lu";
+        throw SolverBreakdown(os.str());
+    }
+    inv = c.asDiagonal() * lu.inverse() * r.asDiagonal();
+}
+
 void BlockSOR::invert_blocks() {
     const int* ao = A_->outerIndexPtr();
     const int* ai = A_->innerIndexPtr();
@@ -207,26 +287,19 @@ void BlockSOR::invert_blocks() {
                 inv = lu.inverse();
                 continue;
             }
-            std::ostringstream os;
-            if (s == 1)
-                os << "BlockSOR::setup: zero or missing diagonal in row " << s0
-                   << "; contact-multiplier rows have zero diagonals: use blocks that group each "
-                      "contact node's multipliers with its vertex, or ILU/LU";
-            else
-                os << "BlockSOR::setup: singular " << s << "x" << s << " diagonal block " << b
-                   << " (rows " << s0 << ".." << s0 + s - 1 << ", smallest LU pivot " << min_pivot
-                   << ", largest entry " << scale
-                   << "); group each contact node's multipliers with its vertex";
-            MLC_CHECK(false, os.str());
+            robust_inverse(block, b, s0, inv);
+            continue;
         }
         if (s == 2) {
             // Closed form (the common vertex block without multipliers).
             const double det = block(0, 0) * block(1, 1) - block(0, 1) * block(1, 0);
             const double dscale =
                 std::abs(block(0, 0) * block(1, 1)) + std::abs(block(0, 1) * block(1, 0));
-            MLC_CHECK(dscale > 0.0 && std::abs(det) > tol * dscale,
-                      "BlockSOR::setup: diagonal block " << b << " (rows " << s0 << ".." << s0 + 1
-                                                         << ") is singular");
+            if (!(dscale > 0.0 && std::abs(det) > tol * dscale)) {
+                robust_inverse(block, b, s0, inv);
+                inv *= omega;
+                continue;
+            }
             const double f = omega / det;
             out[0] = f * block(1, 1);
             out[1] = -f * block(0, 1);
@@ -236,9 +309,11 @@ void BlockSOR::invert_blocks() {
         }
         Eigen::FullPivLU<Eigen::MatrixXd> lu(block);
         lu.setThreshold(tol);
-        MLC_CHECK(lu.isInvertible(), "BlockSOR::setup: diagonal block " << b << " (rows " << s0
-                                                                        << ".." << s0 + s - 1
-                                                                        << ") is singular");
+        if (!lu.isInvertible()) {
+            robust_inverse(block, b, s0, inv);
+            inv *= omega;
+            continue;
+        }
         inv = omega * lu.inverse();
     }
 }

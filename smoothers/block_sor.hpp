@@ -8,6 +8,8 @@
 #include "core/csr.hpp"
 #include "core/linear_operator.hpp"
 
+#include <Eigen/Dense>
+
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -67,9 +69,11 @@ struct BlockSORParams {
     /// uniform blocks of `block_size`. Pass the vertex starts of the contact dof map so that a
     /// contact vertex with its multipliers forms one 4x4 (3x3 frictionless) block.
     std::vector<Index> block_starts = {};
-    /// A diagonal block is singular when a pivot of its partial-pivoting LU satisfies
-    /// |u_kk| <= singular_tol * max |block entry|, in [0, 1). Default 1e-14: exact zeros and
-    /// round-off remnants only.
+    /// Pivot threshold in [0, 1) of the block inversions: the fast paths take a block whose
+    /// pivots exceed singular_tol times its largest entry (in_order: partial-pivoting LU; unrolled:
+    /// |det| against the 2x2 products, full-pivoting LU threshold), other blocks are equilibrated
+    /// and singular when a full-pivoting LU pivot of the scaled block is below singular_tol times
+    /// its largest (see `BlockSOR`). Default 1e-14: exact zeros and round-off remnants only.
     double singular_tol = 1e-14;
     /// Number of parts (hybrid Gauss–Seidel, see `BlockSOR`), >= 0: 0 takes kHybridParts; at
     /// most one part per kMinRowsPerThread rows is used (small matrices stay sequential). The
@@ -101,9 +105,20 @@ std::vector<Index> uniform_block_starts(Index n, Index block_size);
 ///
 /// Each D_I is inverted once in `setup` (and again in `update_values`) by dense LU, so zero
 /// scalar diagonals inside a block (contact multipliers in stick or slip-normal rows) are fine as
-/// long as the block is nonsingular. A singular block (for point blocks: a zero or missing
-/// diagonal) throws mlc::InvalidInput from `setup` naming the block and its rows: the blocking
-/// does not suit A, so group each contact node's multipliers with its vertex.
+/// long as the block is nonsingular. The kernel's fast path (see `Kernel`) tests its pivots
+/// against singular_tol times the block's largest entry or pivot; a block it rejects is not
+/// necessarily singular: a vertex + multiplier block mixes rows of size E with multiplier rows of
+/// size 1 and 1/r, so with a large r ([[K, 0], [0, -I/r]]) or nu near 1/2 (K of size 1e8 next to
+/// entries 1) its pivots span more than 1/singular_tol. Such a block is equilibrated (rows and
+/// columns scaled by powers of two until their largest entries are within a factor 2 of 1) and
+/// inverted by full-pivoting LU with the threshold singular_tol relative to the scaled block's
+/// largest pivot. Only then:
+/// - a zero row or column inside a block (for point blocks: a zero or missing diagonal) throws
+///   mlc::InvalidInput naming the block and its rows: the blocking does not suit A, so group
+///   each contact node's multipliers with its vertex;
+/// - a block that is singular even equilibrated throws mlc::SolverBreakdown with the block's
+///   entries (the Jacobian is singular at that node).
+/// Blocks that pass the fast path are inverted exactly as before the fallback existed.
 ///
 /// Parts (hybrid Gauss–Seidel, as in hypre's threaded relaxation): with `parts` != 1 the blocks
 /// are cut at setup into P contiguous runs of about equal nonzeros, one per OpenMP thread. Each
@@ -160,7 +175,11 @@ public:
 
 private:
     void derive_structure(); // parts and diagonal positions, from *A_'s pattern
+    using InverseMap =
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
     void invert_blocks();
+    // D^{-1} of a block the kernel's fast path rejected (equilibrated full-pivot LU); throws.
+    void robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, InverseMap inv) const;
     void half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero) const;
     // One part's sweep (blocks [b0, b1)), other parts' unknowns read from snap_.
     void sweep_part(const double* bp, double* xp, Index b0, Index b1, bool forward, bool from_zero,

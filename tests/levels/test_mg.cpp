@@ -140,3 +140,22 @@ TEST(MultilevelPreconditioner, GalerkinCoarseOperatorsConvergeLikeRediscretizati
     so.linear.pc = "mg:coarse=algebraic";
     EXPECT_THROW(solve(p, so), InvalidInput);
 }
+
+TEST(MultilevelPreconditioner, StiffContactBlocksOfLargeRAreSmoothed_Slow) {
+    // r = 1e4 E (1.3e9): the 4x4 vertex + multiplier block of a gap vertex is
+    // [[K, 0], [0, -I/r]] with pivots 1e5 and 7.7e-10, which the smoother's full-pivot LU test
+    // (threshold 1e-14 relative to the largest pivot) used to call singular. Equilibrated, the
+    // blocks are inverted and mg gives the exact solver's solution with few iterations.
+    auto p = apps::load_scene("square");
+    p.levels = 3;
+    p.load_steps = 2;
+    for (auto& c : p.contacts)
+        c.r = 1e4 * p.bodies[0].material.E;
+    const RunResult ref = solve(p, {});
+    ASSERT_TRUE(ref.converged) << ref.failure;
+    const RunResult r = run_square_problem(p);
+    ASSERT_TRUE(r.converged) << r.failure;
+    EXPECT_LT((r.x - ref.x).norm(), 1e-6 * ref.x.norm());
+    for (int m : max_iterations(r))
+        EXPECT_LE(m, 30);
+}

@@ -52,7 +52,6 @@ Eigen::MatrixXd explicit_inverse(const SparseMatrix& A, const std::vector<Index>
     return C.inverse();
 }
 
-
 struct Case {
     const char* name;
     SparseMatrix A;
@@ -157,4 +156,161 @@ TEST(BlockSOR, RejectsBadParamsAndBlocking) {
     EXPECT_NE(os.str().find("omega=1"), std::string::npos);
     EXPECT_EQ(BlockSOR(BlockSORParams{.omega = 1.5, .sweep = Sweep::symmetric}).name(),
               "ssor(omega=1.5)");
+}
+
+namespace {
+
+// Two vertex + multiplier blocks (rows 0..3 and 4..7) with the given 4x4 diagonal block D, the
+// same at both vertices, coupled through their displacements by -c (a weak elastic spring).
+SparseMatrix two_contact_vertices(const Eigen::Matrix4d& D, double c) {
+    std::vector<Triplet> t;
+    for (int v = 0; v < 2; ++v)
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j)
+                if (D(i, j) != 0.0) t.emplace_back(4 * v + i, 4 * v + j, D(i, j));
+    for (int d = 0; d < 2; ++d) {
+        t.emplace_back(d, 4 + d, -c);
+        t.emplace_back(4 + d, d, -c);
+    }
+    SparseMatrix A(8, 8);
+    A.setFromTriplets(t.begin(), t.end());
+    A.makeCompressed();
+    return A;
+}
+
+// The blocks that stopped the mg smoother (square, level 4): a gap vertex with r = 1.3e9
+// ([[K, 0], [0, -I/r]]: pivots 1e5 and 7.7e-10) and a slip vertex with nu = 0.4999 (K of
+// size 2e8 next to multiplier entries of size 1 and 1/r = 7.7e-5).
+Eigen::Matrix4d gap_block_large_r() {
+    Eigen::Matrix4d D = Eigen::Matrix4d::Zero();
+    D(0, 0) = D(1, 1) = 99305.6;
+    D(2, 2) = D(3, 3) = -1.0 / 1.3e9;
+    return D;
+}
+Eigen::Matrix4d slip_block_nearly_incompressible() {
+    Eigen::Matrix4d D;
+    D << 2.16768e+08, -1.08354e+08, 0, -1, //
+        -1.08341e+08, 2.16781e+08, 0, 1,   //
+        0, -1, -7.69231e-05, -7.69231e-05, //
+        0, 1, 0, 0;
+    return D;
+}
+
+} // namespace
+
+TEST(BlockSOR, BlocksSingularOnlyInFloatingPointAreInverted) {
+    for (const Kernel kernel : {Kernel::in_order, Kernel::unrolled})
+        for (const Eigen::Matrix4d& D : {gap_block_large_r(), slip_block_nearly_incompressible()}) {
+            // The old tests: the unrolled kernel's full-pivot LU and the in-order kernel's
+            // partial-pivot LU against singular_tol times the largest entry both reject D.
+            Eigen::FullPivLU<Eigen::MatrixXd> full(D);
+            full.setThreshold(1e-14);
+            ASSERT_FALSE(full.isInvertible());
+            const SparseMatrix A = two_contact_vertices(D, 1e-3);
+            BlockSOR S(BlockSORParams{.block_starts = {0, 4}, .kernel = kernel});
+            ASSERT_NO_THROW(S.setup(A));
+            // One sweep solves each block exactly: the block part of the residual vanishes
+            // and the whole residual drops, with a finite correction.
+            const Vector b = Vector::LinSpaced(8, 1.0, 8.0);
+            Vector x = Vector::Zero(8);
+            S.smooth(b, x);
+            ASSERT_TRUE(x.allFinite());
+            const Vector r = b - A * x;
+            EXPECT_LT(r.norm(), 1e-2 * b.norm()) << to_string(kernel);
+            // The block inverse itself is backward stable: A x = b for the decoupled blocks up
+            // to round-off in ||A|| ||x||.
+            const SparseMatrix A0 = two_contact_vertices(D, 0.0);
+            S.setup(A0);
+            S.apply(b, x);
+            const double scale = testmat::dense(A0).cwiseAbs().maxCoeff() * x.cwiseAbs().maxCoeff();
+            EXPECT_LT((A0 * x - b).lpNorm<Eigen::Infinity>(), 1e-14 * scale) << to_string(kernel);
+        }
+}
+
+TEST(BlockSOR, RegularBlocksKeepTheirFastPathBitForBit) {
+    // A regular 2x2 and 4x4 block: the unrolled kernel's inverses are the closed form and
+    // omega times Eigen's full-pivot LU inverse; the in-order kernel's the partial-pivot one,
+    // with omega applied after the block product, exactly as before the fallback existed.
+    Eigen::Matrix4d D;
+    D << 4, -1, 0.5, 0, //
+        -1, 5, 0, 1,    //
+        0.5, 0, -2, 0,  //
+        0, 1, 0, -3;
+    const SparseMatrix A = two_contact_vertices(D, 0.0);
+    Eigen::Matrix4d D2 = D; // its 2x2 diagonal blocks only, for 2x2 blocking
+    D2.block(0, 2, 2, 2).setZero();
+    D2.block(2, 0, 2, 2).setZero();
+    const SparseMatrix A2 = two_contact_vertices(D2, 0.0);
+    const Vector b = Vector::LinSpaced(8, -1.0, 3.0);
+    const double w = 1.3;
+    for (const Kernel kernel : {Kernel::in_order, Kernel::unrolled}) {
+        BlockSOR S(BlockSORParams{.omega = w, .block_starts = {0, 2, 4, 6}, .kernel = kernel});
+        S.setup(A2);
+        Vector x;
+        S.apply(b, x);
+        for (int blk = 0; blk < 4; ++blk) {
+            const Eigen::Matrix2d Db = testmat::dense(A2).block(2 * blk, 2 * blk, 2, 2);
+            Eigen::Matrix2d inv;
+            if (kernel == Kernel::unrolled) {
+                const double det = Db(0, 0) * Db(1, 1) - Db(0, 1) * Db(1, 0);
+                const double f = w / det;
+                inv << f * Db(1, 1), -f * Db(0, 1), -f * Db(1, 0), f * Db(0, 0);
+            } else {
+                inv = Eigen::PartialPivLU<Eigen::MatrixXd>(Db).inverse();
+            }
+            // The sweep's residual for this block (the blocks are decoupled: b itself).
+            for (int a = 0; a < 2; ++a) {
+                double c = 0.0;
+                for (int q = 0; q < 2; ++q)
+                    c += inv(a, q) * b[2 * blk + q];
+                const double expected = kernel == Kernel::unrolled ? c : w * c;
+                EXPECT_EQ(x[2 * blk + a], expected) << to_string(kernel) << " block " << blk;
+            }
+        }
+        BlockSOR S4(BlockSORParams{.omega = w, .block_starts = {0, 4}, .kernel = kernel});
+        S4.setup(A);
+        S4.apply(b, x);
+        Eigen::Matrix4d inv;
+        if (kernel == Kernel::unrolled) {
+            Eigen::FullPivLU<Eigen::MatrixXd> lu{Eigen::MatrixXd(D)};
+            lu.setThreshold(1e-14);
+            inv = w * lu.inverse();
+        } else {
+            inv = Eigen::PartialPivLU<Eigen::MatrixXd>(Eigen::MatrixXd(D)).inverse();
+        }
+        for (int a = 0; a < 4; ++a) {
+            double c = 0.0;
+            for (int q = 0; q < 4; ++q)
+                c += inv(a, q) * b[q];
+            EXPECT_EQ(x[a], kernel == Kernel::unrolled ? c : w * c) << to_string(kernel);
+        }
+    }
+}
+
+TEST(BlockSOR, TrulySingularBlockIsABreakdownAndAZeroRowABadBlocking) {
+    // Rank 3 with no zero row or column: a numerical breakdown, named with the block.
+    Eigen::Matrix4d D;
+    D << 1, 2, 0, 1, //
+        2, 4, 0, 2,  //
+        0, 0, 3, 1,  //
+        1, 0, 1, 5;
+    for (const Kernel kernel : {Kernel::in_order, Kernel::unrolled}) {
+        BlockSOR S(BlockSORParams{.block_starts = {0, 4}, .kernel = kernel});
+        try {
+            S.setup(two_contact_vertices(D, 0.0));
+            FAIL() << "expected SolverBreakdown";
+        } catch (const SolverBreakdown& e) {
+            const std::string m = e.what();
+            EXPECT_NE(m.find("diagonal block 0 (rows 0..3)"), std::string::npos) << m;
+            EXPECT_NE(m.find("rank 3 of 4"), std::string::npos) << m;
+        }
+        // A zero row in the block: the blocking does not suit A.
+        Eigen::Matrix4d Z = D;
+        Z.row(3).setZero();
+        Z(3, 3) = 0.0;
+        SparseMatrix A = two_contact_vertices(Z, 0.0);
+        A.coeffRef(3, 7) = 1.0; // row 3 is not empty, only its diagonal block part
+        A.makeCompressed();
+        EXPECT_THROW(S.setup(A), InvalidInput);
+    }
 }
