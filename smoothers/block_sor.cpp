@@ -214,6 +214,39 @@ void print_block(std::ostream& os, const Eigen::MatrixXd& D) {
 // with the block printed).
 void BlockSOR::robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, InverseMap inv) const {
     const Index s = D.rows();
+    // An unknown whose row and column are both zero in the block is decoupled from the others
+    // (e.g. the tangential multiplier of a stuck node whose tangential displacement is
+    // prescribed: its equation and its column vanish from the Jacobian). Its correction is zero
+    // (the pseudo-inverse), and the rest of the block is inverted without it.
+    // Only in a block of several unknowns and when the unknown's whole row of A is zero (a
+    // point block's zero diagonal stays the error below).
+    auto decoupled = [&](Index i) {
+        if (s == 1 || D.row(i).cwiseAbs().maxCoeff() > 0.0 || D.col(i).cwiseAbs().maxCoeff() > 0.0)
+            return false;
+        const Index row = s0 + i;
+        const double* av = A_->valuePtr();
+        for (int p = A_->outerIndexPtr()[row]; p < A_->outerIndexPtr()[row + 1]; ++p)
+            if (av[p] != 0.0) return false;
+        return true;
+    };
+    std::vector<Index> keep;
+    for (Index i = 0; i < s; ++i)
+        if (!decoupled(i)) keep.push_back(i);
+    if (static_cast<Index>(keep.size()) < s) {
+        inv.setZero();
+        const Index k = static_cast<Index>(keep.size());
+        if (k == 0) return;
+        Eigen::MatrixXd Dk(k, k);
+        for (Index i = 0; i < k; ++i)
+            for (Index j = 0; j < k; ++j)
+                Dk(i, j) = D(keep[static_cast<size_t>(i)], keep[static_cast<size_t>(j)]);
+        Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Ik(k, k);
+        robust_inverse(Dk, b, s0, InverseMap(Ik.data(), k, k));
+        for (Index i = 0; i < k; ++i)
+            for (Index j = 0; j < k; ++j)
+                inv(keep[static_cast<size_t>(i)], keep[static_cast<size_t>(j)]) = Ik(i, j);
+        return;
+    }
     for (Index i = 0; i < s; ++i) {
         if (D.row(i).cwiseAbs().maxCoeff() > 0.0 && D.col(i).cwiseAbs().maxCoeff() > 0.0) continue;
         std::ostringstream os;

@@ -314,3 +314,27 @@ TEST(BlockSOR, TrulySingularBlockIsABreakdownAndAZeroRowABadBlocking) {
         EXPECT_THROW(S.setup(A), InvalidInput);
     }
 }
+
+TEST(BlockSOR, ADecoupledUnknownGetsNoCorrectionAndTheRestOfItsBlockIsInverted) {
+    // A stuck contact node whose tangential displacement is prescribed: its tangential
+    // multiplier (row and column 1 of the block) has vanished from the Jacobian.
+    Eigen::Matrix4d D;
+    D << 4, 0, 1, 0, //
+        0, 0, 0, 0,  //
+        1, 0, 3, 1,  //
+        0, 0, 1, 2;
+    for (const Kernel kernel : {Kernel::in_order, Kernel::unrolled}) {
+        SCOPED_TRACE(to_string(kernel));
+        const SparseMatrix A = two_contact_vertices(D, 0.0);
+        BlockSOR S(BlockSORParams{.block_starts = {0, 4}, .kernel = kernel});
+        ASSERT_NO_THROW(S.setup(A));
+        Vector b = Vector::LinSpaced(8, 1.0, 8.0);
+        b[1] = b[5] = 0.0; // consistent right-hand side: the decoupled rows read 0 = 0
+        Vector x;
+        S.apply(b, x);
+        EXPECT_EQ(x[1], 0.0);
+        EXPECT_EQ(x[5], 0.0);
+        // The other unknowns solve their 3x3 blocks exactly.
+        EXPECT_LT((A * x - b).lpNorm<Eigen::Infinity>(), 1e-14 * 8.0);
+    }
+}
