@@ -9,7 +9,7 @@
 ///  - chunks are CLAIMED with an atomic counter, by the calling thread and the workers alike;
 ///  - completion is a count of finished chunks: the caller never waits for a worker that has not
 ///    claimed anything (a descheduled worker simply does not take part);
-///  - idle workers spin briefly (tens of microseconds, with a pause instruction) and then sleep on
+///  - idle workers spin briefly (2 ms, with a pause instruction) and then sleep on
 ///    a futex, so an idle machine gets low latency and a loaded one loses no core to spinning.
 ///
 /// Determinism: which chunks exist depends only on the arguments (never on the number of threads
