@@ -146,7 +146,7 @@ TEST(MultilevelPreconditioner, StiffContactBlocksOfLargeRAreSmoothed_Slow) {
     // [[K, 0], [0, -I/r]] with pivots 1e5 and 7.7e-10, which the smoother's full-pivot LU test
     // (threshold 1e-14 relative to the largest pivot) used to call singular. Equilibrated, the
     // blocks are inverted and mg gives the exact solver's solution with few iterations.
-    auto p = apps::load_scene("square");
+    auto p = scene::load_scene("square");
     p.levels = 3;
     p.load_steps = 2;
     for (auto& c : p.contacts)
