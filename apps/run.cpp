@@ -35,9 +35,10 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
         }
     }
     p.validate();
-    const levels::SolverChoice choice =
-        levels::choose_solver(p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol});
     levels::SolveOptions so;
+    so.predicted_sizes = levels::predict_level_sizes(p); // level 0 built once for both
+    const levels::SolverChoice choice = levels::choose_solver(
+        p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}, &so.predicted_sizes);
     so.progress = opt.quiet ? nullptr : &os;
     so.coarse_to_fine = !opt.cold;
     so.linear = choice.spec;

@@ -220,7 +220,7 @@ private:
                     coarse_lu_->update_values(coarse_jac_->matrix());
                 coarse_factored_ = true;
                 coarse_M_used_ = cM;
-            } catch (const SolverBreakdown& e) {
+            } catch (const SolverBreakdown&) {
                 // The coarse Jacobian is singular at these statuses (for instance the
                 // tangential multiplier of a stuck node whose tangential displacement is
                 // prescribed: a zero row and column). The level below's own exact solver
@@ -228,7 +228,6 @@ private:
                 // says so.
                 coarse_exact_ = std::make_unique<CoarseSolverAsPreconditioner>(*ctx_->coarse_solver,
                                                                                ctx_->coarse_M);
-                coarse_fallback_ = e.what();
             }
         }
         if (mg_ && coarse_exact_ && mg_coarse_ == coarse_lu_.get())
@@ -395,7 +394,6 @@ private:
     bool coarse_factored_ = false;
     // When the coarse LU broke down: the level below's exact solver as coarse solve.
     std::unique_ptr<Preconditioner> coarse_exact_;
-    std::string coarse_fallback_;
     std::vector<Eigen::Matrix2d> coarse_M_used_;
     // MG: the coarse correction (the level below's cycle, or coarse_lu_), set at every solve.
     bool mg_ = false;

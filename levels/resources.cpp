@@ -67,7 +67,8 @@ double mg_crossover_unknowns(const Problem& problem) {
     return kMgCrossoverOneBody;
 }
 
-SolverChoice choose_solver(const Problem& problem, const SolverRequest& req) {
+SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
+                           const std::vector<LevelSize>* known_sizes) {
     SolverChoice c;
     LinearSolverSpec& s = c.spec;
     const bool krylov_option = req.pc || req.krylov || req.rel_tol;
@@ -103,8 +104,8 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req) {
         }
     } else {
         c.automatic = true;
-        const auto sizes = predict_level_sizes(problem);
-        const double n = sizes.back().unknowns;
+        const double n = known_sizes ? known_sizes->back().unknowns
+                                     : predict_level_sizes(problem).back().unknowns;
         const double crossover = mg_crossover_unknowns(problem);
         std::ostringstream os;
         os << std::setprecision(3);

@@ -65,7 +65,9 @@ struct SolverChoice {
 /// unknowns on the finest level, Krylov (CGS) + `mg` above it when levels exist. A Krylov
 /// option next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying
 /// so.
-SolverChoice choose_solver(const Problem& problem, const SolverRequest& request);
+/// `sizes`: predict_level_sizes(problem) when the caller has it already (it builds level 0).
+SolverChoice choose_solver(const Problem& problem, const SolverRequest& request,
+                           const std::vector<LevelSize>* sizes = nullptr);
 
 /// Peak resident memory a run is estimated to need, and its parts.
 struct MemoryEstimate {

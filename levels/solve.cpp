@@ -49,7 +49,13 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     RunResult res;
     res.solver.spec = options.linear;
     res.solver.reason = "as given";
-    res.predicted_sizes = predict_level_sizes(problem);
+    MLC_CHECK(options.predicted_sizes.empty() ||
+                  options.predicted_sizes.size() == static_cast<size_t>(problem.levels) + 1,
+              "SolveOptions::predicted_sizes has " << options.predicted_sizes.size()
+                                                   << " levels, the problem "
+                                                   << problem.levels + 1);
+    res.predicted_sizes =
+        options.predicted_sizes.empty() ? predict_level_sizes(problem) : options.predicted_sizes;
     res.memory = estimate_memory(res.predicted_sizes, options.linear,
                                  options.coarse_to_fine || options.solve_all_levels ||
                                      needs_coarse_level(options.linear));

@@ -37,6 +37,9 @@ struct SolveOptions {
     LinearSolverSpec linear;
     /// Solve every level even in cold mode (the status-transfer study compares per level).
     bool solve_all_levels = false;
+    /// predict_level_sizes(problem) when the caller computed it already (it builds level 0);
+    /// empty: solve computes it.
+    std::vector<LevelSize> predicted_sizes;
 };
 
 /// Confusion table of predicted (rows) against converged (columns) statuses, indexed by
