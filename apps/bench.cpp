@@ -2,6 +2,8 @@
 // `mlcontact bench square` and `mlcontact bench elastic`.
 #include "apps/bench.hpp"
 
+#include "apps/preconditioners.hpp"
+
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/timer.hpp"
@@ -86,6 +88,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
               "bench square: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench square: --repeat must be >= 1, found " << opt.repeat);
     MLC_CHECK(!opt.pcs.empty(), "bench square: no --pc given");
+    check_preconditioner_names(opt.pcs, true);
     levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
     const std::filesystem::path out =

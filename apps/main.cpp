@@ -7,6 +7,7 @@
 // non-zero exit code: 1 for bad input, 2 for a solve that did not converge, 3 for a numerical
 // breakdown.
 #include "apps/bench.hpp"
+#include "apps/preconditioners.hpp"
 #include "apps/run.hpp"
 #include "apps/study_accuracy.hpp"
 #include "apps/study_error_vs_time.hpp"
@@ -42,11 +43,13 @@ int main(int argc, char** argv) {
     run->add_option("--krylov", ro.krylov,
                     "Krylov method (implies a Krylov solve): cgs (default), bicg, bicgstab, gmres");
     run->add_option("--pc", ro.pc,
-                    "preconditioner (implies a Krylov solve), e.g. mg (default with levels), "
-                    "diag, ilu:1, cf, sorcf:omega=1.2, ebe");
+                    mlc::apps::pc_option_help("preconditioner (implies a Krylov solve; default mg "
+                                              "above the crossover, see the report)"));
     run->add_option("--linear-tol", ro.linear_rel_tol,
                     "relative tolerance of each Krylov solve (implies a Krylov solve; default "
                     "1e-10)");
+    auto* pcs = app.add_subcommand("preconditioners",
+                                   "list the preconditioners, their options and what they need");
     auto* study = app.add_subcommand("study", "run a study (see README: Studies)");
     study->require_subcommand(1);
     mlc::apps::StatusTransferOptions sto;
@@ -74,7 +77,8 @@ int main(int argc, char** argv) {
                    "solver the run default may choose, one table each)")
         ->check(CLI::IsMember({"schur", "lu", "krylov"}));
     ex->add_option("--krylov", exo.krylov, "Krylov method (implies a Krylov solve)");
-    ex->add_option("--pc", exo.pc, "preconditioner (implies a Krylov solve), e.g. mg");
+    ex->add_option("--pc", exo.pc,
+                   mlc::apps::pc_option_help("preconditioner (implies a Krylov solve)"));
     ex->add_option("--linear-tol", exo.linear_rel_tol,
                    "relative tolerance of each Krylov solve (implies a Krylov solve)");
     mlc::apps::ErrorVsTimeOptions evo;
@@ -95,7 +99,8 @@ int main(int argc, char** argv) {
     ps->add_option("--mu", pso.mu, "friction coefficients (list)")->delimiter(',');
     ps->add_option("--r", pso.r_over_E, "penalty factors r/E (list)")->delimiter(',');
     ps->add_option("--pc", pso.pcs,
-                   "preconditioners (list; default diag ilu:0 cf sorcf ebe ebe:variant=c5)");
+                   mlc::apps::pc_option_help(
+                       "preconditioners (list; default diag ilu:0 cf sorcf ebe ebe:variant=c5)"));
     ps->add_option("--krylov", pso.krylovs, "Krylov methods (list; default cgs)")->delimiter(',');
     ps->add_option("--steps", pso.load_steps, "load steps (default: the scene's)");
     ps->add_option("--tol", pso.rel_tol, "Krylov relative tolerance (default 1e-8)");
@@ -124,7 +129,8 @@ int main(int argc, char** argv) {
     bsq->add_option("--levels,-l", bso.levels, "finest level (default 3)");
     bsq->add_option(
         "--pc", bso.pcs,
-        "solvers (space-separated list): schur, lu, or preconditioner specs (default mg)");
+        mlc::apps::pc_option_help(
+            "solvers (space-separated list): schur, lu, or preconditioner specs (default mg)"));
     bsq->add_option("--krylov", bso.krylov, "Krylov method for the preconditioners (default cgs)");
     bsq->add_option("--tol", bso.rel_tol, "Krylov relative tolerance (default 1e-8)");
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
@@ -182,6 +188,10 @@ int main(int argc, char** argv) {
                 sto_q == "paper" ? mlc::transfer::QRule::paper : mlc::transfer::QRule::conservative;
             return mlc::apps::study_status_transfer(mlc::scene::load_scene(sto_scene), sto,
                                                     std::cout);
+        }
+        if (*pcs) {
+            mlc::apps::print_preconditioners(std::cout);
+            return 0;
         }
         if (*scenes) {
             for (const auto& n : mlc::scene::builtin_scene_names())

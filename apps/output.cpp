@@ -238,6 +238,27 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             sv.insert("automatic", r.solver.automatic);
             sv.insert("reason", r.solver.reason);
             root.insert("solver", sv);
+            if (r.multigrid) {
+                const solvers::MultigridReport& m = *r.multigrid;
+                toml::table mg;
+                toml::array rows;
+                for (const auto& lv : m.levels) {
+                    toml::table row;
+                    row.insert("level", lv.level);
+                    row.insert("rows", static_cast<int64_t>(lv.rows));
+                    row.insert("nonzeros", static_cast<int64_t>(lv.nonzeros));
+                    row.insert("solve", lv.solve);
+                    rows.push_back(std::move(row));
+                }
+                mg.insert("levels", std::move(rows));
+                mg.insert("operator_complexity", m.operator_complexity);
+                mg.insert("grid_complexity", m.grid_complexity);
+                mg.insert("cycle", m.cycle);
+                mg.insert("smoother", m.smoother);
+                mg.insert("coarse_solver", m.coarse_solver);
+                mg.insert("coarse_operators", m.coarse_operators);
+                root.insert("multigrid", std::move(mg));
+            }
             toml::table mt;
             mt.insert("estimate_bytes", r.memory.bytes);
             mt.insert("estimate_hierarchy_bytes", r.memory.hierarchy_bytes);

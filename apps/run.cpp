@@ -49,6 +49,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     os << "memory: estimated peak " << levels::format_bytes(r.memory.bytes) << " of "
        << levels::format_bytes(r.memory_limit.bytes) << " available (" << r.memory_limit.source
        << "); measured peak " << levels::format_bytes(peak_rss_bytes()) << "\n";
+    if (r.multigrid) os << *r.multigrid;
     os << "\n";
     print_header(os, p, r);
     print_summary(os, p, r);

@@ -2,6 +2,8 @@
 // Preconditioner study (issue: the papers' Krylov solvers and preconditioners).
 #include "apps/study_preconditioners.hpp"
 
+#include "apps/preconditioners.hpp"
+
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"
@@ -172,6 +174,7 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 6, "--levels must lie in [1, 6]");
     MLC_CHECK(!opt.pcs.empty() && !opt.krylovs.empty() && !opt.mu.empty() && !opt.r_over_E.empty(),
               "empty preconditioner, Krylov, mu or r list");
+    check_preconditioner_names(opt.pcs);
     for (double m : opt.mu)
         MLC_CHECK(m >= 0, "--mu values must be >= 0, found " << m);
     for (double r : opt.r_over_E)

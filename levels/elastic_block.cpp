@@ -64,19 +64,20 @@ ElasticMultigrid::ElasticMultigrid(const Hierarchy& h, const std::vector<Elastic
                                    << " levels (at least two needed)");
     P.resize(n);
     R.resize(n);
-    cycle.resize(n);
-    lu = std::make_unique<solvers::SparseLUPreconditioner>();
-    lu->setup(blocks[0].K);
-    for (size_t l = 1; l < n; ++l) {
-        P[l] = displacement_prolongation(h.transfers[l - 1].T, blocks[l], blocks[l - 1]);
-        R[l] = P[l].transpose();
-        const Preconditioner* below =
-            l == 1 ? static_cast<const Preconditioner*>(lu.get()) : cycle[l - 1].get();
-        cycle[l] = std::make_unique<solvers::MultigridCycle>(
-            P[l], R[l], [below](const Vector& r, Vector& z) { below->apply(r, z); },
-            solvers::vertex_block_starts(blocks[l].vertex), params);
-        cycle[l]->setup(blocks[l].K);
+    std::vector<solvers::MultigridLevelData> data(n);
+    for (size_t l = 0; l < n; ++l) {
+        if (l > 0) {
+            P[l] = displacement_prolongation(h.transfers[l - 1].T, blocks[l], blocks[l - 1]);
+            R[l] = P[l].transpose();
+            data[l].T = &P[l];
+            data[l].R = &R[l];
+        }
+        data[l].block_starts = solvers::vertex_block_starts(blocks[l].vertex);
     }
+    mg = std::make_unique<solvers::Multigrid>(std::move(data), params);
+    for (size_t l = 0; l + 1 < n; ++l)
+        mg->set_operator(static_cast<int>(l), blocks[l].K);
+    mg->setup(blocks[n - 1].K);
 }
 
 } // namespace mlc::levels

@@ -33,18 +33,18 @@ ElasticBlock elastic_block(const Level& L);
 SparseMatrix displacement_prolongation(const SparseMatrix& T, const ElasticBlock& fine,
                                        const ElasticBlock& coarse);
 
-/// The geometric V-cycle on the elastic blocks of all levels: P = displacement_prolongation of
+/// The geometric V-cycle on the elastic blocks of all levels, a third client of
+/// solvers::Multigrid (rediscretized: each level's stiffness): P = displacement_prolongation of
 /// each transfer, R = P^T, vertex-block Gauss–Seidel, sparse LU on level 0. `blocks[l]` is the
-/// elastic block of h.levels[l]; both must outlive this object (the cycles keep references).
+/// elastic block of h.levels[l]; both must outlive this object (the multigrid keeps references).
 struct ElasticMultigrid {
     std::vector<SparseMatrix> P, R; ///< per level >= 1: from / to the level below
-    std::unique_ptr<solvers::SparseLUPreconditioner> lu;
-    std::vector<std::unique_ptr<solvers::MultigridCycle>> cycle; ///< per level >= 1
-    /// Builds and sets up the cycles of levels 1..L (at least two levels).
+    std::unique_ptr<solvers::Multigrid> mg;
+    /// Builds and sets up the multigrid over levels 0..L (at least two levels).
     ElasticMultigrid(const Hierarchy& h, const std::vector<ElasticBlock>& blocks,
                      solvers::MultigridParams params = {});
-    /// The finest level's cycle.
-    const solvers::MultigridCycle& finest() const { return *cycle.back(); }
+    /// The V-cycle from the finest level.
+    const solvers::Multigrid& finest() const { return *mg; }
 };
 
 } // namespace mlc::levels

@@ -166,9 +166,7 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
             ScopedTimer t(timings_, "newton/linear_solve");
             R = -R;
             dx.setZero();
-            solver_->set_forcing(forcing_term(k, norm, scale));
-            lin = solver_->solve(M, R, dx);
-            solver_->set_forcing(0.0); // others may call this solver (CF's coarse=solver)
+            lin = solver_->solve(M, R, dx, forcing_term(k, norm, scale));
         }
         rep.linear_iterations += lin.iterations;
         rep.linear_iterations_per_newton.push_back(lin.iterations);

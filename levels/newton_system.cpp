@@ -101,7 +101,8 @@ public:
         : jac_(level), solver_(std::move(solver)) {
         MLC_CHECK(solver_ != nullptr, "no linear solver given");
     }
-    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) override {
+    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                      double) override {
         const double t0 = wall_seconds();
         jac_.assemble(M);
         const double assembly = wall_seconds() - t0;
@@ -237,7 +238,8 @@ public:
         bl_.resize(m_);
     }
 
-    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) override {
+    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                      double) override {
         const double t0 = wall_seconds();
         const Level& L = level_;
         const Index nu = static_cast<Index>(dof_of_u_.size());
@@ -329,11 +331,11 @@ std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s) {
 
 std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level,
                                                               const LinearSolverSpec& spec,
-                                                              const CoarseContext* context) {
+                                                              const LevelBelow* below) {
     spec.validate();
     if (spec.method == "schur") return make_schur_system_solver(level);
     if (spec.method == "lu") return make_assembled_system_solver(level, make_sparse_lu_solver());
-    return make_krylov_system_solver(level, spec, context);
+    return make_krylov_system_solver(level, spec, below);
 }
 
 } // namespace mlc::levels

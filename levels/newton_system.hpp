@@ -5,6 +5,7 @@
 
 #include "core/linear_operator.hpp"
 #include "levels/level.hpp"
+#include "solvers/mg.hpp"
 #include "transfer/transfer.hpp"
 
 #include <Eigen/Dense>
@@ -50,21 +51,27 @@ class NewtonSystemSolver {
 public:
     virtual ~NewtonSystemSolver() = default;
     /// dx = J(M)^{-1} b. dx is resized; its content on entry is the initial guess of an
-    /// iterative method (zero is fine).
-    virtual SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b,
-                              Vector& dx) = 0;
+    /// iterative method (zero is fine). `forcing` is the inexact-Newton tolerance of this solve:
+    /// an iterative solver stops at the relative residual max(forcing, its own rel_tol); direct
+    /// solvers ignore it (they are exact).
+    virtual SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                              double forcing) = 0;
+    /// An exact-as-configured solve (forcing 0).
+    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) {
+        return solve(M, b, dx, 0.0);
+    }
     /// "lu", "schur", or the Krylov/preconditioner pair.
     virtual std::string name() const = 0;
-    /// Inexact Newton: the relative tolerance of the following solves is max(eta, the solver's
-    /// own rel_tol); 0 restores the solver's own. Direct solvers ignore it (they are exact).
-    virtual void set_forcing(double eta) { (void)eta; }
-    /// For the multilevel preconditioner of the level above: this solver's preconditioner set
-    /// up on J(M) (assembled, and refreshed only when M differs from the last call's), or null
-    /// when it has none (direct solvers). Valid until the next `solve` or call of this function.
-    virtual const Preconditioner* preconditioner_for(const std::vector<Eigen::Matrix2d>& M) {
-        (void)M;
-        return nullptr;
-    }
+    /// The converged statuses of the level below for the current load step. The driver calls
+    /// this after every load step of the level below, before this level's solves; solvers
+    /// whose preconditioner uses the level below (cf, sorcf, mg) need it, the others ignore it.
+    virtual void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) { (void)M; }
+    /// Assembles J(M) and sets the preconditioner up on it, unless M is the last call's: the
+    /// level above's multigrid, which shares this level's, calls it with this level's
+    /// converged statuses. Direct solvers have nothing to prepare.
+    virtual void prepare(const std::vector<Eigen::Matrix2d>& M) { (void)M; }
+    /// The multigrid preconditioner this solver uses (null when it has none).
+    virtual const solvers::Multigrid* multigrid() const { return nullptr; }
 };
 
 /// Assembles J(M) (pattern fixed per level) and calls `solver` on it. `level` must outlive it.
@@ -103,23 +110,24 @@ struct LinearSolverSpec {
 
 std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s);
 
-/// What multilevel preconditioners may use from the level below; all null/empty on level 0.
-struct CoarseContext {
+/// The level below, for the preconditioners that use it (registry entries with
+/// needs_level_below). Its pointees must outlive the solvers built with it; the coarse statuses
+/// reach the solver by NewtonSystemSolver::set_coarse_statuses.
+struct LevelBelow {
     const Level* coarse = nullptr;                     ///< the level below
     const transfer::LevelTransfer* transfer = nullptr; ///< coarse -> this level
-    NewtonSystemSolver* coarse_solver = nullptr;       ///< exact solver of the coarse Jacobian
-    std::vector<Eigen::Matrix2d> coarse_M;             ///< converged coarse statuses (per element)
-    /// The level below's own context (null on level 0 or when the level below has none): the
-    /// chain down to level 0, for operators built over all levels (mg:coarse=galerkin).
-    const CoarseContext* below = nullptr;
-    bool available() const { return coarse && transfer && coarse_solver; }
+    NewtonSystemSolver* solver = nullptr;              ///< the level below's solver
+    /// The level below's own LevelBelow (null on level 0 or when the level below has none):
+    /// the chain down to the lowest level solved, for multigrids over all levels.
+    const LevelBelow* below = nullptr;
+    bool available() const { return coarse && transfer && solver; }
 };
 
-/// Builds the Newton system solver of `spec` for a level. `context` (may be null) gives
-/// two-level preconditioners what they need; they throw InvalidInput without it. The context's
-/// pointees must outlive the returned object.
-std::unique_ptr<NewtonSystemSolver>
-make_newton_system_solver(const Level& level, const LinearSolverSpec& spec,
-                          const CoarseContext* context = nullptr);
+/// Builds the Newton system solver of `spec` for a level. `below` (may be null) gives the
+/// preconditioners that need the level below what they use; they throw InvalidInput without
+/// it. Its pointees must outlive the returned object.
+std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level,
+                                                              const LinearSolverSpec& spec,
+                                                              const LevelBelow* below = nullptr);
 
 } // namespace mlc::levels

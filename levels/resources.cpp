@@ -3,6 +3,8 @@
 // the memory this process may use.
 #include "levels/resources.hpp"
 
+#include "solvers/factory.hpp"
+
 #include "core/check.hpp"
 #include "levels/level.hpp"
 
@@ -96,6 +98,14 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
         if (req.pc) {
             s.pc = *req.pc;
             c.reason = "Krylov solve with --pc " + s.pc + " as requested";
+            // The registry says what the name is and whether it needs the level below.
+            const solvers::PreconditionerEntry* entry = solvers::find_preconditioner(s.pc);
+            MLC_CHECK(entry != nullptr,
+                      "unknown preconditioner '"
+                          << s.pc << "'; valid: " << solvers::preconditioner_names(", ")
+                          << " (`mlcontact preconditioners` lists their options)");
+            MLC_CHECK(has_levels || !entry->needs_level_below,
+                      "--pc " << s.pc << " needs the level below: use --levels >= 1");
         } else {
             s.pc = has_levels ? "mg" : "ilu:0";
             c.reason = has_levels ? "--linear krylov: multilevel mg over the levels"

@@ -3,6 +3,7 @@
 #include "levels/solve.hpp"
 
 #include "core/check.hpp"
+#include "solvers/factory.hpp"
 
 #include <iomanip>
 #include <sstream>
@@ -19,10 +20,11 @@ double LevelStep::agreement() const {
 
 namespace {
 
+// The registry says which preconditioners use the level below.
 bool needs_coarse_level(const LinearSolverSpec& spec) {
     if (spec.method != "krylov") return false;
-    const std::string name = spec.pc.substr(0, spec.pc.find(':'));
-    return name == "cf" || name == "sorcf" || name == "mg";
+    const solvers::PreconditionerEntry* entry = solvers::find_preconditioner(spec.pc);
+    return entry != nullptr && entry->needs_level_below;
 }
 
 void print_progress(std::ostream& os, int level, int n_levels, int step, int n_steps,
@@ -69,8 +71,9 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         options.coarse_to_fine || options.solve_all_levels || needs_coarse_level(options.linear);
     const int first = all_levels ? 0 : finest;
 
-    // Solvers, Newton drivers and coarse contexts per level (contexts are updated every step).
-    std::vector<CoarseContext> context(static_cast<size_t>(n_levels));
+    // Solvers, Newton drivers and the level below of each level (fixed; the coarse statuses are
+    // passed by set_coarse_statuses after every coarse load step).
+    std::vector<LevelBelow> below(static_cast<size_t>(n_levels));
     std::vector<std::unique_ptr<ContactNewton>> newton(static_cast<size_t>(n_levels));
     std::vector<NewtonSystemSolver*> system(static_cast<size_t>(n_levels), nullptr);
     for (int l = first; l < n_levels; ++l) {
@@ -78,14 +81,14 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         const Level& L = levels[static_cast<size_t>(l)];
         LinearSolverSpec spec = options.linear;
         if (l == 0 && l != finest) spec = LinearSolverSpec{};
-        auto& ctx = context[static_cast<size_t>(l)];
+        auto& lb = below[static_cast<size_t>(l)];
         if (l > first) {
-            ctx.coarse = &levels[static_cast<size_t>(l - 1)];
-            ctx.transfer = &res.hierarchy.transfers[static_cast<size_t>(l - 1)];
-            ctx.coarse_solver = system[static_cast<size_t>(l - 1)];
-            if (l - 1 > first) ctx.below = &context[static_cast<size_t>(l - 1)];
+            lb.coarse = &levels[static_cast<size_t>(l - 1)];
+            lb.transfer = &res.hierarchy.transfers[static_cast<size_t>(l - 1)];
+            lb.solver = system[static_cast<size_t>(l - 1)];
+            if (l - 1 > first) lb.below = &below[static_cast<size_t>(l - 1)];
         }
-        auto sys = make_newton_system_solver(L, spec, &ctx);
+        auto sys = make_newton_system_solver(L, spec, &lb);
         system[static_cast<size_t>(l)] = sys.get();
         newton[static_cast<size_t>(l)] =
             std::make_unique<ContactNewton>(L, problem.newton, std::move(sys), &res.timings);
@@ -162,10 +165,12 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             }
             L.dofs.expand(x[li], L.u_fixed_at(s), u_now[li]);
             if (l + 1 < n_levels) {
-                // The level above needs this level's converged statuses (two-level
-                // preconditioners).
+                // The level above's preconditioner (cf, sorcf, mg) uses this level at its
+                // converged statuses.
                 Vector R(x[li].size());
-                nw.residual(s, u_prev[li], x[li], R, nullptr, &context[li + 1].coarse_M, nullptr);
+                std::vector<Eigen::Matrix2d> converged;
+                nw.residual(s, u_prev[li], x[li], R, nullptr, &converged, nullptr);
+                system[li + 1]->set_coarse_statuses(converged);
             }
         }
         if (!res.converged) break;
@@ -179,6 +184,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             u_prev[static_cast<size_t>(l)] = u_now[static_cast<size_t>(l)];
     }
     res.x = x.back();
+    if (const solvers::Multigrid* mg = system[static_cast<size_t>(finest)]->multigrid())
+        res.multigrid = mg->report();
     return res;
 }
 

@@ -12,6 +12,7 @@
 #include "levels/resources.hpp"
 
 #include <array>
+#include <optional>
 #include <ostream>
 #include <vector>
 
@@ -76,6 +77,9 @@ struct RunResult {
     /// The Newton-system solver of levels >= 1 (SolveOptions::linear); the driver that chose
     /// it (choose_solver) fills `automatic` and `reason`.
     SolverChoice solver;
+    /// The finest level's multigrid (levels, sizes, complexities, smoother, coarse solve) when
+    /// its solver uses one.
+    std::optional<solvers::MultigridReport> multigrid;
     MemoryEstimate memory;
     MemoryLimit memory_limit;
     bool converged = false;

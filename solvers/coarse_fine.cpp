@@ -241,4 +241,13 @@ make_coarse_fine(CoarseFineSplit split, CoarseSolve coarse_solve, const CoarseFi
                                                       std::move(inner), "cf");
 }
 
+MultiplierScale parse_multiplier_scale(std::string_view name) {
+    if (name == "q") return MultiplierScale::q;
+    if (name == "none") return MultiplierScale::none;
+    if (name == "qt") return MultiplierScale::qt;
+    if (name == "qinv") return MultiplierScale::qinv;
+    MLC_CHECK(false, "unknown multiplier scale '" << name << "'; valid: q, none, qt, qinv");
+    return MultiplierScale::q;
+}
+
 } // namespace mlc::solvers

@@ -97,6 +97,15 @@ std::ostream& operator<<(std::ostream& os, InnerSolve s);
 /// Parses "lu" or "cgs"; anything else throws mlc::InvalidInput.
 InnerSolve parse_inner_solve(std::string_view name);
 
+/// How multiplier entries pass between the levels in CF and SORCF, with q the factor of Q at a
+/// coarse contact vertex (1/2 for the paper's rule): "q" (z_c = q z_H, r_H = r_c; the default),
+/// "none" (no factor), "qt" (z_c = q z_H, r_H = q r_c, as R = Q^T would), "qinv"
+/// (z_c = q z_H, r_H = r_c / q).
+enum class MultiplierScale { q, none, qt, qinv };
+
+/// Parses "q", "none", "qt" or "qinv"; anything else throws mlc::InvalidInput.
+MultiplierScale parse_multiplier_scale(std::string_view name);
+
 /// Parameters of `make_coarse_fine`.
 struct CoarseFineParams {
     /// Inner solver of A_ff. Default lu: exact, so C is a fixed operator and any Krylov method

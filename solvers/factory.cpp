@@ -8,6 +8,7 @@
 #include "smoothers/jacobi.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/hypre/boomeramg.hpp"
+#include "solvers/sorcf.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -39,17 +40,17 @@ const PreconditionerEntry* find_entry(std::string_view name) {
     return nullptr;
 }
 
-std::unique_ptr<Preconditioner> build_none(SpecOptions& o) {
+std::unique_ptr<Preconditioner> build_none(SpecOptions& o, const LevelData*) {
     o.finish();
     return std::make_unique<IdentityPreconditioner>();
 }
 
-std::unique_ptr<Preconditioner> build_diag(SpecOptions& o) {
+std::unique_ptr<Preconditioner> build_diag(SpecOptions& o, const LevelData*) {
     o.finish();
     return std::make_unique<smoothers::Jacobi>();
 }
 
-std::unique_ptr<Preconditioner> build_ilu(SpecOptions& o) {
+std::unique_ptr<Preconditioner> build_ilu(SpecOptions& o, const LevelData*) {
     smoothers::ILUKParams p;
     p.fill_level = o.get_int("k", 0);
     o.finish();
@@ -66,47 +67,121 @@ std::unique_ptr<Preconditioner> build_sor_with(SpecOptions& o, smoothers::Sweep 
     return std::make_unique<smoothers::BlockSOR>(p);
 }
 
-std::unique_ptr<Preconditioner> build_sor(SpecOptions& o) {
+std::unique_ptr<Preconditioner> build_sor(SpecOptions& o, const LevelData*) {
     return build_sor_with(o, smoothers::Sweep::forward);
 }
 
-std::unique_ptr<Preconditioner> build_ssor(SpecOptions& o) {
+std::unique_ptr<Preconditioner> build_ssor(SpecOptions& o, const LevelData*) {
     return build_sor_with(o, smoothers::Sweep::symmetric);
 }
 
-std::unique_ptr<Preconditioner> build_lu(SpecOptions& o) {
+std::unique_ptr<Preconditioner> build_lu(SpecOptions& o, const LevelData*) {
     o.finish();
     return std::make_unique<SparseLUPreconditioner>();
 }
 
-// The level-aware preconditioners are built by levels::make_krylov_system_solver from the level
-// data; they are listed here so that error messages name them.
-[[noreturn]] void throw_level_aware(const char* name) {
-    std::ostringstream os;
-    os << "preconditioner '" << name
-       << "' is built from the level hierarchy, not from a matrix alone: use it as a "
-          "Newton-system preconditioner (--linear krylov --pc "
-       << name << "; cf and sorcf need --levels >= 1 and the coarse-to-fine solve)";
-    throw InvalidInput(os.str());
+// The level-aware preconditioners: built from the level data of the Newton-system driver.
+const LevelData& require_level(const LevelData* level, const char* name, bool needs_below) {
+    if (level == nullptr) {
+        std::ostringstream os;
+        os << "preconditioner '" << name
+           << "' is built from the level hierarchy, not from a matrix alone: use it as a "
+              "Newton-system preconditioner (--pc "
+           << name << (needs_below ? ", with --levels >= 1" : "") << ")";
+        throw InvalidInput(os.str());
+    }
+    MLC_CHECK(!needs_below || level->has_level_below,
+              name << " needs the level below: use with --levels >= 1 and the coarse-to-fine "
+                      "solve");
+    return *level;
 }
 
-std::unique_ptr<Preconditioner> build_cf(SpecOptions&) {
-    throw_level_aware("cf");
+// CF and SORCF: the split with the multiplier factors, and the coarse solve.
+struct CoarseFineInputs {
+    CoarseFineSplit split;
+    CoarseSolve coarse;
+};
+
+CoarseFineInputs coarse_fine_inputs(SpecOptions& o, const LevelData& level, const char* name) {
+    const MultiplierScale scale = parse_multiplier_scale(o.get_string("scale", "q"));
+    const std::string coarse = o.get_string("coarse", "lu");
+    MLC_CHECK(coarse == "solver" || coarse == "lu",
+              "option coarse=" << coarse << " of " << name << ": valid solver, lu");
+    CoarseFineInputs in;
+    in.coarse = coarse == "lu" ? level.coarse_lu() : level.coarse_solver;
+    in.split = level.coarse_fine_split(scale);
+    return in;
 }
 
-std::unique_ptr<Preconditioner> build_sorcf(SpecOptions&) {
-    throw_level_aware("sorcf");
+std::unique_ptr<Preconditioner> build_cf(SpecOptions& o, const LevelData* level) {
+    const LevelData& L = require_level(level, "cf", true);
+    CoarseFineInputs in = coarse_fine_inputs(o, L, "cf");
+    CoarseFineParams p;
+    p.inner = parse_inner_solve(o.get_string("inner", "lu"));
+    p.inner_tol = o.get_double("tol", p.inner_tol);
+    p.inner_max_iter = o.get_int("maxit", p.inner_max_iter);
+    o.finish();
+    return make_coarse_fine(std::move(in.split), std::move(in.coarse), p);
 }
 
-std::unique_ptr<Preconditioner> build_ebe(SpecOptions&) {
-    throw_level_aware("ebe");
+std::unique_ptr<Preconditioner> build_sorcf(SpecOptions& o, const LevelData* level) {
+    const LevelData& L = require_level(level, "sorcf", true);
+    CoarseFineInputs in = coarse_fine_inputs(o, L, "sorcf");
+    SorcfParams p;
+    p.omega = o.get_double("omega", p.omega);
+    const int block = o.get_int("block", 0);
+    MLC_CHECK(block == 0 || block == 1,
+              "option block=" << block << " of sorcf: valid 0 (scalar D*), 1 (blocks)");
+    p.block = block == 1;
+    o.finish();
+    return make_sorcf(std::move(in.split), std::move(in.coarse), p);
 }
 
-std::unique_ptr<Preconditioner> build_mg(SpecOptions&) {
-    throw_level_aware("mg");
+std::unique_ptr<Preconditioner> build_ebe(SpecOptions& o, const LevelData* level) {
+    const LevelData& L = require_level(level, "ebe", false);
+    smoothers::EBEParams p;
+    p.variant = smoothers::parse_ebe_variant(o.get_string("variant", "c1"));
+    const std::string unit = o.get_string("unit", "multipliers");
+    MLC_CHECK(unit == "contact" || unit == "multipliers",
+              "option unit=" << unit << " of ebe: valid contact, multipliers");
+    p.unit_scaling = unit == "contact" ? smoothers::UnitScaling::contact_unknowns
+                                       : smoothers::UnitScaling::multipliers;
+    o.finish();
+    return std::make_unique<smoothers::EBE>(*L.elements(), p);
 }
 
-std::unique_ptr<Preconditioner> build_amg(SpecOptions& o) {
+std::unique_ptr<Preconditioner> build_mg(SpecOptions& o, const LevelData* level) {
+    const LevelData& L = require_level(level, "mg", true);
+    MultigridParams p;
+    p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
+    p.post_sweeps = o.get_int("post", p.post_sweeps);
+    p.omega = o.get_double("omega", p.omega);
+    const std::string coarse = o.get_string("coarse", "rediscretize");
+    MLC_CHECK(coarse == "rediscretize" || coarse == "galerkin",
+              "option coarse=" << coarse << " of mg: valid rediscretize, galerkin");
+    o.finish();
+    p.validate();
+    MLC_CHECK(L.hierarchy.size() >= 2,
+              "mg: the level data holds " << L.hierarchy.size() << " level(s), at least two");
+    if (coarse == "galerkin") {
+        MLC_CHECK(L.hierarchy_from_level0,
+                  "mg:coarse=galerkin needs every level below in the coarse-to-fine solve");
+        return std::make_unique<Multigrid>(L.hierarchy, p, CoarseOperators::galerkin);
+    }
+    if (L.below_multigrid != nullptr)
+        return Multigrid::above(*L.below_multigrid, L.hierarchy.back(), p);
+    MultigridLevelData below = L.hierarchy[L.hierarchy.size() - 2];
+    below.T = below.R = nullptr;
+    return std::make_unique<Multigrid>(std::vector<MultigridLevelData>{below, L.hierarchy.back()},
+                                       p);
+}
+
+std::unique_ptr<Preconditioner> build_amg(SpecOptions& o, const LevelData* level) {
+    MLC_CHECK(level == nullptr || !level->has_multipliers,
+              "amg (hypre BoomerAMG) preconditions the elastic block only (symmetric "
+              "positive definite); the contact Jacobian has zero multiplier "
+              "diagonals: use --pc mg, or compare on the elastic block with "
+              "`mlcontact bench elastic`");
     BoomerAMGParams p;
     p.num_functions = o.get_int("fn", p.num_functions);
     p.nodal = o.get_int("nodal", p.nodal);
@@ -122,31 +197,69 @@ std::unique_ptr<Preconditioner> build_amg(SpecOptions& o) {
 const std::vector<PreconditionerEntry>& preconditioner_registry() {
     // One row per name; builders read their options through SpecOptions and call finish().
     static const std::vector<PreconditionerEntry> table = {
-        {"none", "none (identity)", "", &build_none},
-        {"diag", "diag (Jacobi; zero diagonals patched)", "", &build_diag},
-        {"ilu", "ilu[:K] or ilu:k=K (ILU(K), fill level K >= 0, default 0)", "k", &build_ilu},
-        {"sor", "sor[:omega=W,sweeps=N,block=B] (forward SOR, 0 < W < 2, defaults 1, 1, 1)", "",
+        {"none", "none (identity)", "", {}, false, false, &build_none},
+        {"diag", "diag (Jacobi; zero diagonals patched)", "", {}, false, false, &build_diag},
+        {"ilu",
+         "ilu[:K] or ilu:k=K (ILU(K), fill level K >= 0, default 0)",
+         "k",
+         {"k"},
+         false,
+         false,
+         &build_ilu},
+        {"sor",
+         "sor[:omega=W,sweeps=N,block=B] (forward SOR, 0 < W < 2, defaults 1, 1, 1)",
+         "",
+         {"omega", "sweeps", "block"},
+         false,
+         false,
          &build_sor},
-        {"ssor", "ssor[:omega=W,sweeps=N,block=B] (symmetric SOR, same options)", "", &build_ssor},
-        {"lu", "lu (sparse direct LU)", "", &build_lu},
+        {"ssor",
+         "ssor[:omega=W,sweeps=N,block=B] (symmetric SOR, same options)",
+         "",
+         {"omega", "sweeps", "block"},
+         false,
+         false,
+         &build_ssor},
+        {"lu", "lu (sparse direct LU)", "", {}, false, false, &build_lu},
         {"cf",
-         "cf[:inner=lu|cgs,tol=T,maxit=N,scale=q|none|qt|qinv,coarse=lu|solver] (coarse/fine, "
+         "cf[:scale=q|none|qt|qinv,coarse=lu|solver,inner=lu|cgs,tol=T,maxit=N] (coarse/fine, "
          "1995; needs the level below)",
-         "", &build_cf},
+         "",
+         {"scale", "coarse", "inner", "tol", "maxit"},
+         true,
+         true,
+         &build_cf},
         {"sorcf",
-         "sorcf[:omega=W,block=0|1,scale=...,coarse=...] (SOR coarse/fine, 1995; needs the "
+         "sorcf[:scale=...,coarse=...,omega=W,block=0|1] (SOR coarse/fine, 1995; needs the "
          "level below)",
-         "", &build_sorcf},
-        {"ebe", "ebe[:variant=c1|c4|c5,unit=multipliers|contact] (element-by-element, 1997)", "",
+         "",
+         {"scale", "coarse", "omega", "block"},
+         true,
+         true,
+         &build_sorcf},
+        {"ebe",
+         "ebe[:variant=c1|c4|c5,unit=multipliers|contact] (element-by-element, 1997)",
+         "",
+         {"variant", "unit"},
+         true,
+         false,
          &build_ebe},
         {"mg",
-         "mg[:pre=N,post=N,omega=W] (multilevel V-cycle over all levels, vertex-block "
-         "Gauss-Seidel; needs the level below)",
-         "", &build_mg},
+         "mg[:pre=N,post=N,omega=W,coarse=rediscretize|galerkin] (multilevel V-cycle over all "
+         "levels, vertex-block Gauss-Seidel; needs the level below)",
+         "",
+         {"pre", "post", "omega", "coarse"},
+         true,
+         true,
+         &build_mg},
         {"amg",
          "amg[:fn=2,nodal=0,theta=0.25,agg=0] (hypre BoomerAMG V-cycle, for the elastic "
          "block: symmetric positive definite, fn interleaved components per vertex)",
-         "", &build_amg},
+         "",
+         {"fn", "nodal", "theta", "agg"},
+         false,
+         false,
+         &build_amg},
     };
     return table;
 }
@@ -194,6 +307,12 @@ PreconditionerSpec parse_preconditioner_spec(std::string_view spec) {
 
 SpecOptions::SpecOptions(const PreconditionerSpec& spec) : spec_(spec) {}
 
+std::string SpecOptions::get_string(const std::string& key, const std::string& fallback) {
+    used_.push_back(key);
+    const auto it = spec_.options.find(key);
+    return it == spec_.options.end() ? fallback : it->second;
+}
+
 double SpecOptions::get_double(const std::string& key, double fallback) {
     used_.push_back(key);
     const auto it = spec_.options.find(key);
@@ -235,13 +354,27 @@ void SpecOptions::finish() const {
     }
 }
 
-std::unique_ptr<Preconditioner> make_preconditioner(std::string_view spec) {
+const PreconditionerEntry* find_preconditioner(std::string_view spec) {
+    std::string name(trim(spec.substr(0, spec.find(':'))));
+    std::transform(name.begin(), name.end(), name.begin(),
+                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    return find_entry(name);
+}
+
+std::string preconditioner_names(std::string_view separator) {
+    std::string out;
+    for (const auto& e : preconditioner_registry())
+        out += (out.empty() ? "" : std::string(separator)) + e.name;
+    return out;
+}
+
+std::unique_ptr<Preconditioner> make_preconditioner(std::string_view spec, const LevelData* level) {
     const PreconditionerSpec parsed = parse_preconditioner_spec(spec);
     const PreconditionerEntry* entry = find_entry(parsed.name);
     MLC_CHECK(entry != nullptr, "unknown preconditioner '" << parsed.name << "' in spec '" << spec
                                                            << "'; valid specs:" << valid_names());
     SpecOptions options(parsed);
-    return entry->build(options);
+    return entry->build(options, level);
 }
 
 } // namespace mlc::solvers

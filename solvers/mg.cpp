@@ -6,9 +6,11 @@
 #include "core/csr.hpp"
 #include "core/timer.hpp"
 #include "smoothers/matrix_checks.hpp"
+#include "solvers/direct.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 namespace mlc::solvers {
@@ -28,7 +30,7 @@ std::ostream& operator<<(std::ostream& os, const MultigridParams& p) {
 
 namespace {
 // The cycle's smoother: vertex-block Gauss–Seidel in threaded parts with the unrolled kernel
-// (params validated first, so that a bad omega is reported as the cycle's).
+// (params validated first, so that a bad omega is reported as the multigrid's).
 smoothers::BlockSORParams smoother_params(const MultigridParams& params,
                                           std::vector<Index> block_starts) {
     params.validate();
@@ -40,63 +42,227 @@ smoothers::BlockSORParams smoother_params(const MultigridParams& params,
 }
 } // namespace
 
-MultigridCycle::MultigridCycle(const SparseMatrix& T, const SparseMatrix& R, CoarseSolve coarse,
-                               std::vector<Index> block_starts, MultigridParams params)
-    : T_(T), R_(R), coarse_(std::move(coarse)),
-      smoother_(smoother_params(params, std::move(block_starts))), params_(params) {
-    params_.validate();
-    MLC_CHECK(R.rows() == T.cols() && R.cols() == T.rows(),
-              "MultigridCycle: R is " << R.rows() << " x " << R.cols() << ", T is " << T.rows()
-                                      << " x " << T.cols() << " (R must be coarse x fine)");
-}
+// One level: on level 0 the coarse solve; above it the transfer from the level below, the
+// smoother and the work vectors of the cycle.
+struct Multigrid::Level {
+    Level(const MultigridLevelData& d, const MultigridParams& p)
+        : T(d.T), R(d.R), params(p), smoother(smoother_params(p, d.block_starts)) {}
+    const SparseMatrix* T = nullptr;
+    const SparseMatrix* R = nullptr;
+    MultigridParams params;
+    smoothers::BlockSOR smoother;           // levels >= 1
+    std::unique_ptr<Preconditioner> coarse; // level 0
+    bool coarse_replaced = false;           // level 0: set_coarse_solver was called
+    const SparseMatrix* A = nullptr;        // the operator (borrowed, or `owned`)
+    SparseMatrix owned;                     // Galerkin operator
+    mutable Vector res, rc, ec;             // levels >= 1
 
-void MultigridCycle::setup(const SparseMatrix& A) {
-    MLC_CHECK(A.rows() == T_.rows(), "MultigridCycle::setup: the matrix has "
-                                         << A.rows() << " rows, the prolongation " << T_.rows());
-    A_ = &A;
-    smoother_.setup(A);
-    res_.resize(A.rows());
-    rc_.resize(R_.rows());
-    ec_.resize(R_.rows());
-}
-
-void MultigridCycle::update_values(const SparseMatrix& A) {
-    if (A_ == nullptr || res_.size() != A.rows()) {
-        setup(A);
-        return;
-    }
-    A_ = &A;
-    smoother_.update_values(A);
-}
-
-void MultigridCycle::apply(const Vector& r, Vector& z) const {
-    MLC_CHECK(A_ != nullptr, "MultigridCycle: call setup first");
-    smoothers::check_size(r, A_->rows(), "MultigridCycle::apply", "r");
-    MLC_CHECK(static_cast<bool>(coarse_), "MultigridCycle: no coarse solve set");
-    if (params_.pre_sweeps == 0) {
-        z.setZero(r.size());
-        res_ = r;
-    } else {
-        smoother_.forward_from_zero(r, z, res_);
-        for (int k = 1; k < params_.pre_sweeps; ++k)
-            smoother_.sweep(r, z, smoothers::Sweep::forward);
-        if (params_.pre_sweeps > 1) {
-            res_ = r;
-            res_.noalias() -= *A_ * z;
+    // Full setup (`full`) or a refresh reusing the structure; the first call is always full.
+    void set(const SparseMatrix& M, bool full) {
+        if (!T) { // level 0
+            const bool first = A == nullptr;
+            A = &M;
+            if (coarse_replaced) return;
+            if (full || first)
+                coarse->setup(M);
+            else
+                coarse->update_values(M);
+            return;
+        }
+        MLC_CHECK(M.rows() == T->rows(), "Multigrid: the operator has "
+                                             << M.rows() << " rows, the prolongation "
+                                             << T->rows());
+        if (full || A == nullptr || res.size() != M.rows()) {
+            A = &M;
+            smoother.setup(M);
+            res.resize(M.rows());
+            rc.resize(R->rows());
+            ec.resize(R->rows());
+        } else {
+            A = &M;
+            smoother.update_values(M);
         }
     }
-    csr_multiply(R_, res_, rc_);
-    coarse_(rc_, ec_);
-    csr_multiply(T_, ec_, z, true);
-    for (int k = 0; k < params_.post_sweeps; ++k)
-        smoother_.sweep(r, z, smoothers::Sweep::backward);
+};
+
+Multigrid::Multigrid(std::vector<MultigridLevelData> levels, MultigridParams params,
+                     CoarseOperators coarse_operators)
+    : coarse_operators_(coarse_operators) {
+    params.validate();
+    MLC_CHECK(levels.size() >= 2,
+              "Multigrid: " << levels.size() << " level(s) given, at least two needed");
+    for (size_t k = 0; k < levels.size(); ++k) {
+        const MultigridLevelData& d = levels[k];
+        if (k == 0) {
+            MLC_CHECK(d.T == nullptr && d.R == nullptr,
+                      "Multigrid: the coarsest level has no level below (T and R must be null)");
+        } else {
+            MLC_CHECK(d.T != nullptr && d.R != nullptr,
+                      "Multigrid: level " << k << " needs T and R");
+            MLC_CHECK(d.R->rows() == d.T->cols() && d.R->cols() == d.T->rows(),
+                      "Multigrid: level " << k << ": R is " << d.R->rows() << " x " << d.R->cols()
+                                          << ", T is " << d.T->rows() << " x " << d.T->cols()
+                                          << " (R must be coarse x fine)");
+            if (k >= 2)
+                MLC_CHECK(d.T->cols() == levels[k - 1].T->rows(),
+                          "Multigrid: level " << k << "'s prolongation has " << d.T->cols()
+                                              << " columns, level " << k - 1 << " "
+                                              << levels[k - 1].T->rows() << " rows");
+        }
+        auto L = std::make_shared<Level>(d, params);
+        if (k == 0) L->coarse = std::make_unique<SparseLUPreconditioner>();
+        levels_.push_back(std::move(L));
+    }
 }
 
-std::string MultigridCycle::name() const {
+std::unique_ptr<Multigrid> Multigrid::above(const Multigrid& below, MultigridLevelData top,
+                                            MultigridParams params) {
+    params.validate();
+    MLC_CHECK(top.T != nullptr && top.R != nullptr,
+              "Multigrid::above: the new level needs T and R");
+    const Level& under = *below.levels_.back();
+    const Index under_rows = under.T ? under.T->rows() : (under.A ? under.A->rows() : -1);
+    MLC_CHECK(top.R->rows() == top.T->cols() && top.R->cols() == top.T->rows() &&
+                  (under_rows < 0 || top.T->cols() == under_rows),
+              "Multigrid::above: T is " << top.T->rows() << " x " << top.T->cols() << ", R is "
+                                        << top.R->rows() << " x " << top.R->cols()
+                                        << ", the level below has " << under_rows << " rows");
+    MLC_CHECK(below.coarse_operators_ == CoarseOperators::rediscretized,
+              "Multigrid::above: only rediscretized multigrids share their levels");
+    std::unique_ptr<Multigrid> mg(new Multigrid());
+    mg->levels_ = below.levels_;
+    mg->levels_.push_back(std::make_shared<Level>(top, params));
+    return mg;
+}
+
+void Multigrid::set_operator(int k, const SparseMatrix& A) {
+    MLC_CHECK(k >= 0 && k + 1 < n_levels(), "Multigrid::set_operator: level "
+                                                << k << " is not below the finest ("
+                                                << n_levels() - 1 << "); use setup for it");
+    MLC_CHECK(coarse_operators_ == CoarseOperators::rediscretized,
+              "Multigrid::set_operator: the coarse operators are Galerkin products");
+    levels_[static_cast<size_t>(k)]->set(A, false);
+}
+
+void Multigrid::set_coarse_solver(std::unique_ptr<Preconditioner> coarse) {
+    MLC_CHECK(coarse != nullptr, "Multigrid::set_coarse_solver: null solver");
+    Level& L0 = *levels_.front();
+    L0.coarse = std::move(coarse);
+    L0.coarse_replaced = true;
+}
+
+void Multigrid::set_galerkin_operators(const SparseMatrix& A) {
+    // A_{k-1} = R_k A_k T_k from the finest down; then the levels set up from level 0 up.
+    const SparseMatrix* Ak = &A;
+    for (size_t k = levels_.size() - 1; k >= 1; --k) {
+        const Level& L = *levels_[k];
+        Level& below = *levels_[k - 1];
+        const SparseMatrix RA = *L.R * (*Ak);
+        below.owned = RA * *L.T;
+        below.owned.makeCompressed();
+        Ak = &below.owned;
+    }
+    for (size_t k = 0; k + 1 < levels_.size(); ++k)
+        levels_[k]->set(levels_[k]->owned, true);
+}
+
+void Multigrid::setup(const SparseMatrix& A) {
+    if (coarse_operators_ == CoarseOperators::galerkin) set_galerkin_operators(A);
+    levels_.back()->set(A, true);
+}
+
+void Multigrid::update_values(const SparseMatrix& A) {
+    if (coarse_operators_ == CoarseOperators::galerkin) set_galerkin_operators(A);
+    levels_.back()->set(A, false);
+}
+
+void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
+    const Level& L = *levels_[static_cast<size_t>(k)];
+    if (k == 0) {
+        MLC_CHECK(L.A != nullptr || L.coarse_replaced,
+                  "Multigrid: the coarsest operator is not set");
+        L.coarse->apply(r, z);
+        return;
+    }
+    MLC_CHECK(L.A != nullptr, "Multigrid: the operator of level " << k << " is not set");
+    const MultigridParams& p = L.params;
+    if (p.pre_sweeps == 0) {
+        z.setZero(r.size());
+        L.res = r;
+    } else {
+        L.smoother.forward_from_zero(r, z, L.res);
+        for (int s = 1; s < p.pre_sweeps; ++s)
+            L.smoother.sweep(r, z, smoothers::Sweep::forward);
+        if (p.pre_sweeps > 1) {
+            L.res = r;
+            L.res.noalias() -= *L.A * z;
+        }
+    }
+    csr_multiply(*L.R, L.res, L.rc);
+    cycle(k - 1, L.rc, L.ec);
+    csr_multiply(*L.T, L.ec, z, true);
+    for (int s = 0; s < p.post_sweeps; ++s)
+        L.smoother.sweep(r, z, smoothers::Sweep::backward);
+}
+
+void Multigrid::apply(const Vector& r, Vector& z) const {
+    const Level& top = *levels_.back();
+    MLC_CHECK(top.A != nullptr, "Multigrid: call setup first");
+    smoothers::check_size(r, top.A->rows(), "Multigrid::apply", "r");
+    cycle(n_levels() - 1, r, z);
+}
+
+std::string Multigrid::name() const {
+    const MultigridParams& p = levels_.back()->params;
     std::ostringstream os;
-    os << "mg(pre=" << params_.pre_sweeps << ",post=" << params_.post_sweeps
-       << ",omega=" << params_.omega << ")";
+    os << "mg(pre=" << p.pre_sweeps << ",post=" << p.post_sweeps << ",omega=" << p.omega << ")";
     return os.str();
+}
+
+MultigridReport Multigrid::report() const {
+    MultigridReport r;
+    double nnz = 0, rows = 0;
+    for (size_t k = 0; k < levels_.size(); ++k) {
+        const Level& L = *levels_[k];
+        MultigridLevelReport row;
+        row.level = static_cast<int>(k);
+        row.rows = L.A ? L.A->rows() : (L.T ? L.T->rows() : 0);
+        row.nonzeros = L.A ? L.A->nonZeros() : 0;
+        row.solve = k == 0 ? L.coarse->name() : "smoother";
+        nnz += static_cast<double>(row.nonzeros);
+        rows += static_cast<double>(row.rows);
+        r.levels.push_back(row);
+    }
+    const auto& top = r.levels.back();
+    r.operator_complexity = top.nonzeros > 0 ? nnz / static_cast<double>(top.nonzeros) : 0.0;
+    r.grid_complexity = top.rows > 0 ? rows / static_cast<double>(top.rows) : 0.0;
+    const MultigridParams& p = levels_.back()->params;
+    std::ostringstream cyc;
+    cyc << "V(" << p.pre_sweeps << "," << p.post_sweeps << "), omega = " << p.omega;
+    r.cycle = cyc.str();
+    std::ostringstream sm;
+    sm << "vertex-block Gauss-Seidel, forward before / backward after, " << smoothers::kHybridParts
+       << " threaded parts";
+    r.smoother = sm.str();
+    const Level& L0 = *levels_.front();
+    r.coarse_solver =
+        L0.coarse_replaced ? L0.coarse->name() + " (the coarse LU was singular)" : "sparse LU";
+    r.coarse_operators =
+        coarse_operators_ == CoarseOperators::galerkin ? "Galerkin (R A T)" : "rediscretized";
+    return r;
+}
+
+std::ostream& operator<<(std::ostream& os, const MultigridReport& r) {
+    os << "multigrid  " << r.levels.size() << " levels, " << r.cycle << ", coarse operators "
+       << r.coarse_operators << "\n";
+    os << "  level        rows     nonzeros  solve\n";
+    for (auto it = r.levels.rbegin(); it != r.levels.rend(); ++it)
+        os << "  " << std::setw(5) << it->level << "  " << std::setw(10) << it->rows << "  "
+           << std::setw(11) << it->nonzeros << "  " << it->solve << "\n";
+    os << "  operator complexity " << std::fixed << std::setprecision(3) << r.operator_complexity
+       << ", grid complexity " << r.grid_complexity << std::defaultfloat << "\n";
+    os << "  smoother " << r.smoother << "; coarse solve " << r.coarse_solver << "\n";
+    return os;
 }
 
 // ---------------------------------------------------------------------------------------------

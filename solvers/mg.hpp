@@ -1,28 +1,36 @@
 // SPDX-License-Identifier: MIT
-/// @file Geometric multigrid V-cycle for the level hierarchy: one `MultigridCycle` per level,
-/// each calling the level below through a `CoarseSolve` (the level below's own cycle, or a direct
-/// solve on the coarsest level), smoothed by vertex-block Gauss–Seidel (smoothers::BlockSOR with
-/// threaded parts and the unrolled kernel), which copes with the zero diagonals of the contact
-/// multiplier rows: one block per vertex, its 2 displacements and, at a contact vertex, its 1 or 2
-/// multipliers, so the zero multiplier diagonals of stick and slip rows sit inside a nonsingular
-/// 3x3/4x4 block.
+/// @file Geometric multigrid over the level hierarchy: `Multigrid`, a Preconditioner that owns
+/// its levels (operator, transfer, smoother, work vectors) and the coarse solve, smoothed by
+/// vertex-block Gauss–Seidel (smoothers::BlockSOR with threaded parts and the unrolled kernel),
+/// which copes with the zero diagonals of the contact multiplier rows: one block per vertex, its
+/// 2 displacements and, at a contact vertex, its 1 or 2 multipliers, so the zero multiplier
+/// diagonals of stick and slip rows sit inside a nonsingular 3x3/4x4 block.
 ///
-/// One cycle on A z = r (z = 0 on entry) is
+/// One V-cycle on level k, A_k z = r (z = 0 on entry), is
 ///
-///     pre-smooth:  z <- z + S_fwd (r - A z)          (nu1 forward block Gauss–Seidel sweeps)
-///     coarse:      z <- z + T A_H^{-1}~ R (r - A z)  (A_H^{-1}~: the level below's cycle)
-///     post-smooth: z <- z + S_bwd (r - A z)          (nu2 backward sweeps)
+///     pre-smooth:  z <- z + S_fwd (r - A_k z)              (nu1 forward block Gauss–Seidel sweeps)
+///     coarse:      z <- z + T_k B_{k-1} R_k (r - A_k z)    (B_{k-1}: the cycle of level k-1)
+///     post-smooth: z <- z + S_bwd (r - A_k z)              (nu2 backward sweeps)
 ///
-/// with T the prolongation (P on displacements, Q on multipliers: transfer::LevelTransfer::T) and
-/// R = T^T. Every step is linear in r and nothing depends on the iteration, so the cycle is a
-/// fixed linear operator: CGS, BiCGStab and (non-flexible) GMRES all apply. With forward pre-
-/// and backward post-sweeps (nu1 = nu2) and a symmetric A and A_H, the cycle is symmetric too,
-/// so it also preconditions CG (`pcg` below) on the elastic block.
+/// and on level 0 z = A_0^{-1} r by the coarse solver (sparse LU unless replaced). T_k is the
+/// prolongation from level k-1 (P on displacements, Q on multipliers: transfer::LevelTransfer::T)
+/// and R_k = T_k^T. Every step is linear in r and nothing depends on the iteration, so the cycle
+/// is a fixed linear operator: CGS, BiCGStab and (non-flexible) GMRES all apply. With forward
+/// pre- and backward post-sweeps (nu1 = nu2) and symmetric operators, the cycle is symmetric
+/// too, so it also preconditions CG (`pcg` below) on the elastic block.
+///
+/// Two ways of filling the coarse operators:
+/// - rediscretized: each level's operator is given by `set_operator` (the contact solve: each
+///   level's own Jacobian at its converged statuses; the elastic block: each level's stiffness);
+/// - Galerkin: `setup(A)` computes A_{k-1} = R_k A_k T_k from the finest down to level 0.
+///
+/// The coarse-to-fine solve runs one multigrid per level; `Multigrid::above` builds the one of
+/// level l on the levels of level l-1's (shared, not copied: their operators, smoothers and
+/// coarse solve), so each level is set up once per change of its operator.
 #pragma once
 
 #include "core/linear_operator.hpp"
 #include "smoothers/block_sor.hpp"
-#include "solvers/coarse_fine.hpp"
 
 #include <memory>
 #include <ostream>
@@ -31,7 +39,7 @@
 
 namespace mlc::solvers {
 
-/// Parameters of `MultigridCycle`.
+/// Parameters of `Multigrid` (its smoothing).
 struct MultigridParams {
     int pre_sweeps = 1;  ///< forward smoothing sweeps before the coarse correction, >= 0
     int post_sweeps = 1; ///< backward sweeps after it, >= 0 (pre + post >= 1)
@@ -43,36 +51,101 @@ struct MultigridParams {
 /// Prints every field of `p` on one line.
 std::ostream& operator<<(std::ostream& os, const MultigridParams& p);
 
-/// One level of the V-cycle (see the file comment). Borrows T and R (they must outlive it) and
-/// the coarse solve (what it refers to must outlive it; it must be linear and accept a zero
-/// initial guess). `setup` stores a reference to A (A must outlive the next setup).
-///
-/// `apply` does not allocate (work vectors sized at `setup`) when the coarse solve does not;
-/// not thread-safe (mutable work vectors).
-class MultigridCycle final : public Preconditioner {
+/// Plain data of one multigrid level: the transfer from the level below and the smoother blocks.
+struct MultigridLevelData {
+    /// Prolongation from the level below (this level's rows x the level below's), borrowed (it
+    /// must outlive the Multigrid); null on the coarsest level.
+    const SparseMatrix* T = nullptr;
+    /// Restriction to the level below (usually T^T), borrowed; null on the coarsest level.
+    const SparseMatrix* R = nullptr;
+    /// Smoother blocks (smoothers::BlockSORParams::block_starts; empty: blocks of 2 rows).
+    /// Unused on the coarsest level.
+    std::vector<Index> block_starts;
+};
+
+/// How the coarse operators are obtained.
+enum class CoarseOperators {
+    rediscretized, ///< given level by level (`set_operator`)
+    galerkin       ///< R A T from the finest down, at every `setup`/`update_values`
+};
+
+/// One row of `MultigridReport`.
+struct MultigridLevelReport {
+    int level = 0;      ///< 0 = coarsest
+    Index rows = 0;     ///< unknowns of the level's operator
+    Index nonzeros = 0; ///< stored nonzeros of the level's operator
+    std::string solve;  ///< "smoother" or the coarse solver's name
+};
+
+/// What a multigrid is: its levels and their sizes, complexities, smoother and coarse solve.
+struct MultigridReport {
+    std::vector<MultigridLevelReport> levels; ///< coarsest first
+    /// Sum of the levels' nonzeros over the finest level's (the cost of a cycle in mat-vecs).
+    double operator_complexity = 0.0;
+    /// Sum of the levels' rows over the finest level's (the memory of the work vectors).
+    double grid_complexity = 0.0;
+    std::string cycle;            ///< e.g. "V(1,1), omega = 1"
+    std::string smoother;         ///< e.g. "vertex-block Gauss-Seidel (2 threaded parts)"
+    std::string coarse_solver;    ///< e.g. "sparse LU"
+    std::string coarse_operators; ///< "rediscretized" or "Galerkin"
+};
+
+/// Prints `r` as a table: one row per level (finest first), then the complexities, cycle,
+/// smoother and coarse solver.
+std::ostream& operator<<(std::ostream& os, const MultigridReport& r);
+
+/// The multigrid preconditioner (see the file comment). Not thread-safe (mutable work vectors);
+/// `apply` does not allocate when the coarse solver does not.
+class Multigrid final : public Preconditioner {
 public:
-    /// @param T  prolongation, fine x coarse
-    /// @param R  restriction, coarse x fine (usually T^T)
-    /// @param block_starts  smoother blocks of the fine level (smoothers::BlockSORParams::
-    ///                      block_starts; empty: blocks of 2 rows)
-    MultigridCycle(const SparseMatrix& T, const SparseMatrix& R, CoarseSolve coarse,
-                   std::vector<Index> block_starts, MultigridParams params = {});
+    /// A multigrid on `levels` (coarsest first, at least two; T and R of every level above the
+    /// coarsest, with consistent sizes). The coarse solve is a sparse LU of the coarsest
+    /// operator. Validates `params`.
+    Multigrid(std::vector<MultigridLevelData> levels, MultigridParams params,
+              CoarseOperators coarse_operators = CoarseOperators::rediscretized);
+
+    /// The multigrid of the level above `below`'s finest: `top` is the new finest level, the
+    /// levels below are `below`'s own (shared; `below` may be destroyed first). Rediscretized.
+    static std::unique_ptr<Multigrid> above(const Multigrid& below, MultigridLevelData top,
+                                            MultigridParams params);
+
+    /// How the coarse operators are filled.
+    CoarseOperators coarse_operators() const { return coarse_operators_; }
+
+    /// Number of levels (the finest is n_levels() - 1).
+    int n_levels() const { return static_cast<int>(levels_.size()); }
+
+    /// The operator of level k < finest (rediscretized): borrowed (it must stay valid until the
+    /// next call for k). Sets up that level's smoother, or factors it on level 0 (a singular
+    /// matrix throws mlc::SolverBreakdown; `set_coarse_solver` then installs another solve).
+    /// The first call for a level does the full setup, later ones reuse its structure.
+    void set_operator(int k, const SparseMatrix& A);
+
+    /// Replaces the coarse solve of level 0, already set up (for instance an exact solver that
+    /// copes with a singular coarse operator). Shared with the multigrids of the levels above.
+    void set_coarse_solver(std::unique_ptr<Preconditioner> coarse);
+
+    /// The finest level's operator (borrowed until the next setup). With Galerkin coarse
+    /// operators, also computes and sets up every coarser level.
     void setup(const SparseMatrix& A) override;
+    /// Same as setup, reusing the finest smoother's structure.
     void update_values(const SparseMatrix& A) override;
+    /// One V-cycle from the finest level.
     void apply(const Vector& r, Vector& z) const override;
-    /// "mg(pre=1,post=1,omega=1)".
+    /// "mg(pre=1,post=1,omega=1)" (the finest level's parameters).
     std::string name() const override;
-    /// Replaces the coarse solve (e.g. when the level below was set up anew).
-    void set_coarse(CoarseSolve coarse) { coarse_ = std::move(coarse); }
+
+    /// Levels, sizes, complexities, smoother and coarse solve (operators must be set).
+    MultigridReport report() const;
 
 private:
-    const SparseMatrix& T_;
-    const SparseMatrix& R_;
-    CoarseSolve coarse_;
-    smoothers::BlockSOR smoother_;
-    MultigridParams params_;
-    const SparseMatrix* A_ = nullptr;
-    mutable Vector res_, rc_, ec_;
+    struct Level;
+    Multigrid() = default;
+    void cycle(int k, const Vector& r, Vector& z) const;
+    void set_galerkin_operators(const SparseMatrix& A);
+
+    std::vector<std::shared_ptr<Level>> levels_; ///< coarsest first
+    CoarseOperators coarse_operators_ = CoarseOperators::rediscretized;
 };
 
 /// Preconditioned conjugate gradients for a symmetric positive definite A with a symmetric

@@ -71,12 +71,11 @@ struct TwoLevels {
         J->assemble(fine_M);
     }
 
-    CoarseContext context() {
-        CoarseContext c;
+    LevelBelow below() {
+        LevelBelow c;
         c.coarse = &coarse;
         c.transfer = &transfer;
-        c.coarse_solver = coarse_solver.get();
-        c.coarse_M = coarse_M;
+        c.solver = coarse_solver.get();
         return c;
     }
 };
@@ -94,9 +93,10 @@ struct Outcome {
 
 Outcome solve_with(const std::string& krylov, const std::string& pc, double rel_tol = 1e-9) {
     TwoLevels& t = two_levels();
-    const CoarseContext ctx = t.context();
+    const LevelBelow below = t.below();
     LinearSolverSpec spec{.method = "krylov", .krylov = krylov, .pc = pc, .rel_tol = rel_tol};
-    auto solver = make_newton_system_solver(t.fine, spec, &ctx);
+    auto solver = make_newton_system_solver(t.fine, spec, &below);
+    solver->set_coarse_statuses(t.coarse_M);
     Outcome o;
     Vector dx = Vector::Zero(t.b.size());
     o.result = solver->solve(t.fine_M, t.b, dx);
@@ -193,10 +193,10 @@ TEST(KrylovSystem, LevelAwarePreconditionersCheckTheirInput) {
         EXPECT_NE(std::string(e.what()).find("cf needs the level below"), std::string::npos)
             << e.what();
     }
-    const CoarseContext empty;
+    const LevelBelow empty;
     EXPECT_THROW(make_newton_system_solver(t.fine, {.method = "krylov", .pc = "sorcf"}, &empty),
                  InvalidInput);
-    const CoarseContext ctx = t.context();
+    const LevelBelow ctx = t.below();
     for (const std::string pc : {"cf:inner=ilu", "cf:scale=half", "cf:coarse=amg", "cf:omega=1",
                                  "sorcf:block=2", "sorcf:omega=2", "ebe:variant=c2", "ebe:omega=1"})
         EXPECT_THROW(make_newton_system_solver(t.fine, {.method = "krylov", .pc = pc}, &ctx),
@@ -206,17 +206,17 @@ TEST(KrylovSystem, LevelAwarePreconditionersCheckTheirInput) {
     EXPECT_NO_THROW(make_newton_system_solver(t.fine, {.method = "krylov", .pc = "ebe"}, nullptr));
 }
 
-TEST(KrylovSystem, TheCoarseStatusesAreReadAtEverySolve) {
-    // The coarse-to-fine driver builds the solver before the coarse level is solved and fills
-    // coarse_M afterwards, at every load step.
+TEST(KrylovSystem, TheCoarseStatusesArePassedByTheDriver) {
+    // The coarse-to-fine driver builds the solver before the coarse level is solved and passes
+    // the coarse statuses afterwards (set_coarse_statuses), at every load step.
     TwoLevels& t = two_levels();
-    CoarseContext ctx = t.context();
-    ctx.coarse_M.clear();
-    auto solver =
-        make_newton_system_solver(t.fine, {.method = "krylov", .pc = "cf", .rel_tol = 1e-9}, &ctx);
+    const LevelBelow below = t.below();
+    auto solver = make_newton_system_solver(
+        t.fine, {.method = "krylov", .pc = "cf", .rel_tol = 1e-9}, &below);
     Vector dx;
     EXPECT_THROW(solver->solve(t.fine_M, t.b, dx), InvalidInput);
-    ctx.coarse_M = t.coarse_M;
+    EXPECT_THROW(solver->set_coarse_statuses({Eigen::Matrix2d::Identity()}), InvalidInput);
+    solver->set_coarse_statuses(t.coarse_M);
     dx.setZero(t.b.size());
     const SolveResult first = solver->solve(t.fine_M, t.b, dx);
     EXPECT_TRUE(first.converged);
@@ -228,7 +228,8 @@ TEST(KrylovSystem, TheCoarseStatusesAreReadAtEverySolve) {
     EXPECT_LT(again.setup_seconds, first.setup_seconds);
     // Other coarse statuses (all stuck): the coarse LU is refactored, CF is a different
     // preconditioner but still converges.
-    ctx.coarse_M.assign(t.coarse_M.size(), Eigen::Matrix2d::Identity());
+    solver->set_coarse_statuses(
+        std::vector<Eigen::Matrix2d>(t.coarse_M.size(), Eigen::Matrix2d::Identity()));
     dx.setZero(t.b.size());
     const SolveResult stuck = solver->solve(t.fine_M, t.b, dx);
     EXPECT_TRUE(stuck.converged);

@@ -63,6 +63,20 @@ TEST(MultilevelPreconditioner, WorksInsideCgsBicgstabAndGmres) {
     }
 }
 
+TEST(MultilevelPreconditioner, TheRunReportsTheMultigridOfTheFinestLevel) {
+    const RunResult r = run_square(2, "cgs", "mg", 1);
+    ASSERT_TRUE(r.converged) << r.failure;
+    ASSERT_TRUE(r.multigrid.has_value());
+    ASSERT_EQ(r.multigrid->levels.size(), 3u);
+    for (size_t l = 0; l < 3; ++l)
+        EXPECT_EQ(r.multigrid->levels[l].rows, r.hierarchy.levels[l].n_unknowns()) << l;
+    EXPECT_GT(r.multigrid->operator_complexity, 1.0);
+    // Without mg, no multigrid.
+    auto p = scene::load_scene("square");
+    p.levels = 1;
+    EXPECT_FALSE(solve(p, {}).multigrid.has_value());
+}
+
 TEST(MultilevelPreconditioner, IterationsDoNotGrowWithTheLevel) {
     const RunResult r = run_square(3, "cgs", "mg", 2); // two load steps keep the test short
     ASSERT_TRUE(r.converged) << r.failure;

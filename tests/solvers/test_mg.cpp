@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <memory>
+#include <sstream>
 
 using namespace mlc;
 
@@ -251,4 +252,69 @@ TEST(Multigrid, GalerkinElasticOperatorIsTheRediscretizedOne) {
             kmax = std::max(kmax, std::abs(eh.blocks[l - 1].K.valuePtr()[k]));
         EXPECT_LT(dmax, 1e-12 * kmax) << "level " << l;
     }
+}
+
+TEST(Multigrid, OwnsItsLevelsAndReportsThem) {
+    ElasticHierarchy e(2);
+    const solvers::MultigridReport r = e.mg->finest().report();
+    ASSERT_EQ(r.levels.size(), 3u);
+    double nnz = 0, rows = 0;
+    for (size_t l = 0; l < 3; ++l) {
+        EXPECT_EQ(r.levels[l].level, static_cast<int>(l));
+        EXPECT_EQ(r.levels[l].rows, e.blocks[l].K.rows());
+        EXPECT_EQ(r.levels[l].nonzeros, e.blocks[l].K.nonZeros());
+        nnz += static_cast<double>(e.blocks[l].K.nonZeros());
+        rows += static_cast<double>(e.blocks[l].K.rows());
+    }
+    EXPECT_DOUBLE_EQ(r.operator_complexity, nnz / static_cast<double>(e.K().nonZeros()));
+    EXPECT_DOUBLE_EQ(r.grid_complexity, rows / static_cast<double>(e.K().rows()));
+    // Refinement by four: both complexities lie between 1 and 4/3.
+    EXPECT_GT(r.operator_complexity, 1.0);
+    EXPECT_LT(r.operator_complexity, 4.0 / 3.0 + 0.02);
+    EXPECT_EQ(r.levels[0].solve, "lu");
+    EXPECT_EQ(r.levels[2].solve, "smoother");
+    EXPECT_EQ(r.coarse_operators, "rediscretized");
+    std::ostringstream table;
+    table << r;
+    EXPECT_NE(table.str().find("operator complexity"), std::string::npos) << table.str();
+}
+
+TEST(Multigrid, TheLevelAboveSharesTheLevelsBelowAndAppliesTheSameCycle) {
+    // Levels 0..2 built at once, and level 2 built above a multigrid of levels 0..1: the same
+    // linear map, bit for bit (the levels below are shared, not copied).
+    ElasticHierarchy e(2);
+    const auto& P = e.mg->P;
+    const auto& R = e.mg->R;
+    auto data = [&](size_t l) {
+        solvers::MultigridLevelData d;
+        if (l > 0) {
+            d.T = &P[l];
+            d.R = &R[l];
+        }
+        d.block_starts = solvers::vertex_block_starts(e.blocks[l].vertex);
+        return d;
+    };
+    solvers::Multigrid below({data(0), data(1)}, {});
+    below.set_operator(0, e.blocks[0].K);
+    below.setup(e.blocks[1].K);
+    auto above = solvers::Multigrid::above(below, data(2), {});
+    EXPECT_EQ(above->n_levels(), 3);
+    above->setup(e.K());
+    Vector z1, z2;
+    const Vector r = Vector::LinSpaced(e.K().rows(), -1.0, 2.0);
+    above->apply(r, z1);
+    e.mg->finest().apply(r, z2);
+    EXPECT_EQ((z1 - z2).lpNorm<Eigen::Infinity>(), 0.0);
+    // Galerkin: the operators are R A T products, which for the elastic block equal the
+    // rediscretized stiffness up to round-off (GalerkinElasticOperatorIsTheRediscretizedOne),
+    // so one cycle agrees to round-off.
+    solvers::Multigrid gal({data(0), data(1), data(2)}, {}, solvers::CoarseOperators::galerkin);
+    gal.setup(e.K());
+    Vector z3;
+    gal.apply(r, z3);
+    EXPECT_LT((z3 - z2).norm(), 1e-8 * z2.norm());
+    EXPECT_EQ(gal.report().coarse_operators, "Galerkin (R A T)");
+    EXPECT_THROW(gal.set_operator(0, e.blocks[0].K), InvalidInput);
+    EXPECT_THROW(solvers::Multigrid({data(1)}, {}), InvalidInput);          // one level
+    EXPECT_THROW(solvers::Multigrid({data(1), data(2)}, {}), InvalidInput); // coarsest with T
 }

@@ -1,0 +1,167 @@
+// SPDX-License-Identifier: MIT
+// The preconditioner registry is the one list of names: the CLI help, `mlcontact
+// preconditioners`, the study's and the bench's lists and the driver's choice all agree with it.
+#include "apps/bench.hpp"
+#include "apps/preconditioners.hpp"
+#include "apps/study_preconditioners.hpp"
+#include "core/check.hpp"
+#include "levels/resources.hpp"
+#include "scene/scene.hpp"
+#include "solvers/factory.hpp"
+#include "solvers/hypre/boomeramg.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <sstream>
+
+using namespace mlc;
+
+namespace {
+
+std::string name_of(const std::string& spec) {
+    return spec.substr(0, spec.find(':'));
+}
+
+// Level data whose callables return empty inputs: enough for a builder to read its options.
+solvers::LevelData stub_level_data() {
+    solvers::LevelData d;
+    d.has_level_below = true;
+    d.coarse_fine_split = [](solvers::MultiplierScale) { return solvers::CoarseFineSplit{}; };
+    d.coarse_lu = []() -> solvers::CoarseSolve { return [](const Vector&, Vector&) {}; };
+    d.coarse_solver = [](const Vector&, Vector&) {};
+    return d;
+}
+
+} // namespace
+
+TEST(Registry, NamesAreUniqueAndEveryEntryIsComplete) {
+    std::set<std::string> names;
+    for (const auto& e : solvers::preconditioner_registry()) {
+        EXPECT_TRUE(names.insert(e.name).second) << e.name << " registered twice";
+        EXPECT_EQ(e.usage.rfind(e.name, 0), 0u) << "usage of " << e.name << ": " << e.usage;
+        EXPECT_NE(e.build, nullptr) << e.name;
+        EXPECT_TRUE(!e.needs_level_below || e.level_aware) << e.name;
+        if (!e.positional_key.empty())
+            EXPECT_NE(std::find(e.options.begin(), e.options.end(), e.positional_key),
+                      e.options.end())
+                << e.name;
+        for (const auto& key : e.options)
+            EXPECT_NE(e.usage.find(key), std::string::npos)
+                << e.name << "'s usage does not mention its option " << key;
+    }
+    // The level-aware ones of the papers and ours.
+    for (const char* n : {"cf", "sorcf", "mg"})
+        EXPECT_TRUE(solvers::find_preconditioner(n)->needs_level_below) << n;
+    EXPECT_TRUE(solvers::find_preconditioner("ebe")->level_aware);
+    EXPECT_FALSE(solvers::find_preconditioner("ebe")->needs_level_below);
+    EXPECT_EQ(solvers::find_preconditioner("MG:pre=2")->name, "mg");
+    EXPECT_EQ(solvers::find_preconditioner("amgx"), nullptr);
+}
+
+TEST(Registry, DeclaredOptionsAreExactlyTheOnesTheBuilderReads) {
+    // An unknown key is reported with the list of the keys the builder read: that list must be
+    // the entry's declared options, for every entry.
+    const solvers::LevelData data = stub_level_data();
+    for (const auto& e : solvers::preconditioner_registry()) {
+        const std::string spec = e.name + ":bogus_key=1";
+        try {
+            solvers::make_preconditioner(spec, &data);
+            ADD_FAILURE() << spec << " was accepted";
+        } catch (const InvalidInput& err) {
+            const std::string msg = err.what();
+            std::ostringstream expected;
+            for (size_t i = 0; i < e.options.size(); ++i)
+                expected << (i ? ", " : "") << e.options[i];
+            EXPECT_NE(msg.find("unknown option 'bogus_key'"), std::string::npos) << msg;
+            EXPECT_NE(msg.find("valid options: " +
+                               (e.options.empty() ? std::string("none") : expected.str())),
+                      std::string::npos)
+                << e.name << ": " << msg;
+        }
+    }
+}
+
+TEST(Registry, LevelAwareEntriesRefuseToBeBuiltFromAMatrixAlone) {
+    for (const auto& e : solvers::preconditioner_registry()) {
+        if (!e.level_aware) {
+            if (e.name != "amg" || solvers::have_hypre())
+                EXPECT_NO_THROW(solvers::make_preconditioner(e.name)) << e.name;
+            continue;
+        }
+        try {
+            solvers::make_preconditioner(e.name);
+            ADD_FAILURE() << e.name << " built without level data";
+        } catch (const InvalidInput& err) {
+            EXPECT_NE(std::string(err.what()).find("level hierarchy"), std::string::npos)
+                << err.what();
+        }
+        if (!e.needs_level_below) continue;
+        solvers::LevelData alone; // a level without the level below
+        try {
+            solvers::make_preconditioner(e.name, &alone);
+            ADD_FAILURE() << e.name << " built without the level below";
+        } catch (const InvalidInput& err) {
+            EXPECT_NE(std::string(err.what()).find(e.name + " needs the level below"),
+                      std::string::npos)
+                << err.what();
+        }
+    }
+}
+
+TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
+    const auto& reg = solvers::preconditioner_registry();
+    // CLI help and `mlcontact preconditioners`.
+    const std::string help = apps::pc_option_help("preconditioner");
+    std::ostringstream listing;
+    apps::print_preconditioners(listing);
+    for (const auto& e : reg) {
+        EXPECT_NE(help.find(e.name), std::string::npos) << e.name << " missing from: " << help;
+        EXPECT_NE(listing.str().find(e.usage), std::string::npos) << e.name;
+    }
+    // The study's and the bench's default lists name registered preconditioners, and both
+    // accept every registered name and refuse others.
+    for (const auto& spec : apps::PreconditionerStudyOptions{}.pcs)
+        EXPECT_NE(solvers::find_preconditioner(spec), nullptr) << spec;
+    for (const auto& spec : apps::BenchSquareOptions{}.pcs)
+        EXPECT_NE(solvers::find_preconditioner(spec), nullptr) << spec;
+    std::vector<std::string> all;
+    for (const auto& e : reg)
+        all.push_back(e.name);
+    EXPECT_NO_THROW(apps::check_preconditioner_names(all));
+    all.push_back("schur");
+    EXPECT_NO_THROW(apps::check_preconditioner_names(all, true));
+    EXPECT_THROW(apps::check_preconditioner_names(all), InvalidInput);
+    EXPECT_THROW(apps::check_preconditioner_names({"amgx"}, true), InvalidInput);
+    apps::BenchSquareOptions bench;
+    bench.pcs = {"amgx"};
+    std::ostringstream sink;
+    EXPECT_THROW(apps::bench_square(bench, sink), InvalidInput);
+    // The driver: the preconditioner it chooses is registered, and needs the level below
+    // exactly when there is one (mg with levels, a single-level one without).
+    for (int L : {0, 1, 3}) {
+        auto p = scene::load_scene("square");
+        p.levels = L;
+        for (const levels::SolverRequest& req :
+             {levels::SolverRequest{.linear = std::string("krylov")}, levels::SolverRequest{}}) {
+            const levels::SolverChoice c = levels::choose_solver(p, req);
+            if (c.spec.method != "krylov") continue;
+            const solvers::PreconditionerEntry* e = solvers::find_preconditioner(c.spec.pc);
+            ASSERT_NE(e, nullptr) << c.spec.pc;
+            EXPECT_EQ(e->needs_level_below, L >= 1) << c.spec.pc << " at levels " << L;
+        }
+        // A name that needs the level below, asked for without one: refused before building.
+        for (const auto& e : reg) {
+            if (!e.needs_level_below) continue;
+            levels::SolverRequest req;
+            req.pc = e.name;
+            if (L == 0)
+                EXPECT_THROW(levels::choose_solver(p, req), InvalidInput) << e.name;
+            else
+                EXPECT_EQ(levels::choose_solver(p, req).spec.pc, e.name);
+        }
+    }
+    levels::SolverRequest bad;
+    bad.pc = "amgx";
+    EXPECT_THROW(levels::choose_solver(scene::load_scene("square"), bad), InvalidInput);
+}
