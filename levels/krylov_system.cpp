@@ -73,8 +73,6 @@ public:
                                                          : MgMode::two_level;
         uses_coarse_statuses_ = below_ != nullptr && entry != nullptr && entry->needs_level_below &&
                                 mg_mode_ != MgMode::galerkin;
-        if (mg_mode_ == MgMode::two_level)
-            coarse_jac_ = std::make_unique<JacobianAssembler>(*below_->coarse);
     }
 
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
@@ -182,6 +180,9 @@ private:
                 throw SolverBreakdown("CF: the coarse solve (" + below_->solver->name() +
                                       ") did not converge: " + res.message);
         };
+        d.top.T = &below_->transfer->T;
+        d.top.R = &below_->transfer->R;
+        d.top.block_starts = level_vertex_blocks(level_);
         // The levels from the lowest one solved up to this one, coarsest first.
         std::vector<const Level*> lv{&level_};
         std::vector<const transfer::LevelTransfer*> tr{below_->transfer};
@@ -191,16 +192,20 @@ private:
                                                                       : nullptr);
             if (c->below == nullptr || !c->below->available()) break;
         }
-        for (size_t k = lv.size(); k-- > 0;) {
-            solvers::MultigridLevelData m;
-            if (tr[k] != nullptr) {
-                m.T = &tr[k]->T;
-                m.R = &tr[k]->R;
-            }
-            m.block_starts = level_vertex_blocks(*lv[k]);
-            d.hierarchy.push_back(std::move(m));
-        }
         d.hierarchy_from_level0 = lv.back()->mesh.n_coarse_vertices == 0;
+        d.hierarchy = [lv, tr]() {
+            std::vector<solvers::MultigridLevelData> h;
+            for (size_t k = lv.size(); k-- > 0;) {
+                solvers::MultigridLevelData m;
+                if (tr[k] != nullptr) {
+                    m.T = &tr[k]->T;
+                    m.R = &tr[k]->R;
+                }
+                m.block_starts = level_vertex_blocks(*lv[k]);
+                h.push_back(std::move(m));
+            }
+            return h;
+        };
         const auto& T = below_->transfer->T;
         MLC_CHECK(T.rows() == level_.n_unknowns() && T.cols() == below_->coarse->n_unknowns(),
                   "the transfer is " << T.rows() << " x " << T.cols() << ", expected "
@@ -224,6 +229,8 @@ private:
             below_->solver->prepare(coarse_M_);
             return;
         }
+        if (mg_mode_ == MgMode::two_level && !coarse_jac_)
+            coarse_jac_ = std::make_unique<JacobianAssembler>(*below_->coarse);
         if (!coarse_jac_ || coarse_fallback_set_ ||
             (coarse_factored_ && coarse_M_ == coarse_M_used_))
             return;

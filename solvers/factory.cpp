@@ -161,19 +161,18 @@ std::unique_ptr<Preconditioner> build_mg(SpecOptions& o, const LevelData* level)
               "option coarse=" << coarse << " of mg: valid rediscretize, galerkin");
     o.finish();
     p.validate();
-    MLC_CHECK(L.hierarchy.size() >= 2,
-              "mg: the level data holds " << L.hierarchy.size() << " level(s), at least two");
     if (coarse == "galerkin") {
         MLC_CHECK(L.hierarchy_from_level0,
                   "mg:coarse=galerkin needs every level below in the coarse-to-fine solve");
-        return std::make_unique<Multigrid>(L.hierarchy, p, CoarseOperators::galerkin);
+        return std::make_unique<Multigrid>(L.hierarchy(), p, CoarseOperators::galerkin);
     }
-    if (L.below_multigrid != nullptr)
-        return Multigrid::above(*L.below_multigrid, L.hierarchy.back(), p);
-    MultigridLevelData below = L.hierarchy[L.hierarchy.size() - 2];
+    if (L.below_multigrid != nullptr) return Multigrid::above(*L.below_multigrid, L.top, p);
+    // Two levels: the level below (its operator set by the caller, factored) and this one.
+    std::vector<MultigridLevelData> h = L.hierarchy();
+    MLC_CHECK(h.size() >= 2, "mg: the level data holds " << h.size() << " level(s), at least two");
+    MultigridLevelData below = std::move(h[h.size() - 2]);
     below.T = below.R = nullptr;
-    return std::make_unique<Multigrid>(std::vector<MultigridLevelData>{below, L.hierarchy.back()},
-                                       p);
+    return std::make_unique<Multigrid>(std::vector<MultigridLevelData>{std::move(below), L.top}, p);
 }
 
 std::unique_ptr<Preconditioner> build_amg(SpecOptions& o, const LevelData* level) {

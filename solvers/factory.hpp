@@ -78,10 +78,12 @@ struct LevelData {
     std::function<CoarseSolve()> coarse_lu;
     /// The level below's own Newton-system solver at its converged statuses.
     CoarseSolve coarse_solver;
+    /// mg: this level's multigrid data (the transfer from the level below, its smoother blocks).
+    MultigridLevelData top;
     /// mg: the levels from the lowest one solved up to this one (coarsest first; the lowest
-    /// entry has no T or R), their transfers and smoother blocks.
-    std::vector<MultigridLevelData> hierarchy;
-    /// hierarchy starts at level 0 (mg:coarse=galerkin needs it).
+    /// entry has no T or R), their transfers and smoother blocks; computed when asked.
+    std::function<std::vector<MultigridLevelData>()> hierarchy;
+    /// hierarchy() starts at level 0 (mg:coarse=galerkin needs it).
     bool hierarchy_from_level0 = false;
     /// mg: the level below's own multigrid when it has one (the rediscretized mg extends it,
     /// Multigrid::above); else null: a two-level multigrid whose coarse operator (the level
