@@ -45,6 +45,9 @@ int main(int argc, char** argv) {
     run->add_option("--pc", ro.pc,
                     mlc::apps::pc_option_help("preconditioner (implies a Krylov solve; default mg "
                                               "above the crossover, see the report)"));
+    run->add_flag("--no-fallback", ro.no_fallback,
+                  "a Newton system the Krylov solve fails on ends the run, instead of being "
+                  "solved again by the exact schur solver (the default; reported)");
     run->add_option("--linear-tol", ro.linear_rel_tol,
                     "relative tolerance of each Krylov solve (implies a Krylov solve; default "
                     "1e-10)");

@@ -237,6 +237,11 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             }
             sv.insert("automatic", r.solver.automatic);
             sv.insert("reason", r.solver.reason);
+            int fallbacks = 0;
+            for (const auto& ls : r.level_steps)
+                for (const auto& st : ls)
+                    fallbacks += st.report.fallback_solves;
+            sv.insert("fallback_solves", fallbacks);
             root.insert("solver", sv);
             if (r.multigrid) {
                 const solvers::MultigridReport& m = *r.multigrid;

@@ -42,6 +42,10 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     so.progress = opt.quiet ? nullptr : &os;
     so.coarse_to_fine = !opt.cold;
     so.linear = choice.spec;
+    MLC_CHECK(!opt.no_fallback || choice.spec.method == "krylov",
+              "--no-fallback applies to Krylov solves only; the solver of this run is "
+                  << choice.spec.method << " (" << choice.reason << ")");
+    so.exact_fallback = !opt.no_fallback;
     os << "mlcontact: solving '" << p.name << "'\n";
     os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
     levels::RunResult r = levels::solve(p, so);
@@ -50,6 +54,22 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
        << levels::format_bytes(r.memory_limit.bytes) << " available (" << r.memory_limit.source
        << "); measured peak " << levels::format_bytes(peak_rss_bytes()) << "\n";
     if (r.multigrid) os << *r.multigrid;
+    {
+        int fallbacks = 0;
+        std::string first;
+        for (const auto& ls : r.level_steps)
+            for (const auto& st : ls) {
+                if (first.empty() && !st.report.fallback_reason.empty())
+                    first = "level " + std::to_string(st.level) + ", load step " +
+                            std::to_string(st.report.step) + ": " + st.report.fallback_reason;
+                fallbacks += st.report.fallback_solves;
+            }
+        if (fallbacks > 0)
+            os << "exact fallback: " << fallbacks
+               << " Newton system(s) solved again by the exact schur solver after the Krylov "
+                  "solve failed (first: "
+               << first << ")\n";
+    }
     os << "\n";
     print_header(os, p, r);
     print_summary(os, p, r);

@@ -25,6 +25,9 @@ struct RunOptions {
     std::optional<std::string> krylov;    ///< Krylov method (implies a Krylov solve)
     std::optional<std::string> pc;        ///< preconditioner spec (implies a Krylov solve)
     std::optional<double> linear_rel_tol; ///< relative tolerance of each Krylov solve
+    /// No exact fallback: a Newton system the Krylov solve fails on ends the run (exit 2/3)
+    /// instead of being solved again by the exact schur solver.
+    bool no_fallback = false;
 };
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not

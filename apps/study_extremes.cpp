@@ -48,11 +48,13 @@ Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec&
     const double t0 = wall_seconds();
     levels::SolveOptions so;
     so.linear = solver;
+    so.exact_fallback = true; // as `mlcontact run` does
     const auto r = levels::solve(p, so);
     f["seconds"] = num(wall_seconds() - t0);
-    int newton = 0, krylov = 0, cycling = -1, krylov_systems = 0;
+    int newton = 0, krylov = 0, cycling = -1, krylov_systems = 0, fallbacks = 0;
     for (const auto& ls : r.level_steps)
         for (const auto& st : ls) {
+            fallbacks += st.report.fallback_solves;
             newton += st.report.iterations;
             krylov += st.report.linear_iterations;
             krylov_systems += static_cast<int>(st.report.linear_iterations_per_newton.size());
@@ -64,6 +66,7 @@ Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec&
     if (krylov_systems > 0)
         f["krylov_per_newton"] = num(static_cast<double>(krylov) / krylov_systems);
     if (cycling >= 0) f["cycling"] = "damped";
+    if (fallbacks > 0) f["fallbacks"] = std::to_string(fallbacks);
     if (!r.converged) {
         f["status"] = "no conv";
         f["diagnosis"] = r.failure;
@@ -241,6 +244,7 @@ mu = 0.3
                       mm.levels = si.levels = l;
                       levels::SolveOptions so;
                       so.linear = solver;
+                      so.exact_fallback = true;
                       const auto a = levels::solve(mm, so);
                       const auto b = levels::solve(si, so);
                       Fields f;
@@ -398,6 +402,9 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
                 notes += (notes.empty() ? "" : "; ") + std::string("g/st/s+/s- ") + f["statuses"];
             if (f.count("cycling"))
                 notes += (notes.empty() ? "" : "; ") + std::string("status cycling, damped");
+            if (f.count("fallbacks"))
+                notes += (notes.empty() ? "" : "; ") + f["fallbacks"] +
+                         " Newton system(s) solved by the exact fallback";
             if (f.count("unit_diff_u"))
                 notes += "rel. diff u " + f["unit_diff_u"] + ", lambda " + f["unit_diff_lambda"];
             os << std::left << std::setw(26) << c.name << std::setw(11) << get("status")

@@ -58,6 +58,7 @@ public:
         params_.rel_tol = spec.rel_tol;
         params_.max_iter = spec.max_iter;
         params_.restart = spec.restart;
+        params_.give_up_budget = spec.give_up_budget;
         params_.validate();
         if (below != nullptr && below->available()) below_ = below;
         const solvers::PreconditionerEntry* entry = solvers::find_preconditioner(spec.pc);

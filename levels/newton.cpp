@@ -166,7 +166,21 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
             ScopedTimer t(timings_, "newton/linear_solve");
             R = -R;
             dx.setZero();
-            lin = solver_->solve(M, R, dx, forcing_term(k, norm, scale));
+            try {
+                if (fallback_) {
+                    // The Krylov solve failed on this level before: the exact solver from then
+                    // on (it is set up; another failed attempt per system would only cost).
+                    lin = fallback_->solve(M, R, dx);
+                    ++rep.fallback_solves;
+                } else {
+                    lin = solver_->solve(M, R, dx, forcing_term(k, norm, scale));
+                }
+            } catch (const SolverBreakdown& e) {
+                if (!make_fallback_) throw;
+                lin = SolveResult{};
+                lin.reason = StopReason::breakdown;
+                lin.message = e.what();
+            }
         }
         rep.linear_iterations += lin.iterations;
         rep.linear_iterations_per_newton.push_back(lin.iterations);
@@ -179,6 +193,29 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
                             std::isfinite(lin.relative_residual) && lin.relative_residual < 0.5 &&
                             dx.allFinite();
         if (usable) ++rep.inexact_steps;
+        if (!lin.converged && !usable && make_fallback_ && !fallback_) {
+            // The exact fallback: the same system solved again, exactly.
+            const std::string why = std::string(to_string(lin.reason)) +
+                                    (lin.message.empty() ? "" : " (" + lin.message + ")");
+            try {
+                if (!fallback_) fallback_ = make_fallback_();
+            } catch (const InvalidInput& e) {
+                rep.message = "linear solve failed at Newton iteration " + std::to_string(k) +
+                              ": " + why + "; no exact fallback: " + e.what();
+                break;
+            }
+            ScopedTimer t(timings_, "newton/fallback_solve");
+            dx.setZero();
+            const SolveResult ex = fallback_->solve(M, R, dx);
+            rep.linear_seconds += ex.setup_seconds + ex.solve_seconds;
+            if (rep.fallback_solves++ == 0)
+                rep.fallback_reason = solver_->name() + " failed at Newton iteration " +
+                                      std::to_string(k) + ": " + why + "; solved by " +
+                                      fallback_->name();
+            lin.converged = ex.converged;
+            lin.reason = ex.reason;
+            lin.message = ex.message;
+        }
         if (!lin.converged && !usable) {
             rep.message = "linear solve failed at Newton iteration " + std::to_string(k) + ": " +
                           std::string(to_string(lin.reason)) +

@@ -40,6 +40,10 @@ struct StepReport {
     int inexact_steps = 0;                ///< steps taken from a Krylov solve stopped at max_iter
     int cycling_detected_at = -1;         ///< iterate at which statuses returned to an earlier set
     int damped_steps = 0;                 ///< steps taken with backtracking on ||R|| after cycling
+    /// Newton systems solved again by the exact fallback solver after the solver failed on them
+    /// (ContactNewton::set_fallback), and why the first of them failed.
+    int fallback_solves = 0;
+    std::string fallback_reason;
     double seconds = 0.0;
     std::string message; ///< diagnosis when not converged
 };
@@ -86,11 +90,24 @@ public:
 
     const Level& level() const { return level_; }
 
+    /// A fallback for the Newton systems the solver fails on (a Krylov solve that neither
+    /// converged nor reduced the residual by half, or a numerical breakdown): `make` builds it on
+    /// first use (the driver gives the exact `schur` solver, after checking that it fits in
+    /// memory; `make` throws InvalidInput when it does not), and the system is solved again with
+    /// it; the later systems of this level are then solved by it directly (a preconditioner
+    /// that failed once on a level is not tried again there). Counted in
+    /// StepReport::fallback_solves. Without one (default) the failure ends the step.
+    void set_fallback(std::function<std::unique_ptr<NewtonSystemSolver>()> make) {
+        make_fallback_ = std::move(make);
+    }
+
 private:
     const Level& level_;
     NewtonParams params_;
     std::unique_ptr<NewtonSystemSolver> solver_;
     Timings* timings_;
+    std::function<std::unique_ptr<NewtonSystemSolver>()> make_fallback_;
+    std::unique_ptr<NewtonSystemSolver> fallback_;
 };
 
 } // namespace mlc::levels

@@ -93,6 +93,11 @@ make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> s
 /// is refactored when statuses change. Setup: one Cholesky and m solves for S per level.
 std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level);
 
+/// The Krylov iteration budget with an exact fallback: a solve projected to need more
+/// iterations than this (at its observed rate) is given up and the system solved exactly. The
+/// multigrid needs 5 to 30 on every scene we have; a few hundred means it is failing there.
+inline constexpr int kFallbackKrylovBudget = 500;
+
 /// How each Newton system is solved.
 struct LinearSolverSpec {
     /// "schur" (exact, condensed on the contact set; default), "lu" (SparseLU on the assembled
@@ -105,6 +110,10 @@ struct LinearSolverSpec {
     double rel_tol = 1e-10;
     int max_iter = 5000; ///< Krylov iterations per Newton step
     int restart = 50;    ///< GMRES restart length
+    /// Cut slow Krylov solves short: 0 (default) never, else the iteration budget of
+    /// solvers::KrylovParams::give_up_budget. The driver sets kFallbackKrylovBudget when an
+    /// exact fallback follows a failed solve (SolveOptions::exact_fallback).
+    int give_up_budget = 0;
     void validate() const;
 };
 

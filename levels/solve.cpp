@@ -3,6 +3,7 @@
 #include "levels/solve.hpp"
 
 #include "core/check.hpp"
+#include "core/memory.hpp"
 #include "solvers/factory.hpp"
 
 #include <iomanip>
@@ -81,6 +82,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         const Level& L = levels[static_cast<size_t>(l)];
         LinearSolverSpec spec = options.linear;
         if (l == 0 && l != finest) spec = LinearSolverSpec{};
+        if (options.exact_fallback && spec.method == "krylov")
+            spec.give_up_budget = kFallbackKrylovBudget;
         auto& lb = below[static_cast<size_t>(l)];
         if (l > first) {
             lb.coarse = &levels[static_cast<size_t>(l - 1)];
@@ -92,6 +95,19 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         system[static_cast<size_t>(l)] = sys.get();
         newton[static_cast<size_t>(l)] =
             std::make_unique<ContactNewton>(L, problem.newton, std::move(sys), &res.timings);
+        if (options.exact_fallback && spec.method == "krylov") {
+            const LevelSize size = res.predicted_sizes[static_cast<size_t>(l)];
+            newton[static_cast<size_t>(l)]->set_fallback([&L, size, l]() {
+                const double need = estimate_memory({size}, LinearSolverSpec{}, false).solver_bytes;
+                const MemoryLimit limit = process_memory_limit();
+                const double free = limit.bytes - peak_rss_bytes();
+                MLC_CHECK(need < free, "the exact schur solver of level "
+                                           << l << " needs an estimated " << format_bytes(need)
+                                           << ", more than the " << format_bytes(free) << " left ("
+                                           << limit.source << ")");
+                return make_schur_system_solver(L);
+            });
+        }
     }
 
     std::vector<Vector> x(static_cast<size_t>(n_levels)), u_prev(static_cast<size_t>(n_levels)),

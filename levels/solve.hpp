@@ -38,6 +38,13 @@ struct SolveOptions {
     LinearSolverSpec linear;
     /// Solve every level even in cold mode (the status-transfer study compares per level).
     bool solve_all_levels = false;
+    /// Levels solved by a Krylov method: a Newton system the Krylov solve fails on (neither
+    /// converged nor reduced the residual by half, or a breakdown) is solved again by the exact
+    /// `schur` solver of that level, built on first use when it fits in memory
+    /// (ContactNewton::set_fallback; counted in StepReport::fallback_solves and reported).
+    /// The driver (`mlcontact run`, `study extremes`) turns it on; studies that measure the
+    /// preconditioners themselves leave it off.
+    bool exact_fallback = false;
     /// predict_level_sizes(problem) when the caller computed it already (it builds level 0);
     /// empty: solve computes it.
     std::vector<LevelSize> predicted_sizes;

@@ -8,6 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 namespace mlc::solvers {
@@ -19,6 +22,8 @@ void KrylovParams::validate() const {
               "KrylovParams::abs_tol must be finite and >= 0, found " << abs_tol);
     MLC_CHECK(max_iter >= 0, "KrylovParams::max_iter must be >= 0, found " << max_iter);
     MLC_CHECK(restart >= 1, "KrylovParams::restart must be >= 1, found " << restart);
+    MLC_CHECK(give_up_budget >= 0,
+              "KrylovParams::give_up_budget must be >= 0, found " << give_up_budget);
 }
 
 std::ostream& operator<<(std::ostream& os, const KrylovParams& p) {
@@ -80,6 +85,24 @@ public:
     }
     void record(double rnorm) {
         if (p_.record_history) res_.history.push_back(rnorm);
+        if (rnorm < best_) best_ = rnorm;
+    }
+
+    // Whether to stop before iteration `it`: max_iter reached (empty message), or a rate that
+    // projects more than give_up_budget iterations in all.
+    std::optional<std::string> should_stop(int it) const {
+        if (it >= p_.max_iter) return std::string();
+        if (p_.give_up_budget <= 0 || it == 0 || it % 50 != 0) return std::nullopt;
+        const double r0 = res_.initial_residual;
+        if (!(r0 > 0.0) || !(best_ > tol_)) return std::nullopt;
+        const double rate = std::log(r0 / best_) / it; // per iteration, natural log
+        const double needed = rate > 0.0 ? std::log(best_ / tol_) / rate : 1e300;
+        if (static_cast<double>(it) + needed <= p_.give_up_budget) return std::nullopt;
+        std::ostringstream os;
+        os << std::setprecision(3) << "given up at iteration " << it << ": the residual fell by "
+           << r0 / best_ << ", at that rate the tolerance needs about " << needed
+           << " more iterations (budget " << p_.give_up_budget << ")";
+        return os.str();
     }
 
     // t = b - A x; returns ||t||.
@@ -125,6 +148,7 @@ private:
     double t0_;
     double bnorm_ = 0.0;
     double tol_ = 0.0;
+    double best_ = std::numeric_limits<double>::infinity(); // smallest monitored residual
     SolveResult res_;
 };
 
@@ -162,8 +186,8 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
                                   at("(z0, z0) with z0 = C^{-1} r0", it, rho));
             restart = false;
         }
-        if (it >= params.max_iter)
-            return run.finish(StopReason::max_iter, it, run.true_residual(t));
+        if (const auto stop = run.should_stop(it))
+            return run.finish(StopReason::max_iter, it, run.true_residual(t), *stop);
 
         A.apply(q, t);
         M.apply(t, y); // y = C^{-1} A q
@@ -221,8 +245,8 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
     bool restart = true;
     double rho_old = 1.0;
     while (true) {
-        if (it >= params.max_iter)
-            return run.finish(StopReason::max_iter, it, run.true_residual(t));
+        if (const auto stop = run.should_stop(it))
+            return run.finish(StopReason::max_iter, it, run.true_residual(t), *stop);
         M.apply(r, z);
         M.apply_transpose(rt, zt);
         const double rho = z.dot(rt);
@@ -299,8 +323,8 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
             p.setZero();
             restart = false;
         }
-        if (it >= params.max_iter)
-            return run.finish(StopReason::max_iter, it, run.true_residual(t));
+        if (const auto stop = run.should_stop(it))
+            return run.finish(StopReason::max_iter, it, run.true_residual(t), *stop);
         const double rho = rh.dot(r);
         if (bad(rho))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
@@ -371,7 +395,8 @@ SolveResult gmres(const LinearOperator& A, const Preconditioner& M, const Vector
     int it = 0;
     while (true) {
         if (run.ok(beta)) return run.finish(StopReason::converged, it, beta);
-        if (it >= params.max_iter) return run.finish(StopReason::max_iter, it, beta);
+        if (const auto stop = run.should_stop(it))
+            return run.finish(StopReason::max_iter, it, beta, *stop);
 
         V.col(0) = w / beta;
         g.setZero();

@@ -29,6 +29,11 @@ struct KrylovParams {
     /// GMRES restart length m >= 1 (ignored by the other methods). Default 50: memory
     /// (m + 1) n doubles, a usual compromise between robustness and cost.
     int restart = 50;
+    /// Cut a slow solve short: every 50 iterations, when the residual reduction observed so far,
+    /// continued at its average rate, would need more than `give_up_budget` iterations in all to
+    /// reach the tolerance, stop (reason max_iter, the message says so). Default 0: never; the
+    /// Newton driver sets it when an exact fallback solve follows a failure.
+    int give_up_budget = 0;
     /// Store the monitored residual norm of every iteration in SolveResult::history.
     /// Default false: no allocation proportional to the iteration count.
     bool record_history = false;

@@ -332,3 +332,37 @@ TEST(Krylov, ParsesNamesAndPrintsParams) {
          {"rel_tol=1e-08", "abs_tol=0", "max_iter=1000", "restart=50", "record_history=false"})
         EXPECT_NE(os.str().find(f), std::string::npos) << os.str();
 }
+
+TEST(Krylov, ASlowSolveIsGivenUpOnlyWhenItsRateMissesTheBudget) {
+    // Unpreconditioned CG-like methods on a 2D Laplacian of 60 x 60 need a few hundred
+    // iterations for 1e-10: with a budget of 60 the projection at iteration 50 exceeds it and
+    // the solve stops there (reason max_iter, the message says why); with a budget far above
+    // the need, or none, the solve runs to convergence with the same iteration count.
+    const SparseMatrix A = testmat::laplace_2d(60);
+    const MatrixOperator op(A);
+    IdentityPreconditioner I;
+    const Vector b = A * Vector::Ones(A.rows());
+    for (Krylov k : {Krylov::cgs, Krylov::bicgstab, Krylov::gmres}) {
+        Vector x0, x1, x2;
+        const KrylovParams base{.rel_tol = 1e-10, .max_iter = 5000};
+        const SolveResult free = solve(k, op, I, b, x0, base);
+        ASSERT_TRUE(free.converged) << k << ": " << free;
+        ASSERT_GT(free.iterations, 60) << k;
+        KrylovParams tight = base;
+        tight.give_up_budget = 60;
+        const SolveResult cut = solve(k, op, I, b, x1, tight);
+        EXPECT_FALSE(cut.converged) << k;
+        EXPECT_EQ(cut.reason, StopReason::max_iter) << k;
+        EXPECT_LE(cut.iterations, 100) << k; // at the first check, 50 (GMRES: its restart)
+        EXPECT_NE(cut.message.find("given up at iteration"), std::string::npos) << cut.message;
+        KrylovParams loose = base;
+        loose.give_up_budget = 100 * free.iterations;
+        const SolveResult same = solve(k, op, I, b, x2, loose);
+        EXPECT_TRUE(same.converged) << k;
+        EXPECT_EQ(same.iterations, free.iterations) << k;
+        EXPECT_EQ((x2 - x0).norm(), 0.0) << k;
+    }
+    KrylovParams bad;
+    bad.give_up_budget = -1;
+    EXPECT_THROW(bad.validate(), InvalidInput);
+}
