@@ -9,6 +9,7 @@
 #include "levels/level.hpp"
 #include "levels/newton_system.hpp"
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -41,7 +42,8 @@ struct StepReport {
     int cycling_detected_at = -1;         ///< iterate at which statuses returned to an earlier set
     int damped_steps = 0;                 ///< steps taken with backtracking on ||R|| after cycling
     double seconds = 0.0;
-    std::string message; ///< diagnosis when not converged
+    std::string message;  ///< diagnosis when not converged
+    bool stopped = false; ///< stopped on request (ContactNewton::set_stop), not converged
 };
 
 /// The full state of a converged (or last) iterate, for reports and output.
@@ -72,6 +74,8 @@ public:
 
     /// Per contact node state (reported statuses: a frictionless node in contact is reported as
     /// slip_forward/backward by the sign of its slip increment, or stick if it did not move).
+    /// A gap node reports lambda = (0, 0) exactly, the value of the projection at the converged
+    /// state (the iterate carries round-off such as 1e-111).
     std::vector<ContactNodeState> node_states(double s, const Vector& u_prev_full,
                                               const Vector& x) const;
 
@@ -86,11 +90,16 @@ public:
 
     const Level& level() const { return level_; }
 
+    /// A flag polled after every Newton iteration: once it is set, solve() returns after the
+    /// current iteration with StepReport::stopped (and converged false). Null: never stops.
+    void set_stop(const std::atomic<bool>* stop) { stop_ = stop; }
+
 private:
     const Level& level_;
     NewtonParams params_;
     std::unique_ptr<NewtonSystemSolver> solver_;
     Timings* timings_;
+    const std::atomic<bool>* stop_ = nullptr;
 };
 
 } // namespace mlc::levels
