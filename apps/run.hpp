@@ -3,6 +3,7 @@
 /// write the result files.
 #pragma once
 
+#include <atomic>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -25,10 +26,20 @@ struct RunOptions {
     std::optional<std::string> krylov;    ///< Krylov method (implies a Krylov solve)
     std::optional<std::string> pc;        ///< preconditioner spec (implies a Krylov solve)
     std::optional<double> linear_rel_tol; ///< relative tolerance of each Krylov solve
+    std::string vtu = "binary";           ///< VTU encoding: binary (zlib, appended) or ascii
+    bool every_step = false;   ///< a VTU per load step of the finest level + solution.pvd
+    bool every_level = false;  ///< also a VTU series + collection per coarser level
+    bool plot = false;         ///< draw contact.png (scripts/plot_contact.py)
+    bool progress_eta = false; ///< progress lines with the time left (stdout is a terminal)
+    /// Polled by the solve (levels::SolveOptions::stop); when it is set, the run stops after the
+    /// current Newton iteration, writes the files of the completed steps and returns 128 +
+    /// stop_signal() (apps/interrupt.hpp). Null: never stops.
+    const std::atomic<bool>* stop = nullptr;
 };
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not
-/// converge (the report says which and how). Throws InvalidInput for bad input.
+/// converge (the report says which and how), 130 / 143 when stopped by SIGINT / SIGTERM (see
+/// RunOptions::stop). Throws InvalidInput for bad input.
 int run_scene(const RunOptions& opt, std::ostream& os);
 
 } // namespace mlc::apps
