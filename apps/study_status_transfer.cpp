@@ -2,6 +2,7 @@
 // Status-transfer study (issue: level hierarchy and coarse-to-fine Newton).
 #include "apps/study_status_transfer.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"
 
@@ -110,7 +111,7 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
     if (!cold.converged) os << "note: the cold run failed: " << cold.failure << "\n";
 
     // Per level and step rows.
-    std::ofstream csv(dir / "status_transfer.csv");
+    AtomicOfstream csv(dir / "status_transfer.csv");
     csv << "level,step,unknowns,contact_nodes,newton_warm,newton_cold,agreement,mispredicted,"
            "mispredicted_at_zone_boundary";
     for (auto p : kStatusNames)
@@ -210,7 +211,7 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
            << agree_min << "\n";
     }
     // Final statuses along the contact boundary per level (for the plot).
-    std::ofstream sc(dir / "statuses.csv");
+    AtomicOfstream sc(dir / "statuses.csv");
     sc << "level,x,y,status\n" << std::setprecision(12);
     for (int l = 0; l <= opt.levels; ++l) {
         const auto& L = warm.levels()[static_cast<size_t>(l)];
@@ -229,7 +230,7 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
         root.insert("newton_per_step_cold_levels_2_up", cold_sum / n_avg);
         root.insert("min_predicted_status_agreement_levels_2_up", agree_min);
     }
-    std::ofstream js(dir / "status_transfer.json");
+    AtomicOfstream js(dir / "status_transfer.json");
     js << toml::json_formatter{root} << "\n";
     csv.close();
     sc.close();

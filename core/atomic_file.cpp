@@ -4,6 +4,7 @@
 
 #include "core/check.hpp"
 
+#include <exception>
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
@@ -38,6 +39,43 @@ void write_file_atomically(const std::filesystem::path& file,
         std::error_code ec;
         std::filesystem::remove(tmp, ec);
         throw;
+    }
+}
+
+AtomicOfstream::AtomicOfstream(const std::filesystem::path& file)
+    : std::ofstream(temporary_path(file), std::ios::binary | std::ios::trunc), file_(file),
+      uncaught_(std::uncaught_exceptions()), pending_(is_open()) {}
+
+AtomicOfstream::AtomicOfstream(AtomicOfstream&& other) noexcept
+    : std::ofstream(std::move(other)), file_(std::move(other.file_)), uncaught_(other.uncaught_),
+      pending_(other.pending_) {
+    other.pending_ = false;
+}
+
+AtomicOfstream::~AtomicOfstream() {
+    if (!pending_) return;
+    if (std::uncaught_exceptions() > uncaught_) {
+        std::ofstream::close();
+        std::error_code ec;
+        std::filesystem::remove(temporary_path(file_), ec);
+        return;
+    }
+    close();
+}
+
+void AtomicOfstream::close() {
+    if (!pending_) return;
+    pending_ = false;
+    std::ofstream::close();
+    std::error_code ec;
+    if (fail()) {
+        std::filesystem::remove(temporary_path(file_), ec);
+        return;
+    }
+    std::filesystem::rename(temporary_path(file_), file_, ec);
+    if (ec) {
+        setstate(std::ios::failbit);
+        std::filesystem::remove(temporary_path(file_), ec);
     }
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <ostream>
 
@@ -20,5 +21,25 @@ std::filesystem::path temporary_path(const std::filesystem::path& file);
 /// removed and `file` is left as it was.
 void write_file_atomically(const std::filesystem::path& file,
                            const std::function<void(std::ostream&)>& write);
+
+/// An output file stream written to temporary_path(file) and renamed to `file` when closed: a
+/// drop-in for std::ofstream in code that writes a file piece by piece. close() (or the
+/// destructor, when the scope ends normally) closes and renames; a write or rename failure sets
+/// failbit, so `good()` after close() says whether the file is complete. Destroyed during stack
+/// unwinding (an exception), it removes the temporary and leaves `file` as it was.
+class AtomicOfstream : public std::ofstream {
+public:
+    explicit AtomicOfstream(const std::filesystem::path& file);
+    AtomicOfstream(AtomicOfstream&& other) noexcept;
+    AtomicOfstream& operator=(AtomicOfstream&&) = delete;
+    ~AtomicOfstream() override;
+    /// Closes the temporary and renames it to the file (once; later calls do nothing).
+    void close();
+
+private:
+    std::filesystem::path file_;
+    int uncaught_ = 0;
+    bool pending_ = false; ///< the temporary exists and was not renamed or removed yet
+};
 
 } // namespace mlc
