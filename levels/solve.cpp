@@ -45,11 +45,13 @@ void print_progress(std::ostream& os, int level, int n_levels, int step, int n_s
                          : "  FAILED");
 }
 
-/// "12 s", "3 min 05 s", "1 h 02 min".
+/// "0.4 s", "12 s", "3 min 05 s", "1 h 02 min".
 std::string format_duration(double t) {
     const long s = std::lround(std::max(0.0, t));
     std::ostringstream os;
-    if (s < 60)
+    if (t < 9.95)
+        os << std::fixed << std::setprecision(1) << std::max(0.0, t) << " s";
+    else if (s < 60)
         os << s << " s";
     else if (s < 3600)
         os << s / 60 << " min " << std::setw(2) << std::setfill('0') << s % 60 << " s";

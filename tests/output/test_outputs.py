@@ -283,3 +283,35 @@ def test_sigint_exits_130(tmp_path):
     assert rc == 130, out
     assert "stopped by SIGINT" in out, out
     check_left_files(tmp_path)
+
+
+def progress_lines(text):
+    return [line.strip() for line in text.splitlines() if line.strip().startswith("step ")
+            and " level " in line]
+
+
+def test_progress_gives_the_time_left_on_a_terminal_only(tmp_path):
+    import pty
+    import re
+    master, slave = pty.openpty()
+    p = subprocess.Popen([MLCONTACT, "run", "square", "--levels", "2", "--out", str(tmp_path)],
+                         stdout=slave, stderr=slave, env=ENV)
+    os.close(slave)
+    out = b""
+    while True:
+        try:
+            chunk = os.read(master, 65536)
+        except OSError:  # the child closed the terminal
+            break
+        if not chunk:
+            break
+        out += chunk
+    assert p.wait() == 0
+    os.close(master)
+    lines = progress_lines(out.decode())
+    assert len(lines) == 15, out  # 3 levels x 5 load steps, one line each
+    eta = re.compile(r"\[(\d+\.\d|\d+) s elapsed, ~(\d+\.\d|\d+) s left\]$")
+    assert all(eta.search(line) for line in lines), lines
+    assert lines[-1].endswith("~0.0 s left]")
+    piped = progress_lines(run("square", "--levels", "2", "--out", str(tmp_path)).stdout)
+    assert len(piped) == 15 and not any("left]" in line for line in piped)
