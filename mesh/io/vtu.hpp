@@ -42,8 +42,9 @@ const char* to_string(VtuFormat f);
 /// "Warp By Vector" applies them directly. Both formats hold the same arrays with the same
 /// values: binary stores every double bit for bit (Float64, connectivity Int32, offsets Int64,
 /// types UInt8, each array compressed with zlib in blocks of 1 MiB, the blocks compressed in
-/// parallel); ascii writes numbers with std::to_chars in the shortest form that reads back to the
-/// same double, so values round-trip exactly there too.
+/// parallel; a block that does not shrink to half is stored uncompressed, see vtu.cpp); ascii
+/// writes numbers with std::to_chars in the shortest form that reads back to the same double, so
+/// values round-trip exactly there too.
 ///
 /// Everything is checked before the file is touched: field sizes against the mesh
 /// (n_vertices * n_components for point fields, n_triangles * n_components for cell fields),
