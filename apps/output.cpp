@@ -99,7 +99,10 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
            << "  " << std::scientific << std::setprecision(2) << s.residuals.back() << std::setw(7)
            << s.counts.gap << std::setw(7) << s.counts.stick << std::setw(7)
            << s.counts.slip_forward << std::setw(7) << s.counts.slip_backward << std::setw(10)
-           << std::fixed << std::setprecision(3) << s.seconds << (s.converged ? "" : "  no conv")
+           << std::fixed << std::setprecision(3) << s.seconds
+           << (s.converged ? ""
+               : s.stopped ? "  stopped"
+                           : "  no conv")
            << "\n";
     os << std::defaultfloat;
     if (r.converged) {
