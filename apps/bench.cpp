@@ -4,6 +4,7 @@
 
 #include "apps/preconditioners.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/timer.hpp"
@@ -49,9 +50,9 @@ std::string json_string(const std::string& s) {
     return out + "\"";
 }
 
-std::ofstream open_json(const std::filesystem::path& file) {
+AtomicOfstream open_json(const std::filesystem::path& file) {
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-    std::ofstream f(file);
+    AtomicOfstream f(file);
     MLC_CHECK(f.good(), "cannot write " << file.string());
     f << std::setprecision(6);
     return f;
@@ -95,7 +96,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         opt.out.empty() ? std::filesystem::path("out/bench/" + opt.scene + "_L" +
                                                 std::to_string(opt.levels) + ".json")
                         : opt.out;
-    std::ofstream js = open_json(out);
+    AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
        << ",\n  \"krylov\": " << json_string(opt.krylov) << ",\n  \"rel_tol\": " << opt.rel_tol
        << ",\n  \"repeat\": " << opt.repeat << ",\n  \"runs\": [";
@@ -295,7 +296,7 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
         opt.out.empty() ? std::filesystem::path("out/bench/elastic_" + opt.scene + "_L" +
                                                 std::to_string(opt.levels) + ".json")
                         : opt.out;
-    std::ofstream js = open_json(out);
+    AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"level\": " << opt.levels
        << ",\n  \"unknowns\": " << n << ",\n  \"nonzeros\": " << fine.K.nonZeros()
        << ",\n  \"rel_tol\": " << opt.rel_tol << ",\n  \"repeat\": " << opt.repeat

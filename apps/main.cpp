@@ -5,8 +5,10 @@
 // test); `mlcontact scenes` lists the built-in scenes; `mlcontact show NAME` prints one, as a
 // starting point for your own scene file. Every error is reported as one line on stderr with a
 // non-zero exit code: 1 for bad input, 2 for a solve that did not converge, 3 for a numerical
-// breakdown.
+// breakdown; a run stopped by SIGINT / SIGTERM exits 130 / 143 after writing the files of its
+// completed load steps.
 #include "apps/bench.hpp"
+#include "apps/interrupt.hpp"
 #include "apps/preconditioners.hpp"
 #include "apps/run.hpp"
 #include "apps/study_accuracy.hpp"
@@ -20,6 +22,7 @@
 
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <unistd.h>
 
 int main(int argc, char** argv) {
     mlc::keep_freed_memory();
@@ -53,6 +56,16 @@ int main(int argc, char** argv) {
                     "1e-10)");
     auto* pcs = app.add_subcommand("preconditioners",
                                    "list the preconditioners, their options and what they need");
+    run->add_option("--vtu", ro.vtu,
+                    "VTU encoding: binary (appended, zlib-compressed; default) or ascii")
+        ->check(CLI::IsMember({"binary", "ascii"}));
+    run->add_flag("--every-step", ro.every_step,
+                  "write a VTU per load step (solution_step_0001.vtu, ...) and solution.pvd");
+    run->add_flag("--every-level", ro.every_level,
+                  "with --every-step's files, a VTU series and solution_level_<l>.pvd per "
+                  "coarser level solved");
+    run->add_flag("--plot", ro.plot,
+                  "draw contact.png: pressure and tangential traction along each contact pair");
     auto* study = app.add_subcommand("study", "run a study (see README: Studies)");
     study->require_subcommand(1);
     mlc::apps::StatusTransferOptions sto;
@@ -158,7 +171,12 @@ int main(int argc, char** argv) {
         return app.exit(e);
     }
     try {
-        if (*run) return mlc::apps::run_scene(ro, std::cout);
+        if (*run) {
+            mlc::apps::install_stop_handlers();
+            ro.stop = &mlc::apps::stop_flag();
+            ro.progress_eta = ::isatty(STDOUT_FILENO) == 1;
+            return mlc::apps::run_scene(ro, std::cout);
+        }
         if (*bsq) {
             bso.out = bso_out;
             return mlc::apps::bench_square(bso, std::cout);

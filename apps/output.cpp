@@ -2,6 +2,7 @@
 // Report and result files of a run.
 #include "apps/output.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "levels/checks.hpp"
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 #include <toml++/toml.h>
 
@@ -97,7 +99,10 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
            << "  " << std::scientific << std::setprecision(2) << s.residuals.back() << std::setw(7)
            << s.counts.gap << std::setw(7) << s.counts.stick << std::setw(7)
            << s.counts.slip_forward << std::setw(7) << s.counts.slip_backward << std::setw(10)
-           << std::fixed << std::setprecision(3) << s.seconds << (s.converged ? "" : "  no conv")
+           << std::fixed << std::setprecision(3) << s.seconds
+           << (s.converged ? ""
+               : s.stopped ? "  stopped"
+                           : "  no conv")
            << "\n";
     os << std::defaultfloat;
     if (r.converged) {
@@ -110,13 +115,8 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
         // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
         const auto& L = r.finest();
         for (size_t k = 0; k < p.contacts.size(); ++k) {
-            Vec2 f = Vec2::Zero();
             int closed = 0;
-            for (size_t e = 0; e < L.contacts.size(); ++e) {
-                if (L.contacts[e].pair != static_cast<int>(k)) continue;
-                f -= r.nodes[e].lambda_t * L.contacts[e].t + r.nodes[e].lambda_n * L.contacts[e].n;
-                closed += r.nodes[e].status != contact::Status::gap;
-            }
+            const Vec2 f = contact_resultant(L, r.nodes, static_cast<int>(k), &closed);
             os << "contact '" << p.contacts[k].name << "': resultant on the contactor ("
                << std::setprecision(6) << f.x() << ", " << f.y() << "), " << closed
                << " nodes in contact\n";
@@ -126,32 +126,214 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
     r.timings.print(os);
 }
 
-void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
-                   const levels::RunResult& r) {
-    const auto& L = r.finest();
-    std::filesystem::create_directories(dir);
-    // Check everything first so that no partial result set is left behind.
-    for (Index i = 0; i < r.u_full.size(); ++i)
-        require_finite(r.u_full[i], "displacement");
-    for (const auto& n : r.nodes) {
+void write_solution_vtu(const std::filesystem::path& file, const levels::Level& L,
+                        const Vector& u_full, const std::vector<levels::ContactNodeState>& nodes,
+                        mesh::VtuFormat format) {
+    for (Index i = 0; i < u_full.size(); ++i)
+        require_finite(u_full[i], "displacement");
+    for (const auto& n : nodes) {
         require_finite(n.lambda_t, "lambda_t");
         require_finite(n.lambda_n, "lambda_n");
     }
+    const auto stresses = fem::triangle_stresses(L.mesh, L.materials, u_full);
+    for (double v : stresses)
+        require_finite(v, "stress");
+    const int nv = L.mesh.n_vertices();
+    mesh::Field disp{"displacement", 2,
+                     std::vector<double>(u_full.data(), u_full.data() + u_full.size())};
+    mesh::Field status{"contact_status", 1, std::vector<double>(static_cast<size_t>(nv), -1.0)};
+    mesh::Field force{"contact_force", 2, std::vector<double>(static_cast<size_t>(2 * nv), 0.0)};
+    mesh::Field lt{"lambda_t", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
+    mesh::Field ln{"lambda_n", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
+    for (size_t e = 0; e < nodes.size(); ++e) {
+        const auto& n = nodes[e];
+        const auto& el = L.contacts[e];
+        const size_t v = static_cast<size_t>(n.vertex);
+        status.values[v] = static_cast<double>(static_cast<int>(n.status));
+        // Force the obstacle/target exerts on the body: -(lambda_t t + lambda_n n).
+        const Vec2 f = -(n.lambda_t * el.t + n.lambda_n * el.n);
+        force.values[2 * v] = f.x() + 0.0; // + 0.0: no -0 for the zero force of a gap node
+        force.values[2 * v + 1] = f.y() + 0.0;
+        lt.values[v] = n.lambda_t;
+        ln.values[v] = n.lambda_n;
+    }
+    mesh::Field stress{"stress", 3, stresses};
+    mesh::Field vm{"von_mises", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()))};
+    mesh::Field body{"body", 1,
+                     std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()), 0.0)};
+    for (int t = 0; t < L.mesh.n_triangles(); ++t) {
+        const double sx = stresses[static_cast<size_t>(3 * t)],
+                     sy = stresses[static_cast<size_t>(3 * t + 1)],
+                     sxy = stresses[static_cast<size_t>(3 * t + 2)];
+        const auto& m = fem::material_of(L.mesh, L.materials, t);
+        // Plane strain: sigma_zz = nu (sx + sy); plane stress: 0.
+        const double sz = m.plane == fem::Plane::strain ? m.nu * (sx + sy) : 0.0;
+        vm.values[static_cast<size_t>(t)] = std::sqrt(
+            0.5 * ((sx - sy) * (sx - sy) + (sy - sz) * (sy - sz) + (sz - sx) * (sz - sx)) +
+            3.0 * sxy * sxy);
+        if (!L.mesh.attribute.empty())
+            body.values[static_cast<size_t>(t)] = L.mesh.attribute[static_cast<size_t>(t)];
+    }
+    mesh::write_vtu(file, L.mesh, {disp, status, force, lt, ln}, {stress, vm, body}, format);
+}
+
+ContactGeometry contact_geometry(const levels::Problem& p, const levels::Level& L) {
+    const size_t ne = L.contacts.size();
+    ContactGeometry g;
+    g.length.assign(ne, 0.0);
+    g.arc.assign(ne, 0.0);
+    const auto& verts = L.mesh.vertices;
+    for (size_t k = 0; k < p.contacts.size(); ++k) {
+        const auto& pair = p.contacts[k];
+        const auto tag = L.mesh.find_tag(pair.contactor);
+        if (!tag) continue;
+        // The pair's contact-boundary edges, oriented with the body on the left.
+        std::map<int, int> next, prev;
+        for (const auto& be : L.mesh.boundary) {
+            if (be.tag != *tag) continue;
+            const Vec2& a = verts[static_cast<size_t>(be.v0)];
+            const Vec2& b = verts[static_cast<size_t>(be.v1)];
+            if (pair.region && !(pair.region->contains(a) && pair.region->contains(b))) continue;
+            next[be.v0] = be.v1;
+            prev[be.v1] = be.v0;
+            const double h = (b - a).norm();
+            for (int v : {be.v0, be.v1})
+                if (const int e = L.contact_of_vertex[static_cast<size_t>(v)];
+                    e >= 0 && L.contacts[static_cast<size_t>(e)].pair == static_cast<int>(k))
+                    g.length[static_cast<size_t>(e)] += 0.5 * h;
+        }
+        // Walk the pieces: open ones from their start (no incoming edge), in the order of their
+        // first contact node; then closed loops from their first contact node.
+        std::vector<int> order; // contact elements of the pair, in element order
+        for (size_t e = 0; e < ne; ++e)
+            if (L.contacts[e].pair == static_cast<int>(k)) order.push_back(static_cast<int>(e));
+        std::map<int, bool> visited;
+        double arc = 0.0;
+        bool any = false;
+        Vec2 last = Vec2::Zero();
+        auto walk = [&](int v) {
+            if (any) arc += (verts[static_cast<size_t>(v)] - last).norm();
+            any = true;
+            while (true) {
+                visited[v] = true;
+                if (const int e = L.contact_of_vertex[static_cast<size_t>(v)];
+                    e >= 0 && L.contacts[static_cast<size_t>(e)].pair == static_cast<int>(k))
+                    g.arc[static_cast<size_t>(e)] = arc;
+                last = verts[static_cast<size_t>(v)];
+                const auto it = next.find(v);
+                if (it == next.end() || visited[it->second]) break;
+                arc += (verts[static_cast<size_t>(it->second)] - last).norm();
+                v = it->second;
+            }
+        };
+        // Start of the piece holding vertex v (its first vertex, or v itself on a loop).
+        auto start_of = [&](int v) {
+            std::map<int, bool> seen;
+            while (prev.count(v) && !seen[v]) {
+                seen[v] = true;
+                v = prev[v];
+            }
+            return v; // on a loop: back at a vertex already seen, which has a predecessor
+        };
+        for (bool loops : {false, true})
+            for (int e : order) {
+                const int v = L.contacts[static_cast<size_t>(e)].vertex[0];
+                if (visited[v]) continue;
+                int s0 = start_of(v);
+                const bool loop = prev.count(s0) > 0;
+                if (loop != loops) continue;
+                if (loop) s0 = v;
+                walk(s0);
+            }
+    }
+    return g;
+}
+
+Vec2 contact_resultant(const levels::Level& L, const std::vector<levels::ContactNodeState>& nodes,
+                       int pair, int* in_contact) {
+    Vec2 f = Vec2::Zero();
+    int closed = 0;
+    for (size_t e = 0; e < L.contacts.size() && e < nodes.size(); ++e) {
+        if (L.contacts[e].pair != pair) continue;
+        f -= nodes[e].lambda_t * L.contacts[e].t + nodes[e].lambda_n * L.contacts[e].n;
+        closed += nodes[e].status != contact::Status::gap;
+    }
+    if (in_contact) *in_contact = closed;
+    return f;
+}
+
+namespace {
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+std::string csv_field(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string q = "\"";
+    for (char c : s)
+        q += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return q + "\"";
+}
+
+/// Pressure or traction per unit length of a nodal multiplier: -lambda / length (0 for a node
+/// with no contact-boundary edge, length 0).
+double per_length(double lambda, double length) {
+    return length > 0.0 ? -lambda / length + 0.0 : 0.0;
+}
+
+void write_contact_steps(const std::filesystem::path& file, const levels::Problem& p,
+                         const levels::RunResult& r) {
+    const auto& L = r.finest();
+    const ContactGeometry g = contact_geometry(p, L);
+    write_file_atomically(file, [&](std::ostream& f) {
+        f << "step,s,pair,x,y,ux,uy,lambda_t,lambda_n,length,arc,pressure,traction_t,status\n"
+          << std::setprecision(17);
+        for (int k = 0; k < r.completed_steps && k < static_cast<int>(r.step_nodes.size()); ++k) {
+            const double s = static_cast<double>(k + 1) / p.load_steps;
+            const auto& nodes = r.step_nodes[static_cast<size_t>(k)];
+            for (size_t e = 0; e < nodes.size(); ++e) {
+                const auto& n = nodes[e];
+                const double len = g.length[e];
+                f << k + 1 << "," << s << ","
+                  << csv_field(p.contacts[static_cast<size_t>(L.contacts[e].pair)].name) << ","
+                  << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << ","
+                  << n.lambda_t << "," << n.lambda_n << "," << len << "," << g.arc[e] << ","
+                  << per_length(n.lambda_n, len) << "," << per_length(n.lambda_t, len) << ","
+                  << contact::to_string(n.status) << "\n";
+            }
+        }
+    });
+}
+
+} // namespace
+
+std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
+                                       const levels::RunResult& r, const OutputOptions& options) {
+    const auto& L = r.finest();
+    std::filesystem::create_directories(dir);
+    std::vector<std::string> written;
+    if (!r.converged && !r.stopped) return written;
+    // Check everything first so that no partial result set is left behind.
+    for (const auto& nodes : r.step_nodes)
+        for (const auto& n : nodes) {
+            require_finite(n.lambda_t, "lambda_t");
+            require_finite(n.lambda_n, "lambda_n");
+        }
     for (const auto& s : r.steps)
         for (double v : s.residuals)
             require_finite(v, "Newton residual");
-    const auto stresses = fem::triangle_stresses(L.mesh, L.materials, r.u_full);
-    for (double v : stresses)
-        require_finite(v, "stress");
-
-    { // contact.csv: one row per contact node of the final state.
-        std::ofstream f(dir / "contact.csv");
-        f << "x,y,ux,uy,lambda_t,lambda_n,status\n" << std::setprecision(17);
-        for (const auto& n : r.nodes)
-            f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << "," << n.lambda_t
-              << "," << n.lambda_n << "," << contact::to_string(n.status) << "\n";
-        MLC_CHECK(f.good(), "cannot write " << (dir / "contact.csv").string());
+    if (r.converged) {
+        write_solution_vtu(dir / "solution.vtu", L, r.u_full, r.nodes, options.vtu);
+        written.push_back("solution.vtu");
+        // contact.csv: one row per contact node of the final state.
+        write_file_atomically(dir / "contact.csv", [&](std::ostream& f) {
+            f << "x,y,ux,uy,lambda_t,lambda_n,status\n" << std::setprecision(17);
+            for (const auto& n : r.nodes)
+                f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << ","
+                  << n.lambda_t << "," << n.lambda_n << "," << contact::to_string(n.status) << "\n";
+        });
+        written.push_back("contact.csv");
     }
+    write_contact_steps(dir / "contact_steps.csv", p, r);
+    written.push_back("contact_steps.csv");
     { // summary.json
         toml::table root;
         root.insert("scene", p.name);
@@ -163,6 +345,11 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
         root.insert("vertices", static_cast<int64_t>(L.mesh.n_vertices()));
         root.insert("triangles", static_cast<int64_t>(L.mesh.n_triangles()));
         root.insert("converged", r.converged);
+        root.insert("stopped", r.stopped);
+        if (r.stopped) root.insert("stopped_at", r.failure);
+        root.insert("load_steps", static_cast<int64_t>(p.load_steps));
+        root.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
+        root.insert("vtu_format", mesh::to_string(options.vtu));
         toml::array steps;
         int total_newton = 0;
         for (const auto& s : r.steps) {
@@ -216,6 +403,19 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
         }
         root.insert("levels", lv);
         root.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
+        if (r.completed_steps > 0) { // per pair, at the last completed step
+            toml::array cs;
+            for (size_t k = 0; k < p.contacts.size(); ++k) {
+                int closed = 0;
+                const Vec2 f = contact_resultant(L, r.nodes, static_cast<int>(k), &closed);
+                toml::table c;
+                c.insert("name", p.contacts[k].name);
+                c.insert("resultant", toml::array{f.x(), f.y()});
+                c.insert("nodes_in_contact", static_cast<int64_t>(closed));
+                cs.push_back(c);
+            }
+            root.insert("contacts", cs);
+        }
         if (r.converged) {
             const levels::StateChecks c = levels::check_state(p, r);
             toml::table ct;
@@ -278,52 +478,54 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
         for (const auto& [name, e] : r.timings.table())
             tt.insert(name, e.seconds);
         root.insert("timings_seconds", tt);
-        std::ofstream f(dir / "summary.json");
-        f << toml::json_formatter{root} << "\n";
-        MLC_CHECK(f.good(), "cannot write " << (dir / "summary.json").string());
+        write_file_atomically(dir / "summary.json",
+                              [&](std::ostream& f) { f << toml::json_formatter{root} << "\n"; });
+        written.push_back("summary.json");
     }
-    { // solution.vtu
-        const int nv = L.mesh.n_vertices();
-        mesh::Field disp{"displacement", 2,
-                         std::vector<double>(r.u_full.data(), r.u_full.data() + r.u_full.size())};
-        mesh::Field status{"contact_status", 1, std::vector<double>(static_cast<size_t>(nv), -1.0)};
-        mesh::Field force{"contact_force", 2,
-                          std::vector<double>(static_cast<size_t>(2 * nv), 0.0)};
-        mesh::Field lt{"lambda_t", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
-        mesh::Field ln{"lambda_n", 1, std::vector<double>(static_cast<size_t>(nv), 0.0)};
-        for (size_t e = 0; e < r.nodes.size(); ++e) {
-            const auto& n = r.nodes[e];
-            const auto& el = L.contacts[e];
-            const size_t v = static_cast<size_t>(n.vertex);
-            status.values[v] = static_cast<double>(static_cast<int>(n.status));
-            // Force the obstacle/target exerts on the body: -(lambda_t t + lambda_n n).
-            const Vec2 f = -(n.lambda_t * el.t + n.lambda_n * el.n);
-            force.values[2 * v] = f.x();
-            force.values[2 * v + 1] = f.y();
-            lt.values[v] = n.lambda_t;
-            ln.values[v] = n.lambda_n;
-        }
-        mesh::Field stress{"stress", 3, stresses};
-        mesh::Field vm{"von_mises", 1,
-                       std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()))};
-        mesh::Field body{"body", 1,
-                         std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()), 0.0)};
-        for (int t = 0; t < L.mesh.n_triangles(); ++t) {
-            const double sx = stresses[static_cast<size_t>(3 * t)],
-                         sy = stresses[static_cast<size_t>(3 * t + 1)],
-                         sxy = stresses[static_cast<size_t>(3 * t + 2)];
-            const auto& m = fem::material_of(L.mesh, L.materials, t);
-            // Plane strain: sigma_zz = nu (sx + sy); plane stress: 0.
-            const double sz = m.plane == fem::Plane::strain ? m.nu * (sx + sy) : 0.0;
-            vm.values[static_cast<size_t>(t)] = std::sqrt(
-                0.5 * ((sx - sy) * (sx - sy) + (sy - sz) * (sy - sz) + (sz - sx) * (sz - sx)) +
-                3.0 * sxy * sxy);
-            if (!L.mesh.attribute.empty())
-                body.values[static_cast<size_t>(t)] = L.mesh.attribute[static_cast<size_t>(t)];
-        }
-        mesh::write_vtu(dir / "solution.vtu", L.mesh, {disp, status, force, lt, ln},
-                        {stress, vm, body});
+    return written;
+}
+
+StepFiles::StepFiles(std::filesystem::path dir, const levels::Problem& p, bool every_level,
+                     mesh::VtuFormat format)
+    : dir_(std::move(dir)), finest_(p.levels), every_level_(every_level), format_(format),
+      series_(static_cast<size_t>(p.levels) + 1) {
+    digits_ = std::max(4, static_cast<int>(std::to_string(p.load_steps).size()));
+    std::filesystem::create_directories(dir_);
+    // Step files of an earlier run (a longer one would leave steps this run does not list).
+    for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+        const std::string name = entry.path().filename().string();
+        const bool ours =
+            (name.rfind("solution_step_", 0) == 0 || name.rfind("solution_level_", 0) == 0) &&
+            (name.ends_with(".vtu") || name.ends_with(".pvd"));
+        if (ours) std::filesystem::remove(entry.path());
     }
+}
+
+void StepFiles::operator()(const levels::LevelStepState& s) {
+    if (s.level != finest_ && !every_level_) return;
+    std::ostringstream step;
+    step << std::setw(digits_) << std::setfill('0') << s.step;
+    const std::string prefix =
+        s.level == finest_ ? "solution" : "solution_level_" + std::to_string(s.level);
+    const std::string name = prefix + "_step_" + step.str() + ".vtu";
+    write_solution_vtu(dir_ / name, *s.L, *s.u_full, *s.nodes, format_);
+    auto& series = series_[static_cast<size_t>(s.level)];
+    series.emplace_back(s.s, name);
+    mesh::write_pvd(dir_ / (prefix + ".pvd"), series);
+}
+
+int StepFiles::finest_steps() const {
+    return static_cast<int>(series_[static_cast<size_t>(finest_)].size());
+}
+
+std::vector<std::string> StepFiles::collections() const {
+    std::vector<std::string> out;
+    for (size_t l = 0; l < series_.size(); ++l)
+        if (!series_[l].empty())
+            out.push_back(static_cast<int>(l) == finest_
+                              ? std::string("solution.pvd")
+                              : "solution_level_" + std::to_string(l) + ".pvd");
+    return out;
 }
 
 } // namespace mlc::apps

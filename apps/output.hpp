@@ -1,13 +1,18 @@
 // SPDX-License-Identifier: MIT
-/// @file What a run writes: the readable report, contact.csv, summary.json and solution.vtu.
+/// @file What a run writes: the readable report, contact.csv, contact_steps.csv, summary.json,
+/// solution.vtu and, per load step, the VTU series with their ParaView collections.
 /// Every number is checked finite before a file is written; a NaN/Inf aborts with a diagnosis.
 #pragma once
 
 #include "levels/problem.hpp"
 #include "levels/solve.hpp"
+#include "mesh/io/vtu.hpp"
 
 #include <filesystem>
 #include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace mlc::apps {
 
@@ -24,8 +29,66 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
 /// Prints the per-step table, checks (force balance, Coulomb, complementarity) and timings.
 void print_summary(std::ostream& os, const levels::Problem& p, const levels::RunResult& r);
 
-/// Writes contact.csv, summary.json and solution.vtu into dir (created if needed).
-void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
-                   const levels::RunResult& r);
+/// How a run writes its files.
+struct OutputOptions {
+    mesh::VtuFormat vtu = mesh::VtuFormat::binary; ///< --vtu binary|ascii
+};
+
+/// Writes one level's state as a VTU: point fields displacement, contact_status (-1 off the
+/// contact boundary, else contact::Status), contact_force (the force the target exerts on the
+/// node, -(lambda_t t + lambda_n n)), lambda_t, lambda_n; cell fields stress (xx, yy, xy),
+/// von_mises, body. Non-finite values throw SolverBreakdown before anything is written.
+void write_solution_vtu(const std::filesystem::path& file, const levels::Level& L,
+                        const Vector& u_full, const std::vector<levels::ContactNodeState>& nodes,
+                        mesh::VtuFormat format);
+
+/// Per contact node of a level (L.contacts order): its tributary length, half the sum of the
+/// lengths of the contact-boundary edges at the node (the boundary edges carrying the pair's
+/// contactor tag, inside its region if it has one), and its arc length along that boundary from
+/// the pair's first node (the boundary walked counter-clockwise around the body, i.e. with the
+/// body on the left; separate pieces joined by the straight distance between them).
+struct ContactGeometry {
+    std::vector<double> length;
+    std::vector<double> arc;
+};
+ContactGeometry contact_geometry(const levels::Problem& p, const levels::Level& L);
+
+/// Resultant force the target exerts on pair k's contactor nodes, -sum(lambda_t t + lambda_n n)
+/// in global axes, and the number of its nodes in contact.
+Vec2 contact_resultant(const levels::Level& L, const std::vector<levels::ContactNodeState>& nodes,
+                       int pair, int* in_contact = nullptr);
+
+/// Writes the files of a run into dir (created if needed), each under a temporary name renamed
+/// when complete: when converged, solution.vtu, contact.csv, contact_steps.csv and
+/// summary.json; when stopped on request, contact_steps.csv (the completed steps) and
+/// summary.json; nothing else. Returns the names of the files written.
+std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
+                                       const levels::RunResult& r,
+                                       const OutputOptions& options = {});
+
+/// --every-step / --every-level: writes each converged load step's VTU as soon as it is done
+/// (solution_step_0001.vtu, ... for the finest level; solution_level_<l>_step_0001.vtu for
+/// level l < finest with every_level) and rewrites the collection of that level after each
+/// (solution.pvd, solution_level_<l>.pvd), with the load parameter s as the time. Use as
+/// SolveOptions::on_level_step. Files of this naming left in dir by an earlier run are removed
+/// when constructed.
+class StepFiles {
+public:
+    StepFiles(std::filesystem::path dir, const levels::Problem& p, bool every_level,
+              mesh::VtuFormat format);
+    void operator()(const levels::LevelStepState& s);
+    /// Load steps written of the finest level.
+    int finest_steps() const;
+    /// The collections written so far.
+    std::vector<std::string> collections() const;
+
+private:
+    std::filesystem::path dir_;
+    int finest_ = 0;
+    int digits_ = 4;
+    bool every_level_ = false;
+    mesh::VtuFormat format_;
+    std::vector<std::vector<std::pair<double, std::string>>> series_; ///< per level
+};
 
 } // namespace mlc::apps

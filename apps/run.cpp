@@ -2,13 +2,17 @@
 // `mlcontact run`.
 #include "apps/run.hpp"
 
+#include "apps/interrupt.hpp"
 #include "apps/output.hpp"
+#include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <optional>
 
 namespace mlc::apps {
 
@@ -35,17 +39,29 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
         }
     }
     p.validate();
+    MLC_CHECK(opt.vtu == "binary" || opt.vtu == "ascii",
+              "--vtu must be binary or ascii, found '" << opt.vtu << "'");
+    OutputOptions out;
+    out.vtu = opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
+    const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
     levels::SolveOptions so;
     so.predicted_sizes = levels::predict_level_sizes(p); // level 0 built once for both
     const levels::SolverChoice choice = levels::choose_solver(
         p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}, &so.predicted_sizes);
     so.progress = opt.quiet ? nullptr : &os;
+    so.progress_eta = opt.progress_eta;
     so.coarse_to_fine = !opt.cold;
     so.linear = choice.spec;
     MLC_CHECK(!opt.no_fallback || choice.spec.method == "krylov",
               "--no-fallback applies to Krylov solves only; the solver of this run is "
                   << choice.spec.method << " (" << choice.reason << ")");
     so.exact_fallback = !opt.no_fallback;
+    so.stop = opt.stop;
+    std::optional<StepFiles> steps;
+    if (opt.every_step || opt.every_level) {
+        steps.emplace(dir, p, opt.every_level, out.vtu);
+        so.on_level_step = [&](const levels::LevelStepState& s) { (*steps)(s); };
+    }
     os << "mlcontact: solving '" << p.name << "'\n";
     os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
     levels::RunResult r = levels::solve(p, so);
@@ -73,14 +89,33 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     os << "\n";
     print_header(os, p, r);
     print_summary(os, p, r);
-    const std::string dir = opt.out.empty() ? "out/" + p.name : opt.out;
-    if (!r.converged) {
+    if (!r.converged && !r.stopped) {
         os << "\nerror: " << r.failure << "\n";
         return 2;
     }
-    write_outputs(dir, p, r);
-    os << "\nwrote " << dir << "/solution.vtu, " << dir << "/contact.csv, " << dir
-       << "/summary.json\n";
+    std::vector<std::string> files = write_outputs(dir, p, r, out);
+    if (steps) {
+        for (const auto& c : steps->collections())
+            files.push_back(c);
+        if (steps->finest_steps() > 0)
+            files.push_back("solution_step_*.vtu (" + std::to_string(steps->finest_steps()) +
+                            " load steps)");
+    }
+    if (opt.plot && r.completed_steps > 0 &&
+        run_plot_script("plot_contact.py", dir, os, steps ? "--all-steps" : ""))
+        files.push_back("contact.png");
+    os << "\nwrote";
+    for (size_t i = 0; i < files.size(); ++i)
+        os << (i ? ", " : " ") << (dir / files[i]).string();
+    os << "\n";
+    if (r.stopped) {
+        const int sig = stop_signal();
+        os << "\nstopped by " << signal_name(sig) << ": " << r.failure << "; the files above hold "
+           << (r.completed_steps > 0 ? "load steps 1-" + std::to_string(r.completed_steps)
+                                     : std::string("no load step"))
+           << "\n";
+        return 128 + (sig > 0 ? sig : 2);
+    }
     return 0;
 }
 

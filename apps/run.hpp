@@ -3,6 +3,7 @@
 /// write the result files.
 #pragma once
 
+#include <atomic>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -28,10 +29,20 @@ struct RunOptions {
     /// No exact fallback: a Newton system the Krylov solve fails on ends the run (exit 2/3)
     /// instead of being solved again by the exact schur solver.
     bool no_fallback = false;
+    std::string vtu = "binary"; ///< VTU encoding: binary (zlib, appended) or ascii
+    bool every_step = false;    ///< a VTU per load step of the finest level + solution.pvd
+    bool every_level = false;   ///< also a VTU series + collection per coarser level
+    bool plot = false;          ///< draw contact.png (scripts/plot_contact.py)
+    bool progress_eta = false;  ///< progress lines with the time left (stdout is a terminal)
+    /// Polled by the solve (levels::SolveOptions::stop); when it is set, the run stops after the
+    /// current Newton iteration, writes the files of the completed steps and returns 128 +
+    /// stop_signal() (apps/interrupt.hpp). Null: never stops.
+    const std::atomic<bool>* stop = nullptr;
 };
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not
-/// converge (the report says which and how). Throws InvalidInput for bad input.
+/// converge (the report says which and how), 130 / 143 when stopped by SIGINT / SIGTERM (see
+/// RunOptions::stop). Throws InvalidInput for bad input.
 int run_scene(const RunOptions& opt, std::ostream& os);
 
 } // namespace mlc::apps

@@ -4,6 +4,7 @@
 
 #include "apps/closed_form.hpp"
 #include "apps/study_status_transfer.hpp"
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/timer.hpp"
 
@@ -365,7 +366,7 @@ int study_accuracy(const levels::Problem& problem_in, const AccuracyOptions& opt
         }
     }
     // CSV (long format) and JSON.
-    std::ofstream csv(dir / "accuracy.csv");
+    AtomicOfstream csv(dir / "accuracy.csv");
     csv << "level,unknowns,contact_nodes,seconds,quantity,value,reference,error,order\n"
         << std::setprecision(12);
     toml::array jl;
@@ -404,7 +405,7 @@ int study_accuracy(const levels::Problem& problem_in, const AccuracyOptions& opt
     toml::table root;
     root.insert("scene", problem.name);
     root.insert("levels", jl);
-    std::ofstream js(dir / "accuracy.json");
+    AtomicOfstream js(dir / "accuracy.json");
     js << toml::json_formatter{root} << "\n";
     csv.close();
     js.close();

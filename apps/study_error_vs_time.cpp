@@ -4,6 +4,7 @@
 
 #include "apps/closed_form.hpp"
 #include "apps/study_status_transfer.hpp"
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 #include "levels/solve.hpp"
@@ -32,9 +33,18 @@ std::vector<Config> configurations() {
     c.push_back({"c2f schur newton 1e-6", true, {}, 1e-6});
     c.push_back({"c2f lu", true, {.method = "lu"}, 1e-10});
     c.push_back({"cold lu", false, {.method = "lu"}, 1e-10});
-    c.push_back({"c2f gmres+ilu0 1e-8", true, {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8}, 1e-8});
-    c.push_back({"cold gmres+ilu0 1e-8", false, {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8}, 1e-8});
-    c.push_back({"c2f cgs+ilu0 1e-6", true, {.method = "krylov", .krylov = "cgs", .pc = "ilu:0", .rel_tol = 1e-6}, 1e-6});
+    c.push_back({"c2f gmres+ilu0 1e-8",
+                 true,
+                 {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8},
+                 1e-8});
+    c.push_back({"cold gmres+ilu0 1e-8",
+                 false,
+                 {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8},
+                 1e-8});
+    c.push_back({"c2f cgs+ilu0 1e-6",
+                 true,
+                 {.method = "krylov", .krylov = "cgs", .pc = "ilu:0", .rel_tol = 1e-6},
+                 1e-6});
     return c;
 }
 
@@ -58,7 +68,9 @@ Vector nodal_traction(const levels::Level& L, const std::vector<levels::ContactN
         const int a = L.contact_of_vertex[static_cast<size_t>(e.v0)];
         const int b = L.contact_of_vertex[static_cast<size_t>(e.v1)];
         if (a < 0 && b < 0) continue;
-        const double len = (L.mesh.vertices[static_cast<size_t>(e.v1)] - L.mesh.vertices[static_cast<size_t>(e.v0)]).norm();
+        const double len = (L.mesh.vertices[static_cast<size_t>(e.v1)] -
+                            L.mesh.vertices[static_cast<size_t>(e.v0)])
+                               .norm();
         if (a >= 0) tributary[e.v0] += 0.5 * len;
         if (b >= 0) tributary[e.v1] += 0.5 * len;
     }
@@ -74,8 +86,8 @@ Vector nodal_traction(const levels::Level& L, const std::vector<levels::ContactN
 }
 
 struct Errors {
-    double energy = 0.0;   ///< relative energy-norm displacement error
-    double traction = 0.0; ///< relative L2 traction error along the contact boundary
+    double energy = 0.0;       ///< relative energy-norm displacement error
+    double traction = 0.0;     ///< relative L2 traction error along the contact boundary
     double closed_form = -1.0; ///< relative L2 pressure error against the closed form (hertz)
 };
 
@@ -125,7 +137,8 @@ Errors errors_against(const levels::RunResult& ref, int l, const levels::RunResu
 int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOptions& opt,
                         std::ostream& os) {
     MLC_CHECK(opt.max_level >= 0 && opt.max_level <= 6, "--levels must lie in [0, 6]");
-    MLC_CHECK(opt.reference_offset >= 1 && opt.reference_offset <= 2, "reference offset must be 1 or 2");
+    MLC_CHECK(opt.reference_offset >= 1 && opt.reference_offset <= 2,
+              "reference offset must be 1 or 2");
     levels::Problem problem = problem_in;
     const auto dir = opt.out.empty()
                          ? std::filesystem::path("out/studies") / (problem.name + "_error_vs_time")
@@ -133,7 +146,8 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
     std::filesystem::create_directories(dir);
     const int Lref = opt.max_level + opt.reference_offset;
     os << "work-precision study: scene '" << problem.name << "', levels 0.." << opt.max_level
-       << ", reference on level " << Lref << " (coarse-to-fine, exact)\n" << std::flush;
+       << ", reference on level " << Lref << " (coarse-to-fine, exact)\n"
+       << std::flush;
     problem.levels = Lref;
     const levels::RunResult ref = levels::solve(problem);
     if (!ref.converged) {
@@ -151,11 +165,13 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
         bool pareto = false;
     };
     std::vector<Row> rows;
-    os << "\n" << std::left << std::setw(26) << "configuration" << std::right << std::setw(6) << "level"
+    os << "\n"
+       << std::left << std::setw(26) << "configuration" << std::right << std::setw(6) << "level"
        << std::setw(10) << "unknowns" << std::setw(10) << "seconds" << std::setw(13) << "energy err"
        << std::setw(14) << "traction err";
     if (problem.name == "hertz") os << std::setw(14) << "vs closed form";
-    os << std::setw(8) << "newton" << std::setw(9) << "krylov" << "\n";
+    os << std::setw(8) << "newton" << std::setw(9) << "krylov"
+       << "\n";
     for (const auto& c : configurations())
         for (int l = 0; l <= opt.max_level; ++l) {
             levels::Problem p = problem;
@@ -173,8 +189,9 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
                     row.krylov += st.report.linear_iterations;
                 }
             if (r.converged) row.err = errors_against(ref, l, r, problem);
-            os << std::left << std::setw(26) << c.name << std::right << std::setw(6) << l << std::setw(10)
-               << row.unknowns << std::setw(10) << std::setprecision(3) << row.seconds;
+            os << std::left << std::setw(26) << c.name << std::right << std::setw(6) << l
+               << std::setw(10) << row.unknowns << std::setw(10) << std::setprecision(3)
+               << row.seconds;
             if (r.converged) {
                 os << std::setw(13) << row.err.energy << std::setw(14) << row.err.traction;
                 if (row.err.closed_form >= 0) os << std::setw(14) << row.err.closed_form;
@@ -188,7 +205,9 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
     // as fast and at least as accurate. Errors within 1% of each other count as equal: runs
     // that solve the same level to tolerance differ only in the digits the solver tolerance
     // leaves, which is no accuracy a user can buy.
-    auto primary = [&](const Row& r) { return r.err.closed_form >= 0 ? r.err.closed_form : r.err.energy; };
+    auto primary = [&](const Row& r) {
+        return r.err.closed_form >= 0 ? r.err.closed_form : r.err.energy;
+    };
     auto no_worse = [&](const Row& b, const Row& a) { return primary(b) <= 1.01 * primary(a); };
     for (auto& a : rows) {
         if (!a.converged) continue;
@@ -200,16 +219,19 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
                 break;
             }
     }
-    std::ofstream csv(dir / "error_vs_time.csv");
-    csv << "configuration,level,unknowns,seconds,converged,energy_error,traction_error,closed_form_error,"
-           "primary_error,newton,krylov,pareto\n" << std::setprecision(6);
+    AtomicOfstream csv(dir / "error_vs_time.csv");
+    csv << "configuration,level,unknowns,seconds,converged,energy_error,traction_error,closed_form_"
+           "error,"
+           "primary_error,newton,krylov,pareto\n"
+        << std::setprecision(6);
     toml::array jr;
-    os << "\nPareto front (seconds, " << (problem.name == "hertz" ? "pressure error vs closed form" : "energy error")
-       << "):\n";
+    os << "\nPareto front (seconds, "
+       << (problem.name == "hertz" ? "pressure error vs closed form" : "energy error") << "):\n";
     for (const auto& r : rows) {
         csv << '"' << r.config << "\"," << r.level << "," << r.unknowns << "," << r.seconds << ","
-            << r.converged << "," << r.err.energy << "," << r.err.traction << "," << r.err.closed_form
-            << "," << primary(r) << "," << r.newton << "," << r.krylov << "," << r.pareto << "\n";
+            << r.converged << "," << r.err.energy << "," << r.err.traction << ","
+            << r.err.closed_form << "," << primary(r) << "," << r.newton << "," << r.krylov << ","
+            << r.pareto << "\n";
         toml::table t;
         t.insert("configuration", r.config);
         t.insert("level", static_cast<int64_t>(r.level));
@@ -222,14 +244,15 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
         t.insert("pareto", r.pareto);
         jr.push_back(t);
         if (r.pareto)
-            os << "  " << std::left << std::setw(26) << r.config << std::right << " level " << r.level
-               << "  " << std::setprecision(3) << r.seconds << " s  error " << primary(r) << "\n";
+            os << "  " << std::left << std::setw(26) << r.config << std::right << " level "
+               << r.level << "  " << std::setprecision(3) << r.seconds << " s  error " << primary(r)
+               << "\n";
     }
     toml::table root;
     root.insert("scene", problem.name);
     root.insert("reference_level", static_cast<int64_t>(Lref));
     root.insert("runs", jr);
-    std::ofstream js(dir / "error_vs_time.json");
+    AtomicOfstream js(dir / "error_vs_time.json");
     js << toml::json_formatter{root} << "\n";
     csv.close();
     js.close();

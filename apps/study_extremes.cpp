@@ -2,6 +2,7 @@
 // Stability study over stiff and extreme cases (benchmarks.md, "Stiff and extreme cases").
 #include "apps/study_extremes.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "levels/checks.hpp"
 #include "levels/solve.hpp"
@@ -378,7 +379,7 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "
        << opt.seconds_per_case << " s per case, " << solvers.size() << " Newton-system solver(s)\n";
-    std::ofstream csv(dir / "extremes.csv");
+    AtomicOfstream csv(dir / "extremes.csv");
     csv << "solver,case,description,result,exit,newton,krylov,krylov_per_newton,residual,"
            "penetration,coulomb,balance,seconds,notes\n";
     toml::array jrows;
@@ -433,7 +434,7 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     toml::table root;
     root.insert("levels", static_cast<int64_t>(opt.levels));
     root.insert("cases", jrows);
-    std::ofstream js(dir / "extremes.json");
+    AtomicOfstream js(dir / "extremes.json");
     js << toml::json_formatter{root} << "\n";
     os << "\nwrote " << (dir / "extremes.csv").string() << ", extremes.json\n";
     return bad ? 3 : 0;

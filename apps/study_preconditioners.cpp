@@ -5,6 +5,7 @@
 #include "apps/preconditioners.hpp"
 
 #include "apps/study_status_transfer.hpp"
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"
 
@@ -193,7 +194,7 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
        << "total s"
        << "  result\n"
        << std::flush;
-    std::ofstream csv(dir / "preconditioners.csv");
+    AtomicOfstream csv(dir / "preconditioners.csv");
     csv << "krylov,pc,mu,r_over_E,level,unknowns,newton,krylov_per_newton_mean,krylov_per_newton_"
            "max,"
            "seconds_per_newton,setup_seconds,total_seconds,result\n";
@@ -287,7 +288,7 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
                     }
                 }
     // The paper's numbers, for the plot and the table.
-    std::ofstream pp(dir / "paper_1997_square.csv");
+    AtomicOfstream pp(dir / "paper_1997_square.csv");
     pp << "pc,unknowns,seconds_per_newton\n";
     for (const auto& p : kPaper)
         pp << p.pc << "," << p.unknowns << "," << p.seconds << "\n";
@@ -302,7 +303,7 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
     toml::table root;
     root.insert("scene", problem.name);
     root.insert("runs", jr);
-    std::ofstream js(dir / "preconditioners.json");
+    AtomicOfstream js(dir / "preconditioners.json");
     js << toml::json_formatter{root} << "\n";
     csv.close();
     js.close();

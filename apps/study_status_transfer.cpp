@@ -2,6 +2,7 @@
 // Status-transfer study (issue: level hierarchy and coarse-to-fine Newton).
 #include "apps/study_status_transfer.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"
 
@@ -56,15 +57,19 @@ std::vector<int> distance_to_zone_boundary(const levels::Level& L,
 
 } // namespace
 
-bool run_plot_script(const std::string& script, const std::filesystem::path& dir, std::ostream& os) {
+bool run_plot_script(const std::string& script, const std::filesystem::path& dir, std::ostream& os,
+                     const std::string& extra) {
     const std::filesystem::path path = std::filesystem::path(MLC_SOURCE_DIR) / "scripts" / script;
     if (!std::filesystem::exists(path)) {
-        os << "plot: " << path.string() << " not found (run from a source checkout to draw plots)\n";
+        os << "plot: " << path.string()
+           << " not found (run from a source checkout to draw plots)\n";
         return false;
     }
     // Debian's interpreter has python3-matplotlib; a python3 earlier on PATH may not.
-    const std::string py = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    const std::string cmd = py + " '" + path.string() + "' '" + dir.string() + "'";
+    const std::string py =
+        std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+    const std::string cmd =
+        py + " '" + path.string() + "' '" + dir.string() + "'" + (extra.empty() ? "" : " " + extra);
     const int rc = std::system(cmd.c_str());
     if (rc != 0) {
         os << "plot: '" << cmd << "' failed (exit " << rc
@@ -80,7 +85,8 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
               "the status-transfer study needs --levels between 1 and 8, found " << opt.levels);
     levels::Problem problem = problem_in;
     problem.levels = opt.levels;
-    const auto dir = opt.out.empty() ? std::filesystem::path("out") / problem.name / "status_transfer" : opt.out;
+    const auto dir =
+        opt.out.empty() ? std::filesystem::path("out") / problem.name / "status_transfer" : opt.out;
     std::filesystem::create_directories(dir);
 
     os << "status-transfer study: scene '" << problem.name << "', levels 0.." << opt.levels << ", "
@@ -105,11 +111,12 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
     if (!cold.converged) os << "note: the cold run failed: " << cold.failure << "\n";
 
     // Per level and step rows.
-    std::ofstream csv(dir / "status_transfer.csv");
+    AtomicOfstream csv(dir / "status_transfer.csv");
     csv << "level,step,unknowns,contact_nodes,newton_warm,newton_cold,agreement,mispredicted,"
            "mispredicted_at_zone_boundary";
     for (auto p : kStatusNames)
-        for (auto f : kStatusNames) csv << ",pred_" << p << "__final_" << f;
+        for (auto f : kStatusNames)
+            csv << ",pred_" << p << "__final_" << f;
     csv << "\n";
     toml::array jlevels;
     os << "\n level  unknowns  contacts  newton/step warm  cold   agreement  mispredicted  at zone "
@@ -141,8 +148,8 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
             mis += m;
             mis_near += near;
             csv << l << "," << st.report.step << "," << L.n_unknowns() << "," << L.n_contact_nodes()
-                << "," << st.report.iterations << "," << cold_it << "," << st.agreement() << "," << m
-                << "," << near;
+                << "," << st.report.iterations << "," << cold_it << "," << st.agreement() << ","
+                << m << "," << near;
             for (size_t a = 0; a < 4; ++a)
                 for (size_t b = 0; b < 4; ++b) {
                     csv << "," << st.confusion[a][b];
@@ -180,7 +187,8 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
         toml::array conf;
         for (size_t a = 0; a < 4; ++a) {
             toml::array row;
-            for (size_t b = 0; b < 4; ++b) row.push_back(static_cast<int64_t>(total[a][b]));
+            for (size_t b = 0; b < 4; ++b)
+                row.push_back(static_cast<int64_t>(total[a][b]));
             conf.push_back(row);
         }
         jl.insert("confusion_predicted_rows_final_cols", conf);
@@ -190,7 +198,8 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
             os << "        confusion (rows predicted, cols final; gap stick slip+ slip-):";
             for (size_t a = 0; a < 4; ++a) {
                 os << (a ? " |" : " ");
-                for (size_t b = 0; b < 4; ++b) os << " " << total[a][b];
+                for (size_t b = 0; b < 4; ++b)
+                    os << " " << total[a][b];
             }
             os << "\n";
         }
@@ -202,14 +211,15 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
            << agree_min << "\n";
     }
     // Final statuses along the contact boundary per level (for the plot).
-    std::ofstream sc(dir / "statuses.csv");
+    AtomicOfstream sc(dir / "statuses.csv");
     sc << "level,x,y,status\n" << std::setprecision(12);
     for (int l = 0; l <= opt.levels; ++l) {
         const auto& L = warm.levels()[static_cast<size_t>(l)];
         const auto& st = warm.level_steps[static_cast<size_t>(l)].back().final_statuses;
         for (size_t e = 0; e < st.size(); ++e) {
             const Vec2 p = L.mesh.vertices[static_cast<size_t>(L.contacts[e].vertex[0])];
-            sc << l << "," << p.x() << "," << p.y() << "," << kStatusNames[static_cast<size_t>(st[e])] << "\n";
+            sc << l << "," << p.x() << "," << p.y() << ","
+               << kStatusNames[static_cast<size_t>(st[e])] << "\n";
         }
     }
     toml::table root;
@@ -220,12 +230,13 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
         root.insert("newton_per_step_cold_levels_2_up", cold_sum / n_avg);
         root.insert("min_predicted_status_agreement_levels_2_up", agree_min);
     }
-    std::ofstream js(dir / "status_transfer.json");
+    AtomicOfstream js(dir / "status_transfer.json");
     js << toml::json_formatter{root} << "\n";
     csv.close();
     sc.close();
     js.close();
-    os << "wrote " << (dir / "status_transfer.csv").string() << ", status_transfer.json, statuses.csv\n";
+    os << "wrote " << (dir / "status_transfer.csv").string()
+       << ", status_transfer.json, statuses.csv\n";
     if (opt.plot && run_plot_script("plot_status_transfer.py", dir, os))
         os << "wrote " << (dir / "status_transfer.png").string() << "\n";
     return cold.converged ? 0 : 2;

@@ -15,11 +15,12 @@ namespace mlc::apps {
 /// Options of the status-transfer study.
 struct StatusTransferOptions {
     std::string scene = "square";
-    int levels = 3;                                 ///< finest level
-    std::filesystem::path out;                      ///< output folder (default out/<scene>/status_transfer)
+    int levels = 3;            ///< finest level
+    std::filesystem::path out; ///< output folder (default out/<scene>/status_transfer)
     transfer::QRule q_rule = transfer::QRule::paper;
-    bool increment = false; ///< warm start from the interpolated coarse increment (SolveOptions::transfer_increment)
-    bool plot = true;                               ///< draw the PNG with matplotlib
+    bool increment = false; ///< warm start from the interpolated coarse increment
+                            ///< (SolveOptions::transfer_increment)
+    bool plot = true;       ///< draw the PNG with matplotlib
 };
 
 /// Runs the scene coarse-to-fine and cold on levels 0..L (every level solved in both), prints the
@@ -31,6 +32,8 @@ int study_status_transfer(const levels::Problem& problem, const StatusTransferOp
 
 /// Runs a plotting script of scripts/ with Debian's python3 (which has matplotlib). Returns
 /// false (and says why on `os`) when python3 or matplotlib is missing or the script failed.
-bool run_plot_script(const std::string& script, const std::filesystem::path& dir, std::ostream& os);
+/// `extra` is appended to the command line (further arguments, already quoted).
+bool run_plot_script(const std::string& script, const std::filesystem::path& dir, std::ostream& os,
+                     const std::string& extra = "");
 
 } // namespace mlc::apps

@@ -161,6 +161,11 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
             rep.message = os.str();
             break;
         }
+        if (stop_ && stop_->load()) {
+            rep.stopped = true;
+            rep.message = "stopped on request after " + std::to_string(k) + " Newton iterations";
+            break;
+        }
         SolveResult lin;
         {
             ScopedTimer t(timings_, "newton/linear_solve");
@@ -268,6 +273,7 @@ std::vector<ContactNodeState> ContactNewton::node_states(double s, const Vector&
         ns.d_n = es.d_n;
         ns.d_t = es.d_t;
         ns.status = es.proj.status;
+        if (ns.status == contact::Status::gap) ns.lambda_t = ns.lambda_n = 0.0;
         if (!el.frictional() && ns.status != contact::Status::gap) {
             if (es.d_t > 1e-9 * umax)
                 ns.status = contact::Status::slip_forward;

@@ -9,6 +9,7 @@
 #include "levels/level.hpp"
 #include "levels/newton_system.hpp"
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -45,7 +46,8 @@ struct StepReport {
     int fallback_solves = 0;
     std::string fallback_reason;
     double seconds = 0.0;
-    std::string message; ///< diagnosis when not converged
+    std::string message;  ///< diagnosis when not converged
+    bool stopped = false; ///< stopped on request (ContactNewton::set_stop), not converged
 };
 
 /// The full state of a converged (or last) iterate, for reports and output.
@@ -76,6 +78,8 @@ public:
 
     /// Per contact node state (reported statuses: a frictionless node in contact is reported as
     /// slip_forward/backward by the sign of its slip increment, or stick if it did not move).
+    /// A gap node reports lambda = (0, 0) exactly, the value of the projection at the converged
+    /// state (the iterate carries round-off such as 1e-111).
     std::vector<ContactNodeState> node_states(double s, const Vector& u_prev_full,
                                               const Vector& x) const;
 
@@ -100,6 +104,9 @@ public:
     void set_fallback(std::function<std::unique_ptr<NewtonSystemSolver>()> make) {
         make_fallback_ = std::move(make);
     }
+    /// A flag polled after every Newton iteration: once it is set, solve() returns after the
+    /// current iteration with StepReport::stopped (and converged false). Null: never stops.
+    void set_stop(const std::atomic<bool>* stop) { stop_ = stop; }
 
 private:
     const Level& level_;
@@ -108,6 +115,7 @@ private:
     Timings* timings_;
     std::function<std::unique_ptr<NewtonSystemSolver>()> make_fallback_;
     std::unique_ptr<NewtonSystemSolver> fallback_;
+    const std::atomic<bool>* stop_ = nullptr;
 };
 
 } // namespace mlc::levels

@@ -6,6 +6,8 @@
 #include "core/memory.hpp"
 #include "solvers/factory.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -41,7 +43,47 @@ void print_progress(std::ostream& os, int level, int n_levels, int step, int n_s
        << rep.counts.slip_forward << " slip- " << rep.counts.slip_backward;
     if (ls.predicted) os << "  predicted " << std::fixed << std::setprecision(3) << ls.agreement();
     os << "  " << std::fixed << std::setprecision(2) << rep.seconds << " s" << std::defaultfloat
-       << (rep.converged ? "" : "  FAILED") << "\n";
+       << (rep.converged ? ""
+           : rep.stopped ? "  stopped"
+                         : "  FAILED");
+}
+
+/// "0.4 s", "12 s", "3 min 05 s", "1 h 02 min".
+std::string format_duration(double t) {
+    const long s = std::lround(std::max(0.0, t));
+    std::ostringstream os;
+    if (t < 9.95)
+        os << std::fixed << std::setprecision(1) << std::max(0.0, t) << " s";
+    else if (s < 60)
+        os << s << " s";
+    else if (s < 3600)
+        os << s / 60 << " min " << std::setw(2) << std::setfill('0') << s % 60 << " s";
+    else
+        os << s / 3600 << " h " << std::setw(2) << std::setfill('0') << (s % 3600) / 60 << " min";
+    return os.str();
+}
+
+/// Estimated seconds left after load step `step` of level `level`: the remaining levels of this
+/// step and every level of the remaining steps, each at the mean time of its steps so far; a
+/// level not solved yet at the time of the level below scaled by the ratio of unknowns.
+double time_left(const std::vector<Level>& levels, int first, int level, int step, int n_steps,
+                 const std::vector<double>& seconds, const std::vector<int>& count) {
+    const int finest = static_cast<int>(levels.size()) - 1;
+    std::vector<double> per(levels.size(), 0.0);
+    for (int l = first; l <= finest; ++l) {
+        const size_t li = static_cast<size_t>(l);
+        if (count[li] > 0)
+            per[li] = seconds[li] / count[li];
+        else if (l > first)
+            per[li] = per[li - 1] * static_cast<double>(levels[li].n_unknowns()) /
+                      static_cast<double>(levels[li - 1].n_unknowns());
+    }
+    double left = 0.0, all = 0.0;
+    for (int l = first; l <= finest; ++l) {
+        all += per[static_cast<size_t>(l)];
+        if (l > level) left += per[static_cast<size_t>(l)];
+    }
+    return left + (n_steps - step) * all;
 }
 
 } // namespace
@@ -121,6 +163,11 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         static_cast<size_t>(n_levels)); // each level's state before its solve
     res.level_steps.resize(static_cast<size_t>(n_levels));
     res.converged = true;
+    for (auto& nw : newton)
+        if (nw) nw->set_stop(options.stop);
+    const double t_start = wall_seconds();
+    std::vector<double> level_seconds(static_cast<size_t>(n_levels), 0.0);
+    std::vector<int> level_count(static_cast<size_t>(n_levels), 0);
     for (int step = 1; step <= problem.load_steps && res.converged; ++step) {
         const double s = static_cast<double>(step) / problem.load_steps;
         for (int l = first; l < n_levels; ++l) {
@@ -162,11 +209,33 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 for (size_t e = 0; e < ls.final_statuses.size(); ++e)
                     ++ls.confusion[static_cast<size_t>(ls.predicted_statuses[e])]
                                   [static_cast<size_t>(ls.final_statuses[e])];
-            if (options.progress)
-                print_progress(*options.progress, l, n_levels, step, problem.load_steps, ls);
+            level_seconds[li] += ls.report.seconds;
+            ++level_count[li];
+            if (options.progress) {
+                std::ostream& os = *options.progress;
+                print_progress(os, l, n_levels, step, problem.load_steps, ls);
+                if (options.progress_eta && ls.report.converged)
+                    os << "  [" << format_duration(wall_seconds() - t_start) << " elapsed, ~"
+                       << format_duration(time_left(levels, first, l, step, problem.load_steps,
+                                                    level_seconds, level_count))
+                       << " left]";
+                os << std::endl;
+            }
             const bool ok = ls.report.converged;
             if (l == finest) res.steps.push_back(ls.report);
             res.level_steps[li].push_back(std::move(ls));
+            if (!ok && res.level_steps[li].back().report.stopped) {
+                std::ostringstream os;
+                os << "stopped during load step " << step << " of " << problem.load_steps
+                   << " (load factor " << s << ")";
+                if (n_levels > 1) os << " on level " << l;
+                os << " after " << res.level_steps[li].back().report.iterations
+                   << " Newton iterations; " << res.completed_steps << " load steps completed";
+                res.failure = os.str();
+                res.stopped = true;
+                res.converged = false;
+                break;
+            }
             if (!ok) {
                 const auto& rep = res.level_steps[li].back().report;
                 std::ostringstream os;
@@ -180,6 +249,10 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 break;
             }
             L.dofs.expand(x[li], L.u_fixed_at(s), u_now[li]);
+            if (options.on_level_step) {
+                const auto nodes = nw.node_states(s, u_prev[li], x[li]);
+                options.on_level_step({l, step, s, &L, &u_now[li], &nodes});
+            }
             if (l + 1 < n_levels) {
                 // The level above's preconditioner (cf, sorcf, mg) uses this level at its
                 // converged statuses.
@@ -192,10 +265,9 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         if (!res.converged) break;
         res.nodes = newton.back()->node_states(s, u_prev.back(), x.back());
         res.u_full = u_now.back();
-        if (options.keep_step_states) {
-            res.step_u_full.push_back(res.u_full);
-            res.step_nodes.push_back(res.nodes);
-        }
+        if (options.keep_step_states) res.step_u_full.push_back(res.u_full);
+        res.step_nodes.push_back(res.nodes);
+        res.completed_steps = step;
         for (int l = first; l < n_levels; ++l)
             u_prev[static_cast<size_t>(l)] = u_now[static_cast<size_t>(l)];
     }

@@ -12,16 +12,40 @@
 #include "levels/resources.hpp"
 
 #include <array>
+#include <atomic>
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <vector>
 
 namespace mlc::levels {
 
+/// A converged load step of one level, as SolveOptions::on_level_step sees it (valid during the
+/// call only).
+struct LevelStepState {
+    int level = 0;
+    int step = 0;                                         ///< 1-based load step
+    double s = 0.0;                                       ///< load parameter step / load_steps
+    const Level* L = nullptr;                             ///< the level
+    const Vector* u_full = nullptr;                       ///< nodal displacements (2 per vertex)
+    const std::vector<ContactNodeState>* nodes = nullptr; ///< contact node states
+};
+
 /// Options of one run that are not part of the problem.
 struct SolveOptions {
     std::ostream* progress = nullptr; ///< per-step progress lines, or null for silence
-    bool keep_step_states = false;    ///< keep the finest state after every step
+    /// Progress lines also give the time elapsed and an estimate of the time left (the driver
+    /// sets it when its output is a terminal).
+    bool progress_eta = false;
+    /// Keep the finest displacements after every step (step_u_full); the contact node states of
+    /// every step (step_nodes) are always kept.
+    bool keep_step_states = false;
+    /// Polled after every Newton iteration: once set, the run stops after the current
+    /// iteration (RunResult::stopped; the completed load steps are kept). Null: never stops.
+    const std::atomic<bool>* stop = nullptr;
+    /// Called after every converged load step of every solved level (levels bottom up, then
+    /// the next step), e.g. to write that step's files as soon as it is done.
+    std::function<void(const LevelStepState&)> on_level_step;
     /// Coarse-to-fine: in every load step solve level 0, interpolate (P u, Q lambda) to level 1 as
     /// the initial guess, solve there, and so on to the finest. Off ("cold"): only the finest
     /// level is solved, from its previous step's state (every level when the preconditioner
@@ -76,7 +100,7 @@ struct RunResult {
     Vector u_full;                       ///< final nodal displacements (2 per vertex)
     std::vector<ContactNodeState> nodes; ///< final contact node states (finest)
     std::vector<Vector> step_u_full;     ///< finest, per step, when keep_step_states
-    std::vector<std::vector<ContactNodeState>> step_nodes; ///< per step, when keep_step_states
+    std::vector<std::vector<ContactNodeState>> step_nodes; ///< finest, per completed step
     Timings timings;
     /// Predicted sizes, the peak-memory estimate for this run's solver and what the process may
     /// use, all computed before the hierarchy was built.
@@ -90,7 +114,11 @@ struct RunResult {
     MemoryEstimate memory;
     MemoryLimit memory_limit;
     bool converged = false;
-    std::string failure; ///< diagnosis of the first step that failed
+    std::string failure; ///< diagnosis of the first step that failed (or where the run stopped)
+    /// Stopped on request (SolveOptions::stop) before the last load step was complete; `failure`
+    /// says where. converged is false.
+    bool stopped = false;
+    int completed_steps = 0; ///< load steps completed on every solved level
     const Level& finest() const { return hierarchy.finest(); }
     const std::vector<Level>& levels() const { return hierarchy.levels; }
 };

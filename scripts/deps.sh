@@ -6,7 +6,9 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libhypre-dev libopenmpi-dev openmpi-bin
   libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev libsuitesparse-dev
+  zlib1g-dev                    # binary (zlib-compressed) VTU output
   python3 python3-matplotlib
+  python3-vtk9 python3-pytest   # tests: VTK's own reader opens our VTU/PVD files
   clang-14 libclang-rt-14-dev   # sanitizer build and libFuzzer (scripts/sanitize.sh, fuzz.sh)
 )
 missing=()

@@ -7,6 +7,7 @@ Usage: plot_accuracy.py DIR
 """
 import csv
 import json
+import os
 import sys
 from collections import defaultdict
 
@@ -47,4 +48,6 @@ except (OSError, ValueError, KeyError):
     scene = "?"
 ax.set_title(f"{scene}: closed-form errors per level")
 fig.tight_layout()
-fig.savefig(f"{d}/accuracy.png", dpi=120)
+png = f"{d}/accuracy.png"
+fig.savefig(png + ".tmp", dpi=120, format="png")  # renamed when complete
+os.replace(png + ".tmp", png)

@@ -10,6 +10,7 @@ Usage: plot_bench.py OUT.png FILE.json [FILE.json ...]
 Run with Debian's /usr/bin/python3 (matplotlib).
 """
 import json
+import os
 import sys
 from collections import defaultdict
 
@@ -70,5 +71,7 @@ ax[0].set_title("(a) time per Newton step per unknown")
 ax[1].set_title("(b) iterations per Newton step")
 fig.suptitle("square, mu = 1, 5 load steps, coarse-to-fine, CGS rel. tol 1e-8 (2 cores)")
 fig.tight_layout()
-fig.savefig(out, dpi=110)
+png = out
+fig.savefig(png + ".tmp", dpi=110, format="png")  # renamed when complete
+os.replace(png + ".tmp", png)
 print(f"wrote {out}")

@@ -6,6 +6,7 @@ the level written next to each point, the Pareto front as a black step line.
 Usage: plot_error_vs_time.py DIR
 """
 import csv
+import os
 import sys
 from collections import defaultdict
 
@@ -43,4 +44,6 @@ ax.set_title(f"{scene}: error against run time (numbers: level)")
 ax.grid(alpha=0.3, which="both")
 ax.legend(fontsize=8)
 fig.tight_layout()
-fig.savefig(f"{d}/error_vs_time.png", dpi=110)
+png = f"{d}/error_vs_time.png"
+fig.savefig(png + ".tmp", dpi=110, format="png")  # renamed when complete
+os.replace(png + ".tmp", png)

@@ -8,6 +8,7 @@ against the friction coefficient and (d) against the penalty factor, at the fine
 Usage: plot_preconditioners.py DIR
 """
 import csv
+import os
 import sys
 from collections import defaultdict
 
@@ -66,4 +67,6 @@ for panel, var, fixed, fixval, label in ((ax[1][0], "mu", "r_over_E", r0, "frict
     panel.grid(alpha=0.3)
     panel.legend(fontsize=7)
 fig.tight_layout()
-fig.savefig(f"{d}/preconditioners.png", dpi=100)
+png = f"{d}/preconditioners.png"
+fig.savefig(png + ".tmp", dpi=100, format="png")  # renamed when complete
+os.replace(png + ".tmp", png)

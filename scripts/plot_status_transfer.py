@@ -6,6 +6,7 @@ Right: Newton iterations per load step on every level, coarse-to-fine (warm) and
 Usage: plot_status_transfer.py DIR
 """
 import csv
+import os
 import sys
 from collections import defaultdict
 
@@ -49,4 +50,6 @@ b.grid(alpha=0.3)
 b.legend()
 b.set_title("Newton iterations")
 fig.tight_layout()
-fig.savefig(f"{d}/status_transfer.png", dpi=110)
+png = f"{d}/status_transfer.png"
+fig.savefig(png + ".tmp", dpi=110, format="png")  # renamed when complete
+os.replace(png + ".tmp", png)

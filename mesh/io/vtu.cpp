@@ -5,13 +5,17 @@
 
 #include "core/check.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <set>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
+#include <zlib.h>
 
 namespace mlc::mesh {
 
@@ -173,10 +177,215 @@ void write_atomically(const std::filesystem::path& file, const char* who, Write&
     }
 }
 
+/// One array of the appended section: its opening DataArray attributes and its encoded bytes
+/// (the UInt64 compression header followed by the zlib blocks).
+struct AppendedArray {
+    std::string attributes; ///< type, Name, NumberOfComponents (without format/offset)
+    std::vector<unsigned char> encoded;
+};
+
+/// One zlib stream of `size` bytes at `in` (level 0: stored, a copy) into `out` (resized).
+bool deflate_block(const unsigned char* in, std::size_t size, int level, int strategy,
+                   std::vector<unsigned char>& out) {
+    z_stream z{};
+    if (deflateInit2(&z, level, Z_DEFLATED, 15, 8, strategy) != Z_OK) return false;
+    out.resize(deflateBound(&z, static_cast<uLong>(size)));
+    z.next_in = const_cast<unsigned char*>(in);
+    z.avail_in = static_cast<uInt>(size);
+    z.next_out = out.data();
+    z.avail_out = static_cast<uInt>(out.size());
+    const bool done = deflate(&z, Z_FINISH) == Z_STREAM_END;
+    out.resize(z.total_out);
+    deflateEnd(&z);
+    return done;
+}
+
+/// An array of the appended section before compression.
+struct RawArray {
+    std::vector<unsigned char> bytes;
+    /// Doubles of a solution field: compressed with Z_RLE (runs of zero bytes and repeated
+    /// values; twice as fast as the default match search on these arrays for a few percent of
+    /// size); geometry and integers with the default strategy (long repeated patterns).
+    bool field = false;
+};
+
+/// Compresses each array the way vtkZLibDataCompressor does with header_type="UInt64": a
+/// header [number of blocks, block size, size of the last block (0: full), compressed size of
+/// each block] followed by the blocks (1 MiB each), each a zlib stream of its own. The blocks of
+/// all arrays are compressed in parallel at level 1. A block whose first 16 KiB do not shrink
+/// to half at level 1 is stored (level 0, a copy): the doubles of displacements, stresses and
+/// von Mises have noisy mantissas and shrink by 10-35 % only, at the cost of most of the
+/// compression time, while the geometry, connectivity, offsets and the mostly-zero contact
+/// arrays shrink 3-100 times. At level 5 of the square: 26.9 MB (ASCII: 76.8 MB; everything at
+/// level 1: 22.6 MB in 2.5 times the time), written faster than the ASCII file.
+std::vector<std::vector<unsigned char>> zlib_encode(const std::vector<RawArray>& raws) {
+    constexpr std::size_t block = 1 << 20, sample = 1 << 14;
+    std::vector<std::pair<std::size_t, std::size_t>> tasks; // (array, first byte)
+    for (std::size_t a = 0; a < raws.size(); ++a)
+        for (std::size_t begin = 0; begin < raws[a].bytes.size(); begin += block)
+            tasks.emplace_back(a, begin);
+    std::vector<std::vector<unsigned char>> packed(tasks.size());
+    bool ok = true;
+#pragma omp parallel for schedule(dynamic) reduction(&& : ok)
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(tasks.size()); ++k) {
+        const auto [a, begin] = tasks[static_cast<std::size_t>(k)];
+        const unsigned char* in = raws[a].bytes.data() + begin;
+        const std::size_t size = std::min(block, raws[a].bytes.size() - begin);
+        const int strategy = raws[a].field ? Z_RLE : Z_DEFAULT_STRATEGY;
+        auto& out = packed[static_cast<std::size_t>(k)];
+        const std::size_t probe = std::min(sample, size);
+        ok = ok && deflate_block(in, probe, 1, strategy, out);
+        const int level =
+            static_cast<double>(out.size()) > 0.5 * static_cast<double>(probe) ? 0 : 1;
+        ok = ok && deflate_block(in, size, level, strategy, out);
+    }
+    if (!ok) throw std::runtime_error("write_vtu: zlib compression failed");
+    std::vector<std::vector<unsigned char>> encoded(raws.size());
+    std::size_t k = 0;
+    for (std::size_t a = 0; a < raws.size(); ++a) {
+        const std::size_t n = raws[a].bytes.size();
+        const std::size_t n_blocks = (n + block - 1) / block;
+        std::vector<std::uint64_t> header{n_blocks, block, n % block};
+        for (std::size_t b = 0; b < n_blocks; ++b)
+            header.push_back(packed[k + b].size());
+        auto& out = encoded[a];
+        out.resize(header.size() * sizeof(std::uint64_t));
+        std::memcpy(out.data(), header.data(), out.size()); // little endian (checked)
+        for (std::size_t b = 0; b < n_blocks; ++b, ++k) {
+            out.insert(out.end(), packed[k].begin(), packed[k].end());
+            std::vector<unsigned char>().swap(packed[k]);
+        }
+    }
+    return encoded;
+}
+
+template <class T> std::vector<unsigned char> raw_bytes(const std::vector<T>& v) {
+    std::vector<unsigned char> out(v.size() * sizeof(T));
+    if (!v.empty()) std::memcpy(out.data(), v.data(), out.size());
+    return out;
+}
+
+/// A field's DataArray attributes and its bytes as Float64, 2-component fields padded to 3
+/// (z = 0).
+std::pair<std::string, std::vector<unsigned char>> field_bytes(const Field& f) {
+    const std::size_t nc = static_cast<std::size_t>(f.n_components);
+    const std::size_t n = f.values.size() / nc;
+    std::string attributes = "type=\"Float64\" Name=\"" + xml_escape(f.name) +
+                             "\" NumberOfComponents=\"" + std::to_string(nc == 2 ? 3 : nc) + "\"";
+    if (nc != 2) return {attributes, raw_bytes(f.values)};
+    std::vector<double> padded(3 * n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        padded[3 * i] = f.values[2 * i];
+        padded[3 * i + 1] = f.values[2 * i + 1];
+    }
+    return {attributes, raw_bytes(padded)};
+}
+
+void put_appended_refs(BufferedFile& out, const std::vector<AppendedArray>& arrays,
+                       std::size_t first, std::size_t count, std::uint64_t& offset) {
+    for (std::size_t i = first; i < first + count; ++i) {
+        out.put("        <DataArray ");
+        out.put(arrays[i].attributes);
+        out.put(" format=\"appended\" offset=\"");
+        out.put_number(offset);
+        out.put("\"/>\n");
+        offset += arrays[i].encoded.size();
+    }
+}
+
+void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
+                      const std::vector<Field>& point_fields,
+                      const std::vector<Field>& cell_fields) {
+    static_assert(sizeof(double) == 8);
+    {
+        const std::uint16_t one = 1;
+        unsigned char first = 0;
+        std::memcpy(&first, &one, 1);
+        MLC_CHECK(first == 1, "write_vtu: binary output is written little endian only");
+    }
+    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    // Order in the file: point fields, cell fields, points, connectivity, offsets, types.
+    std::vector<std::string> attributes;
+    std::vector<RawArray> raws;
+    for (const auto* fields : {&point_fields, &cell_fields})
+        for (const Field& f : *fields) {
+            auto [a, bytes] = field_bytes(f);
+            attributes.push_back(std::move(a));
+            raws.push_back({std::move(bytes), true});
+        }
+    {
+        std::vector<double> xyz(3 * nv, 0.0);
+        for (std::size_t v = 0; v < nv; ++v) {
+            xyz[3 * v] = m.vertices[v].x();
+            xyz[3 * v + 1] = m.vertices[v].y();
+        }
+        attributes.push_back("type=\"Float64\" NumberOfComponents=\"3\"");
+        raws.push_back({raw_bytes(xyz)});
+    }
+    {
+        std::vector<std::int32_t> conn(3 * nt);
+        std::vector<std::int64_t> offsets(nt);
+        for (std::size_t t = 0; t < nt; ++t) {
+            for (std::size_t k = 0; k < 3; ++k)
+                conn[3 * t + k] = m.triangles[t][k];
+            offsets[t] = static_cast<std::int64_t>(3 * (t + 1));
+        }
+        attributes.push_back("type=\"Int32\" Name=\"connectivity\"");
+        raws.push_back({raw_bytes(conn)});
+        attributes.push_back("type=\"Int64\" Name=\"offsets\"");
+        raws.push_back({raw_bytes(offsets)});
+        attributes.push_back("type=\"UInt8\" Name=\"types\"");
+        raws.push_back({std::vector<unsigned char>(nt, 5)});
+    }
+    std::vector<AppendedArray> arrays(raws.size());
+    {
+        auto encoded = zlib_encode(raws);
+        std::vector<RawArray>().swap(raws);
+        for (std::size_t a = 0; a < arrays.size(); ++a)
+            arrays[a] = {std::move(attributes[a]), std::move(encoded[a])};
+    }
+    write_atomically(file, "write_vtu", [&](BufferedFile& out) {
+        out.put("<?xml version=\"1.0\"?>\n"
+                "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+                "byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+                "compressor=\"vtkZLibDataCompressor\">\n"
+                "  <UnstructuredGrid>\n"
+                "    <Piece NumberOfPoints=\"");
+        out.put_number(nv);
+        out.put("\" NumberOfCells=\"");
+        out.put_number(nt);
+        out.put("\">\n");
+        std::uint64_t offset = 0;
+        out.put("      <PointData>\n");
+        put_appended_refs(out, arrays, 0, point_fields.size(), offset);
+        out.put("      </PointData>\n      <CellData>\n");
+        put_appended_refs(out, arrays, point_fields.size(), cell_fields.size(), offset);
+        out.put("      </CellData>\n      <Points>\n");
+        const std::size_t geometry = point_fields.size() + cell_fields.size();
+        put_appended_refs(out, arrays, geometry, 1, offset);
+        out.put("      </Points>\n      <Cells>\n");
+        put_appended_refs(out, arrays, geometry + 1, 3, offset);
+        out.put("      </Cells>\n"
+                "    </Piece>\n"
+                "  </UnstructuredGrid>\n"
+                "  <AppendedData encoding=\"raw\">\n   _");
+        for (const auto& a : arrays)
+            out.put(std::string_view(reinterpret_cast<const char*>(a.encoded.data()),
+                                     a.encoded.size()));
+        out.put("\n  </AppendedData>\n"
+                "</VTKFile>\n");
+    });
+}
+
 } // namespace
 
+const char* to_string(VtuFormat f) {
+    return f == VtuFormat::binary ? "binary" : "ascii";
+}
+
 void write_vtu(const std::filesystem::path& file, const Mesh& m,
-               const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields) {
+               const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields,
+               VtuFormat format) {
     const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
     for (std::size_t v = 0; v < nv; ++v)
         MLC_CHECK(m.vertices[v].allFinite(),
@@ -189,6 +398,10 @@ void write_vtu(const std::filesystem::path& file, const Mesh& m,
                                              << " but the mesh has " << nv << " vertices");
     check_fields(point_fields, "point", "vertex", nv);
     check_fields(cell_fields, "cell", "triangle", nt);
+    if (format == VtuFormat::binary) {
+        write_vtu_binary(file, m, point_fields, cell_fields);
+        return;
+    }
 
     write_atomically(file, "write_vtu", [&](BufferedFile& out) {
         out.put("<?xml version=\"1.0\"?>\n"

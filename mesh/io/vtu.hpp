@@ -22,21 +22,39 @@ struct Field {
     std::vector<double> values; ///< n_entities * n_components entries, all finite
 };
 
-/// Writes a mesh and fields as an ASCII VTK XML UnstructuredGrid file that ParaView opens.
+/// How write_vtu encodes the arrays.
+enum class VtuFormat {
+    /// Appended raw binary data, zlib-compressed in blocks (header_type="UInt64",
+    /// compressor="vtkZLibDataCompressor"): what VTK's own writer produces by default. Doubles
+    /// are stored bit for bit.
+    binary,
+    /// Every number as text inside its DataArray (format="ascii"); readable by eye.
+    ascii
+};
+
+/// "binary" or "ascii".
+const char* to_string(VtuFormat f);
+
+/// Writes a mesh and fields as a VTK XML UnstructuredGrid file that ParaView opens.
 ///
 /// Points are (x, y, 0); triangles are VTK_TRIANGLE (type 5) with the mesh's vertex order.
 /// Two-component fields are written with three components (z = 0), so that ParaView's
-/// "Warp By Vector" applies them directly. Numbers are written with std::to_chars in the
-/// shortest form that reads back to the same double, so values round-trip exactly.
+/// "Warp By Vector" applies them directly. Both formats hold the same arrays with the same
+/// values: binary stores every double bit for bit (Float64, connectivity Int32, offsets Int64,
+/// types UInt8, each array compressed with zlib in blocks of 1 MiB, the blocks compressed in
+/// parallel; a block that does not shrink to half is stored uncompressed, see vtu.cpp); ascii
+/// writes numbers with std::to_chars in the shortest form that reads back to the same double, so
+/// values round-trip exactly there too.
 ///
 /// Everything is checked before the file is touched: field sizes against the mesh
 /// (n_vertices * n_components for point fields, n_triangles * n_components for cell fields),
 /// names, and that every value and coordinate is finite. A violation throws InvalidInput naming
 /// the field, entity and component, and no file is created. The file is written to a temporary
-/// next to it and renamed at the end, so a reader never sees a half-written file; an I/O failure
-/// throws std::runtime_error and removes the temporary. Writes about 10^6 triangles per second.
+/// next to it ("<file>.tmp") and renamed at the end, so a reader never sees a half-written file;
+/// an I/O failure throws std::runtime_error and removes the temporary.
 void write_vtu(const std::filesystem::path& file, const Mesh& m,
-               const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields);
+               const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields,
+               VtuFormat format = VtuFormat::binary);
 
 /// Writes a ParaView collection (.pvd) listing a time series of .vtu files, e.g. load steps.
 ///

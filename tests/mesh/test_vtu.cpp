@@ -7,11 +7,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <unistd.h>
+#include <zlib.h>
 
 using namespace mlc;
 using namespace mlc::mesh;
@@ -96,7 +99,7 @@ TEST_F(Vtu, RoundTripsMeshAndFields) {
     }
     const Field p{"pressure", 1, {std::acos(-1.0), -1.0 / 7}};
     const Field s{"stress <xx>", 3, {1, 2, 3, 4, 5, 6}};
-    write_vtu(file, m, {u}, {p, s});
+    write_vtu(file, m, {u}, {p, s}, VtuFormat::ascii);
     ASSERT_TRUE(fs::exists(file));
     EXPECT_FALSE(fs::exists(file.string() + ".tmp"));
 
@@ -139,6 +142,98 @@ TEST_F(Vtu, RoundTripsMeshAndFields) {
     expect_close(p.values[0], pp[0], "pressure 0");
     expect_close(p.values[1], pp[1], "pressure 1");
     EXPECT_EQ(data_array(xml, "Name=\"stress &lt;xx&gt;\""), s.values);
+}
+
+namespace {
+
+/// The decoded bytes of an appended, zlib-compressed array (header_type UInt64) of a binary VTU,
+/// found by the `marker` in its DataArray tag; empty (and a test failure) if anything is off.
+std::vector<unsigned char> appended_array(const std::string& xml, const std::string& marker) {
+    std::size_t at = xml.find(marker);
+    EXPECT_NE(at, std::string::npos) << marker;
+    if (at == std::string::npos) return {};
+    if (marker.back() == '>') at = xml.find("<DataArray", at);
+    EXPECT_EQ(attribute(xml, "format", at), "appended");
+    const std::size_t offset = std::stoull(attribute(xml, "offset", at));
+    const std::size_t data = xml.find('_', xml.find("<AppendedData encoding=\"raw\">")) + 1;
+    const auto* p = reinterpret_cast<const unsigned char*>(xml.data()) + data + offset;
+    std::uint64_t head[3];
+    std::memcpy(head, p, sizeof head);
+    const std::uint64_t n_blocks = head[0], block = head[1], last = head[2];
+    std::vector<std::uint64_t> sizes(n_blocks);
+    std::memcpy(sizes.data(), p + sizeof head, n_blocks * 8);
+    const unsigned char* blocks = p + sizeof head + n_blocks * 8;
+    std::vector<unsigned char> out;
+    for (std::uint64_t b = 0; b < n_blocks; ++b) {
+        uLongf n = (b + 1 == n_blocks && last != 0) ? last : block;
+        std::vector<unsigned char> chunk(n);
+        EXPECT_EQ(uncompress(chunk.data(), &n, blocks, sizes[b]), Z_OK);
+        chunk.resize(n);
+        out.insert(out.end(), chunk.begin(), chunk.end());
+        blocks += sizes[b];
+    }
+    return out;
+}
+
+template <class T> std::vector<T> as(const std::vector<unsigned char>& bytes) {
+    std::vector<T> v(bytes.size() / sizeof(T));
+    std::memcpy(v.data(), bytes.data(), v.size() * sizeof(T));
+    return v;
+}
+
+} // namespace
+
+TEST_F(Vtu, BinaryHoldsTheSameArraysBitForBit) {
+    const fs::path dir = scratch_dir();
+    // Large enough for several 1 MiB compression blocks: 90601 points (2.2 MB of coordinates),
+    // 180000 triangles (a 4.3 MB stress field), none a whole number of blocks.
+    const Mesh m = structured_rectangle(Vec2(0, 0), Vec2(2, 1), 300, 300);
+    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    Field u{"displacement", 2, {}};
+    for (std::size_t v = 0; v < nv; ++v) {
+        u.values.push_back(std::sin(1.0 + v) / 3);
+        u.values.push_back(1e-300 * v);
+    }
+    Field s{"stress <xx>", 3, {}};
+    for (std::size_t t = 0; t < 3 * nt; ++t)
+        s.values.push_back(std::cos(0.1 * t) * 1e5);
+    const Field zero{"zero", 1, std::vector<double>(nt, 0.0)};
+    write_vtu(dir / "b.vtu", m, {u}, {s, zero});
+    write_vtu(dir / "a.vtu", m, {u}, {s, zero}, VtuFormat::ascii);
+    EXPECT_FALSE(fs::exists(dir / "b.vtu.tmp"));
+    const std::string xml = slurp(dir / "b.vtu");
+    EXPECT_NE(xml.find("header_type=\"UInt64\""), std::string::npos);
+    EXPECT_NE(xml.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
+    EXPECT_EQ(attribute(xml, "NumberOfPoints"), std::to_string(nv));
+    EXPECT_EQ(attribute(xml, "NumberOfCells"), std::to_string(nt));
+    EXPECT_LT(fs::file_size(dir / "b.vtu"), fs::file_size(dir / "a.vtu"));
+
+    const auto points = as<double>(appended_array(xml, "<Points>"));
+    ASSERT_EQ(points.size(), 3 * nv);
+    for (std::size_t v = 0; v < nv; v += 37) {
+        EXPECT_EQ(points[3 * v], m.vertices[v].x());
+        EXPECT_EQ(points[3 * v + 1], m.vertices[v].y());
+        EXPECT_EQ(points[3 * v + 2], 0.0);
+    }
+    const auto uu = as<double>(appended_array(xml, "Name=\"displacement\""));
+    ASSERT_EQ(uu.size(), 3 * nv);
+    for (std::size_t v = 0; v < nv; ++v) {
+        ASSERT_EQ(uu[3 * v], u.values[2 * v]) << v;
+        ASSERT_EQ(uu[3 * v + 1], u.values[2 * v + 1]) << v;
+        ASSERT_EQ(uu[3 * v + 2], 0.0) << v;
+    }
+    EXPECT_EQ(as<double>(appended_array(xml, "Name=\"stress &lt;xx&gt;\"")), s.values);
+    EXPECT_EQ(as<double>(appended_array(xml, "Name=\"zero\"")), zero.values);
+    const auto conn = as<std::int32_t>(appended_array(xml, "Name=\"connectivity\""));
+    ASSERT_EQ(conn.size(), 3 * nt);
+    for (std::size_t t = 0; t < nt; ++t)
+        for (int k = 0; k < 3; ++k)
+            ASSERT_EQ(conn[3 * t + k], m.triangles[t][k]);
+    const auto offsets = as<std::int64_t>(appended_array(xml, "Name=\"offsets\""));
+    ASSERT_EQ(offsets.size(), nt);
+    EXPECT_EQ(offsets.front(), 3);
+    EXPECT_EQ(offsets.back(), static_cast<std::int64_t>(3 * nt));
+    EXPECT_EQ(appended_array(xml, "Name=\"types\""), std::vector<unsigned char>(nt, 5));
 }
 
 TEST_F(Vtu, NonFiniteValueThrowsAndLeavesNoFile) {
@@ -199,7 +294,7 @@ TEST_F(Vtu, OverwritesAndWritesLargerMeshes) {
     std::vector<double> x(m.vertices.size());
     for (std::size_t v = 0; v < x.size(); ++v)
         x[v] = m.vertices[v].x() * m.vertices[v].y();
-    write_vtu(file, m, {Field{"xy", 1, x}}, {});
+    write_vtu(file, m, {Field{"xy", 1, x}}, {}, VtuFormat::ascii);
     const std::string xml = slurp(file);
     EXPECT_EQ(attribute(xml, "NumberOfPoints"), std::to_string(41 * 21));
     EXPECT_EQ(attribute(xml, "NumberOfCells"), std::to_string(2 * 40 * 20));
