@@ -86,11 +86,16 @@ public:
 
     const Level& level() const { return level_; }
 
+    /// Polled before every iteration of solve(); true stops it by throwing mlc::Interrupted
+    /// (levels::SolveOptions::interrupt_requested). Empty: never polled.
+    void set_interrupt(std::function<bool()> requested) { interrupt_ = std::move(requested); }
+
 private:
     const Level& level_;
     NewtonParams params_;
     std::unique_ptr<NewtonSystemSolver> solver_;
     Timings* timings_;
+    std::function<bool()> interrupt_;
 };
 
 } // namespace mlc::levels
