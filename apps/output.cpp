@@ -108,15 +108,9 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
            << c.penetration << std::defaultfloat << "\n";
         // Per pair: the resultant force the target exerts on the contactor nodes (global axes),
         // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
-        const auto& L = r.finest();
         for (size_t k = 0; k < p.contacts.size(); ++k) {
-            Vec2 f = Vec2::Zero();
             int closed = 0;
-            for (size_t e = 0; e < L.contacts.size(); ++e) {
-                if (L.contacts[e].pair != static_cast<int>(k)) continue;
-                f -= r.nodes[e].lambda_t * L.contacts[e].t + r.nodes[e].lambda_n * L.contacts[e].n;
-                closed += r.nodes[e].status != contact::Status::gap;
-            }
+            const Vec2 f = levels::contact_resultant(r, static_cast<int>(k), &closed);
             os << "contact '" << p.contacts[k].name << "': resultant on the contactor ("
                << std::setprecision(6) << f.x() << ", " << f.y() << "), " << closed
                << " nodes in contact\n";
@@ -225,6 +219,21 @@ void write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
             ct.insert("complementarity", c.complementarity);
             ct.insert("penetration", c.penetration);
             root.insert("checks", ct);
+            // Per pair, the resultant the report prints (levels::contact_resultant).
+            toml::array pairs;
+            for (size_t k = 0; k < p.contacts.size(); ++k) {
+                int closed = 0;
+                const Vec2 f = levels::contact_resultant(r, static_cast<int>(k), &closed);
+                toml::table t;
+                t.insert("name", p.contacts[k].name);
+                toml::array fa;
+                fa.push_back(f.x());
+                fa.push_back(f.y());
+                t.insert("resultant", fa);
+                t.insert("in_contact", static_cast<int64_t>(closed));
+                pairs.push_back(t);
+            }
+            root.insert("contacts", pairs);
         }
         {
             const auto& sp = r.solver.spec;
