@@ -12,8 +12,7 @@
 
 namespace mlc::apps {
 
-int run_scene(const RunOptions& opt, std::ostream& os) {
-    levels::Problem p = scene::load_scene(opt.scene);
+void apply_overrides(levels::Problem& p, const RunOptions& opt) {
     if (opt.levels) {
         MLC_CHECK(*opt.levels >= 0 && *opt.levels <= 12,
                   "--levels must lie in [0, 12], found " << *opt.levels);
@@ -35,13 +34,25 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
         }
     }
     p.validate();
+}
+
+levels::SolveOptions run_solve_options(const levels::Problem& p, const RunOptions& opt,
+                                       levels::SolverChoice& choice) {
     levels::SolveOptions so;
     so.predicted_sizes = levels::predict_level_sizes(p); // level 0 built once for both
-    const levels::SolverChoice choice = levels::choose_solver(
-        p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}, &so.predicted_sizes);
-    so.progress = opt.quiet ? nullptr : &os;
+    choice = levels::choose_solver(p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol},
+                                   &so.predicted_sizes);
     so.coarse_to_fine = !opt.cold;
     so.linear = choice.spec;
+    return so;
+}
+
+int run_scene(const RunOptions& opt, std::ostream& os) {
+    levels::Problem p = scene::load_scene(opt.scene);
+    apply_overrides(p, opt);
+    levels::SolverChoice choice;
+    levels::SolveOptions so = run_solve_options(p, opt, choice);
+    so.progress = opt.quiet ? nullptr : &os;
     os << "mlcontact: solving '" << p.name << "'\n";
     os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
     levels::RunResult r = levels::solve(p, so);
