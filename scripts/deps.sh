@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libhypre-dev libopenmpi-dev openmpi-bin
   libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev libsuitesparse-dev
   python3 python3-matplotlib
+  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (python/)
   clang-14 libclang-rt-14-dev   # sanitizer build and libFuzzer (scripts/sanitize.sh, fuzz.sh)
 )
 missing=()
