@@ -16,6 +16,7 @@ See README.md, section "Python".
 
 import csv as _csv
 import json as _json
+import numbers as _numbers
 import os as _os
 import tempfile as _tempfile
 
@@ -30,7 +31,7 @@ __version__ = _core.__version__
 STATUS_NAMES = tuple(_core.status_names)
 GAP, STICK, SLIP_FORWARD, SLIP_BACKWARD = range(4)
 
-__all__ = ["Scene", "Result", "solve", "NotConverged", "SolverBreakdown", "UnknownKey",
+__all__ = ["Scene", "Result", "solve", "NotConverged", "SolverBreakdown", "UnknownKey", "BadType",
            "study_status_transfer", "study_accuracy", "tractions", "STATUS_NAMES", "__version__"]
 
 
@@ -48,13 +49,23 @@ class UnknownKey(ValueError, AttributeError):
     """Setting a scene parameter that does not exist (a ValueError naming the key)."""
 
 
+class BadType(ValueError, TypeError):
+    """A parameter or option of the wrong type (a ValueError naming it)."""
+
+
+_INT_KEYS = ("levels", "load_steps", "newton_max_iter")
 _SCENE_KEYS = tuple(k for k in dir(Scene) if isinstance(getattr(Scene, k), property))
 
 
 def _scene_setattr(self, name, value):
     if name not in _SCENE_KEYS:
         raise UnknownKey(f"unknown scene parameter '{name}' (known: {', '.join(_SCENE_KEYS)})")
-    object.__setattr__(self, name, value)
+    try:
+        object.__setattr__(self, name, value)
+    except TypeError as e:
+        if "incompatible function arguments" not in str(e):  # read-only: an AttributeError
+            raise
+        raise BadType(f"{name}: {value!r} is not a {'whole ' if name in _INT_KEYS else ''}number") from None
 
 
 Scene.__setattr__ = _scene_setattr
@@ -77,9 +88,17 @@ def solve(scene, *, levels=None, mu=None, r=None, load_steps=None, solver=None, 
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"solve() needs a mlcontact.Scene, got {type(scene).__name__}")
-    result = _core.solve(scene, levels=levels, mu=mu, r=r, load_steps=load_steps, solver=solver,
-                         krylov=krylov, pc=pc, linear_tol=linear_tol, cold=cold,
-                         keep_steps=keep_steps, progress=progress)
+    options = {}
+    for name, value, kind in (("levels", levels, int), ("load_steps", load_steps, int),
+                              ("mu", mu, float), ("r", r, float), ("linear_tol", linear_tol, float),
+                              ("solver", solver, str), ("krylov", krylov, str), ("pc", pc, str)):
+        if value is not None:  # numpy scalars too (a sweep over np.arange)
+            abc = {int: _numbers.Integral, float: _numbers.Real, str: str}[kind]
+            if not isinstance(value, abc) or isinstance(value, bool):
+                raise BadType(f"{name}: {value!r} is not {'an' if kind is int else 'a'} {kind.__name__}")
+            value = kind(value)
+        options[name] = value
+    result = _core.solve(scene, cold=cold, keep_steps=keep_steps, progress=progress, **options)
     if not result.converged and raise_on_failure:
         raise NotConverged(result.failure, result)
     return result
