@@ -56,6 +56,25 @@ for d in includes:  # the installed tree, the dependencies', never the source or
     assert not inside or d.startswith(work + "/"), f"the example compiles against {d}"
     assert not re.search(r"/(core|mesh|fem|levels)/?$", d), f"generic include folder {d}"
 
+# Every installed header compiles from the installed tree alone (one translation unit including
+# them all, linked against mlcontact::mlcontact): no include left pointing at a generic folder.
+hdr = os.path.join(work, "all_headers")
+os.makedirs(hdr)
+headers = sorted(os.path.relpath(os.path.join(d, f), inc) for d, _, fs in os.walk(os.path.join(inc, "mlcontact"))
+                 for f in fs if f.endswith(".hpp"))
+assert len(headers) > 40, headers
+with open(os.path.join(hdr, "all_headers.cpp"), "w") as f:
+    f.writelines(f"#include <{h}>\n" for h in headers)
+    f.write("int main() { return 0; }\n")
+with open(os.path.join(hdr, "CMakeLists.txt"), "w") as f:
+    f.write("cmake_minimum_required(VERSION 3.20)\nproject(all_headers LANGUAGES CXX)\n"
+            "set(CMAKE_CXX_STANDARD 20)\nfind_package(mlcontact 0.1 REQUIRED)\n"
+            "add_executable(all_headers all_headers.cpp)\n"
+            "target_link_libraries(all_headers PRIVATE mlcontact::mlcontact)\n")
+run([cmake, "-S", hdr, "-B", os.path.join(hdr, "build"), f"-DCMAKE_PREFIX_PATH={prefix}"])
+run([cmake, "--build", os.path.join(hdr, "build")])
+print(f"package: all {len(headers)} installed headers compile together from {inc}")
+
 scene, levels = "square", "1"
 out = run([os.path.join(ex, "contact_resultant"), scene, levels])
 print(out, end="")
