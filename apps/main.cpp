@@ -27,6 +27,7 @@
 int main(int argc, char** argv) {
     mlc::keep_freed_memory();
     CLI::App app{"mlcontact: multilevel frictional contact in 2D linear elasticity"};
+    app.set_version_flag("--version", std::string("mlcontact ") + MLC_VERSION);
     app.require_subcommand(1);
     mlc::apps::RunOptions ro;
     auto* run = app.add_subcommand("run", "solve a scene (default: the built-in 'square')");

@@ -113,10 +113,9 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
            << c.penetration << std::defaultfloat << "\n";
         // Per pair: the resultant force the target exerts on the contactor nodes (global axes),
         // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
-        const auto& L = r.finest();
         for (size_t k = 0; k < p.contacts.size(); ++k) {
             int closed = 0;
-            const Vec2 f = contact_resultant(L, r.nodes, static_cast<int>(k), &closed);
+            const Vec2 f = levels::contact_resultant(r, static_cast<int>(k), &closed);
             os << "contact '" << p.contacts[k].name << "': resultant on the contactor ("
                << std::setprecision(6) << f.x() << ", " << f.y() << "), " << closed
                << " nodes in contact\n";
@@ -247,19 +246,6 @@ ContactGeometry contact_geometry(const levels::Problem& p, const levels::Level& 
             }
     }
     return g;
-}
-
-Vec2 contact_resultant(const levels::Level& L, const std::vector<levels::ContactNodeState>& nodes,
-                       int pair, int* in_contact) {
-    Vec2 f = Vec2::Zero();
-    int closed = 0;
-    for (size_t e = 0; e < L.contacts.size() && e < nodes.size(); ++e) {
-        if (L.contacts[e].pair != pair) continue;
-        f -= nodes[e].lambda_t * L.contacts[e].t + nodes[e].lambda_n * L.contacts[e].n;
-        closed += nodes[e].status != contact::Status::gap;
-    }
-    if (in_contact) *in_contact = closed;
-    return f;
 }
 
 namespace {
@@ -407,7 +393,7 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
             toml::array cs;
             for (size_t k = 0; k < p.contacts.size(); ++k) {
                 int closed = 0;
-                const Vec2 f = contact_resultant(L, r.nodes, static_cast<int>(k), &closed);
+                const Vec2 f = levels::contact_resultant(r, static_cast<int>(k), &closed);
                 toml::table c;
                 c.insert("name", p.contacts[k].name);
                 c.insert("resultant", toml::array{f.x(), f.y()});

@@ -53,11 +53,6 @@ struct ContactGeometry {
 };
 ContactGeometry contact_geometry(const levels::Problem& p, const levels::Level& L);
 
-/// Resultant force the target exerts on pair k's contactor nodes, -sum(lambda_t t + lambda_n n)
-/// in global axes, and the number of its nodes in contact.
-Vec2 contact_resultant(const levels::Level& L, const std::vector<levels::ContactNodeState>& nodes,
-                       int pair, int* in_contact = nullptr);
-
 /// Writes the files of a run into dir (created if needed), each under a temporary name renamed
 /// when complete: when converged, solution.vtu, contact.csv, contact_steps.csv and
 /// summary.json; when stopped on request, contact_steps.csv (the completed steps) and

@@ -16,8 +16,7 @@
 
 namespace mlc::apps {
 
-int run_scene(const RunOptions& opt, std::ostream& os) {
-    levels::Problem p = scene::load_scene(opt.scene);
+void apply_overrides(levels::Problem& p, const RunOptions& opt) {
     if (opt.levels) {
         MLC_CHECK(*opt.levels >= 0 && *opt.levels <= 12,
                   "--levels must lie in [0, 12], found " << *opt.levels);
@@ -39,23 +38,35 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
         }
     }
     p.validate();
-    MLC_CHECK(opt.vtu == "binary" || opt.vtu == "ascii",
-              "--vtu must be binary or ascii, found '" << opt.vtu << "'");
-    OutputOptions out;
-    out.vtu = opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
-    const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
+}
+
+levels::SolveOptions run_solve_options(const levels::Problem& p, const RunOptions& opt,
+                                       levels::SolverChoice& choice) {
     levels::SolveOptions so;
     so.predicted_sizes = levels::predict_level_sizes(p); // level 0 built once for both
-    const levels::SolverChoice choice = levels::choose_solver(
-        p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}, &so.predicted_sizes);
-    so.progress = opt.quiet ? nullptr : &os;
-    so.progress_eta = opt.progress_eta;
+    choice = levels::choose_solver(p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol},
+                                   &so.predicted_sizes);
     so.coarse_to_fine = !opt.cold;
     so.linear = choice.spec;
     MLC_CHECK(!opt.no_fallback || choice.spec.method == "krylov",
               "--no-fallback applies to Krylov solves only; the solver of this run is "
                   << choice.spec.method << " (" << choice.reason << ")");
     so.exact_fallback = !opt.no_fallback;
+    return so;
+}
+
+int run_scene(const RunOptions& opt, std::ostream& os) {
+    levels::Problem p = scene::load_scene(opt.scene);
+    apply_overrides(p, opt);
+    MLC_CHECK(opt.vtu == "binary" || opt.vtu == "ascii",
+              "--vtu must be binary or ascii, found '" << opt.vtu << "'");
+    OutputOptions out;
+    out.vtu = opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
+    const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
+    levels::SolverChoice choice;
+    levels::SolveOptions so = run_solve_options(p, opt, choice);
+    so.progress = opt.quiet ? nullptr : &os;
+    so.progress_eta = opt.progress_eta;
     so.stop = opt.stop;
     std::optional<StepFiles> steps;
     if (opt.every_step || opt.every_level) {

@@ -3,7 +3,10 @@
 /// write the result files.
 #pragma once
 
+#include "levels/problem.hpp"
+#include "levels/solve.hpp"
 #include <atomic>
+
 #include <optional>
 #include <ostream>
 #include <string>
@@ -39,6 +42,17 @@ struct RunOptions {
     /// stop_signal() (apps/interrupt.hpp). Null: never stops.
     const std::atomic<bool>* stop = nullptr;
 };
+
+/// Applies the overrides of `opt` (levels, load steps, mu and r of every pair) to `p`, each checked
+/// as the command line checks it, and validates the result. Throws InvalidInput naming the option.
+void apply_overrides(levels::Problem& p, const RunOptions& opt);
+
+/// The solve options of `mlcontact run` for `p` (after apply_overrides): the Newton-system solver
+/// chosen as the driver chooses it (levels::choose_solver, returned in `choice`), coarse-to-fine
+/// unless opt.cold, no progress stream. The Python module solves with these, so that its numbers
+/// are the driver's.
+levels::SolveOptions run_solve_options(const levels::Problem& p, const RunOptions& opt,
+                                       levels::SolverChoice& choice);
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not
 /// converge (the report says which and how), 130 / 143 when stopped by SIGINT / SIGTERM (see

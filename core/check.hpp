@@ -21,6 +21,13 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// A solve stopped on request (levels::SolveOptions::interrupt_requested), between Newton
+/// iterations; the message says where.
+class Interrupted : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 /// A nonlinear (Newton) solve that did not converge; the message says where and how.
 class ConvergenceFailure : public std::runtime_error {
 public:

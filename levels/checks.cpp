@@ -74,4 +74,17 @@ StateChecks check_state(const Problem& p, const RunResult& r) {
     return c;
 }
 
+Vec2 contact_resultant(const RunResult& r, int pair, int* in_contact) {
+    const auto& L = r.finest();
+    Vec2 f = Vec2::Zero();
+    int closed = 0;
+    for (size_t e = 0; e < L.contacts.size() && e < r.nodes.size(); ++e) {
+        if (L.contacts[e].pair != pair) continue;
+        f -= r.nodes[e].lambda_t * L.contacts[e].t + r.nodes[e].lambda_n * L.contacts[e].n;
+        closed += r.nodes[e].status != contact::Status::gap;
+    }
+    if (in_contact) *in_contact = closed;
+    return f;
+}
+
 } // namespace mlc::levels

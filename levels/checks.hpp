@@ -35,4 +35,9 @@ struct StateChecks {
 /// excess only at nodes in contact and the slip equality only at slipping frictional nodes.
 StateChecks check_state(const Problem& p, const RunResult& r);
 
+/// The resultant force the target exerts on the contactor nodes of contact pair `pair` in the
+/// final state of a run (finest level, global axes): -sum (lambda_t t + lambda_n n) over the pair's
+/// nodes. `in_contact`, if given, receives the number of those nodes not in gap.
+Vec2 contact_resultant(const RunResult& r, int pair, int* in_contact = nullptr);
+
 } // namespace mlc::levels

@@ -103,6 +103,9 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
     std::vector<std::vector<contact::Status>> history; // status vectors of the iterates
     bool damped = false;
     for (int k = 0;; ++k) {
+        if (interrupt_ && interrupt_())
+            throw Interrupted("interrupted before Newton iteration " + std::to_string(k + 1) +
+                              " at load factor " + std::to_string(s));
         double scale = 0.0, norm = 0.0;
         {
             ScopedTimer t(timings_, "newton/residual");

@@ -107,6 +107,9 @@ public:
     /// A flag polled after every Newton iteration: once it is set, solve() returns after the
     /// current iteration with StepReport::stopped (and converged false). Null: never stops.
     void set_stop(const std::atomic<bool>* stop) { stop_ = stop; }
+    /// Polled before every iteration of solve(); true stops it by throwing mlc::Interrupted
+    /// (levels::SolveOptions::interrupt_requested). Empty: never polled.
+    void set_interrupt(std::function<bool()> requested) { interrupt_ = std::move(requested); }
 
 private:
     const Level& level_;
@@ -116,6 +119,7 @@ private:
     std::function<std::unique_ptr<NewtonSystemSolver>()> make_fallback_;
     std::unique_ptr<NewtonSystemSolver> fallback_;
     const std::atomic<bool>* stop_ = nullptr;
+    std::function<bool()> interrupt_;
 };
 
 } // namespace mlc::levels

@@ -150,6 +150,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 return make_schur_system_solver(L);
             });
         }
+        newton[static_cast<size_t>(l)]->set_interrupt(options.interrupt_requested);
     }
 
     std::vector<Vector> x(static_cast<size_t>(n_levels)), u_prev(static_cast<size_t>(n_levels)),
@@ -202,7 +203,13 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 ls.predicted = true;
                 ls.predicted_statuses = nw.statuses(s, u_prev[li], xl);
             }
-            ls.report = nw.solve(s, u_prev[li], x[li]);
+            try {
+                ls.report = nw.solve(s, u_prev[li], x[li]);
+            } catch (const Interrupted& e) {
+                throw Interrupted("load step " + std::to_string(step) + "/" +
+                                  std::to_string(problem.load_steps) + " on level " +
+                                  std::to_string(l) + ": " + e.what());
+            }
             ls.report.step = step;
             ls.final_statuses = nw.statuses(s, u_prev[li], x[li]);
             if (ls.predicted)

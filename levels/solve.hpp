@@ -72,6 +72,11 @@ struct SolveOptions {
     /// predict_level_sizes(problem) when the caller computed it already (it builds level 0);
     /// empty: solve computes it.
     std::vector<LevelSize> predicted_sizes;
+    /// Polled before every Newton iteration on every level; when it returns true the solve stops
+    /// there by throwing mlc::Interrupted naming the level, load step and iteration. Empty: never
+    /// polled. The Python module checks Python's signal handlers here, so that Ctrl-C during
+    /// mlcontact.solve() raises KeyboardInterrupt within one Newton iteration.
+    std::function<bool()> interrupt_requested;
 };
 
 /// Confusion table of predicted (rows) against converged (columns) statuses, indexed by

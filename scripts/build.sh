@@ -6,4 +6,4 @@ bash scripts/deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" > build.log 2>&1 || { cat build.log; exit 1; }
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake --build build -j"$jobs" >> build.log 2>&1 || { tail -n 60 build.log; exit 1; }
-echo "build: ok (log in build.log); driver at build/bin/mlcontact"
+echo "build: ok (log in build.log); driver at build/bin/mlcontact, Python module in build/python (PYTHONPATH=build/python /usr/bin/python3)"

@@ -8,7 +8,8 @@ packages=(
   libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev libsuitesparse-dev
   zlib1g-dev                    # binary (zlib-compressed) VTU output
   python3 python3-matplotlib
-  python3-vtk9 python3-pytest   # tests: VTK's own reader opens our VTU/PVD files
+  python3-vtk9                  # tests: VTK's own reader opens our VTU/PVD files
+  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (python/) and the Python tests
   clang-14 libclang-rt-14-dev   # sanitizer build and libFuzzer (scripts/sanitize.sh, fuzz.sh)
 )
 missing=()

@@ -27,7 +27,7 @@ else
   [ -n "$cxx" ] || { echo "fuzz: clang++ not found (libFuzzer needs clang; install clang-14)"; exit 1; }
   cmake -S . -B "$dir" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
     "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g1 -D_GLIBCXX_ASSERTIONS" -DCGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE=TRUE \
-    -DMLC_SANITIZE=ON -DMLC_BUILD_FUZZ=ON -DMLC_WITH_HYPRE=OFF -DMLC_BUILD_BENCH=OFF \
+    -DMLC_SANITIZE=ON -DMLC_BUILD_FUZZ=ON -DMLC_WITH_HYPRE=OFF -DMLC_BUILD_BENCH=OFF -DMLC_BUILD_PYTHON=OFF \
     -DMLC_BUILD_TESTS=OFF > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; exit 1; }
 fi
 jobs=${MLC_JOBS:-$(nproc 2>/dev/null || echo 2)}

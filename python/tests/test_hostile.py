@@ -1,0 +1,89 @@
+# SPDX-License-Identifier: MIT
+"""Hostile input from Python: every hostile scene of the C++ tests (tests/data/hostile/*.toml, read
+by tests/apps/test_hostile_scene.cpp too, with its "# expect:" line), the bad scenes of
+tests/data and the fuzz seed corpus give a ValueError (or parse, when valid) - in a child process
+with a time limit, so that a crash or a hang fails the test instead of the suite."""
+import glob
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from conftest import DATA, ENV, SOURCE
+
+HOSTILE = sorted(glob.glob(os.path.join(DATA, "hostile", "*.toml")))
+CORPUS = sorted(glob.glob(os.path.join(SOURCE, "tests", "fuzz", "corpus", "scene", "*")))
+
+CHILD = r"""
+import json, sys, time
+import mlcontact
+path, how = sys.argv[1], sys.argv[2]
+t0 = time.monotonic()
+try:
+    if how == "file":
+        s = mlcontact.Scene.from_file(path)
+    else:
+        s = mlcontact.Scene.from_toml(open(path, errors="replace").read(), origin=path)
+    out = {"outcome": "valid", "triangles": s.n_triangles}
+except ValueError as e:
+    out = {"outcome": "ValueError", "message": str(e)}
+except Exception as e:
+    out = {"outcome": type(e).__name__, "message": str(e)}
+out["seconds"] = time.monotonic() - t0
+print(json.dumps(out))
+"""
+
+
+def parse_in_child(path, how):
+    p = subprocess.run([sys.executable, "-c", CHILD, path, how], capture_output=True, text=True,
+                       env=ENV, timeout=60)
+    assert p.returncode == 0, f"the child crashed ({p.returncode}): {p.stderr[-2000:]}"
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def expectation(path):
+    for line in open(path):
+        if line.startswith("# expect: "):
+            what = line[len("# expect: "):].strip()
+            if what.startswith("valid: "):
+                return "valid", int(what[len("valid: "):].split()[0])
+            assert what.startswith("invalid"), line
+            return "invalid", what[len("invalid: "):] if what.startswith("invalid: ") else ""
+    raise AssertionError(f"{path} has no '# expect:' line")
+
+
+def test_the_shared_files_are_there():
+    names = {os.path.basename(p) for p in HOSTILE}
+    assert {"rectangle_too_large.toml", "gmsh_from_a_device.toml", "thin_strip.toml"} <= names
+    assert CORPUS
+
+
+@pytest.mark.parametrize("how", ["file", "toml"])
+@pytest.mark.parametrize("path", HOSTILE, ids=os.path.basename)
+def test_hostile_scene(path, how):
+    kind, detail = expectation(path)
+    out = parse_in_child(path, how)
+    if kind == "valid":
+        assert out["outcome"] == "valid", out
+        assert out["triangles"] == detail
+    else:
+        assert out["outcome"] == "ValueError", out
+        assert detail in out["message"]
+        assert path in out["message"], out["message"]  # names the file
+    assert out["seconds"] < 10
+
+
+def test_bad_poisson_names_nu_file_and_line():
+    path = os.path.join(DATA, "bad_poisson.toml")
+    out = parse_in_child(path, "file")
+    assert out["outcome"] == "ValueError"
+    assert out["message"].startswith(path + ":") and "Poisson's ratio nu must lie in" in out["message"]
+
+
+@pytest.mark.parametrize("path", CORPUS, ids=os.path.basename)
+def test_fuzz_seed_parses_or_is_a_value_error(path):
+    out = parse_in_child(path, "file")
+    assert out["outcome"] in ("valid", "ValueError"), out
+    assert out["seconds"] < 10
