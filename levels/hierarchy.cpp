@@ -19,6 +19,9 @@ transfer::ContactNodes contact_nodes(const Level& level) {
 Hierarchy build_hierarchy(const Problem& problem, transfer::QRule rule, Timings* timings) {
     problem.validate();
     Hierarchy h;
+    // Reserved: growing the vector would copy every level built so far.
+    h.levels.reserve(static_cast<size_t>(problem.levels) + 1);
+    h.transfers.reserve(static_cast<size_t>(problem.levels));
     mesh::Mesh m = problem.mesh0;
     for (int l = 0;; ++l) {
         {

@@ -157,15 +157,19 @@ public:
         // the others by nested dissection. Then P K0 P^T = L L^T with L = [L_ii 0; L_ci L_cc] and,
         // as B only touches c, S = B K0^{-1} B^T = X^T X with X = L_cc^{-1} B_c^T: the
         // factorization gives S without a solve per contact component.
-        std::vector<Triplet> kt;
-        const SparseMatrix& K = level.elastic.K;
-        kt.reserve(static_cast<size_t>(K.nonZeros()));
-        for (int i = 0; i < K.outerSize(); ++i)
-            for (SparseMatrix::InnerIterator it(K, i); it; ++it)
-                kt.emplace_back(u_of_dof_[static_cast<size_t>(i)],
-                                u_of_dof_[static_cast<size_t>(it.col())], it.value());
+        // The temporaries below are freed as soon as the next one is built (the peak memory of
+        // this solver on small levels is theirs as much as the factor's).
         SparseMatrixCol K0(nu, nu);
-        K0.setFromTriplets(kt.begin(), kt.end());
+        {
+            std::vector<Triplet> kt;
+            const SparseMatrix& K = level.elastic.K;
+            kt.reserve(static_cast<size_t>(K.nonZeros()));
+            for (int i = 0; i < K.outerSize(); ++i)
+                for (SparseMatrix::InnerIterator it(K, i); it; ++it)
+                    kt.emplace_back(u_of_dof_[static_cast<size_t>(i)],
+                                    u_of_dof_[static_cast<size_t>(it.col())], it.value());
+            K0.setFromTriplets(kt.begin(), kt.end());
+        }
         Eigen::VectorXd r = Eigen::Map<const Eigen::VectorXd>(rdiag_.data(), m_);
         K0 += SparseMatrixCol(B_.transpose() * r.asDiagonal() * B_);
         std::vector<char> is_c(static_cast<size_t>(nu), 0);
@@ -179,15 +183,20 @@ public:
                 interior.push_back(static_cast<int>(k));
             }
         const Index ni = static_cast<Index>(interior.size());
-        std::vector<Triplet> it_trip;
-        for (int j = 0; j < K0.outerSize(); ++j)
-            for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it)
-                if (local[static_cast<size_t>(it.row())] >= 0 && local[static_cast<size_t>(j)] >= 0)
-                    it_trip.emplace_back(local[static_cast<size_t>(it.row())],
-                                         local[static_cast<size_t>(j)], it.value());
-        SparseMatrixCol Aii(ni, ni);
-        Aii.setFromTriplets(it_trip.begin(), it_trip.end());
-        const std::vector<int> order = solvers::SparseCholesky::fill_reducing_order(Aii);
+        std::vector<int> order;
+        {
+            std::vector<Triplet> it_trip;
+            for (int j = 0; j < K0.outerSize(); ++j)
+                for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it)
+                    if (local[static_cast<size_t>(it.row())] >= 0 &&
+                        local[static_cast<size_t>(j)] >= 0)
+                        it_trip.emplace_back(local[static_cast<size_t>(it.row())],
+                                             local[static_cast<size_t>(j)], it.value());
+            SparseMatrixCol Aii(ni, ni);
+            Aii.setFromTriplets(it_trip.begin(), it_trip.end());
+            std::vector<Triplet>().swap(it_trip);
+            order = solvers::SparseCholesky::fill_reducing_order(Aii);
+        }
         newpos_.assign(static_cast<size_t>(nu), -1);
         for (Index k = 0; k < ni; ++k)
             newpos_[static_cast<size_t>(
@@ -198,23 +207,31 @@ public:
             if (is_c[static_cast<size_t>(k)])
                 newpos_[static_cast<size_t>(k)] = static_cast<int>(next++);
         const Index nc = nu - ni;
-        std::vector<Triplet> pt;
-        pt.reserve(static_cast<size_t>(K0.nonZeros()));
-        for (int j = 0; j < K0.outerSize(); ++j)
-            for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it)
-                pt.emplace_back(newpos_[static_cast<size_t>(it.row())],
-                                newpos_[static_cast<size_t>(j)], it.value());
-        SparseMatrixCol K0p(nu, nu);
-        K0p.setFromTriplets(pt.begin(), pt.end());
-        try {
-            chol_.factor(K0p);
-        } catch (const InvalidInput& e) {
-            throw InvalidInput(
-                std::string("the elastic operator regularized by the contact penalty "
-                            "is singular: some rigid-body motion is held neither by "
-                            "supports nor by the contact candidates (add a support, "
-                            "or widen the contact region); ") +
-                e.what());
+        {
+            // The lower triangle of the permuted K0 only (all the factorization reads).
+            SparseMatrixCol K0p(nu, nu);
+            {
+                std::vector<Triplet> pt;
+                pt.reserve(static_cast<size_t>(K0.nonZeros() / 2 + nu));
+                for (int j = 0; j < K0.outerSize(); ++j)
+                    for (SparseMatrixCol::InnerIterator it(K0, j); it; ++it) {
+                        const int pr = newpos_[static_cast<size_t>(it.row())];
+                        const int pc = newpos_[static_cast<size_t>(j)];
+                        if (pr >= pc) pt.emplace_back(pr, pc, it.value());
+                    }
+                SparseMatrixCol().swap(K0); // frees it (assigning an empty matrix keeps the storage)
+                K0p.setFromTriplets(pt.begin(), pt.end());
+            }
+            try {
+                chol_.factor(K0p);
+            } catch (const InvalidInput& e) {
+                throw InvalidInput(
+                    std::string("the elastic operator regularized by the contact penalty "
+                                "is singular: some rigid-body motion is held neither by "
+                                "supports nor by the contact candidates (add a support, "
+                                "or widen the contact region); ") +
+                    e.what());
+            }
         }
         const Eigen::MatrixXd Lcc = chol_.trailing_block(nc);
         Eigen::MatrixXd X = Eigen::MatrixXd::Zero(nc, m_);

@@ -4,6 +4,7 @@
 
 #include "core/check.hpp"
 
+#include <algorithm>
 #include <cholmod.h>
 #include <cstring>
 
@@ -54,8 +55,19 @@ SparseCholesky::~SparseCholesky() = default;
 
 void SparseCholesky::factor(const SparseMatrixCol& A_in) {
     MLC_CHECK(A_in.rows() == A_in.cols(), "SparseCholesky: matrix is not square");
-    SparseMatrixCol A = A_in.triangularView<Eigen::Lower>();
-    A.makeCompressed();
+    // A compressed lower triangle is viewed as it is (CHOLMOD reads it only); anything else is
+    // copied to one first.
+    bool lower = A_in.isCompressed();
+    for (Index j = 0; lower && j < A_in.outerSize(); ++j) {
+        const int begin = A_in.outerIndexPtr()[j], end = A_in.outerIndexPtr()[j + 1];
+        lower = begin == end || A_in.innerIndexPtr()[begin] >= j;
+    }
+    SparseMatrixCol copy;
+    if (!lower) {
+        copy = A_in.triangularView<Eigen::Lower>();
+        copy.makeCompressed();
+    }
+    SparseMatrixCol& A = lower ? const_cast<SparseMatrixCol&>(A_in) : copy;
     auto& c = impl_->c;
     if (impl_->L) cholmod_free_factor(&impl_->L, &c);
     cholmod_sparse S = lower_view(A, CHOLMOD_REAL);
@@ -87,12 +99,37 @@ void SparseCholesky::solve(const Vector& b, Vector& x) const {
 
 Eigen::MatrixXd SparseCholesky::trailing_block(Index nb) const {
     MLC_CHECK(impl_->L && nb <= impl_->n, "SparseCholesky::trailing_block: bad size");
+    const Index n = impl_->n, first = n - nb;
+    const cholmod_factor* L = impl_->L;
+    if (L->is_super) {
+        // Read the supernodes in place (no copy of the factor): supernode k holds columns
+        // super[k] .. super[k+1]-1, its rows s[pi[k]] .. s[pi[k+1]-1] (the first of them its own
+        // columns), values column by column from px[k]; entries above the diagonal are unused.
+        Eigen::MatrixXd out = Eigen::MatrixXd::Zero(nb, nb);
+        const int* super = static_cast<const int*>(L->super);
+        const int* pi = static_cast<const int*>(L->pi);
+        const int* px = static_cast<const int*>(L->px);
+        const int* rows = static_cast<const int*>(L->s);
+        const double* x = static_cast<const double*>(L->x);
+        for (size_t k = 0; k < L->nsuper; ++k) {
+            const int j0 = super[k], j1 = super[k + 1];
+            if (j1 <= first) continue;
+            const int nr = pi[k + 1] - pi[k];
+            for (int j = std::max<int>(j0, static_cast<int>(first)); j < j1; ++j) {
+                const double* col = x + px[k] + static_cast<size_t>(j - j0) * nr;
+                for (int q = 0; q < nr; ++q) {
+                    const int i = rows[pi[k] + q];
+                    if (i >= j) out(i - first, j - first) = col[q];
+                }
+            }
+        }
+        return out;
+    }
     auto& c = impl_->c;
     cholmod_factor* F = cholmod_copy_factor(impl_->L, &c);
     cholmod_sparse* S = cholmod_factor_to_sparse(F, &c);
     cholmod_free_factor(&F, &c);
     MLC_CHECK(S != nullptr, "CHOLMOD could not convert the factor");
-    const Index n = impl_->n, first = n - nb;
     Eigen::MatrixXd out = Eigen::MatrixXd::Zero(nb, nb);
     const int* p = static_cast<const int*>(S->p);
     const int* i = static_cast<const int*>(S->i);
