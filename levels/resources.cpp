@@ -150,7 +150,7 @@ constexpr double kHierarchyPerUnknown = 104.0;
 constexpr double kKrylovPerNonzero = 24.4;
 constexpr double kKrylovPerUnknown = 130.0;
 constexpr double kLuPerNonzero = 120.0;
-constexpr double kCholeskyPerNonzero = 50.0;
+constexpr double kCholeskyPerNonzero = 20.0;
 
 } // namespace
 
