@@ -52,6 +52,10 @@ int main(int argc, char** argv) {
     run->add_flag("--no-fallback", ro.no_fallback,
                   "a Newton system the Krylov solve fails on ends the run, instead of being "
                   "solved again by the exact schur solver (the default; reported)");
+    run->add_flag("--no-continuation", ro.no_continuation,
+                  "a load step whose Newton fails at the scene's r ends the run, instead of being "
+                  "solved again at r/100 (then r/1e4) with the exact schur solver and finished "
+                  "at r from there (the default; reported)");
     run->add_option("--linear-tol", ro.linear_rel_tol,
                     "relative tolerance of each Krylov solve (implies a Krylov solve; default "
                     "1e-10)");

@@ -428,6 +428,11 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
                 for (const auto& st : ls)
                     fallbacks += st.report.fallback_solves;
             sv.insert("fallback_solves", fallbacks);
+            int continuations = 0;
+            for (const auto& ls : r.level_steps)
+                for (const auto& st : ls)
+                    continuations += st.report.continuation_factor > 0;
+            sv.insert("r_continuations", continuations);
             root.insert("solver", sv);
             if (r.multigrid) {
                 const solvers::MultigridReport& m = *r.multigrid;

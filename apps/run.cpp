@@ -52,6 +52,7 @@ levels::SolveOptions run_solve_options(const levels::Problem& p, const RunOption
               "--no-fallback applies to Krylov solves only; the solver of this run is "
                   << choice.spec.method << " (" << choice.reason << ")");
     so.exact_fallback = !opt.no_fallback;
+    so.r_continuation = !opt.no_continuation;
     return so;
 }
 
@@ -96,6 +97,11 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
                << " Newton system(s) solved again by the exact schur solver after the Krylov "
                   "solve failed (first: "
                << first << ")\n";
+        for (const auto& ls : r.level_steps)
+            for (const auto& st : ls)
+                if (st.report.continuation_factor > 0)
+                    os << "r continuation: level " << st.level << ", load step "
+                       << st.report.step << ": " << st.report.continuation_note << "\n";
     }
     os << "\n";
     print_header(os, p, r);

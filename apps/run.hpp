@@ -32,6 +32,9 @@ struct RunOptions {
     /// No exact fallback: a Newton system the Krylov solve fails on ends the run (exit 2/3)
     /// instead of being solved again by the exact schur solver.
     bool no_fallback = false;
+    /// No r continuation (levels::SolveOptions::r_continuation): a load step whose Newton fails
+    /// at the scene's r ends the run (exit 2) instead of being solved again through a reduced r.
+    bool no_continuation = false;
     std::string vtu = "binary"; ///< VTU encoding: binary (zlib, appended) or ascii
     bool every_step = false;    ///< a VTU per load step of the finest level + solution.pvd
     bool every_level = false;   ///< also a VTU series + collection per coarser level

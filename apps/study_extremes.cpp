@@ -50,12 +50,15 @@ Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec&
     levels::SolveOptions so;
     so.linear = solver;
     so.exact_fallback = true; // as `mlcontact run` does
+    so.r_continuation = true;
     const auto r = levels::solve(p, so);
     f["seconds"] = num(wall_seconds() - t0);
-    int newton = 0, krylov = 0, cycling = -1, krylov_systems = 0, fallbacks = 0;
+    int newton = 0, krylov = 0, cycling = -1, krylov_systems = 0, fallbacks = 0,
+        continuations = 0;
     for (const auto& ls : r.level_steps)
         for (const auto& st : ls) {
             fallbacks += st.report.fallback_solves;
+            continuations += st.report.continuation_factor > 0;
             newton += st.report.iterations;
             krylov += st.report.linear_iterations;
             krylov_systems += static_cast<int>(st.report.linear_iterations_per_newton.size());
@@ -68,6 +71,7 @@ Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec&
         f["krylov_per_newton"] = num(static_cast<double>(krylov) / krylov_systems);
     if (cycling >= 0) f["cycling"] = "damped";
     if (fallbacks > 0) f["fallbacks"] = std::to_string(fallbacks);
+    if (continuations > 0) f["continuations"] = std::to_string(continuations);
     if (!r.converged) {
         f["status"] = "no conv";
         f["diagnosis"] = r.failure;
@@ -246,6 +250,7 @@ mu = 0.3
                       levels::SolveOptions so;
                       so.linear = solver;
                       so.exact_fallback = true;
+                      so.r_continuation = true;
                       const auto a = levels::solve(mm, so);
                       const auto b = levels::solve(si, so);
                       Fields f;
@@ -406,6 +411,9 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
             if (f.count("fallbacks"))
                 notes += (notes.empty() ? "" : "; ") + f["fallbacks"] +
                          " Newton system(s) solved by the exact fallback";
+            if (f.count("continuations"))
+                notes += (notes.empty() ? "" : "; ") + f["continuations"] +
+                         " level step(s) recovered by r continuation";
             if (f.count("unit_diff_u"))
                 notes += "rel. diff u " + f["unit_diff_u"] + ", lambda " + f["unit_diff_lambda"];
             os << std::left << std::setw(26) << c.name << std::setw(11) << get("status")

@@ -45,6 +45,15 @@ struct StepReport {
     /// (ContactNewton::set_fallback), and why the first of them failed.
     int fallback_solves = 0;
     std::string fallback_reason;
+    /// r continuation (SolveOptions::r_continuation): when Newton failed at the scene's r, the
+    /// step was solved again from the same initial guess at continuation_factor * r with the
+    /// exact schur solver, and Newton at the scene's r was restarted from that solution (the
+    /// discrete contact solution does not depend on r; the convergence test is the one at the
+    /// scene's r). 0: not used. `iterations` counts every Newton iteration of the step, those of
+    /// the failed attempt and of the reduced r included; continuation_iterations the latter two.
+    double continuation_factor = 0.0;
+    int continuation_iterations = 0;
+    std::string continuation_note; ///< what failed at r and what the continuation did
     double seconds = 0.0;
     std::string message;  ///< diagnosis when not converged
     bool stopped = false; ///< stopped on request (ContactNewton::set_stop), not converged
@@ -93,6 +102,8 @@ public:
                     double* scale) const;
 
     const Level& level() const { return level_; }
+    /// Hands the Newton-system solver back (this object cannot solve afterwards).
+    std::unique_ptr<NewtonSystemSolver> release_solver() { return std::move(solver_); }
 
     /// A fallback for the Newton systems the solver fails on (a Krylov solve that neither
     /// converged nor reduced the residual by half, or a numerical breakdown): `make` builds it on

@@ -86,6 +86,119 @@ double time_left(const std::vector<Level>& levels, int first, int level, int ste
     return left + (n_steps - step) * all;
 }
 
+/// Multiplies the augmentation parameter of every contact element of a level by `factor` for
+/// its lifetime, and restores the exact values after.
+class ScaledAugmentation {
+public:
+    ScaledAugmentation(Level& L, double factor) : L_(L) {
+        r_.reserve(L.contacts.size());
+        for (auto& e : L.contacts) {
+            r_.push_back(e.r);
+            e.r *= factor;
+        }
+    }
+    ~ScaledAugmentation() {
+        for (size_t e = 0; e < r_.size(); ++e)
+            L_.contacts[e].r = r_[e];
+    }
+    ScaledAugmentation(const ScaledAugmentation&) = delete;
+    ScaledAugmentation& operator=(const ScaledAugmentation&) = delete;
+
+private:
+    Level& L_;
+    std::vector<double> r_;
+};
+
+/// SolveOptions::r_continuation: `failed` is the report of Newton at the scene's r from x0 on
+/// level L (index l), or an empty report (no iteration) when an earlier step of the level
+/// needed the continuation at `first_factor` (tried first; 0: start at 1e-2). Returns the report of the recovered step (x updated) or `failed` with
+/// what was tried appended to its message (x unchanged).
+StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonParams& params,
+                         ContactNewton& nw, double s, const Vector& u_prev, const Vector& x0,
+                         Vector& x, StepReport failed, double first_factor,
+                         std::unique_ptr<NewtonSystemSolver>& kept, const SolveOptions& options,
+                         Timings* timings) {
+    int spent = failed.iterations;
+    std::ostringstream tried;
+    std::vector<double> factors;
+    for (const double f : {1e-2, 1e-4})
+        if (first_factor <= 0 || f <= first_factor) factors.push_back(f);
+    for (const double factor : factors) {
+        const double need = estimate_memory({size}, LinearSolverSpec{}, false).solver_bytes;
+        const MemoryLimit limit = process_memory_limit();
+        const double free = limit.bytes - peak_rss_bytes();
+        const bool reuse = kept && factor == first_factor;
+        if (!reuse && need >= free) {
+            tried << "; no r continuation: the exact schur solver of level " << l
+                  << " needs an estimated " << format_bytes(need) << ", more than the "
+                  << format_bytes(free) << " left (" << limit.source << ")";
+            break;
+        }
+        Vector xc = x0;
+        StepReport low;
+        {
+            ScopedTimer t(timings, "newton/r_continuation");
+            ScaledAugmentation scaled(L, factor);
+            // The schur solver of the scaled level (its factorization holds r) is kept for the
+            // later steps of the level, which start at the same factor.
+            if (!reuse) kept = make_schur_system_solver(L);
+            ContactNewton cn(L, params, std::move(kept), timings);
+            cn.set_stop(options.stop);
+            cn.set_interrupt(options.interrupt_requested);
+            low = cn.solve(s, u_prev, xc);
+            kept = cn.release_solver();
+        }
+        spent += low.iterations;
+        if (low.stopped) {
+            low.iterations = spent;
+            return low;
+        }
+        if (!low.converged) {
+            tried << "; at " << factor << " r (schur) from the same initial guess: "
+                  << low.message;
+            continue;
+        }
+        const int low_iterations = low.iterations;
+        Vector xf = xc;
+        StepReport fin = nw.solve(s, u_prev, xf);
+        spent += fin.iterations;
+        if (fin.stopped) {
+            fin.iterations = spent;
+            return fin;
+        }
+        if (!fin.converged) {
+            tried << "; at " << factor << " r: converged in " << low_iterations
+                  << " Newton iterations, then at r from there: " << fin.message;
+            continue;
+        }
+        std::ostringstream note;
+        if (failed.iterations > 0)
+            note << "Newton at r failed (" << failed.message << "); ";
+        else
+            note << "r continuation " << failed.message << ": ";
+        note << "solved at " << factor
+             << " r by schur in " << low_iterations << " Newton iterations, then at r in "
+             << fin.iterations;
+        fin.continuation_factor = factor;
+        fin.continuation_iterations = spent - fin.iterations;
+        fin.continuation_note = note.str();
+        fin.iterations = spent;
+        fin.linear_iterations += failed.linear_iterations;
+        fin.linear_seconds += failed.linear_seconds + low.linear_seconds;
+        fin.linear_setup_seconds += failed.linear_setup_seconds + low.linear_setup_seconds;
+        fin.linear_assembly_seconds +=
+            failed.linear_assembly_seconds + low.linear_assembly_seconds;
+        fin.fallback_solves += failed.fallback_solves;
+        if (fin.fallback_reason.empty()) fin.fallback_reason = failed.fallback_reason;
+        fin.seconds += failed.seconds + low.seconds;
+        x = xf;
+        return fin;
+    }
+    failed.iterations = spent;
+    failed.message += tried.str();
+    return failed;
+}
+
 } // namespace
 
 RunResult solve(const Problem& problem, const SolveOptions& options) {
@@ -169,6 +282,10 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     const double t_start = wall_seconds();
     std::vector<double> level_seconds(static_cast<size_t>(n_levels), 0.0);
     std::vector<int> level_count(static_cast<size_t>(n_levels), 0);
+    // SolveOptions::r_continuation: the factor that worked on each level (0: not needed yet).
+    std::vector<double> continued(static_cast<size_t>(n_levels), 0.0);
+    std::vector<std::unique_ptr<NewtonSystemSolver>> continuation_solver(
+        static_cast<size_t>(n_levels));
     for (int step = 1; step <= problem.load_steps && res.converged; ++step) {
         const double s = static_cast<double>(step) / problem.load_steps;
         for (int l = first; l < n_levels; ++l) {
@@ -204,7 +321,26 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 ls.predicted_statuses = nw.statuses(s, u_prev[li], xl);
             }
             try {
-                ls.report = nw.solve(s, u_prev[li], x[li]);
+                const Vector x0 = options.r_continuation ? x[li] : Vector();
+                if (continued[li] > 0) {
+                    // Newton at r failed on this level in an earlier step: straight to the
+                    // continuation (a failed attempt at r would only cost).
+                    ls.report = StepReport{};
+                    ls.report.load_factor = s;
+                    ls.report.message = "as in an earlier load step of this level";
+                } else {
+                    ls.report = nw.solve(s, u_prev[li], x[li]);
+                }
+                if (options.r_continuation && !ls.report.converged && !ls.report.stopped &&
+                    !L.contacts.empty()) {
+                    x[li] = x0;
+                    ls.report = continue_in_r(res.hierarchy.levels[li], l,
+                                              res.predicted_sizes[li], problem.newton, nw, s,
+                                              u_prev[li], x0, x[li], std::move(ls.report),
+                                              continued[li], continuation_solver[li], options,
+                                              &res.timings);
+                    continued[li] = ls.report.continuation_factor;
+                }
             } catch (const Interrupted& e) {
                 throw Interrupted("load step " + std::to_string(step) + "/" +
                                   std::to_string(problem.load_steps) + " on level " +

@@ -69,6 +69,15 @@ struct SolveOptions {
     /// The driver (`mlcontact run`, `study extremes`) turns it on; studies that measure the
     /// preconditioners themselves leave it off.
     bool exact_fallback = false;
+    /// A load step whose Newton fails at the scene's r on some level (status cycling, as at
+    /// r = 1e4 E, where the generalized Newton method is only locally convergent) is solved again
+    /// from the same initial guess with r reduced by 100 (then 1e4) on that level, with the
+    /// exact `schur` solver (built for it when it fits in memory, then freed), and Newton at the
+    /// scene's r restarts from that solution with the level's own solver. The answer is the one
+    /// at the scene's r: the discrete contact solution does not depend on r, and the step must
+    /// pass the Newton test at the scene's r. Reported in StepReport::continuation_*. The driver
+    /// (`mlcontact run`, `study extremes`, the Python module) turns it on.
+    bool r_continuation = false;
     /// predict_level_sizes(problem) when the caller computed it already (it builds level 0);
     /// empty: solve computes it.
     std::vector<LevelSize> predicted_sizes;

@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: MIT
+// SolveOptions::r_continuation: at a very large augmentation parameter the generalized Newton
+// method cycles over statuses (it is only locally convergent); the step is solved at a reduced r
+// and finished at the scene's r. The discrete contact solution does not depend on r, so the
+// answer must be the one of the default r = 0.1 E.
+#include "levels/solve.hpp"
+#include "scene/scene.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace mlc;
+using namespace mlc::levels;
+
+namespace {
+
+Problem square_with_r(double r_over_E, int levels) {
+    auto p = scene::load_scene("square");
+    p.levels = levels;
+    for (auto& c : p.contacts)
+        c.r = r_over_E * p.bodies[0].material.E;
+    return p;
+}
+
+double max_lambda_difference(const RunResult& a, const RunResult& b) {
+    double d = 0.0, m = 0.0;
+    for (size_t i = 0; i < a.nodes.size(); ++i) {
+        d = std::max({d, std::abs(a.nodes[i].lambda_n - b.nodes[i].lambda_n),
+                      std::abs(a.nodes[i].lambda_t - b.nodes[i].lambda_t)});
+        m = std::max(m, std::abs(b.nodes[i].lambda_n));
+    }
+    return d / m;
+}
+
+} // namespace
+
+TEST(RContinuation, RecoversTheStepThatCyclesAtHugeR) {
+    // Level 0 of the square at r = 1e5 E: Newton cycles in load step 2 (measured: the relative
+    // residual stalls near 1.6e-2 after 50 iterations).
+    const Problem p = square_with_r(1e5, 0);
+    const RunResult fails = solve(p, {});
+    ASSERT_FALSE(fails.converged);
+    EXPECT_NE(fails.failure.find("load step 2"), std::string::npos) << fails.failure;
+
+    SolveOptions so;
+    so.r_continuation = true;
+    const RunResult r = solve(p, so);
+    ASSERT_TRUE(r.converged) << r.failure;
+    // Step 1 converges at r as before, untouched; step 2 needs the continuation, and the later
+    // steps go straight to it at the factor that worked.
+    EXPECT_EQ(r.steps[0].continuation_factor, 0.0);
+    EXPECT_EQ(r.steps[0].iterations, fails.steps[0].iterations);
+    ASSERT_GT(r.steps[1].continuation_factor, 0.0);
+    EXPECT_LE(r.steps[1].continuation_factor, 1e-2);
+    EXPECT_NE(r.steps[1].continuation_note.find("Newton at r failed"), std::string::npos)
+        << r.steps[1].continuation_note;
+    for (size_t k = 2; k < r.steps.size(); ++k)
+        EXPECT_EQ(r.steps[k].continuation_factor, r.steps[1].continuation_factor);
+    // Every step passed the Newton test at the scene's r.
+    for (const auto& st : r.steps)
+        EXPECT_LE(st.residuals.back(), p.newton.rel_tol);
+
+    // The same answer as the default r = 0.1 E, where Newton converges directly.
+    const RunResult ref = solve(square_with_r(0.1, 0), {});
+    ASSERT_TRUE(ref.converged) << ref.failure;
+    EXPECT_LT((r.u_full - ref.u_full).norm(), 1e-8 * ref.u_full.norm());
+    EXPECT_LT(max_lambda_difference(r, ref), 1e-8);
+    for (size_t i = 0; i < r.nodes.size(); ++i)
+        EXPECT_EQ(r.nodes[i].status, ref.nodes[i].status) << "contact node " << i;
+}
+
+TEST(RContinuation, CoarseToFineWithTheMultigridAtHugeR) {
+    // Coarse-to-fine to level 1 with CGS + mg: the continuation runs on level 0 (exact solves)
+    // and leaves the Krylov solves of level 1 at the scene's r.
+    const Problem p = square_with_r(1e5, 1);
+    SolveOptions so;
+    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg"};
+    so.exact_fallback = true;
+    so.r_continuation = true;
+    const RunResult r = solve(p, so);
+    ASSERT_TRUE(r.converged) << r.failure;
+    int continued = 0;
+    for (const auto& ls : r.level_steps)
+        for (const auto& st : ls)
+            continued += st.report.continuation_factor > 0;
+    EXPECT_GT(continued, 0);
+    SolveOptions ref_options;
+    ref_options.linear = so.linear;
+    const RunResult ref = solve(square_with_r(0.1, 1), ref_options);
+    ASSERT_TRUE(ref.converged) << ref.failure;
+    EXPECT_LT((r.u_full - ref.u_full).norm(), 1e-8 * ref.u_full.norm());
+    EXPECT_LT(max_lambda_difference(r, ref), 1e-8);
+}
+
+TEST(RContinuation, ChangesNothingWhereNewtonConverges) {
+    // The ordinary square: bit for bit the run without the option.
+    auto p = scene::load_scene("square");
+    p.levels = 2;
+    SolveOptions plain;
+    plain.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg"};
+    SolveOptions with = plain;
+    with.r_continuation = true;
+    const RunResult a = solve(p, plain), b = solve(p, with);
+    ASSERT_TRUE(a.converged && b.converged);
+    EXPECT_EQ(a.x, b.x);
+    for (size_t l = 0; l < a.level_steps.size(); ++l)
+        for (size_t k = 0; k < a.level_steps[l].size(); ++k) {
+            EXPECT_EQ(a.level_steps[l][k].report.iterations, b.level_steps[l][k].report.iterations);
+            EXPECT_EQ(b.level_steps[l][k].report.continuation_factor, 0.0);
+        }
+}
