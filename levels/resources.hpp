@@ -37,9 +37,11 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem);
 /// than the exact `schur` (measured, see the README: "Choosing the Newton-system solver"): with
 /// rigid obstacles only, mg is faster and smaller from the first refined level of the built-in
 /// scenes on (2 208 unknowns on the square); with a two-body pair (node on facet or node on
-/// node) mg needs about twice as many Krylov iterations and overtakes schur near 50 000.
+/// node) mg needs about twice as many Krylov iterations and overtakes schur between dovetail
+/// levels 2 and 3 (56 181 and 222 373 unknowns), where schur also stays within 1.15x of mg's
+/// memory below.
 inline constexpr double kMgCrossoverOneBody = 2000;
-inline constexpr double kMgCrossoverTwoBody = 50000;
+inline constexpr double kMgCrossoverTwoBody = 100000;
 
 /// The crossover that applies to `problem` (two-body pairs or not).
 double mg_crossover_unknowns(const Problem& problem);
@@ -62,7 +64,8 @@ struct SolverChoice {
 /// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
 /// without `pc` uses `mg` where a level below exists (problem.levels >= 1) and `ilu:0` on a
 /// single level; nothing at all chooses by size: `schur` up to mg_crossover_unknowns(problem)
-/// unknowns on the finest level, Krylov (CGS) + `mg` above it when levels exist. A Krylov
+/// unknowns on the finest level, Krylov + `mg` above it when levels exist (CGS; BiCGStab with a
+/// two-body pair, where it needs fewer V-cycles). A Krylov
 /// option next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying
 /// so.
 /// `sizes`: predict_level_sizes(problem) when the caller has it already (it builds level 0).

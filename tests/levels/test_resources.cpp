@@ -106,7 +106,7 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
         }
     }
     // Rigid obstacles: mg from the first refined level (square: 2 208 unknowns); two bodies
-    // (dovetail: 14 341 and 56 181 unknowns on levels 1 and 2): from level 2.
+    // (dovetail: 56 181 and 222 373 unknowns on levels 2 and 3): from level 3.
     auto sq = scene::load_scene("square");
     EXPECT_EQ(levels::mg_crossover_unknowns(sq), levels::kMgCrossoverOneBody);
     sq.levels = 0;
@@ -115,10 +115,14 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.pc, "mg");
     auto dt = scene::load_scene("dovetail");
     EXPECT_EQ(levels::mg_crossover_unknowns(dt), levels::kMgCrossoverTwoBody);
-    dt.levels = 1;
-    EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
     dt.levels = 2;
+    EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
+    dt.levels = 3;
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg");
+    // With a two-body pair the Krylov method is BiCGStab (fewer V-cycles there), else CGS.
+    EXPECT_EQ(levels::choose_solver(dt, {}).spec.krylov, "bicgstab");
+    sq.levels = 3;
+    EXPECT_EQ(levels::choose_solver(sq, {}).spec.krylov, "cgs");
 }
 
 TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
