@@ -56,6 +56,7 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     L.path_u_fixed.assign(static_cast<size_t>(K), Vector::Zero(2 * nv));
     const double diam = mesh.diameter();
     for (const auto& s : problem.supports) {
+        if (!s.active_in(1)) continue; // released in step 1 (Problem::at_step gives later steps)
         std::vector<int> verts;
         if (s.point) {
             const int v = mesh.nearest_vertex(*s.point);
@@ -66,7 +67,7 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
                                                           << d << ")");
             verts.push_back(v);
         } else {
-            verts = mesh.vertices_with_tag(mesh.tag(s.tag));
+            verts = mesh.vertices_on_tag(mesh.tag(s.tag)); // boundary edges and interior lines
         }
         for (int v : verts)
             for (int c = 0; c < 2; ++c) {

@@ -84,8 +84,29 @@ void Problem::validate() const {
                   where << ": ux must equal the last entry of ux_path");
         MLC_CHECK(s.uy_path.empty() || (s.uy && *s.uy == s.uy_path.back()),
                   where << ": uy must equal the last entry of uy_path");
+        MLC_CHECK(s.active.empty() || static_cast<int>(s.active.size()) == load_steps,
+                  where << ": active has " << s.active.size() << " entries but there are "
+                        << load_steps << " load steps; give one per load step");
     }
     newton.validate();
+}
+
+Problem Problem::at_step(int step) const {
+    MLC_CHECK(step >= 1 && step <= load_steps,
+              "load step " << step << " out of range 1.." << load_steps);
+    Problem p = *this;
+    p.supports.clear();
+    for (const auto& s : supports)
+        if (s.active_in(step)) {
+            p.supports.push_back(s);
+            p.supports.back().active.clear();
+        }
+    return p;
+}
+
+bool Problem::same_supports(int a, int b) const {
+    return std::all_of(supports.begin(), supports.end(),
+                       [&](const Support& s) { return s.active_in(a) == s.active_in(b); });
 }
 
 int Problem::n_path_points() const {
