@@ -56,7 +56,8 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     L.path_u_fixed.assign(static_cast<size_t>(K), Vector::Zero(2 * nv));
     const double diam = mesh.diameter();
     for (const auto& s : problem.supports) {
-        if (!s.active_in(1)) continue; // released in step 1 (Problem::at_step gives later steps)
+        // Released in step 1: not held (Problem::at_step gives the problem of a later step).
+        if (!problem.support_active(s, 1)) continue;
         std::vector<int> verts;
         if (s.point) {
             const int v = mesh.nearest_vertex(*s.point);

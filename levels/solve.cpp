@@ -197,7 +197,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 nw.reset(); // they refer to the levels about to be replaced
             {
                 ScopedTimer t(&res.timings, "setup/supports_changed");
-                res.hierarchy = build_hierarchy(problem.at_step(step), options.q_rule, &res.timings);
+                res.hierarchy =
+                    build_hierarchy(problem.at_step(step), options.q_rule, &res.timings);
             }
             MLC_CHECK(res.hierarchy.n_levels() == n_levels,
                       "internal error: the rebuilt hierarchy has another number of levels");
@@ -209,10 +210,12 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 x[li] = Vector::Zero(L.n_unknowns());
                 for (int v = 0; v < L.mesh.n_vertices(); ++v)
                     for (int c = 0; c < 2; ++c)
-                        if (const int d = L.dofs.u_dof(v, c); d >= 0) x[li][d] = u_prev[li][2 * v + c];
+                        if (const int d = L.dofs.u_dof(v, c); d >= 0)
+                            x[li][d] = u_prev[li][2 * v + c];
                 for (const auto& [v, lam] : lambda[li]) {
                     const int e = L.contact_of_vertex[static_cast<size_t>(v)];
-                    if (e >= 0 && L.contacts[static_cast<size_t>(e)].n_multipliers() == static_cast<int>(lam.size()))
+                    if (e >= 0 && L.contacts[static_cast<size_t>(e)].n_multipliers() ==
+                                      static_cast<int>(lam.size()))
                         x[li].segment(L.lambda_dof[static_cast<size_t>(e)], lam.size()) = lam;
                 }
             }

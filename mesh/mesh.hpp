@@ -97,8 +97,8 @@ void check_quality(const Mesh& m);
 void check_refined_quality(const Mesh& m);
 
 /// Uniform refinement: every triangle split into four by its edge midpoints. Boundary edges and
-/// interior lines are split in two with the tag and curve inherited; a midpoint on a circular boundary edge is moved
-/// onto the circle. Coarse vertex indices are kept; `parents` is filled.
+/// interior lines are split in two with the tag and curve inherited; a midpoint on a circular
+/// boundary edge is moved onto the circle. Coarse vertex indices are kept; `parents` is filled.
 Mesh refine(const Mesh& coarse);
 
 /// The vertices in the order of a Hilbert curve through their bounding box (2^16 cells a side;

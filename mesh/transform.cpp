@@ -55,8 +55,8 @@ Mesh mirror_about_x(const Mesh& h, double x0) {
     for (const auto& e : h.lines) {
         m.lines.push_back(e);
         if (!(on(e.v0) && on(e.v1)))
-            m.lines.push_back({image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)],
-                               e.tag, -1});
+            m.lines.push_back(
+                {image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)], e.tag, -1});
     }
     check_quality(m);
     return m;

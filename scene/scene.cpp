@@ -253,10 +253,11 @@ void apply_arcs(const Reader& rd, const toml::table& t, const std::string& where
             std::string known;
             for (const auto& [name, k] : m.tag_names)
                 if (m.is_boundary_tag(k)) known += (known.empty() ? "" : ", ") + name;
-            rd.fail(at.get("tag"), w + ".tag: the mesh has no boundary tag '" + tag +
-                                       "' (it has: " + known + ")");
+            rd.fail(at.get("tag"),
+                    w + ".tag: the mesh has no boundary tag '" + tag + "' (it has: " + known + ")");
         }
-        if (!seen.insert(tag).second) rd.fail(at.get("tag"), w + ".tag '" + tag + "' is declared twice");
+        if (!seen.insert(tag).second)
+            rd.fail(at.get("tag"), w + ".tag '" + tag + "' is declared twice");
         // Every vertex of the tagged edges must lie on the circle (the mesher put it there).
         const double tol = 1e-6 * radius;
         for (int v : m.vertices_with_tag(*id)) {
@@ -337,7 +338,7 @@ mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::s
 #ifdef MLC_HAVE_CGAL
         rd.check_keys(t,
                       {"type", "max_size", "min_size", "focus", "grading", "loop", "mirror_x",
-                       "transform"},
+                       "transform", "lines"},
                       where);
         mesh::SizeField sf;
         sf.max_size = rd.number(t, "max_size", where);
@@ -347,9 +348,17 @@ mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::s
             const toml::array* fa = f->as_array();
             if (!fa) rd.fail(f, where + ".focus must be an array of points");
             // Focus points are global (after the transform): back to the domain's own frame.
-            for (const auto& p : *fa)
-                sf.focus.push_back(motion ? motion->inverse(rd.vec2(&p, where + ".focus[]"))
-                                          : rd.vec2(&p, where + ".focus[]"));
+            // With mirror_x the half is meshed and reflected: it is refined toward a focus
+            // point and toward the point's image, which keeps the mesh mirror-symmetric.
+            for (const auto& p : *fa) {
+                const Vec2 q = motion ? motion->inverse(rd.vec2(&p, where + ".focus[]"))
+                                      : rd.vec2(&p, where + ".focus[]");
+                sf.focus.push_back(q);
+                if (const toml::node* mx = t.get("mirror_x"); mx && motion) {
+                    const double x0 = rd.number(mx, where + ".mirror_x");
+                    if (q.x() != x0) sf.focus.emplace_back(2.0 * x0 - q.x(), q.y());
+                }
+            }
         }
         std::vector<std::vector<mesh::Segment>> loops;
         const auto loop_tables = rd.tables(t, "loop", where);
@@ -367,12 +376,31 @@ mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::s
             }
             loops.push_back(std::move(loop));
         }
+        // Constrained interior segments, in the domain's own frame like the loops.
+        std::vector<mesh::Segment> lines;
+        if (const toml::node* ln = t.get("lines")) {
+            const toml::array* la = ln->as_array();
+            if (!la || la->empty())
+                rd.fail(ln, where + ".lines must be a non-empty array of tables { from, to, tag }");
+            for (size_t j = 0; j < la->size(); ++j) {
+                const std::string lw = where + ".lines[" + std::to_string(j) + "]";
+                const toml::table& lt = rd.table(la->get(j), lw);
+                rd.check_keys(lt, {"from", "to", "tag"}, lw);
+                lines.push_back(mesh::Segment::line(rd.vec2(lt, "from", lw), rd.vec2(lt, "to", lw),
+                                                    rd.string(lt, "tag", lw)));
+                if (lines.back().tag.empty()) rd.fail(lt.get("tag"), lw + ".tag is empty");
+            }
+        }
+        const toml::node* where_lines = t.get("lines")      ? t.get("lines")
+                                        : t.get("mirror_x") ? t.get("mirror_x")
+                                                            : &t;
         if (const toml::node* mx = t.get("mirror_x")) {
             const double x0 = rd.number(mx, where + ".mirror_x");
-            return at(rd, mx,
-                      [&] { return mesh::mirror_about_x(mesh::mesh_domain(loops, sf), x0); });
+            const mesh::Mesh half =
+                at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines); });
+            return at(rd, mx, [&] { return mesh::mirror_about_x(half, x0); });
         }
-        return at(rd, &t, [&] { return mesh::mesh_domain(loops, sf); });
+        return at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines); });
 #else
         rd.fail(&t, where + ": type \"domain\" needs CGAL (this build has MLC_WITH_CGAL=OFF)");
 #endif
@@ -521,6 +549,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         if (const toml::node* fn = lt->get("factors")) ld.factors = rd.numbers(fn, w + ".factors");
         p.loads.push_back(ld);
     }
+    std::vector<std::pair<size_t, const toml::node*>> active_nodes; // support index, its node
     for (const toml::table* st : rd.tables(root, "support", "the scene")) {
         const std::string w = "[[support]]";
         rd.check_keys(*st, {"tag", "point", "ux", "uy", "active"}, w);
@@ -551,23 +580,31 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         }
         if (!s.ux && !s.uy) rd.fail(st, w + " fixes nothing: give ux and/or uy");
         if (const toml::node* an = st->get("active")) {
-            // Per load step: true holds the support in that step, false releases it.
+            // Per point of the loading path: true holds the support there, false releases it.
             const toml::array* a = an->as_array();
-            if (!a)
-                rd.fail(an, w + ".active must be an array of true/false, one per load step");
-            if (static_cast<int>(a->size()) != p.load_steps)
-                rd.fail(an, w + ".active has " + std::to_string(a->size()) +
-                                " entries but [scene].load_steps = " +
-                                std::to_string(p.load_steps) + "; give one per load step");
+            if (!a || a->empty())
+                rd.fail(an, w + ".active must be an array of true/false, one per point of the "
+                                "loading path (per load step when load_steps is their number)");
+            active_nodes.emplace_back(p.supports.size(), an);
             for (size_t k = 0; k < a->size(); ++k) {
                 const auto b = a->get(k)->value_exact<bool>();
                 if (!b)
-                    rd.fail(a->get(k), w + ".active[" + std::to_string(k) +
-                                           "] must be true or false");
+                    rd.fail(a->get(k),
+                            w + ".active[" + std::to_string(k) + "] must be true or false");
                 s.active.push_back(*b);
             }
         }
         p.supports.push_back(s);
+    }
+    // Every per-point list has the length K of the loading path; name the `active` that differs.
+    for (const auto& [i, an] : active_nodes) {
+        const int K = p.n_path_points();
+        const size_t n = p.supports[i].active.size();
+        if (static_cast<int>(n) != K)
+            rd.fail(an, "[[support]].active has " + std::to_string(n) +
+                            " entries but the loading path has " + std::to_string(K) +
+                            " points (the length of the scene's other per-step lists: factors, "
+                            "ux/uy lists, active); give one per point");
     }
     // Default augmentation: r = r_over_E x the smallest Young's modulus of the scene. The softer
     // body governs the compliance of a contact pair; scaling r with the stiffer one makes r many
