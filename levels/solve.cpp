@@ -182,8 +182,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         if (!problem.same_supports(step, phase_step)) {
             // New supports: rebuild, then carry the state over. Displacements through the nodal
             // values at the end of the previous step (u_prev, every component, prescribed or
-            // not), multipliers by contactor vertex (a vertex that was fully fixed before has none
-            // yet: 0).
+            // not), multipliers by contactor vertex.
             std::vector<std::vector<std::pair<int, Vector>>> lambda(static_cast<size_t>(n_levels));
             for (int l = first; l < n_levels; ++l) {
                 const Level& L = levels[static_cast<size_t>(l)];
@@ -197,11 +196,49 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 nw.reset(); // they refer to the levels about to be replaced
             {
                 ScopedTimer t(&res.timings, "setup/supports_changed");
-                res.hierarchy =
-                    build_hierarchy(problem.at_step(step), options.q_rule, &res.timings);
+                try {
+                    res.hierarchy =
+                        build_hierarchy(problem.at_step(step), options.q_rule, &res.timings);
+                } catch (const InvalidInput& e) {
+                    throw InvalidInput("load step " + std::to_string(step) +
+                                       ", with the supports active from this step on: " + e.what());
+                }
             }
             MLC_CHECK(res.hierarchy.n_levels() == n_levels,
                       "internal error: the rebuilt hierarchy has another number of levels");
+            // The contact nodes must stay those of the first step: the per-step states
+            // (step_nodes, contact_steps.csv) are read with the final level's contact elements.
+            // They change only when a support fully fixes or frees a contactor vertex.
+            for (int l = first; l < n_levels; ++l) {
+                const Level& L = levels[static_cast<size_t>(l)];
+                const auto& old = lambda[static_cast<size_t>(l)];
+                bool same = old.size() == L.contacts.size();
+                for (size_t e = 0; same && e < old.size(); ++e)
+                    same = old[e].first == L.contacts[e].vertex[0];
+                if (same) continue;
+                // A vertex that is no longer a contact node (now fully fixed), or a new one.
+                std::vector<char> was(static_cast<size_t>(L.mesh.n_vertices()), 0);
+                for (const auto& o : old)
+                    was[static_cast<size_t>(o.first)] = 1;
+                int v = -1;
+                bool fixed = false;
+                for (const auto& o : old)
+                    if (v < 0 && L.contact_of_vertex[static_cast<size_t>(o.first)] < 0) {
+                        v = o.first;
+                        fixed = true;
+                    }
+                for (const auto& c : L.contacts)
+                    if (v < 0 && !was[static_cast<size_t>(c.vertex[0])]) v = c.vertex[0];
+                const Vec2& p = L.mesh.vertices[static_cast<size_t>(std::max(v, 0))];
+                MLC_CHECK(false, "load step "
+                                     << step << ": the supports active from this step on "
+                                     << (fixed ? "fix both components of" : "free a component of")
+                                     << " the contactor vertex (" << p.x() << ", " << p.y()
+                                     << ") on level " << l
+                                     << ", which changes the contact nodes; a support that is "
+                                        "released or taken up along the path may hold one "
+                                        "component of a contactor vertex only");
+            }
             setup_solvers();
             phase_step = step;
             for (int l = 0; l < n_levels; ++l) {

@@ -756,6 +756,12 @@ std::string builtin_scene_text(const std::string& name) {
     return it == s.end() ? std::string() : it->second;
 }
 
+std::string builtin_file_text(const std::string& name) {
+    const auto& f = detail::builtin_files();
+    auto it = f.find(name);
+    return it == f.end() ? std::string() : it->second;
+}
+
 levels::Problem load_scene(const std::string& name_or_path) {
     const std::filesystem::path path(name_or_path);
     const bool looks_like_file = path.extension() == ".toml" || path.has_parent_path();

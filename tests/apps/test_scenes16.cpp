@@ -631,3 +631,30 @@ mesh = { type = "gmsh", file = "FILE", arcs = ARCS }
         with("[{ tag = \"rim\", center = [0.5, -10.0], radius = 10.0 }]").find("test.toml:7:"),
         std::string::npos);
 }
+
+TEST(BadInput, ASupportTakenUpAlongThePathMayNotChangeTheContactNodes) {
+    // The block of incline, a vertex of its bottom fully held from step 2 on: that contact node
+    // would vanish. The whole bottom: the pair would have no node left.
+    std::string text = scene::builtin_scene_text("incline");
+    text = test::replace(text, "load_steps = 1", "load_steps = 2");
+    text = test::replace(text,
+                         "point = [0.0, 0.5]  # the middle of the up-slope face (x = 0)\nux = 0.0",
+                         "point = [0.0, 0.5]\nux = 0.0\n\n[[support]]\nWHERE\nux = "
+                         "0.0\nuy = 0.0\nactive = [false, true]");
+    for (const auto& [where, message] :
+         {std::pair<std::string, std::string>{"point = [1.0, 0.0]",
+                                              "load step 2: the supports active from this step on "
+                                              "fix both components of the contactor vertex (1, 0) "
+                                              "on level 0"},
+          {"tag = \"bottom\"", "load step 2, with the supports active from this step on: "
+                               "contact 'plane' has no contactor node on 'bottom'"}}) {
+        auto p = scene::parse_scene(test::replace(text, "WHERE", where), "builtin:incline");
+        p.levels = 0;
+        try {
+            levels::solve(p);
+            ADD_FAILURE() << "expected InvalidInput for " << where;
+        } catch (const InvalidInput& e) {
+            EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+        }
+    }
+}
