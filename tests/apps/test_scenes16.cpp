@@ -451,7 +451,7 @@ TEST(NewScenes, CoarseToFineNewtonAndMgSolveEveryNewScene) {
         levels::SolveOptions opt;
         opt.linear.method = "krylov";
         opt.linear.pc = "mg";
-        opt.exact_fallback = true;
+        opt.exact_fallback = false; // mg alone (measured: 13 / 99+134 / 13 iterations)
         const auto r = levels::solve(p, opt);
         ASSERT_TRUE(r.converged) << r.failure;
         EXPECT_LE(levels::check_state(p, r).force_balance, 1e-10);
