@@ -168,8 +168,11 @@ int main(int argc, char** argv) {
     bel->add_option("--out,-o", beo_out, "JSON file (default out/bench/elastic_<scene>_L<L>.json)");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
-    auto* show = app.add_subcommand("show", "print a built-in scene's TOML");
-    show->add_option("name", show_name, "built-in scene name")->required();
+    auto* show =
+        app.add_subcommand("show", "print a built-in scene's TOML (or a mesh file it reads)");
+    show->add_option("name", show_name,
+                     "built-in scene name, or a mesh file name such as hertz_gmsh.msh")
+        ->required();
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -225,7 +228,9 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (*show) {
-            const std::string t = mlc::scene::builtin_scene_text(show_name);
+            // A scene, or a mesh file a built-in scene reads (`show hertz_gmsh.msh`).
+            std::string t = mlc::scene::builtin_scene_text(show_name);
+            if (t.empty()) t = mlc::scene::builtin_file_text(show_name);
             if (t.empty()) throw mlc::InvalidInput("no built-in scene named '" + show_name + "'");
             std::cout << t;
             return 0;

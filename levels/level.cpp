@@ -56,6 +56,8 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     L.path_u_fixed.assign(static_cast<size_t>(K), Vector::Zero(2 * nv));
     const double diam = mesh.diameter();
     for (const auto& s : problem.supports) {
+        // Released in step 1: not held (Problem::at_step gives the problem of a later step).
+        if (!problem.support_active(s, 1)) continue;
         std::vector<int> verts;
         if (s.point) {
             const int v = mesh.nearest_vertex(*s.point);
@@ -66,7 +68,7 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
                                                           << d << ")");
             verts.push_back(v);
         } else {
-            verts = mesh.vertices_with_tag(mesh.tag(s.tag));
+            verts = mesh.vertices_on_tag(mesh.tag(s.tag)); // boundary edges and interior lines
         }
         for (int v : verts)
             for (int c = 0; c < 2; ++c) {

@@ -84,8 +84,36 @@ void Problem::validate() const {
                   where << ": ux must equal the last entry of ux_path");
         MLC_CHECK(s.uy_path.empty() || (s.uy && *s.uy == s.uy_path.back()),
                   where << ": uy must equal the last entry of uy_path");
+        check_len(s.active.size(), where + " (active)");
     }
     newton.validate();
+}
+
+Problem Problem::at_step(int step) const {
+    MLC_CHECK(step >= 1 && step <= load_steps,
+              "load step " << step << " out of range 1.." << load_steps);
+    Problem p = *this;
+    p.supports.clear();
+    for (const auto& s : supports)
+        if (support_active(s, step)) {
+            p.supports.push_back(s);
+            p.supports.back().active.clear();
+        }
+    return p;
+}
+
+bool Problem::support_active(const Support& s, int step) const {
+    if (s.active.empty()) return true;
+    // The path segment ((k-1)/K, k/K] holding s = step / load_steps.
+    const long K = static_cast<long>(s.active.size()), n = std::max(load_steps, 1);
+    const long k = std::clamp((static_cast<long>(step) * K + n - 1) / n, 1L, K);
+    return s.active[static_cast<size_t>(k - 1)];
+}
+
+bool Problem::same_supports(int a, int b) const {
+    return std::all_of(supports.begin(), supports.end(), [&](const Support& s) {
+        return support_active(s, a) == support_active(s, b);
+    });
 }
 
 int Problem::n_path_points() const {
@@ -95,6 +123,8 @@ int Problem::n_path_points() const {
         if (!s.ux_path.empty()) return static_cast<int>(s.ux_path.size());
         if (!s.uy_path.empty()) return static_cast<int>(s.uy_path.size());
     }
+    for (const auto& s : supports)
+        if (!s.active.empty()) return static_cast<int>(s.active.size());
     return 1;
 }
 

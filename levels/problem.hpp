@@ -57,6 +57,12 @@ struct Support {
     std::optional<double> uy;    ///< prescribed y displacement at s = 1, if any
     std::vector<double> ux_path; ///< x displacement per path point, or empty (proportional)
     std::vector<double> uy_path; ///< y displacement per path point, or empty (proportional)
+    /// Per point of the loading path (K entries, like `ux_path`): active[k-1] says whether the
+    /// support holds in the load steps whose parameter s lies in ((k-1)/K, k/K] (with
+    /// load_steps = K: one entry per load step). Empty: it holds in every step. A released
+    /// component is an unknown from that step on, starting from its value at the end of the
+    /// previous step (solve() rebuilds the levels; Problem::at_step).
+    std::vector<bool> active;
 };
 
 /// Kind of contact element a pair is discretized with (formulation.md §2).
@@ -137,7 +143,8 @@ struct Problem {
 
     /// Checks materials, pairs (mu >= 0, r > 0, one target of the right kind, an integration
     /// other than nodal only with node_on_facet), load_steps >= 1,
-    /// levels >= 0, and the loading path (every per-point list of the same length).
+    /// levels >= 0, and the loading path (every per-point list of the same length, the support
+    /// activities included).
     /// Throws InvalidInput naming the offending entry.
     void validate() const;
     /// Characteristic Young's modulus (the largest), for defaults such as r = 0.1 E.
@@ -146,8 +153,17 @@ struct Problem {
     /// softer body governs the compliance of a contact pair).
     double min_young_modulus() const;
 
+    /// Whether support `s` holds in load step `step` (1-based; Support::active).
+    bool support_active(const Support& s, int step) const;
+    /// The problem of load step `step` (1-based): the supports released in that step removed and
+    /// the activity of the others cleared (they hold). build_level uses the supports active in
+    /// step 1, so build_level(problem.at_step(k), m) is the level of step k.
+    Problem at_step(int step) const;
+    /// Whether the supports active in steps a and b are the same.
+    bool same_supports(int a, int b) const;
+
     /// Number K of points of the loading path: the common length of the per-point lists of
-    /// loads (`factors`) and supports (`ux_path`, `uy_path`), or 1 when there is none
+    /// loads (`factors`) and supports (`ux_path`, `uy_path`, `active`), or 1 when there is none
     /// (proportional loading). Path point k (1..K) sits at s = k / K; s = 0 is the unloaded state.
     int n_path_points() const;
     /// Value at path point k (1..K) of a proportional quantity `full` (k / K * full) or of a

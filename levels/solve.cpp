@@ -219,7 +219,11 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                                      needs_coarse_level(options.linear));
     res.memory_limit = process_memory_limit();
     check_memory_fits(res.memory, res.memory_limit, res.predicted_sizes);
-    res.hierarchy = build_hierarchy(problem, options.q_rule, &res.timings);
+    // Supports released or taken up between load steps (Support::active) change which components
+    // are unknowns: the hierarchy, its solvers and Newton drivers are then rebuilt for the new
+    // step's supports (Problem::at_step), and the state carried over through the nodal values.
+    int phase_step = 1; // the load step whose supports the current hierarchy has
+    res.hierarchy = build_hierarchy(problem.at_step(1), options.q_rule, &res.timings);
     const auto& levels = res.hierarchy.levels;
     const int n_levels = res.hierarchy.n_levels();
     const int finest = n_levels - 1;
@@ -227,44 +231,50 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         options.coarse_to_fine || options.solve_all_levels || needs_coarse_level(options.linear);
     const int first = all_levels ? 0 : finest;
 
-    // Solvers, Newton drivers and the level below of each level (fixed; the coarse statuses are
-    // passed by set_coarse_statuses after every coarse load step).
+    // Solvers, Newton drivers and the level below of each level (fixed while the supports are;
+    // the coarse statuses are passed by set_coarse_statuses after every coarse load step).
     std::vector<LevelBelow> below(static_cast<size_t>(n_levels));
     std::vector<std::unique_ptr<ContactNewton>> newton(static_cast<size_t>(n_levels));
     std::vector<NewtonSystemSolver*> system(static_cast<size_t>(n_levels), nullptr);
-    for (int l = first; l < n_levels; ++l) {
-        ScopedTimer t(&res.timings, "setup/linear_solver");
-        const Level& L = levels[static_cast<size_t>(l)];
-        LinearSolverSpec spec = options.linear;
-        if (l == 0 && l != finest) spec = LinearSolverSpec{};
-        if (options.exact_fallback && spec.method == "krylov")
-            spec.give_up_budget = kFallbackKrylovBudget;
-        auto& lb = below[static_cast<size_t>(l)];
-        if (l > first) {
-            lb.coarse = &levels[static_cast<size_t>(l - 1)];
-            lb.transfer = &res.hierarchy.transfers[static_cast<size_t>(l - 1)];
-            lb.solver = system[static_cast<size_t>(l - 1)];
-            if (l - 1 > first) lb.below = &below[static_cast<size_t>(l - 1)];
+    auto setup_solvers = [&]() {
+        for (int l = first; l < n_levels; ++l) {
+            ScopedTimer t(&res.timings, "setup/linear_solver");
+            const Level& L = levels[static_cast<size_t>(l)];
+            LinearSolverSpec spec = options.linear;
+            if (l == 0 && l != finest) spec = LinearSolverSpec{};
+            if (options.exact_fallback && spec.method == "krylov")
+                spec.give_up_budget = kFallbackKrylovBudget;
+            auto& lb = below[static_cast<size_t>(l)];
+            lb = LevelBelow{};
+            if (l > first) {
+                lb.coarse = &levels[static_cast<size_t>(l - 1)];
+                lb.transfer = &res.hierarchy.transfers[static_cast<size_t>(l - 1)];
+                lb.solver = system[static_cast<size_t>(l - 1)];
+                if (l - 1 > first) lb.below = &below[static_cast<size_t>(l - 1)];
+            }
+            auto sys = make_newton_system_solver(L, spec, &lb);
+            system[static_cast<size_t>(l)] = sys.get();
+            newton[static_cast<size_t>(l)] =
+                std::make_unique<ContactNewton>(L, problem.newton, std::move(sys), &res.timings);
+            if (options.exact_fallback && spec.method == "krylov") {
+                const LevelSize size = res.predicted_sizes[static_cast<size_t>(l)];
+                newton[static_cast<size_t>(l)]->set_fallback([&L, size, l]() {
+                    const double need =
+                        estimate_memory({size}, LinearSolverSpec{}, false).solver_bytes;
+                    const MemoryLimit limit = process_memory_limit();
+                    const double free = limit.bytes - peak_rss_bytes();
+                    MLC_CHECK(need < free, "the exact schur solver of level "
+                                               << l << " needs an estimated " << format_bytes(need)
+                                               << ", more than the " << format_bytes(free)
+                                               << " left (" << limit.source << ")");
+                    return make_schur_system_solver(L);
+                });
+            }
+            newton[static_cast<size_t>(l)]->set_interrupt(options.interrupt_requested);
+            newton[static_cast<size_t>(l)]->set_stop(options.stop);
         }
-        auto sys = make_newton_system_solver(L, spec, &lb);
-        system[static_cast<size_t>(l)] = sys.get();
-        newton[static_cast<size_t>(l)] =
-            std::make_unique<ContactNewton>(L, problem.newton, std::move(sys), &res.timings);
-        if (options.exact_fallback && spec.method == "krylov") {
-            const LevelSize size = res.predicted_sizes[static_cast<size_t>(l)];
-            newton[static_cast<size_t>(l)]->set_fallback([&L, size, l]() {
-                const double need = estimate_memory({size}, LinearSolverSpec{}, false).solver_bytes;
-                const MemoryLimit limit = process_memory_limit();
-                const double free = limit.bytes - peak_rss_bytes();
-                MLC_CHECK(need < free, "the exact schur solver of level "
-                                           << l << " needs an estimated " << format_bytes(need)
-                                           << ", more than the " << format_bytes(free) << " left ("
-                                           << limit.source << ")");
-                return make_schur_system_solver(L);
-            });
-        }
-        newton[static_cast<size_t>(l)]->set_interrupt(options.interrupt_requested);
-    }
+    };
+    setup_solvers();
 
     std::vector<Vector> x(static_cast<size_t>(n_levels)), u_prev(static_cast<size_t>(n_levels)),
         u_now(static_cast<size_t>(n_levels));
@@ -277,8 +287,6 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         static_cast<size_t>(n_levels)); // each level's state before its solve
     res.level_steps.resize(static_cast<size_t>(n_levels));
     res.converged = true;
-    for (auto& nw : newton)
-        if (nw) nw->set_stop(options.stop);
     const double t_start = wall_seconds();
     std::vector<double> level_seconds(static_cast<size_t>(n_levels), 0.0);
     std::vector<int> level_count(static_cast<size_t>(n_levels), 0);
@@ -288,6 +296,84 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         static_cast<size_t>(n_levels));
     for (int step = 1; step <= problem.load_steps && res.converged; ++step) {
         const double s = static_cast<double>(step) / problem.load_steps;
+        if (!problem.same_supports(step, phase_step)) {
+            // New supports: rebuild, then carry the state over. Displacements through the nodal
+            // values at the end of the previous step (u_prev, every component, prescribed or
+            // not), multipliers by contactor vertex.
+            std::vector<std::vector<std::pair<int, Vector>>> lambda(static_cast<size_t>(n_levels));
+            for (int l = first; l < n_levels; ++l) {
+                const Level& L = levels[static_cast<size_t>(l)];
+                for (size_t e = 0; e < L.contacts.size(); ++e)
+                    lambda[static_cast<size_t>(l)].emplace_back(
+                        L.contacts[e].vertex[0],
+                        x[static_cast<size_t>(l)].segment(L.lambda_dof[e],
+                                                          L.contacts[e].n_multipliers()));
+            }
+            for (auto& nw : newton)
+                nw.reset(); // they refer to the levels about to be replaced
+            {
+                ScopedTimer t(&res.timings, "setup/supports_changed");
+                try {
+                    res.hierarchy =
+                        build_hierarchy(problem.at_step(step), options.q_rule, &res.timings);
+                } catch (const InvalidInput& e) {
+                    throw InvalidInput("load step " + std::to_string(step) +
+                                       ", with the supports active from this step on: " + e.what());
+                }
+            }
+            MLC_CHECK(res.hierarchy.n_levels() == n_levels,
+                      "internal error: the rebuilt hierarchy has another number of levels");
+            // The contact nodes must stay those of the first step: the per-step states
+            // (step_nodes, contact_steps.csv) are read with the final level's contact elements.
+            // They change only when a support fully fixes or frees a contactor vertex.
+            for (int l = first; l < n_levels; ++l) {
+                const Level& L = levels[static_cast<size_t>(l)];
+                const auto& old = lambda[static_cast<size_t>(l)];
+                bool same = old.size() == L.contacts.size();
+                for (size_t e = 0; same && e < old.size(); ++e)
+                    same = old[e].first == L.contacts[e].vertex[0];
+                if (same) continue;
+                // A vertex that is no longer a contact node (now fully fixed), or a new one.
+                std::vector<char> was(static_cast<size_t>(L.mesh.n_vertices()), 0);
+                for (const auto& o : old)
+                    was[static_cast<size_t>(o.first)] = 1;
+                int v = -1;
+                bool fixed = false;
+                for (const auto& o : old)
+                    if (v < 0 && L.contact_of_vertex[static_cast<size_t>(o.first)] < 0) {
+                        v = o.first;
+                        fixed = true;
+                    }
+                for (const auto& c : L.contacts)
+                    if (v < 0 && !was[static_cast<size_t>(c.vertex[0])]) v = c.vertex[0];
+                const Vec2& p = L.mesh.vertices[static_cast<size_t>(std::max(v, 0))];
+                MLC_CHECK(false, "load step "
+                                     << step << ": the supports active from this step on "
+                                     << (fixed ? "fix both components of" : "free a component of")
+                                     << " the contactor vertex (" << p.x() << ", " << p.y()
+                                     << ") on level " << l
+                                     << ", which changes the contact nodes; a support that is "
+                                        "released or taken up along the path may hold one "
+                                        "component of a contactor vertex only");
+            }
+            setup_solvers();
+            phase_step = step;
+            for (int l = 0; l < n_levels; ++l) {
+                const size_t li = static_cast<size_t>(l);
+                const Level& L = levels[li];
+                x[li] = Vector::Zero(L.n_unknowns());
+                for (int v = 0; v < L.mesh.n_vertices(); ++v)
+                    for (int c = 0; c < 2; ++c)
+                        if (const int d = L.dofs.u_dof(v, c); d >= 0)
+                            x[li][d] = u_prev[li][2 * v + c];
+                for (const auto& [v, lam] : lambda[li]) {
+                    const int e = L.contact_of_vertex[static_cast<size_t>(v)];
+                    if (e >= 0 && L.contacts[static_cast<size_t>(e)].n_multipliers() ==
+                                      static_cast<int>(lam.size()))
+                        x[li].segment(L.lambda_dof[static_cast<size_t>(e)], lam.size()) = lam;
+                }
+            }
+        }
         for (int l = first; l < n_levels; ++l) {
             const size_t li = static_cast<size_t>(l);
             const Level& L = levels[li];

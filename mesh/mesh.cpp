@@ -66,6 +66,23 @@ std::vector<int> Mesh::vertices_with_tag(int t) const {
     return out;
 }
 
+std::vector<int> Mesh::vertices_on_tag(int t) const {
+    std::vector<int> out = vertices_with_tag(t);
+    for (const auto& e : lines)
+        if (e.tag == t) {
+            out.push_back(e.v0);
+            out.push_back(e.v1);
+        }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+bool Mesh::is_boundary_tag(int t) const {
+    return std::any_of(boundary.begin(), boundary.end(),
+                       [t](const BoundaryEdge& e) { return e.tag == t; });
+}
+
 std::pair<double, double> Mesh::edge_length_range() const {
     double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
     for (const auto& tri : triangles)
@@ -211,6 +228,15 @@ void check_quality(const Mesh& m) {
                   "boundary edge (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
                                     << "' is not a boundary edge of the triangulation");
     }
+    for (const auto& e : m.lines) {
+        MLC_CHECK(e.v0 >= 0 && e.v0 < nv && e.v1 >= 0 && e.v1 < nv,
+                  "interior line (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
+                                    << "' refers to a vertex out of range");
+        auto it = edges.find(edge_key(e.v0, e.v1));
+        MLC_CHECK(it != edges.end() && it->second == 2,
+                  "interior line (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
+                                    << "' is not an interior edge of the triangulation");
+    }
 }
 
 std::vector<int> hilbert_order(const std::vector<Vec2>& points) {
@@ -304,6 +330,12 @@ Mesh refine(const Mesh& coarse) {
         }
         fine.boundary.push_back({e.v0, m, e.tag, e.curve});
         fine.boundary.push_back({m, e.v1, e.tag, e.curve});
+    }
+    fine.lines.reserve(2 * coarse.lines.size());
+    for (const auto& e : coarse.lines) {
+        const int m = mid(e.v0, e.v1);
+        fine.lines.push_back({e.v0, m, e.tag, -1});
+        fine.lines.push_back({m, e.v1, e.tag, -1});
     }
     return fine;
 }

@@ -40,6 +40,13 @@ struct Mesh {
     /// Per-triangle body (or material) id, inherited by refinement; empty means all 0.
     std::vector<int> attribute;
     std::vector<BoundaryEdge> boundary;
+    /// Tagged interior edges ("lines": constrained interior segments of a domain, physical lines
+    /// of a Gmsh file inside the body, the mirror line of mirror_about_x). Both ends are vertices
+    /// of the mesh and the edge is an edge of two triangles; the orientation means nothing and
+    /// `curve` is -1. Refinement splits them like boundary edges (the halves keep the tag), so
+    /// the vertices it creates on a tagged line carry the tag. Supports may name their tags;
+    /// loads and contact pairs need boundary tags.
+    std::vector<BoundaryEdge> lines;
     std::vector<Circle> circles;
     std::map<std::string, int> tag_names; ///< name -> tag id
     /// For a refined mesh: parents[v - n_coarse] = the two coarse vertices of new vertex v.
@@ -64,6 +71,11 @@ struct Mesh {
     double signed_area(int t) const;
     /// Vertices on boundary edges carrying `tag`, sorted and unique.
     std::vector<int> vertices_with_tag(int tag) const;
+    /// Vertices on boundary edges or interior lines carrying `tag`, sorted and unique (what a
+    /// support on the tag holds).
+    std::vector<int> vertices_on_tag(int tag) const;
+    /// Whether some boundary edge carries `tag` (a tag only on interior lines does not).
+    bool is_boundary_tag(int tag) const;
     /// Smallest and largest edge length.
     std::pair<double, double> edge_length_range() const;
     /// Diameter of the bounding box (the mesh's length scale).
@@ -75,7 +87,7 @@ struct Mesh {
 /// Checks a mesh for use: at least one triangle, indices in range, every triangle with positive
 /// area (relative to the square of the mesh diameter), no two vertices of one body (triangle
 /// attribute) closer than a relative 1e-10 of the diameter (vertices of two touching bodies may
-/// coincide), boundary edges that are edges of a triangle.
+/// coincide), boundary edges that are edges of one triangle, interior lines edges of two.
 /// Throws InvalidInput naming the first defect (triangle or vertex index and coordinates).
 void check_quality(const Mesh& m);
 
@@ -84,9 +96,9 @@ void check_quality(const Mesh& m);
 /// vertices are distinct and its boundary edges are halves of checked ones by construction.
 void check_refined_quality(const Mesh& m);
 
-/// Uniform refinement: every triangle split into four by its edge midpoints. Boundary edges are
-/// split in two with the tag and curve inherited; a midpoint on a circular boundary edge is moved
-/// onto the circle. Coarse vertex indices are kept; `parents` is filled.
+/// Uniform refinement: every triangle split into four by its edge midpoints. Boundary edges and
+/// interior lines are split in two with the tag and curve inherited; a midpoint on a circular
+/// boundary edge is moved onto the circle. Coarse vertex indices are kept; `parents` is filled.
 Mesh refine(const Mesh& coarse);
 
 /// The vertices in the order of a Hilbert curve through their bounding box (2^16 cells a side;

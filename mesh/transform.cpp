@@ -13,6 +13,7 @@ Mesh mirror_about_x(const Mesh& h, double x0) {
     const int nv = h.n_vertices();
     Mesh m = h;
     m.boundary.clear();
+    m.lines.clear();
     std::vector<int> image(static_cast<size_t>(nv));
     int side = 0;
     bool on_line = false;
@@ -43,13 +44,60 @@ Mesh mirror_about_x(const Mesh& h, double x0) {
         m.circles.push_back({Vec2(2.0 * x0 - c.center.x(), c.center.y()), c.radius});
     auto on = [&](int v) { return image[static_cast<size_t>(v)] == v; };
     for (const auto& e : h.boundary) {
-        if (e.curve < 0 && on(e.v0) && on(e.v1)) continue; // on the mirror line: now interior
+        if (e.curve < 0 && on(e.v0) && on(e.v1)) { // on the mirror line: now an interior line
+            m.lines.push_back({e.v0, e.v1, e.tag, -1});
+            continue;
+        }
         m.boundary.push_back(e);
         m.boundary.push_back({image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)],
                               e.tag, e.curve >= 0 ? e.curve + coff : -1});
     }
+    for (const auto& e : h.lines) {
+        m.lines.push_back(e);
+        if (!(on(e.v0) && on(e.v1)))
+            m.lines.push_back(
+                {image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)], e.tag, -1});
+    }
     check_quality(m);
     return m;
+}
+
+namespace {
+/// cos and sin of an angle in degrees, exact at multiples of 90.
+std::pair<double, double> cos_sin_deg(double deg) {
+    const double q = deg / 90.0;
+    if (q == std::round(q)) {
+        const long k = ((static_cast<long>(std::round(q)) % 4) + 4) % 4;
+        static constexpr double c[4] = {1.0, 0.0, -1.0, 0.0}, s[4] = {0.0, 1.0, 0.0, -1.0};
+        return {c[k], s[k]};
+    }
+    const double a = deg * std::acos(-1.0) / 180.0;
+    return {std::cos(a), std::sin(a)};
+}
+} // namespace
+
+Vec2 RigidMotion::apply(const Vec2& p) const {
+    const auto [c, s] = cos_sin_deg(rotate_deg);
+    const Vec2 d = p - about;
+    return about + Vec2(c * d.x() - s * d.y(), s * d.x() + c * d.y()) + translate;
+}
+
+Vec2 RigidMotion::inverse(const Vec2& p) const {
+    const auto [c, s] = cos_sin_deg(rotate_deg);
+    const Vec2 d = p - translate - about;
+    return about + Vec2(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+}
+
+bool RigidMotion::keeps_axes() const {
+    const double q = rotate_deg / 90.0;
+    return q == std::round(q);
+}
+
+void transform_mesh(Mesh& m, const RigidMotion& motion) {
+    for (auto& v : m.vertices)
+        v = motion.apply(v);
+    for (auto& c : m.circles)
+        c.center = motion.apply(c.center);
 }
 
 void merge_into(Mesh& all, const Mesh& b, int body) {
@@ -63,6 +111,8 @@ void merge_into(Mesh& all, const Mesh& b, int body) {
     for (const auto& e : b.boundary)
         all.boundary.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)),
                                 e.curve >= 0 ? e.curve + coff : -1});
+    for (const auto& e : b.lines)
+        all.lines.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)), -1});
 }
 
 } // namespace mlc::mesh

@@ -399,6 +399,63 @@ PYBIND11_MODULE(_core, m) {
             },
             "the contact pairs (copies; set with set_contact)")
         .def_property_readonly(
+            "supports",
+            [](const Scene& s) {
+                py::list out;
+                for (const auto& sp : s.problem.supports) {
+                    py::dict d;
+                    d["tag"] = sp.tag;
+                    d["point"] = sp.point ? py::object(py::make_tuple(sp.point->x(), sp.point->y()))
+                                          : py::object(py::none());
+                    for (int c = 0; c < 2; ++c) {
+                        const auto& full = c == 0 ? sp.ux : sp.uy;
+                        const auto& path = c == 0 ? sp.ux_path : sp.uy_path;
+                        const char* key = c == 0 ? "ux" : "uy";
+                        if (!full)
+                            d[key] = py::none();
+                        else if (path.empty())
+                            d[key] = *full;
+                        else
+                            d[key] = path;
+                    }
+                    py::list active;
+                    for (int k = 1; k <= s.problem.load_steps; ++k)
+                        active.append(s.problem.support_active(sp, k));
+                    d["active"] = active;
+                    out.append(d);
+                }
+                return out;
+            },
+            "the supports (copies): tag or point, ux, uy (a number, a list per path point or "
+            "None) and active, whether it holds in each load step ([[support]].active)")
+        .def_property_readonly(
+            "mesh_tags",
+            [](const Scene& s) {
+                py::dict d;
+                d["vertices"] = s.problem.mesh0.n_vertices();
+                d["boundary_tags"] = [&] {
+                    py::list l;
+                    for (const auto& [n, id] : s.problem.mesh0.tag_names)
+                        if (s.problem.mesh0.is_boundary_tag(id)) l.append(n);
+                    return l;
+                }();
+                d["line_tags"] = [&] {
+                    py::list l;
+                    for (const auto& [n, id] : s.problem.mesh0.tag_names)
+                        for (const auto& e : s.problem.mesh0.lines)
+                            if (e.tag == id) {
+                                l.append(n);
+                                break;
+                            }
+                    return l;
+                }();
+                d["circles"] = static_cast<int>(s.problem.mesh0.circles.size());
+                return d;
+            },
+            "the level-0 mesh's tags: boundary_tags, line_tags (tagged interior lines: mirror "
+            "lines, Gmsh physical lines inside a body, a domain's lines) and the number of "
+            "circles (arc segments and Gmsh arcs) refinement keeps vertices on")
+        .def_property_readonly(
             "materials",
             [](const Scene& s) {
                 py::list out;

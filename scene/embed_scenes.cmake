@@ -1,9 +1,20 @@
-# Generates a C++ source holding every scenes/*.toml as a string (the built-in scenes).
+# Generates a C++ source holding every scenes/*.toml as a string (the built-in scenes), and every
+# scenes/*.msh (the Gmsh meshes they read) by file name.
 file(GLOB scenes ${SRC_DIR}/scenes/*.toml)
 list(SORT scenes)
 set(body "// Generated from scenes/*.toml by scene/embed_scenes.cmake; do not edit.\n#include <map>\n#include <string>\nnamespace mlc::scene::detail {\nconst std::map<std::string, std::string>& builtin_scenes() {\n  static const std::map<std::string, std::string> s = {\n")
 foreach(f ${scenes})
   get_filename_component(name ${f} NAME_WE)
+  file(READ ${f} content)
+  string(APPEND body "    {\"${name}\", R\"mlcscene(${content})mlcscene\"},\n")
+endforeach()
+string(APPEND body "  };\n  return s;\n}\n")
+# Mesh files the built-in scenes read (scenes/*.msh), by file name.
+file(GLOB meshes ${SRC_DIR}/scenes/*.msh)
+list(SORT meshes)
+string(APPEND body "const std::map<std::string, std::string>& builtin_files() {\n  static const std::map<std::string, std::string> s = {\n")
+foreach(f ${meshes})
+  get_filename_component(name ${f} NAME)
   file(READ ${f} content)
   string(APPEND body "    {\"${name}\", R\"mlcscene(${content})mlcscene\"},\n")
 endforeach()

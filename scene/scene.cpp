@@ -22,6 +22,7 @@ namespace mlc::scene {
 
 namespace detail {
 const std::map<std::string, std::string>& builtin_scenes(); // generated
+const std::map<std::string, std::string>& builtin_files();  // generated: scenes/*.msh
 } // namespace detail
 
 namespace {
@@ -212,11 +213,107 @@ mesh::Segment parse_segment(const Reader& rd, const toml::table& t, const std::s
 }
 #endif
 
+/// `transform = { rotate_deg = .., about = [x, y], translate = [x, y] }` of a mesh table.
+std::optional<mesh::RigidMotion> parse_transform(const Reader& rd, const toml::table& t,
+                                                 const std::string& where) {
+    const toml::node* n = t.get("transform");
+    if (!n) return std::nullopt;
+    const std::string w = where + ".transform";
+    const toml::table& tt = rd.table(n, w);
+    rd.check_keys(tt, {"rotate_deg", "about", "translate"}, w);
+    if (tt.empty()) rd.fail(n, w + " is empty: give rotate_deg and/or translate");
+    mesh::RigidMotion m;
+    m.rotate_deg = rd.number_or(tt, "rotate_deg", 0.0, w);
+    if (std::abs(m.rotate_deg) > 3600)
+        rd.fail(tt.get("rotate_deg"), w + ".rotate_deg must lie in [-3600, 3600]");
+    if (tt.get("about")) m.about = rd.vec2(tt, "about", w);
+    if (tt.get("translate")) m.translate = rd.vec2(tt, "translate", w);
+    return m;
+}
+
+/// `arcs = [ { tag = "..", center = [x, y], radius = r } ]` of a Gmsh mesh (global frame): the
+/// boundary edges with the tag get the circle, so that refinement puts new vertices on it.
+void apply_arcs(const Reader& rd, const toml::table& t, const std::string& where, mesh::Mesh& m) {
+    const toml::node* n = t.get("arcs");
+    if (!n) return;
+    const toml::array* a = n->as_array();
+    if (!a || a->empty())
+        rd.fail(n, where + ".arcs must be a non-empty array of tables { tag, center, radius }");
+    std::set<std::string> seen;
+    for (size_t i = 0; i < a->size(); ++i) {
+        const std::string w = where + ".arcs[" + std::to_string(i) + "]";
+        const toml::table& at = rd.table(a->get(i), w);
+        rd.check_keys(at, {"tag", "center", "radius"}, w);
+        const std::string tag = rd.string(at, "tag", w);
+        const Vec2 center = rd.vec2(at, "center", w);
+        const double radius = rd.number(at, "radius", w);
+        if (!(radius > 0)) rd.fail(at.get("radius"), w + ".radius must be > 0");
+        const auto id = m.find_tag(tag);
+        if (!id || !m.is_boundary_tag(*id)) {
+            std::string known;
+            for (const auto& [name, k] : m.tag_names)
+                if (m.is_boundary_tag(k)) known += (known.empty() ? "" : ", ") + name;
+            rd.fail(at.get("tag"),
+                    w + ".tag: the mesh has no boundary tag '" + tag + "' (it has: " + known + ")");
+        }
+        if (!seen.insert(tag).second)
+            rd.fail(at.get("tag"), w + ".tag '" + tag + "' is declared twice");
+        // Every vertex of the tagged edges must lie on the circle (the mesher put it there).
+        const double tol = 1e-6 * radius;
+        for (int v : m.vertices_with_tag(*id)) {
+            const Vec2& p = m.vertices[static_cast<size_t>(v)];
+            const double off = std::abs((p - center).norm() - radius);
+            if (off > tol) {
+                std::ostringstream os;
+                os << w << ": vertex (" << p.x() << ", " << p.y() << ") of tag '" << tag
+                   << "' lies " << off << " off the circle (center (" << center.x() << ", "
+                   << center.y() << "), radius " << radius
+                   << "); the arc's center and radius are in the global frame (after any "
+                      "transform)";
+                rd.fail(at.get("center"), os.str());
+            }
+        }
+        const int c = static_cast<int>(m.circles.size());
+        m.circles.push_back({center, radius});
+        for (auto& e : m.boundary)
+            if (e.tag == *id) e.curve = c;
+    }
+}
+
+mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::string& where,
+                            const std::filesystem::path& base_dir,
+                            const std::optional<mesh::RigidMotion>& motion);
+
+/// A body's mesh: built in its own frame, mirrored (mirror_x), moved (transform), then the arcs
+/// of a Gmsh mesh declared (in the global frame).
 mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string& where,
                       const std::filesystem::path& base_dir) {
+    const auto motion = parse_transform(rd, t, where);
+    mesh::Mesh m = parse_mesh_local(rd, t, where, base_dir, motion);
+    if (motion) {
+        if (const toml::node* mx = t.get("mirror_x"); mx && !motion->keeps_axes()) {
+            std::ostringstream os;
+            os << where << ".transform: rotate_deg = " << motion->rotate_deg
+               << " turns the mirror line x = " << rd.number(mx, where + ".mirror_x")
+               << " of mirror_x off the coordinate axes, where supports act (ux, uy); rotate by "
+                  "a multiple of 90 degrees, or mesh the whole body without mirror_x";
+            rd.fail(t.get("transform"), os.str());
+        }
+        mesh::transform_mesh(m, *motion);
+    }
+    if (t.get("arcs")) apply_arcs(rd, t, where, m);
+    return m;
+}
+
+mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::string& where,
+                            const std::filesystem::path& base_dir,
+                            const std::optional<mesh::RigidMotion>& motion) {
     const std::string type = rd.string(t, "type", where);
+    if (type != "gmsh" && t.get("arcs"))
+        rd.fail(t.get("arcs"), where + ".arcs applies to type \"gmsh\" only (a \"domain\" "
+                                       "declares its arcs in its loops)");
     if (type == "rectangle") {
-        rd.check_keys(t, {"type", "corner", "size", "divisions", "diagonal"}, where);
+        rd.check_keys(t, {"type", "corner", "size", "divisions", "diagonal", "transform"}, where);
         const Vec2 corner = rd.vec2(t, "corner", where);
         const Vec2 size = rd.vec2(t, "size", where);
         const toml::node* dn = rd.need(t, "divisions", where);
@@ -239,7 +336,9 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
     }
     if (type == "domain") {
 #ifdef MLC_HAVE_CGAL
-        rd.check_keys(t, {"type", "max_size", "min_size", "focus", "grading", "loop", "mirror_x"},
+        rd.check_keys(t,
+                      {"type", "max_size", "min_size", "focus", "grading", "loop", "mirror_x",
+                       "transform", "lines"},
                       where);
         mesh::SizeField sf;
         sf.max_size = rd.number(t, "max_size", where);
@@ -248,8 +347,18 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
         if (const toml::node* f = t.get("focus")) {
             const toml::array* fa = f->as_array();
             if (!fa) rd.fail(f, where + ".focus must be an array of points");
-            for (const auto& p : *fa)
-                sf.focus.push_back(rd.vec2(&p, where + ".focus[]"));
+            // Focus points are global (after the transform): back to the domain's own frame.
+            // With mirror_x the half is meshed and reflected: it is refined toward a focus
+            // point and toward the point's image, which keeps the mesh mirror-symmetric.
+            for (const auto& p : *fa) {
+                const Vec2 q = motion ? motion->inverse(rd.vec2(&p, where + ".focus[]"))
+                                      : rd.vec2(&p, where + ".focus[]");
+                sf.focus.push_back(q);
+                if (const toml::node* mx = t.get("mirror_x"); mx && motion) {
+                    const double x0 = rd.number(mx, where + ".mirror_x");
+                    if (q.x() != x0) sf.focus.emplace_back(2.0 * x0 - q.x(), q.y());
+                }
+            }
         }
         std::vector<std::vector<mesh::Segment>> loops;
         const auto loop_tables = rd.tables(t, "loop", where);
@@ -267,21 +376,48 @@ mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string&
             }
             loops.push_back(std::move(loop));
         }
+        // Constrained interior segments, in the domain's own frame like the loops.
+        std::vector<mesh::Segment> lines;
+        if (const toml::node* ln = t.get("lines")) {
+            const toml::array* la = ln->as_array();
+            if (!la || la->empty())
+                rd.fail(ln, where + ".lines must be a non-empty array of tables { from, to, tag }");
+            for (size_t j = 0; j < la->size(); ++j) {
+                const std::string lw = where + ".lines[" + std::to_string(j) + "]";
+                const toml::table& lt = rd.table(la->get(j), lw);
+                rd.check_keys(lt, {"from", "to", "tag"}, lw);
+                lines.push_back(mesh::Segment::line(rd.vec2(lt, "from", lw), rd.vec2(lt, "to", lw),
+                                                    rd.string(lt, "tag", lw)));
+                if (lines.back().tag.empty()) rd.fail(lt.get("tag"), lw + ".tag is empty");
+            }
+        }
+        const toml::node* where_lines = t.get("lines")      ? t.get("lines")
+                                        : t.get("mirror_x") ? t.get("mirror_x")
+                                                            : &t;
         if (const toml::node* mx = t.get("mirror_x")) {
             const double x0 = rd.number(mx, where + ".mirror_x");
-            return at(rd, mx,
-                      [&] { return mesh::mirror_about_x(mesh::mesh_domain(loops, sf), x0); });
+            const mesh::Mesh half =
+                at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines); });
+            return at(rd, mx, [&] { return mesh::mirror_about_x(half, x0); });
         }
-        return at(rd, &t, [&] { return mesh::mesh_domain(loops, sf); });
+        return at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines); });
 #else
         rd.fail(&t, where + ": type \"domain\" needs CGAL (this build has MLC_WITH_CGAL=OFF)");
 #endif
     }
     if (type == "gmsh") {
-        rd.check_keys(t, {"type", "file", "surface"}, where);
+        rd.check_keys(t, {"type", "file", "surface", "transform", "arcs"}, where);
         std::filesystem::path file = rd.string(t, "file", where);
-        if (file.is_relative() && !base_dir.empty()) file = base_dir / file;
         const std::string surface = rd.string_or(t, "surface", "", where);
+        // A built-in scene's mesh is compiled in with it (scenes/*.msh).
+        if (rd.origin().rfind("builtin:", 0) == 0 && file.is_relative() && base_dir.empty()) {
+            const auto& files = detail::builtin_files();
+            if (const auto it = files.find(file.string()); it != files.end())
+                return at(rd, &t, [&] {
+                    return mesh::read_gmsh_text(it->second, "builtin:" + file.string(), surface);
+                });
+        }
+        if (file.is_relative() && !base_dir.empty()) file = base_dir / file;
         return at(rd, &t, [&] { return mesh::read_gmsh(file, surface); });
     }
     rd.fail(t.get("type"),
@@ -370,8 +506,9 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
                 const auto [pos, inserted] = names.emplace(n, id);
                 if (!inserted) merged[id] = pos->second;
             }
-            for (auto& e : m.boundary)
-                if (const auto it = merged.find(e.tag); it != merged.end()) e.tag = it->second;
+            for (auto* edges : {&m.boundary, &m.lines})
+                for (auto& e : *edges)
+                    if (const auto it = merged.find(e.tag); it != merged.end()) e.tag = it->second;
             m.tag_names = std::move(names);
         }
         mesh::merge_into(p.mesh0, m, static_cast<int>(i));
@@ -381,13 +518,22 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         mesh::check_quality(p.mesh0);
         return 0;
     });
-    auto check_tag = [&](const toml::table& t, const std::string& tag, const std::string& w) {
-        if (!p.mesh0.find_tag(tag)) {
+    // Loads and contact pairs need a tag on boundary edges; supports may also name a tagged
+    // interior line (Mesh::lines).
+    auto check_tag = [&](const toml::table& t, const std::string& tag, const std::string& w,
+                         bool boundary_only = true, const char* key = "tag") {
+        const toml::node* n = t.get(key) ? t.get(key) : &t;
+        const auto id = p.mesh0.find_tag(tag);
+        if (!id || (boundary_only && !p.mesh0.is_boundary_tag(*id))) {
             std::string known;
-            for (const auto& [n, id] : p.mesh0.tag_names)
-                known += (known.empty() ? "" : ", ") + n;
-            rd.fail(t.get("tag") ? t.get("tag") : &t,
-                    w + ": unknown boundary tag '" + tag + "' (the mesh has: " + known + ")");
+            for (const auto& [name, k] : p.mesh0.tag_names)
+                if (!boundary_only || p.mesh0.is_boundary_tag(k))
+                    known += (known.empty() ? "" : ", ") + name;
+            if (id)
+                rd.fail(n, w + ": tag '" + tag + "' names interior lines only; " + key +
+                               " needs a boundary tag (the mesh has: " + known + ")");
+            rd.fail(n, w + ": unknown " + (boundary_only ? "boundary " : "") + "tag '" + tag +
+                           "' (the mesh has: " + known + ")");
         }
     };
     for (const toml::table* lt : rd.tables(root, "load", "the scene")) {
@@ -403,15 +549,16 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         if (const toml::node* fn = lt->get("factors")) ld.factors = rd.numbers(fn, w + ".factors");
         p.loads.push_back(ld);
     }
+    std::vector<std::pair<size_t, const toml::node*>> active_nodes; // support index, its node
     for (const toml::table* st : rd.tables(root, "support", "the scene")) {
         const std::string w = "[[support]]";
-        rd.check_keys(*st, {"tag", "point", "ux", "uy"}, w);
+        rd.check_keys(*st, {"tag", "point", "ux", "uy", "active"}, w);
         levels::Support s;
         if (st->get("tag") && st->get("point"))
             rd.fail(st, w + " takes a tag or a point, not both");
         if (st->get("tag")) {
             s.tag = rd.string(*st, "tag", w);
-            check_tag(*st, s.tag, w);
+            check_tag(*st, s.tag, w, false);
         } else if (st->get("point")) {
             s.point = rd.vec2(*st, "point", w);
         } else {
@@ -432,7 +579,32 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
             }
         }
         if (!s.ux && !s.uy) rd.fail(st, w + " fixes nothing: give ux and/or uy");
+        if (const toml::node* an = st->get("active")) {
+            // Per point of the loading path: true holds the support there, false releases it.
+            const toml::array* a = an->as_array();
+            if (!a || a->empty())
+                rd.fail(an, w + ".active must be an array of true/false, one per point of the "
+                                "loading path (per load step when load_steps is their number)");
+            active_nodes.emplace_back(p.supports.size(), an);
+            for (size_t k = 0; k < a->size(); ++k) {
+                const auto b = a->get(k)->value_exact<bool>();
+                if (!b)
+                    rd.fail(a->get(k),
+                            w + ".active[" + std::to_string(k) + "] must be true or false");
+                s.active.push_back(*b);
+            }
+        }
         p.supports.push_back(s);
+    }
+    // Every per-point list has the length K of the loading path; name the `active` that differs.
+    for (const auto& [i, an] : active_nodes) {
+        const int K = p.n_path_points();
+        const size_t n = p.supports[i].active.size();
+        if (static_cast<int>(n) != K)
+            rd.fail(an, "[[support]].active has " + std::to_string(n) +
+                            " entries but the loading path has " + std::to_string(K) +
+                            " points (the length of the scene's other per-step lists: factors, "
+                            "ux/uy lists, active); give one per point");
     }
     // Default augmentation: r = r_over_E x the smallest Young's modulus of the scene. The softer
     // body governs the compliance of a contact pair; scaling r with the stiffer one makes r many
@@ -450,6 +622,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         c.contactor = rd.string(*ct, "contactor", w);
         if (!p.mesh0.find_tag(c.contactor))
             rd.fail(ct->get("contactor"), w + ": unknown contactor tag '" + c.contactor + "'");
+        check_tag(*ct, c.contactor, w, true, "contactor");
         c.mu = rd.number(*ct, "mu", w);
         if (c.mu < 0)
             rd.fail(ct->get("mu"),
@@ -478,6 +651,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
             c.target = rd.string(*ct, "target", w);
             if (!p.mesh0.find_tag(c.target))
                 rd.fail(ct->get("target"), w + ": unknown target tag '" + c.target + "'");
+            check_tag(*ct, c.target, w, true, "target");
             if (c.target == c.contactor)
                 rd.fail(ct->get("target"), w + ": the target tag is the contactor tag");
             const std::string el = rd.string_or(*ct, "element", "node_on_facet", w);
@@ -580,6 +754,12 @@ std::string builtin_scene_text(const std::string& name) {
     const auto& s = detail::builtin_scenes();
     auto it = s.find(name);
     return it == s.end() ? std::string() : it->second;
+}
+
+std::string builtin_file_text(const std::string& name) {
+    const auto& f = detail::builtin_files();
+    auto it = f.find(name);
+    return it == f.end() ? std::string() : it->second;
 }
 
 levels::Problem load_scene(const std::string& name_or_path) {

@@ -27,4 +27,8 @@ std::vector<std::string> builtin_scene_names();
 /// TOML text of a built-in scene, or empty if there is none with that name.
 std::string builtin_scene_text(const std::string& name);
 
+/// Text of a file the built-in scenes read (scenes/*.msh, by file name, e.g. "hertz_gmsh.msh"),
+/// or empty if there is none with that name.
+std::string builtin_file_text(const std::string& name);
+
 } // namespace mlc::scene

@@ -216,18 +216,14 @@ void BlockSOR::robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, Inver
     const Index s = D.rows();
     // An unknown whose row and column are both zero in the block is decoupled from the others
     // (e.g. the tangential multiplier of a stuck node whose tangential displacement is
-    // prescribed: its equation and its column vanish from the Jacobian). Its correction is zero
-    // (the pseudo-inverse), and the rest of the block is inverted without it.
-    // Only in a block of several unknowns and when the unknown's whole row of A is zero (a
-    // point block's zero diagonal stays the error below).
+    // prescribed: its equation and its column vanish from the Jacobian, or, node on facet, keep
+    // only the couplings to the target vertices, in other blocks). Its correction from its own
+    // block is zero (the pseudo-inverse), and the rest of the block is inverted without it.
+    // Only in a block of several unknowns (a point block's zero diagonal stays the error below);
+    // a zero row with a nonzero column (or the reverse) is a blocking that does not suit A.
     auto decoupled = [&](Index i) {
-        if (s == 1 || D.row(i).cwiseAbs().maxCoeff() > 0.0 || D.col(i).cwiseAbs().maxCoeff() > 0.0)
-            return false;
-        const Index row = s0 + i;
-        const double* av = A_->valuePtr();
-        for (int p = A_->outerIndexPtr()[row]; p < A_->outerIndexPtr()[row + 1]; ++p)
-            if (av[p] != 0.0) return false;
-        return true;
+        return s > 1 && D.row(i).cwiseAbs().maxCoeff() == 0.0 &&
+               D.col(i).cwiseAbs().maxCoeff() == 0.0;
     };
     std::vector<Index> keep;
     for (Index i = 0; i < s; ++i)

@@ -20,9 +20,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <ostream>
 #include <queue>
+#include <set>
 #include <unordered_map>
 
 namespace mlc::mesh {
@@ -461,12 +463,46 @@ struct Meshed {
     std::vector<int> next, seg;                   // per flattened boundary point
     std::vector<SubEdge> sub_edges;               // in loop order
     std::vector<std::vector<VertexHandle>> added; // per chord: mesher-added vertices, in order
+    std::vector<SubEdge> line_sub_edges;          // interior lines: seg indexes the lines
 };
+
+/// Follows the constrained edges from `from` to `to` (the pieces a chord was split into by the
+/// mesher), calling visit(a, b) for each piece.
+template <class Visit>
+void walk_chord(const CDT& tr, VertexHandle from, VertexHandle to, const Vec2& from_x,
+                const Vec2& to_x, Visit&& visit) {
+    const Vec2 dir = (to_x - from_x).normalized();
+    VertexHandle cur = from, prev;
+    for (std::size_t step = 0; cur != to; ++step) {
+        MLC_CHECK(step < tr.number_of_vertices(),
+                  "mesh_domain: internal error: lost the chord at " << from_x.transpose());
+        VertexHandle best;
+        double best_cos = 0.5;
+        auto ec = tr.incident_edges(cur), done = ec;
+        do {
+            if (!tr.is_constrained(*ec)) continue;
+            const FaceHandle f = ec->first;
+            VertexHandle n = f->vertex(CDT::ccw(ec->second));
+            if (n == cur) n = f->vertex(CDT::cw(ec->second));
+            if (n == prev || tr.is_infinite(n)) continue;
+            const double c = (to_vec(n->point()) - to_vec(cur->point())).normalized().dot(dir);
+            if (c > best_cos) {
+                best_cos = c;
+                best = n;
+            }
+        } while (++ec != done);
+        MLC_CHECK(best != VertexHandle(), "mesh_domain: internal error: the chord at "
+                                              << from_x.transpose() << " is broken");
+        visit(cur, best);
+        prev = cur;
+        cur = best;
+    }
+}
 
 /// Inserts the boundary, checks and marks the domain (nesting level 1 = inside the outer loop,
 /// outside every hole), and refines it.
 void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<SegmentGeometry>& segs,
-                   const SizeFunction& h, Meshed& p) {
+                   const std::vector<LoopPoints>& lines, const SizeFunction& h, Meshed& p) {
     std::vector<Vec2> x;
     for (const LoopPoints& lp : loops) {
         const int start = static_cast<int>(x.size()), n = static_cast<int>(lp.x.size());
@@ -504,6 +540,45 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
     }
     MLC_CHECK(p.tr.dimension() == 2,
               "mesh_domain: the boundary points are collinear; the domain has no area");
+    // The loop constraints, which alone bound the domain (interior lines are constraints too).
+    std::set<std::pair<VertexHandle, VertexHandle>> loop_edge;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+        loop_edge.emplace(p.vh[k], p.vh[p.next[k]]);
+        loop_edge.emplace(p.vh[p.next[k]], p.vh[k]);
+    }
+    auto is_border = [&](FaceHandle f, int i) {
+        return f->is_constrained(i) &&
+               loop_edge.count({f->vertex(CDT::ccw(i)), f->vertex(CDT::cw(i))}) > 0;
+    };
+    // Interior lines: open polylines, their ends inside the domain or at a loop point.
+    std::vector<std::vector<VertexHandle>> line_vh(lines.size());
+    std::map<VertexHandle, int> line_of; // vertex -> line it belongs to
+    for (std::size_t l = 0; l < lines.size(); ++l) {
+        const auto& lp = lines[l];
+        const std::string w = "line " + std::to_string(l);
+        for (std::size_t k = 0; k < lp.x.size(); ++k) {
+            const VertexHandle v = p.tr.insert(Point(lp.x[k].x(), lp.x[k].y()));
+            const bool end = k == 0 || k + 1 == lp.x.size();
+            MLC_CHECK(v->info().input < 0 || end,
+                      "mesh_domain: " << w << " passes through the boundary point "
+                                      << lp.x[k].transpose()
+                                      << "; interior lines may end on the boundary only at a "
+                                         "segment's end");
+            const auto [it, inserted] = line_of.emplace(v, static_cast<int>(l));
+            MLC_CHECK(inserted || it->second == static_cast<int>(l) || end,
+                      "mesh_domain: " << w << " touches line " << it->second << " at "
+                                      << lp.x[k].transpose() << " away from their ends");
+            line_vh[l].push_back(v);
+        }
+        for (std::size_t k = 0; k + 1 < lp.x.size(); ++k) {
+            try {
+                p.tr.insert_constraint(line_vh[l][k], line_vh[l][k + 1]);
+            } catch (const CDT::Intersection_of_constraints_exception&) {
+                MLC_CHECK(false, "mesh_domain: " << w << " crosses the boundary or another line "
+                                                 << "near " << lp.x[k].transpose());
+            }
+        }
+    }
 
     // Nesting level of each face: number of constraints crossed from the infinite face.
     std::unordered_map<FaceHandle, int> level;
@@ -518,7 +593,7 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
             for (int i = 0; i < 3; ++i) {
                 FaceHandle n = f->neighbor(i);
                 if (level.count(n)) continue;
-                if (f->is_constrained(i)) {
+                if (is_border(f, i)) {
                     border.push(f);
                 } else {
                     level[n] = index;
@@ -533,7 +608,7 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
         border.pop();
         for (int i = 0; i < 3; ++i) {
             FaceHandle n = f->neighbor(i);
-            if (f->is_constrained(i) && !level.count(n)) flood(n, level[f] + 1);
+            if (is_border(f, i) && !level.count(n)) flood(n, level[f] + 1);
         }
     }
     double area = 0;
@@ -554,6 +629,20 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
     MLC_CHECK(std::abs(area - expected) <= 1e-8 * signed_area(loops[0].x),
               "mesh_domain: the meshed area " << area << " differs from outer minus hole areas "
                                               << expected << "; every hole must lie inside loop 0");
+
+    for (std::size_t l = 0; l < lines.size(); ++l)
+        for (std::size_t k = 0; k + 1 < line_vh[l].size(); ++k) {
+            FaceHandle f;
+            int i = 0;
+            MLC_CHECK(p.tr.is_edge(line_vh[l][k], line_vh[l][k + 1], f, i),
+                      "mesh_domain: internal error: lost interior line " << l);
+            const FaceHandle n = f->neighbor(i);
+            MLC_CHECK(!p.tr.is_infinite(f) && !p.tr.is_infinite(n) && f->is_in_domain() &&
+                          n->is_in_domain(),
+                      "mesh_domain: line " << l << " leaves the domain near "
+                                           << lines[l].x[k].transpose()
+                                           << "; interior lines must lie inside it");
+        }
 
     SizeFieldCriteria criteria(shape_bound, h);
     CGAL::Delaunay_mesher_2<CDT, SizeFieldCriteria> mesher(p.tr, criteria);
@@ -592,6 +681,12 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
             cur = best;
         }
     }
+    for (std::size_t l = 0; l < lines.size(); ++l)
+        for (std::size_t k = 0; k + 1 < line_vh[l].size(); ++k)
+            walk_chord(p.tr, line_vh[l][k], line_vh[l][k + 1], lines[l].x[k], lines[l].x[k + 1],
+                       [&](VertexHandle a, VertexHandle b) {
+                           p.line_sub_edges.push_back({a, b, static_cast<int>(l)});
+                       });
 }
 
 std::uint64_t edge_key(int a, int b) {
@@ -601,16 +696,43 @@ std::uint64_t edge_key(int a, int b) {
 
 } // namespace
 
-Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField& size) {
+Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField& size,
+                 const std::vector<Segment>& lines) {
     size.validate();
     std::vector<Circle> circles;
     double diameter = 0;
     const std::vector<SegmentGeometry> segs = resolve_segments(loops, circles, diameter);
     const SizeFunction h(size);
     const std::vector<LoopPoints> points = discretize(segs, h, static_cast<int>(loops.size()));
+    // Interior lines: straight, split like the loop segments; an end within the tolerance of a
+    // loop segment's end is put on it (the only boundary points they may share).
+    std::vector<SegmentGeometry> lgs;
+    const double tol = 1e-9 * diameter;
+    for (std::size_t l = 0; l < lines.size(); ++l) {
+        const Segment& s = lines[l];
+        MLC_CHECK(s.kind == Segment::Kind::line,
+                  "mesh_domain: line " << l << " is an arc; interior lines are straight");
+        MLC_CHECK(s.from.allFinite() && s.to.allFinite(),
+                  "mesh_domain: line " << l << " has a non-finite end point");
+        SegmentGeometry g;
+        g.loop = static_cast<int>(l);
+        g.index = 0;
+        g.a = s.from;
+        g.b = s.to;
+        for (const SegmentGeometry& b : segs)
+            for (Vec2* e : {&g.a, &g.b})
+                if ((*e - b.a).norm() <= tol) *e = b.a;
+        MLC_CHECK((g.b - g.a).norm() > tol,
+                  "mesh_domain: line " << l << " has zero length at " << g.a.transpose());
+        g.tag = s.tag.empty() ? "line" : s.tag;
+        lgs.push_back(g);
+    }
+    std::vector<LoopPoints> line_points = discretize(lgs, h, static_cast<int>(lgs.size()));
+    for (std::size_t l = 0; l < lgs.size(); ++l)
+        line_points[l].x.push_back(lgs[l].b);
 
     Meshed result;
-    refine_domain(points, segs, h, result);
+    refine_domain(points, segs, line_points, h, result);
     // The mesher splits boundary chords where they are encroached; on an arc, move each such
     // vertex radially onto the circle. Arc pieces span at most 15 degrees, so the move is at most
     // 13% of the distance to the nearer chord end, and the triangles around it stay close to
@@ -691,6 +813,9 @@ Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField
         seen[edge_key(be.v0, be.v1)] = true;
         out.boundary.push_back(be);
     }
+    for (const SubEdge& e : result.line_sub_edges)
+        out.lines.push_back(
+            {e.a->info().id, e.b->info().id, out.add_tag(lgs[static_cast<size_t>(e.seg)].tag), -1});
     check_quality(out);
     return out;
 }

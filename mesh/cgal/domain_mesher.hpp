@@ -79,6 +79,13 @@ std::ostream& operator<<(std::ostream& os, const SizeField& size);
 /// index into `circles` (one Circle per distinct center and radius). Vertices are in Hilbert-curve
 /// order. Throws InvalidInput for bad geometry or sizes, naming the loop and segment; calls
 /// check_quality on the result. Runs at about 10^5 triangles per second or faster.
-Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField& size);
+///
+/// `lines`: constrained interior segments (straight; `from`, `to`, `tag`, default tag "line"),
+/// split along h like the loop segments and kept as edges of the triangulation: their edges are
+/// the tagged interior lines of the result (Mesh::lines). Each must lie inside the domain; its
+/// ends may be inside or at a loop segment's end, and lines may meet at their ends only
+/// (InvalidInput naming the line otherwise).
+Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField& size,
+                 const std::vector<Segment>& lines = {});
 
 } // namespace mlc::mesh

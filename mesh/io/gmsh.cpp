@@ -379,7 +379,7 @@ void read_elements_41(Reader& in, MshData& d) {
     in.end("Elements");
 }
 
-MshData parse(const std::filesystem::path& file) {
+std::string read_file(const std::filesystem::path& file) {
     std::ifstream stream(file, std::ios::binary);
     MLC_CHECK(stream.good(), "read_gmsh: cannot open '" << file.string() << "'");
     // The whole file is read into memory: a device (/dev/zero) or a pipe would never end.
@@ -387,7 +387,11 @@ MshData parse(const std::filesystem::path& file) {
               "read_gmsh: '" << file.string() << "' is not a regular file");
     std::stringstream buffer;
     buffer << stream.rdbuf();
-    Reader in(file, buffer.str());
+    return buffer.str();
+}
+
+MshData parse(const std::filesystem::path& file, std::string text) {
+    Reader in(file, std::move(text));
 
     MshData d;
     int version = 0; // 2 or 41
@@ -458,7 +462,12 @@ std::uint64_t edge_key(int a, int b) {
 } // namespace
 
 Mesh read_gmsh(const std::filesystem::path& file, const std::string& surface) {
-    const MshData d = parse(file);
+    return read_gmsh_text(read_file(file), file, surface);
+}
+
+Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
+                    const std::string& surface) {
+    const MshData d = parse(file, text);
     const std::string where = "read_gmsh: " + file.string();
 
     std::unordered_map<std::int64_t, int> node_index;
@@ -585,14 +594,15 @@ Mesh read_gmsh(const std::filesystem::path& file, const std::string& surface) {
         if (a < 0 || b < 0) continue;
         const std::uint64_t key = edge_key(a, b);
         auto it = edges.find(key);
-        if (it == edges.end() || it->second.first != 1 || !tagged.insert(key).second) continue;
+        if (it == edges.end() || it->second.first > 2 || !tagged.insert(key).second) continue;
         const int p = d.phys[d.phys_begin[e]];
         auto name = d.names.find({1, p});
         BoundaryEdge be;
         be.v0 = it->second.second[0];
         be.v1 = it->second.second[1];
         be.tag = m.add_tag(name == d.names.end() ? "tag" + std::to_string(p) : name->second);
-        m.boundary.push_back(be);
+        // An edge of two selected triangles is a tagged interior line.
+        (it->second.first == 1 ? m.boundary : m.lines).push_back(be);
     }
     check_quality(m);
     return m;

@@ -19,8 +19,10 @@ namespace mlc::mesh {
 ///   Their z coordinate must be 0 (to 1e-10 of the mesh size).
 /// - Boundary: every 2-node line (type 1) in a physical curve that is a boundary edge of the
 ///   selected triangles becomes a BoundaryEdge tagged with the physical name ("tag<N>" if
-///   unnamed), oriented counter-clockwise around the body; `curve` = -1. Lines elsewhere (inside
-///   the body, on other bodies) are ignored; an edge in several physical curves keeps the first.
+///   unnamed), oriented counter-clockwise around the body; `curve` = -1. A line in a physical
+///   curve that is an interior edge of the selection (an edge of two selected triangles) becomes
+///   a tagged interior line (Mesh::lines) with that name. Lines elsewhere (on other bodies, or
+///   not edges of the selection) are ignored; an edge in several physical curves keeps the first.
 ///   Boundary edges in no physical curve are not listed.
 /// - Mesh::attribute: the (first) physical surface tag of each triangle, or empty when the
 ///   triangles carry no physical surface.
@@ -32,5 +34,10 @@ namespace mlc::mesh {
 /// elements). An unknown `surface` throws listing the physical surfaces present. Calls
 /// check_quality on the result. Lengths are in the file's units.
 Mesh read_gmsh(const std::filesystem::path& file, const std::string& surface = "");
+
+/// As read_gmsh, from the text of a .msh file (a mesh embedded in the program); `file` names it in
+/// messages only.
+Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
+                    const std::string& surface = "");
 
 } // namespace mlc::mesh
