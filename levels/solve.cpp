@@ -311,6 +311,9 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             }
             for (auto& nw : newton)
                 nw.reset(); // they refer to the levels about to be replaced
+            for (auto& c : continuation_solver)
+                c.reset(); // likewise (SolveOptions::r_continuation starts over)
+            std::fill(continued.begin(), continued.end(), 0.0);
             {
                 ScopedTimer t(&res.timings, "setup/supports_changed");
                 try {
