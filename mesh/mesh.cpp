@@ -54,28 +54,32 @@ double Mesh::signed_area(int t) const {
     return 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
 }
 
-std::vector<int> Mesh::vertices_with_tag(int t) const {
+namespace {
+
+// The sorted distinct end vertices of the edges tagged t in each of the lists.
+template <class... Edges> std::vector<int> end_vertices(int t, const Edges&... lists) {
     std::vector<int> out;
-    for (const auto& e : boundary)
-        if (e.tag == t) {
-            out.push_back(e.v0);
-            out.push_back(e.v1);
-        }
+    auto add = [&](const auto& edges) {
+        for (const auto& e : edges)
+            if (e.tag == t) {
+                out.push_back(e.v0);
+                out.push_back(e.v1);
+            }
+    };
+    (add(lists), ...);
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
 }
 
+} // namespace
+
+std::vector<int> Mesh::vertices_with_tag(int t) const {
+    return end_vertices(t, boundary);
+}
+
 std::vector<int> Mesh::vertices_on_tag(int t) const {
-    std::vector<int> out = vertices_with_tag(t);
-    for (const auto& e : lines)
-        if (e.tag == t) {
-            out.push_back(e.v0);
-            out.push_back(e.v1);
-        }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
+    return end_vertices(t, boundary, lines);
 }
 
 bool Mesh::is_boundary_tag(int t) const {
