@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libhypre-dev libopenmpi-dev openmpi-bin
   libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev libsuitesparse-dev
   zlib1g-dev                    # binary (zlib-compressed) VTU output
+  libmetis-dev                  # mesh partitioning for the distributed solve (mesh/partition)
   python3 python3-matplotlib
   python3-vtk9                  # tests: VTK's own reader opens our VTU/PVD files
   pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (python/) and the Python tests
