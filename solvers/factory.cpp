@@ -199,7 +199,7 @@ std::unique_ptr<Preconditioner> build_mgr(SpecOptions& o, const LevelData* level
     const std::string frelax = o.get_string("frelax", "amg");
     MLC_CHECK(frelax == "amg" || frelax == "jacobi" || frelax == "gs",
               "option frelax=" << frelax << " of mgr: valid amg, jacobi, gs");
-    p.f_relax = frelax == "amg" ? 2 : frelax == "jacobi" ? 18 : 3;
+    p.f_relax = frelax == "amg" ? 2 : frelax == "jacobi" ? 0 : 3;
     p.f_sweeps = o.get_int("fsweeps", p.f_sweeps);
     p.f_amg.strong_threshold = o.get_double("theta", p.f_amg.strong_threshold);
     p.interp_type = o.get_int("interp", p.interp_type);
@@ -283,9 +283,10 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          false,
          &build_amg},
         {"mgr",
-         "mgr[:frelax=amg|jacobi|gs,fsweeps=N,theta=0.25,interp=2,restrict=0,cg=0,smooth=0,"
-         "smoother=0] (hypre MGR on the whole Newton system: F = displacements relaxed by a "
-         "BoomerAMG V-cycle, C = multipliers, reduced system by BoomerAMG; any level)",
+         "mgr[:frelax=amg|jacobi|gs,fsweeps=N,theta=0.25,interp=2,restrict=0,cg=0,smooth=1,"
+         "smoother=16] (hypre MGR on the whole Newton system: global ILU(0) sweep, F = "
+         "displacements relaxed by a BoomerAMG V-cycle, C = multipliers, reduced system by "
+         "BoomerAMG; any level)",
          "",
          {"frelax", "fsweeps", "theta", "interp", "restrict", "cg", "smooth", "smoother"},
          true,

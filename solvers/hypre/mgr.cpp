@@ -162,8 +162,8 @@ std::string MGRPreconditioner::name() const {
     if (params_.interp_type != 2) os << ",interp=" << params_.interp_type;
     if (params_.restrict_type != 0) os << ",restrict=" << params_.restrict_type;
     if (params_.coarse_method != 0) os << ",cg=" << params_.coarse_method;
-    if (params_.global_smooth_iters > 0)
-        os << ",smooth=" << params_.global_smooth_iters << "x" << params_.global_smooth_type;
+    if (params_.global_smooth_iters != 1 || params_.global_smooth_type != 16)
+        os << ",smooth=" << params_.global_smooth_iters << ",smoother=" << params_.global_smooth_type;
     os << ")";
     return os.str();
 }
