@@ -14,7 +14,8 @@
 ///   from zero to the same relative tolerance by our Krylov method with `mg` as the run uses it
 ///   (at each requested thread count), with hypre MGR (solvers/hypre/mgr.hpp) and with
 ///   BoomerAMG on the whole Jacobian (the naive choice), both at one thread through our
-///   Preconditioner interface (hypre has no CGS); per system: statuses, setup and solve seconds,
+///   Preconditioner interface (hypre has no CGS), and MGR inside hypre's own FlexGMRES;
+///   per system: statuses, setup and solve seconds,
 ///   iterations and the true relative residual ||b - J x|| / ||b|| computed here.
 /// All print a table and write JSON.
 #pragma once
@@ -61,6 +62,9 @@ struct BenchNewtonOptions {
     std::string pc = "mg";          ///< our preconditioner spec (the run's)
     std::string mgr = "mgr";        ///< the hypre MGR spec (registry options, e.g. "mgr:theta=0.5")
     bool amg = true;                ///< also BoomerAMG on the whole Jacobian
+    /// Also MGR inside hypre's own FlexGMRES(50) ("mgr+fgmres"), as hypre users run it (hypre
+    /// has no CGS), at 1 thread.
+    bool hypre_gmres = true;
     std::string krylov = "cgs";     ///< Krylov method of every solve
     double rel_tol = 1e-8;          ///< relative tolerance of every solve
     int max_iter = 1000;            ///< iterations per solve (slow solves are cut short earlier)

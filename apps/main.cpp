@@ -172,6 +172,8 @@ int main(int argc, char** argv) {
     bnw->add_option("--pc", bno.pc, "our preconditioner, the run's (default mg)");
     bnw->add_option("--mgr", bno.mgr, "the hypre MGR spec (default mgr; see --pc mgr in run)");
     bnw->add_flag("--no-amg", bno_no_amg, "leave out BoomerAMG on the whole Jacobian");
+    bnw->add_flag("!--no-hypre-gmres", bno.hypre_gmres,
+                  "leave out MGR inside hypre's own FlexGMRES(50) (column mgr+fgmres)");
     bnw->add_option("--krylov", bno.krylov, "Krylov method of every solve (default cgs)");
     bnw->add_option("--tol", bno.rel_tol, "relative tolerance of every solve (default 1e-8)");
     bnw->add_option("--max-iter", bno.max_iter,

@@ -7,6 +7,8 @@
 #include "smoothers/matrix_checks.hpp"
 #include "solvers/hypre/ij_system.hpp"
 
+#include <mpi.h>
+
 #include <cmath>
 #include <sstream>
 
@@ -153,6 +155,51 @@ void MGRPreconditioner::apply(const Vector& r, Vector& z) const {
     HYPRE_MGRSolve(impl_->mgr, impl_->A, impl_->b, impl_->x);
     HYPRE_ClearAllErrors(); // max_iter 1 "not converged" is the preconditioner's normal exit
     impl_->get_vector(impl_->ij_x, z);
+}
+
+SolveResult MGRPreconditioner::solve_fgmres(const SparseMatrix& A, const Vector& b, Vector& x,
+                                            double rel_tol, int max_iter, int restart) const {
+    MLC_CHECK(impl_ != nullptr, "MGRPreconditioner::solve_fgmres: call setup first");
+    smoothers::check_size(b, impl_->n, "MGRPreconditioner::solve_fgmres", "b");
+    MLC_CHECK(A.rows() == impl_->n, "MGRPreconditioner::solve_fgmres: the matrix has "
+                                        << A.rows() << " rows, the setup " << impl_->n);
+    MLC_CHECK(rel_tol > 0 && rel_tol < 1, "solve_fgmres: rel_tol must be in (0, 1)");
+    MLC_CHECK(max_iter >= 1 && restart >= 1, "solve_fgmres: max_iter and restart must be >= 1");
+    if (x.size() != b.size()) x = Vector::Zero(b.size());
+    SolveResult res;
+    res.initial_residual = (b - A * x).norm();
+    Impl& h = *impl_;
+    h.set_vector(h.ij_b, b);
+    h.set_vector(h.ij_x, x);
+    HYPRE_Solver gm = nullptr;
+    HYPRE_ParCSRFlexGMRESCreate(MPI_COMM_SELF, &gm);
+    HYPRE_FlexGMRESSetKDim(gm, restart);
+    HYPRE_FlexGMRESSetTol(gm, rel_tol);
+    HYPRE_FlexGMRESSetAbsoluteTol(gm, 0.0);
+    HYPRE_FlexGMRESSetMaxIter(gm, max_iter);
+    HYPRE_FlexGMRESSetPrintLevel(gm, 0);
+    // MGR is set up already (setup() is timed on its own): FlexGMRES's setup call is a no-op.
+    HYPRE_PtrToParSolverFcn no_setup = [](HYPRE_Solver, HYPRE_ParCSRMatrix, HYPRE_ParVector,
+                                          HYPRE_ParVector) -> HYPRE_Int { return 0; };
+    HYPRE_ParCSRFlexGMRESSetPrecond(gm, HYPRE_MGRSolve, no_setup, h.mgr);
+    HYPRE_ParCSRFlexGMRESSetup(gm, h.A, h.b, h.x);
+    const double t0 = wall_seconds();
+    HYPRE_ParCSRFlexGMRESSolve(gm, h.A, h.b, h.x);
+    res.solve_seconds = wall_seconds() - t0;
+    HYPRE_ClearAllErrors();
+    HYPRE_Int its = 0;
+    HYPRE_FlexGMRESGetNumIterations(gm, &its);
+    HYPRE_ParCSRFlexGMRESDestroy(gm);
+    h.get_vector(h.ij_x, x);
+    res.iterations = static_cast<int>(its);
+    res.final_residual = x.allFinite() ? (b - A * x).norm() : HUGE_VAL;
+    const double bn = b.norm();
+    res.relative_residual = bn > 0 ? res.final_residual / bn : res.final_residual;
+    res.converged = res.relative_residual <= rel_tol;
+    res.reason = res.converged ? StopReason::converged : StopReason::max_iter;
+    if (its > 0 && res.initial_residual > 0 && std::isfinite(res.final_residual))
+        res.average_rate = std::pow(res.final_residual / res.initial_residual, 1.0 / its);
+    return res;
 }
 
 std::string MGRPreconditioner::name() const {

@@ -71,6 +71,12 @@ public:
     std::string name() const override;
     /// Seconds of the last setup spent copying the matrix into hypre (part of the setup).
     double copy_seconds() const { return copy_seconds_; }
+    /// MGR as hypre's own users run it: hypre's FlexGMRES(restart) preconditioned by this MGR
+    /// (set up already) on the matrix of the last setup, to ||b - A x|| <= rel_tol ||b||, from
+    /// x (resized to zero if empty). Returns iterations, the solve seconds and the true residual
+    /// (recomputed here with `A`, which must be the matrix of the last setup).
+    SolveResult solve_fgmres(const SparseMatrix& A, const Vector& b, Vector& x, double rel_tol,
+                             int max_iter, int restart) const;
 
     struct Impl;
 

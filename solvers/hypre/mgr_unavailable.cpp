@@ -20,6 +20,10 @@ MGRPreconditioner::MGRPreconditioner(std::vector<int>, MGRParams) {
 MGRPreconditioner::~MGRPreconditioner() = default;
 void MGRPreconditioner::setup(const SparseMatrix&) {}
 void MGRPreconditioner::apply(const Vector&, Vector&) const {}
+SolveResult MGRPreconditioner::solve_fgmres(const SparseMatrix&, const Vector&, Vector&, double,
+                                            int, int) const {
+    return {};
+}
 std::string MGRPreconditioner::name() const {
     return "mgr";
 }

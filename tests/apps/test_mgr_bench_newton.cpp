@@ -84,9 +84,11 @@ TEST(BenchNewton, OneRecordPerNewtonSystemWithFiniteValues) {
     EXPECT_EQ(count("\"mg@2\": \\{\"iterations\""), systems);
     EXPECT_EQ(count("\"mgr\": \\{\"iterations\""), systems);
     EXPECT_EQ(count("\"amg\": \\{\"iterations\""), systems);
+    EXPECT_EQ(count("\"mgr\\+fgmres\": \\{\"iterations\""), systems);
     EXPECT_EQ(count("\\bnull\\b|\\bnan\\b|\\binf\\b"), 0) << json;
     // mg and MGR reach the tolerance on every system (AMG on the whole Jacobian may not).
     EXPECT_EQ(count("\"mg@1\": \\{[^}]*\"converged\": true"), systems);
     EXPECT_EQ(count("\"mgr\": \\{[^}]*\"converged\": true"), systems);
+    EXPECT_EQ(count("\"mgr\\+fgmres\": \\{[^}]*\"converged\": true"), systems);
     EXPECT_NE(table.str().find("totals over"), std::string::npos) << table.str();
 }
