@@ -2,7 +2,7 @@
 // hypre BoomerAMG (one V-cycle as a Preconditioner) and hypre PCG + BoomerAMG.
 #include "solvers/hypre/boomeramg.hpp"
 
-#include "solvers/hypre/ij_system.hpp"
+#include "solvers/hypre/ij_system.h"
 
 #include "core/check.hpp"
 #include "core/timer.hpp"

@@ -5,7 +5,7 @@
 #include "core/check.hpp"
 #include "core/timer.hpp"
 #include "smoothers/matrix_checks.hpp"
-#include "solvers/hypre/ij_system.hpp"
+#include "solvers/hypre/ij_system.h"
 
 #include <mpi.h>
 

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
-/// @file Internal to solvers/hypre/ (the only folder that includes hypre and MPI): a CSR matrix
-/// copied into a hypre IJ / ParCSR matrix with two IJ vectors, and a BoomerAMG configured from
-/// BoomerAMGParams. Shared by the BoomerAMG and MGR preconditioners. Single process
+/// @file Internal to solvers/hypre/ (the only folder that includes hypre and MPI; named .h, not
+/// .hpp, so that it is not installed with the public headers, which must not need hypre): a CSR
+/// matrix copied into a hypre IJ / ParCSR matrix with two IJ vectors, and a BoomerAMG configured
+/// from BoomerAMGParams. Shared by the BoomerAMG and MGR preconditioners. Single process
 /// (MPI_COMM_SELF), rows 0..n-1.
 #pragma once
 
