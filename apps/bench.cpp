@@ -477,11 +477,9 @@ public:
             solvers::LevelData data;
             data.has_multipliers = true;
             data.unknown_functions = [this]() { return functions_; };
-            row.samples["mgr"].push_back(hypre_solve(J, b, params_, [&]() {
-                return solvers::make_preconditioner(opt_.mgr, &data);
-            }));
-            if (opt_.hypre_gmres)
-                row.samples["mgr+fgmres"].push_back(hypre_fgmres(J, b, data));
+            row.samples["mgr"].push_back(hypre_solve(
+                J, b, params_, [&]() { return solvers::make_preconditioner(opt_.mgr, &data); }));
+            if (opt_.hypre_gmres) row.samples["mgr+fgmres"].push_back(hypre_fgmres(J, b, data));
             if (opt_.amg && pass_.amg)
                 row.samples["amg"].push_back(hypre_solve(J, b, amg_params_, [&]() {
                     solvers::BoomerAMGParams p;
@@ -515,15 +513,15 @@ private:
             s.setup = wall_seconds() - t0;
             if (const auto* m = dynamic_cast<const solvers::MGRPreconditioner*>(pc.get()))
                 s.copy = m->copy_seconds();
-            const SolveResult r = solvers::solve(
-                method_, MatrixOperator(J, MatVec::unrolled), *pc, b, x, params);
+            const SolveResult r =
+                solvers::solve(method_, MatrixOperator(J, MatVec::unrolled), *pc, b, x, params);
             s.solve = r.solve_seconds;
             s.iterations = r.iterations;
             s.relres = true_relres(J, b, x);
             s.converged = r.converged && s.relres <= opt_.rel_tol * (1 + 1e-6);
             if (!s.converged)
-                s.failure = std::string(to_string(r.reason)) +
-                            (r.message.empty() ? "" : ": " + r.message);
+                s.failure =
+                    std::string(to_string(r.reason)) + (r.message.empty() ? "" : ": " + r.message);
         } catch (const std::exception& e) {
             s.relres = true_relres(J, b, x);
             s.failure = std::string("exception: ") + e.what();
@@ -710,9 +708,9 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"level\": " << opt.levels
        << ",\n  \"unknowns\": " << unknowns << ",\n  \"nonzeros\": " << nonzeros
        << ",\n  \"load_steps\": " << problem.load_steps
-       << ",\n  \"krylov\": " << json_string(opt.krylov)
-       << ",\n  \"rel_tol\": " << opt.rel_tol << ",\n  \"max_iter\": " << opt.max_iter
-       << ",\n  \"repeat\": " << opt.repeat << ",\n  \"threads\": [";
+       << ",\n  \"krylov\": " << json_string(opt.krylov) << ",\n  \"rel_tol\": " << opt.rel_tol
+       << ",\n  \"max_iter\": " << opt.max_iter << ",\n  \"repeat\": " << opt.repeat
+       << ",\n  \"threads\": [";
     for (size_t i = 0; i < threads.size(); ++i)
         js << (i ? ", " : "") << threads[i];
     js << "],\n  \"hypre_threads\": 1,\n  \"solvers\": {";
@@ -771,8 +769,8 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
             js << "}";
             os << "  | " << std::setw(18) << (s.converged ? "" : "FAILED") << std::setw(6)
                << s.iterations << std::fixed << std::setprecision(3) << std::setw(9) << s.setup
-               << std::setw(9) << s.solve << std::scientific << std::setprecision(1)
-               << std::setw(9) << s.relres << std::defaultfloat;
+               << std::setw(9) << s.solve << std::scientific << std::setprecision(1) << std::setw(9)
+               << s.relres << std::defaultfloat;
         }
         js << "}";
         os << "\n";
@@ -790,8 +788,8 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
            << ", \"total_seconds\": " << json_number(total)
            << ", \"iterations\": " << total_its[key] << ", \"failed\": " << failed[key];
         if (key != ours && total_full[ours] + total_solve[ours] > 0)
-            js << ", \"time_over_" << ours << "\": "
-               << json_number(total / (total_full[ours] + total_solve[ours]));
+            js << ", \"time_over_" << ours
+               << "\": " << json_number(total / (total_full[ours] + total_solve[ours]));
         js << "}";
         os << "  " << std::setw(18) << std::left << key << std::right << " setup " << std::fixed
            << std::setprecision(3) << total_setup[key];
@@ -800,8 +798,8 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
            << total_its[key] << std::defaultfloat;
         if (failed[key] > 0) os << "  FAILED on " << failed[key] << " system(s)";
         if (key != ours && total_full[ours] + total_solve[ours] > 0)
-            os << "  (" << std::setprecision(3)
-               << total / (total_full[ours] + total_solve[ours]) << "x " << ours << ")";
+            os << "  (" << std::setprecision(3) << total / (total_full[ours] + total_solve[ours])
+               << "x " << ours << ")";
         os << "\n";
     }
     js << "\n  },\n  \"peak_rss_mib\": " << peak_rss_mib() << "\n}\n";

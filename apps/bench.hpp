@@ -58,19 +58,19 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os);
 /// Options of `bench newton`.
 struct BenchNewtonOptions {
     std::string scene = "square";
-    int levels = 3;                 ///< the finest level L (>= 1; levels 0..L are solved)
-    std::string pc = "mg";          ///< our preconditioner spec (the run's)
-    std::string mgr = "mgr";        ///< the hypre MGR spec (registry options, e.g. "mgr:theta=0.5")
-    bool amg = true;                ///< also BoomerAMG on the whole Jacobian
+    int levels = 3;          ///< the finest level L (>= 1; levels 0..L are solved)
+    std::string pc = "mg";   ///< our preconditioner spec (the run's)
+    std::string mgr = "mgr"; ///< the hypre MGR spec (registry options, e.g. "mgr:theta=0.5")
+    bool amg = true;         ///< also BoomerAMG on the whole Jacobian
     /// Also MGR inside hypre's own FlexGMRES(50) ("mgr+fgmres"), as hypre users run it (hypre
     /// has no CGS), at 1 thread.
     bool hypre_gmres = true;
-    std::string krylov = "cgs";     ///< Krylov method of every solve
-    double rel_tol = 1e-8;          ///< relative tolerance of every solve
-    int max_iter = 1000;            ///< iterations per solve (slow solves are cut short earlier)
-    int repeat = 1;                 ///< runs per thread count; times are medians over them
+    std::string krylov = "cgs";        ///< Krylov method of every solve
+    double rel_tol = 1e-8;             ///< relative tolerance of every solve
+    int max_iter = 1000;               ///< iterations per solve (slow solves are cut short earlier)
+    int repeat = 1;                    ///< runs per thread count; times are medians over them
     std::vector<int> threads = {1, 2}; ///< thread counts for our pc (hypre: the 1-thread runs)
-    std::filesystem::path out;      ///< JSON file (default out/bench/newton_<scene>_L<L>.json)
+    std::filesystem::path out;         ///< JSON file (default out/bench/newton_<scene>_L<L>.json)
 };
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every mg and MGR solve

@@ -128,9 +128,9 @@ void MGRPreconditioner::setup(const SparseMatrix& A) {
         HYPRE_MGRSetGlobalSmoothType(h->mgr, p.global_smooth_type);
     }
     h->c_amg = hypre_detail::create_boomeramg(p.c_amg, true, {}, 0);
-    HYPRE_MGRSetCoarseSolver(h->mgr, reinterpret_cast<HYPRE_PtrToParSolverFcn>(HYPRE_BoomerAMGSolve),
-                             reinterpret_cast<HYPRE_PtrToParSolverFcn>(HYPRE_BoomerAMGSetup),
-                             h->c_amg);
+    HYPRE_MGRSetCoarseSolver(
+        h->mgr, reinterpret_cast<HYPRE_PtrToParSolverFcn>(HYPRE_BoomerAMGSolve),
+        reinterpret_cast<HYPRE_PtrToParSolverFcn>(HYPRE_BoomerAMGSetup), h->c_amg);
     HYPRE_MGRSetMaxIter(h->mgr, 1);
     HYPRE_MGRSetTol(h->mgr, 0.0);
     HYPRE_MGRSetPrintLevel(h->mgr, 0);
@@ -210,7 +210,8 @@ std::string MGRPreconditioner::name() const {
     if (params_.restrict_type != 0) os << ",restrict=" << params_.restrict_type;
     if (params_.coarse_method != 0) os << ",cg=" << params_.coarse_method;
     if (params_.global_smooth_iters != 1 || params_.global_smooth_type != 16)
-        os << ",smooth=" << params_.global_smooth_iters << ",smoother=" << params_.global_smooth_type;
+        os << ",smooth=" << params_.global_smooth_iters
+           << ",smoother=" << params_.global_smooth_type;
     os << ")";
     return os.str();
 }

@@ -118,8 +118,7 @@ TEST(MGR, WithoutHypreSaysItIsUnavailable) {
         solvers::MGRPreconditioner pc({0, 1, 2});
         ADD_FAILURE() << "built without hypre";
     } catch (const InvalidInput& e) {
-        EXPECT_NE(std::string(e.what()).find("mgr (hypre MGR) is not available"),
-                  std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("mgr (hypre MGR) is not available"), std::string::npos)
             << e.what();
     }
 }
