@@ -9,7 +9,15 @@
 ///   level, right-hand side the full load) solved to the same relative tolerance by hypre
 ///   BoomerAMG-PCG and by our geometric V-cycle (vertex-block Gauss–Seidel, P / P^T, sparse LU
 ///   on level 0) inside CG and GMRES, side by side in one run.
-/// Both print a table and write JSON.
+/// - `bench newton`: the Newton systems of the finest level, captured from a real coarse-to-fine
+///   run (one per Newton step, through levels::SolveOptions::wrap_system_solver), each solved
+///   from zero to the same relative tolerance by our Krylov method with `mg` as the run uses it
+///   (at each requested thread count), with hypre MGR (solvers/hypre/mgr.hpp) and with
+///   BoomerAMG on the whole Jacobian (the naive choice), both at one thread through our
+///   Preconditioner interface (hypre has no CGS), and MGR inside hypre's own FlexGMRES;
+///   per system: statuses, setup and solve seconds,
+///   iterations and the true relative residual ||b - J x|| / ||b|| computed here.
+/// All print a table and write JSON.
 #pragma once
 
 #include <filesystem>
@@ -46,5 +54,27 @@ struct BenchElasticOptions {
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every solve converged).
 int bench_elastic(const BenchElasticOptions& opt, std::ostream& os);
+
+/// Options of `bench newton`.
+struct BenchNewtonOptions {
+    std::string scene = "square";
+    int levels = 3;          ///< the finest level L (>= 1; levels 0..L are solved)
+    std::string pc = "mg";   ///< our preconditioner spec (the run's)
+    std::string mgr = "mgr"; ///< the hypre MGR spec (registry options, e.g. "mgr:theta=0.5")
+    bool amg = true;         ///< also BoomerAMG on the whole Jacobian
+    /// Also MGR inside hypre's own FlexGMRES(50) ("mgr+fgmres"), as hypre users run it (hypre
+    /// has no CGS), at 1 thread.
+    bool hypre_gmres = true;
+    std::string krylov = "cgs";        ///< Krylov method of every solve
+    double rel_tol = 1e-8;             ///< relative tolerance of every solve
+    int max_iter = 1000;               ///< iterations per solve (slow solves are cut short earlier)
+    int repeat = 1;                    ///< runs per thread count; times are medians over them
+    std::vector<int> threads = {1, 2}; ///< thread counts for our pc (hypre: the 1-thread runs)
+    std::filesystem::path out;         ///< JSON file (default out/bench/newton_<scene>_L<L>.json)
+};
+
+/// Runs the benchmark (see the file comment); returns the exit code (0: every mg and MGR solve
+/// reached the tolerance, 2 otherwise).
+int bench_newton(const BenchNewtonOptions& opt, std::ostream& os);
 
 } // namespace mlc::apps

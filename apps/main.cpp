@@ -166,6 +166,27 @@ int main(int argc, char** argv) {
     bel->add_option("--max-iter", beo.max_iter, "iterations of every solve (default 1000)");
     bel->add_option("--repeat", beo.repeat, "runs per solver, times are medians (default 1)");
     bel->add_option("--out,-o", beo_out, "JSON file (default out/bench/elastic_<scene>_L<L>.json)");
+    mlc::apps::BenchNewtonOptions bno;
+    std::string bno_out;
+    bool bno_no_amg = false;
+    auto* bnw = bench->add_subcommand(
+        "newton", "the finest level's Newton systems of a run: mg vs hypre MGR and BoomerAMG");
+    bnw->add_option("scene", bno.scene, "scene file or built-in name (default square)");
+    bnw->add_option("--levels,-l", bno.levels, "finest level, >= 1 (default 3)");
+    bnw->add_option("--pc", bno.pc, "our preconditioner, the run's (default mg)");
+    bnw->add_option("--mgr", bno.mgr, "the hypre MGR spec (default mgr; see --pc mgr in run)");
+    bnw->add_flag("--no-amg", bno_no_amg, "leave out BoomerAMG on the whole Jacobian");
+    bnw->add_flag("!--no-hypre-gmres", bno.hypre_gmres,
+                  "leave out MGR inside hypre's own FlexGMRES(50) (column mgr+fgmres)");
+    bnw->add_option("--krylov", bno.krylov, "Krylov method of every solve (default cgs)");
+    bnw->add_option("--tol", bno.rel_tol, "relative tolerance of every solve (default 1e-8)");
+    bnw->add_option("--max-iter", bno.max_iter,
+                    "iterations per solve (default 1000; hopeless solves stop earlier)");
+    bnw->add_option("--repeat", bno.repeat, "runs per thread count, times are medians (default 1)");
+    bnw->add_option("--threads", bno.threads,
+                    "thread counts of our preconditioner's runs (default 1 2; hypre: 1)")
+        ->delimiter(',');
+    bnw->add_option("--out,-o", bno_out, "JSON file (default out/bench/newton_<scene>_L<L>.json)");
     auto* scenes = app.add_subcommand("scenes", "list the built-in scenes");
     std::string show_name;
     auto* show =
@@ -188,6 +209,11 @@ int main(int argc, char** argv) {
         if (*bsq) {
             bso.out = bso_out;
             return mlc::apps::bench_square(bso, std::cout);
+        }
+        if (*bnw) {
+            bno.out = bno_out;
+            bno.amg = !bno_no_amg;
+            return mlc::apps::bench_newton(bno, std::cout);
         }
         if (*bel) {
             beo.out = beo_out;

@@ -157,6 +157,14 @@ private:
             }
             return &ebe_elements_;
         };
+        d.unknown_functions = [this]() { // 0 / 1: u_x / u_y; 2 (kMultiplierFunction): lambda
+            std::vector<int> f(static_cast<size_t>(level_.n_unknowns()), 2);
+            for (int v = 0; v < level_.dofs.n_vertices(); ++v)
+                for (int c = 0; c < 2; ++c)
+                    if (const int i = level_.dofs.u_dof(v, c); i >= 0)
+                        f[static_cast<size_t>(i)] = c;
+            return f;
+        };
         if (below_ == nullptr || entry == nullptr || !entry->needs_level_below) return d;
         d.has_level_below = true;
         d.coarse_fine_split = [this](solvers::MultiplierScale scale) {

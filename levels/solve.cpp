@@ -253,6 +253,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 if (l - 1 > first) lb.below = &below[static_cast<size_t>(l - 1)];
             }
             auto sys = make_newton_system_solver(L, spec, &lb);
+            if (options.wrap_system_solver)
+                sys = options.wrap_system_solver(l, L, std::move(sys));
             system[static_cast<size_t>(l)] = sys.get();
             newton[static_cast<size_t>(l)] =
                 std::make_unique<ContactNewton>(L, problem.newton, std::move(sys), &res.timings);

@@ -86,6 +86,14 @@ struct SolveOptions {
     /// polled. The Python module checks Python's signal handlers here, so that Ctrl-C during
     /// mlcontact.solve() raises KeyboardInterrupt within one Newton iteration.
     std::function<bool()> interrupt_requested;
+    /// Wraps the Newton-system solver of each level solved (bottom up, once, before the first
+    /// load step): the wrapper receives the level's index, the level and the solver the run
+    /// built, and returns the one the run uses (forwarding prepare, set_coarse_statuses and
+    /// multigrid to it). `bench newton` records and times the finest level's systems this way.
+    /// Empty: the solvers as built.
+    std::function<std::unique_ptr<NewtonSystemSolver>(int level, const Level& L,
+                                                      std::unique_ptr<NewtonSystemSolver>)>
+        wrap_system_solver;
 };
 
 /// Confusion table of predicted (rows) against converged (columns) statuses, indexed by

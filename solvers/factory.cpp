@@ -8,6 +8,7 @@
 #include "smoothers/jacobi.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/hypre/boomeramg.hpp"
+#include "solvers/hypre/mgr.hpp"
 #include "solvers/sorcf.hpp"
 
 #include <algorithm>
@@ -191,6 +192,28 @@ std::unique_ptr<Preconditioner> build_amg(SpecOptions& o, const LevelData* level
     return std::make_unique<BoomerAMGPreconditioner>(p);
 }
 
+// hypre MGR on the whole Newton system: F = displacements (AMG on A_FF), C = multipliers.
+std::unique_ptr<Preconditioner> build_mgr(SpecOptions& o, const LevelData* level) {
+    const LevelData& L = require_level(level, "mgr", false);
+    MGRParams p;
+    const std::string frelax = o.get_string("frelax", "amg");
+    MLC_CHECK(frelax == "amg" || frelax == "jacobi" || frelax == "gs",
+              "option frelax=" << frelax << " of mgr: valid amg, jacobi, gs");
+    p.f_relax = frelax == "amg" ? 2 : frelax == "jacobi" ? 0 : 3;
+    p.f_sweeps = o.get_int("fsweeps", p.f_sweeps);
+    p.f_amg.strong_threshold = o.get_double("theta", p.f_amg.strong_threshold);
+    p.interp_type = o.get_int("interp", p.interp_type);
+    p.restrict_type = o.get_int("restrict", p.restrict_type);
+    p.coarse_method = o.get_int("cg", p.coarse_method);
+    p.global_smooth_iters = o.get_int("smooth", p.global_smooth_iters);
+    p.global_smooth_type = o.get_int("smoother", p.global_smooth_type);
+    o.finish();
+    p.validate();
+    MLC_CHECK(L.unknown_functions != nullptr,
+              "mgr: the level data gives no unknown functions (C/F split)");
+    return std::make_unique<MGRPreconditioner>(L.unknown_functions(), p);
+}
+
 } // namespace
 
 const std::vector<PreconditionerEntry>& preconditioner_registry() {
@@ -259,6 +282,16 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          false,
          false,
          &build_amg},
+        {"mgr",
+         "mgr[:frelax=amg|jacobi|gs,fsweeps=N,theta=0.25,interp=2,restrict=0,cg=0,smooth=1,"
+         "smoother=16] (hypre MGR on the whole Newton system: global ILU(0) sweep, F = "
+         "displacements relaxed by a BoomerAMG V-cycle, C = multipliers, reduced system by "
+         "BoomerAMG; any level)",
+         "",
+         {"frelax", "fsweeps", "theta", "interp", "restrict", "cg", "smooth", "smoother"},
+         true,
+         false,
+         &build_mgr},
     };
     return table;
 }

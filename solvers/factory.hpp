@@ -67,6 +67,9 @@ struct LevelData {
     /// EBE: the element matrices of the level (elastic, then one per contact element); asking
     /// builds them, and the caller refreshes the contact ones before each setup/update_values.
     std::function<const std::vector<smoothers::ElementMatrix>*()> elements;
+    /// mgr: the function of every unknown of the level, 0 / 1 the x / y displacement component,
+    /// 2 (kMultiplierFunction) a contact multiplier; asking computes it.
+    std::function<std::vector<int>()> unknown_functions;
 
     // The level below (for the entries that need it).
     bool has_level_below = false; ///< the fields below are set
@@ -128,8 +131,8 @@ std::string preconditioner_names(std::string_view separator = ", ");
 /// - "ssor[:...]": the same options, symmetric sweeps;
 /// - "lu": sparse LU (exact);
 /// - "amg[:...]": hypre BoomerAMG (symmetric positive definite matrices);
-/// - with `level` (level-aware): "cf", "sorcf", "ebe", "mg" (see their usage lines and
-///   levels/krylov_system.hpp).
+/// - with `level` (level-aware): "cf", "sorcf", "ebe", "mg", "mgr" (hypre MGR, solvers/hypre/
+///   mgr.hpp; see their usage lines and levels/krylov_system.hpp).
 /// An unknown name or option, or a bad value, throws mlc::InvalidInput listing the valid ones.
 std::unique_ptr<Preconditioner> make_preconditioner(std::string_view spec,
                                                     const LevelData* level = nullptr);

@@ -2,6 +2,8 @@
 // hypre BoomerAMG (one V-cycle as a Preconditioner) and hypre PCG + BoomerAMG.
 #include "solvers/hypre/boomeramg.hpp"
 
+#include "solvers/hypre/ij_system.h"
+
 #include "core/check.hpp"
 #include "core/timer.hpp"
 #include "smoothers/matrix_checks.hpp"
@@ -64,89 +66,98 @@ void ensure_hypre_initialized() {
     (void)done;
 }
 
-// The hypre objects of one matrix: IJ matrix and two IJ vectors (b, x) with their ParCSR views.
-struct BoomerAMGPreconditioner::Impl {
-    HYPRE_IJMatrix ij_A = nullptr;
-    HYPRE_ParCSRMatrix A = nullptr;
-    HYPRE_IJVector ij_b = nullptr, ij_x = nullptr;
-    HYPRE_ParVector b = nullptr, x = nullptr;
-    HYPRE_Solver amg = nullptr;
-    std::vector<HYPRE_BigInt> rows;
-    HYPRE_Int n = 0;
+namespace hypre_detail {
 
-    explicit Impl(const SparseMatrix& M) {
-        ensure_hypre_initialized();
-        n = static_cast<HYPRE_Int>(M.rows());
-        const HYPRE_BigInt last = n - 1;
-        HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, last, 0, last, &ij_A);
-        HYPRE_IJMatrixSetObjectType(ij_A, HYPRE_PARCSR);
-        std::vector<HYPRE_Int> ncols(static_cast<size_t>(n));
-        for (HYPRE_Int i = 0; i < n; ++i)
-            ncols[static_cast<size_t>(i)] = M.outerIndexPtr()[i + 1] - M.outerIndexPtr()[i];
-        HYPRE_IJMatrixSetRowSizes(ij_A, ncols.data());
-        HYPRE_IJMatrixInitialize(ij_A);
-        rows.resize(static_cast<size_t>(n));
-        std::iota(rows.begin(), rows.end(), HYPRE_BigInt{0});
-        std::vector<HYPRE_BigInt> cols(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros());
-        HYPRE_IJMatrixSetValues(ij_A, n, ncols.data(), rows.data(), cols.data(), M.valuePtr());
-        HYPRE_IJMatrixAssemble(ij_A);
-        HYPRE_IJMatrixGetObject(ij_A, reinterpret_cast<void**>(&A));
-        for (auto* v : {&ij_b, &ij_x}) {
-            HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, last, v);
-            HYPRE_IJVectorSetObjectType(*v, HYPRE_PARCSR);
-            HYPRE_IJVectorInitialize(*v);
-            HYPRE_IJVectorAssemble(*v);
-        }
-        HYPRE_IJVectorGetObject(ij_b, reinterpret_cast<void**>(&b));
-        HYPRE_IJVectorGetObject(ij_x, reinterpret_cast<void**>(&x));
+IJSystem::IJSystem(const SparseMatrix& M) {
+    ensure_hypre_initialized();
+    n = static_cast<HYPRE_Int>(M.rows());
+    const HYPRE_BigInt last = n - 1;
+    HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, last, 0, last, &ij_A);
+    HYPRE_IJMatrixSetObjectType(ij_A, HYPRE_PARCSR);
+    std::vector<HYPRE_Int> ncols(static_cast<size_t>(n));
+    for (HYPRE_Int i = 0; i < n; ++i)
+        ncols[static_cast<size_t>(i)] = M.outerIndexPtr()[i + 1] - M.outerIndexPtr()[i];
+    HYPRE_IJMatrixSetRowSizes(ij_A, ncols.data());
+    HYPRE_IJMatrixInitialize(ij_A);
+    rows.resize(static_cast<size_t>(n));
+    std::iota(rows.begin(), rows.end(), HYPRE_BigInt{0});
+    std::vector<HYPRE_BigInt> cols(M.innerIndexPtr(), M.innerIndexPtr() + M.nonZeros());
+    HYPRE_IJMatrixSetValues(ij_A, n, ncols.data(), rows.data(), cols.data(), M.valuePtr());
+    HYPRE_IJMatrixAssemble(ij_A);
+    HYPRE_IJMatrixGetObject(ij_A, reinterpret_cast<void**>(&A));
+    for (auto* v : {&ij_b, &ij_x}) {
+        HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, last, v);
+        HYPRE_IJVectorSetObjectType(*v, HYPRE_PARCSR);
+        HYPRE_IJVectorInitialize(*v);
+        HYPRE_IJVectorAssemble(*v);
     }
+    HYPRE_IJVectorGetObject(ij_b, reinterpret_cast<void**>(&b));
+    HYPRE_IJVectorGetObject(ij_x, reinterpret_cast<void**>(&x));
+}
+
+IJSystem::~IJSystem() {
+    if (ij_A) HYPRE_IJMatrixDestroy(ij_A);
+    if (ij_b) HYPRE_IJVectorDestroy(ij_b);
+    if (ij_x) HYPRE_IJVectorDestroy(ij_x);
+}
+
+void IJSystem::set_vector(HYPRE_IJVector v, const Vector& src) const {
+    HYPRE_IJVectorSetValues(v, n, rows.data(), src.data());
+}
+
+void IJSystem::get_vector(HYPRE_IJVector v, Vector& dst) const {
+    HYPRE_IJVectorGetValues(v, n, rows.data(), dst.data());
+}
+
+HYPRE_Solver create_boomeramg(const BoomerAMGParams& p, bool as_preconditioner,
+                              const std::vector<int>& dof_func, HYPRE_Int n) {
+    HYPRE_Solver amg = nullptr;
+    HYPRE_BoomerAMGCreate(&amg);
+    HYPRE_BoomerAMGSetPrintLevel(amg, 0);
+    HYPRE_BoomerAMGSetNumFunctions(amg, p.num_functions);
+    if (!dof_func.empty()) {
+        MLC_CHECK(static_cast<HYPRE_Int>(dof_func.size()) == n,
+                  "BoomerAMG: dof_func has " << dof_func.size() << " entries for " << n
+                                             << " unknowns");
+        // hypre takes ownership of the array and frees it with free() (host memory).
+        auto* f = static_cast<HYPRE_Int*>(std::malloc(sizeof(HYPRE_Int) * dof_func.size()));
+        MLC_CHECK(f != nullptr, "BoomerAMG: out of memory");
+        for (size_t i = 0; i < dof_func.size(); ++i) {
+            MLC_CHECK(dof_func[i] >= 0 && dof_func[i] < p.num_functions,
+                      "BoomerAMG: dof_func[" << i << "] = " << dof_func[i] << " is not in [0, "
+                                             << p.num_functions << ")");
+            f[i] = dof_func[i];
+        }
+        HYPRE_BoomerAMGSetDofFunc(amg, f);
+    }
+    if (p.nodal > 0) HYPRE_BoomerAMGSetNodal(amg, p.nodal);
+    HYPRE_BoomerAMGSetStrongThreshold(amg, p.strong_threshold);
+    HYPRE_BoomerAMGSetCoarsenType(amg, p.coarsen_type);
+    HYPRE_BoomerAMGSetInterpType(amg, p.interp_type);
+    HYPRE_BoomerAMGSetPMaxElmts(amg, p.p_max_elmts);
+    HYPRE_BoomerAMGSetRelaxType(amg, p.relax_type);
+    HYPRE_BoomerAMGSetAggNumLevels(amg, p.agg_num_levels);
+    HYPRE_BoomerAMGSetNumSweeps(amg, 1);
+    if (as_preconditioner) {
+        HYPRE_BoomerAMGSetTol(amg, 0.0);
+        HYPRE_BoomerAMGSetMaxIter(amg, 1);
+    }
+    return amg;
+}
+
+} // namespace hypre_detail
+
+// One matrix in hypre and its BoomerAMG.
+struct BoomerAMGPreconditioner::Impl : hypre_detail::IJSystem {
+    HYPRE_Solver amg = nullptr;
+
+    explicit Impl(const SparseMatrix& M) : IJSystem(M) {}
     ~Impl() {
         if (amg) HYPRE_BoomerAMGDestroy(amg);
-        if (ij_A) HYPRE_IJMatrixDestroy(ij_A);
-        if (ij_b) HYPRE_IJVectorDestroy(ij_b);
-        if (ij_x) HYPRE_IJVectorDestroy(ij_x);
     }
-    Impl(const Impl&) = delete;
-    Impl& operator=(const Impl&) = delete;
-
     void create_amg(const BoomerAMGParams& p, bool as_preconditioner,
                     const std::vector<int>& dof_func) {
-        HYPRE_BoomerAMGCreate(&amg);
-        HYPRE_BoomerAMGSetPrintLevel(amg, 0);
-        HYPRE_BoomerAMGSetNumFunctions(amg, p.num_functions);
-        if (!dof_func.empty()) {
-            MLC_CHECK(static_cast<HYPRE_Int>(dof_func.size()) == n,
-                      "BoomerAMG: dof_func has " << dof_func.size() << " entries for " << n
-                                                 << " unknowns");
-            // hypre takes ownership of the array and frees it with free() (host memory).
-            auto* f = static_cast<HYPRE_Int*>(std::malloc(sizeof(HYPRE_Int) * dof_func.size()));
-            MLC_CHECK(f != nullptr, "BoomerAMG: out of memory");
-            for (size_t i = 0; i < dof_func.size(); ++i) {
-                MLC_CHECK(dof_func[i] >= 0 && dof_func[i] < p.num_functions,
-                          "BoomerAMG: dof_func[" << i << "] = " << dof_func[i]
-                                                 << " is not in [0, " << p.num_functions << ")");
-                f[i] = dof_func[i];
-            }
-            HYPRE_BoomerAMGSetDofFunc(amg, f);
-        }
-        if (p.nodal > 0) HYPRE_BoomerAMGSetNodal(amg, p.nodal);
-        HYPRE_BoomerAMGSetStrongThreshold(amg, p.strong_threshold);
-        HYPRE_BoomerAMGSetCoarsenType(amg, p.coarsen_type);
-        HYPRE_BoomerAMGSetInterpType(amg, p.interp_type);
-        HYPRE_BoomerAMGSetPMaxElmts(amg, p.p_max_elmts);
-        HYPRE_BoomerAMGSetRelaxType(amg, p.relax_type);
-        HYPRE_BoomerAMGSetAggNumLevels(amg, p.agg_num_levels);
-        HYPRE_BoomerAMGSetNumSweeps(amg, 1);
-        if (as_preconditioner) {
-            HYPRE_BoomerAMGSetTol(amg, 0.0);
-            HYPRE_BoomerAMGSetMaxIter(amg, 1);
-        }
-    }
-    void set_vector(HYPRE_IJVector v, const Vector& src) const {
-        HYPRE_IJVectorSetValues(v, n, rows.data(), src.data());
-    }
-    void get_vector(HYPRE_IJVector v, Vector& dst) const {
-        HYPRE_IJVectorGetValues(v, n, rows.data(), dst.data());
+        amg = hypre_detail::create_boomeramg(p, as_preconditioner, dof_func, n);
     }
 };
 

@@ -55,6 +55,10 @@ TEST(Registry, NamesAreUniqueAndEveryEntryIsComplete) {
         EXPECT_TRUE(solvers::find_preconditioner(n)->needs_level_below) << n;
     EXPECT_TRUE(solvers::find_preconditioner("ebe")->level_aware);
     EXPECT_FALSE(solvers::find_preconditioner("ebe")->needs_level_below);
+    // hypre MGR: the C/F split comes from the level (which unknowns are multipliers); it needs
+    // no level below, so it serves meshes without levels too.
+    EXPECT_TRUE(solvers::find_preconditioner("mgr")->level_aware);
+    EXPECT_FALSE(solvers::find_preconditioner("mgr")->needs_level_below);
     EXPECT_EQ(solvers::find_preconditioner("MG:pre=2")->name, "mg");
     EXPECT_EQ(solvers::find_preconditioner("amgx"), nullptr);
 }
