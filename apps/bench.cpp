@@ -383,26 +383,22 @@ double true_relres(const SparseMatrix& J, const Vector& b, const Vector& x) {
 
 // A coarser level's solver: forwards everything and keeps the largest setup (assembly, smoother,
 // the level below's operator) of its Newton systems in the current load step.
-class CoarseSetupTimer final : public levels::NewtonSystemSolver {
+class CoarseSetupTimer final : public levels::ForwardingSystemSolver {
 public:
     CoarseSetupTimer(std::unique_ptr<levels::NewtonSystemSolver> inner, double* slot)
-        : inner_(std::move(inner)), slot_(slot) {}
+        : ForwardingSystemSolver(std::move(inner)), slot_(slot) {}
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
                       double forcing) override {
-        SolveResult r = inner_->solve(M, b, dx, forcing);
+        SolveResult r = inner().solve(M, b, dx, forcing);
         *slot_ = std::max(*slot_, r.setup_seconds);
         return r;
     }
-    std::string name() const override { return inner_->name(); }
     void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) override {
         *slot_ = 0.0; // a new load step of this level
-        inner_->set_coarse_statuses(M);
+        inner().set_coarse_statuses(M);
     }
-    void prepare(const std::vector<Eigen::Matrix2d>& M) override { inner_->prepare(M); }
-    const solvers::Multigrid* multigrid() const override { return inner_->multigrid(); }
 
 private:
-    std::unique_ptr<levels::NewtonSystemSolver> inner_;
     double* slot_;
 };
 
@@ -415,13 +411,14 @@ struct NewtonBenchPass {
 // The finest level's solver: every system it is given is first solved from zero to the bench
 // tolerance by the run's own solver (timed, setup included), then by MGR and AMG on the same
 // assembled Jacobian; then the run's own solve proceeds as in any run.
-class NewtonSystemRecorder final : public levels::NewtonSystemSolver {
+class NewtonSystemRecorder final : public levels::ForwardingSystemSolver {
 public:
     NewtonSystemRecorder(std::unique_ptr<levels::NewtonSystemSolver> inner,
                          const levels::Level& level, const BenchNewtonOptions& opt,
                          const NewtonBenchPass& pass, const std::vector<double>* coarse_setups,
                          std::vector<NewtonSystemRow>& rows)
-        : inner_(std::move(inner)), level_(level), jac_(level), opt_(opt), pass_(pass),
+        : ForwardingSystemSolver(std::move(inner)), level_(level), jac_(level), opt_(opt),
+          pass_(pass),
           coarse_setups_(coarse_setups), rows_(rows) {
         params_.rel_tol = opt.rel_tol;
         params_.max_iter = opt.max_iter;
@@ -463,7 +460,7 @@ public:
                 for (double c : *coarse_setups_)
                     coarse += c;
             Vector x = Vector::Zero(b.size());
-            const SolveResult r = inner_->solve(M, b, x, 0.0);
+            const SolveResult r = inner().solve(M, b, x, 0.0);
             s.setup = r.setup_seconds - r.assembly_seconds;
             s.setup_full = s.setup + coarse;
             s.solve = r.solve_seconds;
@@ -489,16 +486,13 @@ public:
                     return std::unique_ptr<Preconditioner>(std::move(pc));
                 }));
         }
-        return inner_->solve(M, b, dx, forcing);
+        return inner().solve(M, b, dx, forcing);
     }
-    std::string name() const override { return inner_->name(); }
     void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) override {
         ++step_;
         newton_ = 0;
-        inner_->set_coarse_statuses(M);
+        inner().set_coarse_statuses(M);
     }
-    void prepare(const std::vector<Eigen::Matrix2d>& M) override { inner_->prepare(M); }
-    const solvers::Multigrid* multigrid() const override { return inner_->multigrid(); }
 
 private:
     template <class Make>
@@ -555,7 +549,6 @@ private:
         return s;
     }
 
-    std::unique_ptr<levels::NewtonSystemSolver> inner_;
     const levels::Level& level_;
     levels::JacobianAssembler jac_;
     const BenchNewtonOptions& opt_;

@@ -74,6 +74,31 @@ public:
     virtual const solvers::Multigrid* multigrid() const { return nullptr; }
 };
 
+/// A NewtonSystemSolver that hands everything to another one: derive from it and override what
+/// to watch (bench newton's recorder, the setup timer of the coarser levels, test captures).
+class ForwardingSystemSolver : public NewtonSystemSolver {
+public:
+    explicit ForwardingSystemSolver(std::unique_ptr<NewtonSystemSolver> inner)
+        : inner_(std::move(inner)) {}
+    using NewtonSystemSolver::solve;
+    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                      double forcing) override {
+        return inner_->solve(M, b, dx, forcing);
+    }
+    std::string name() const override { return inner_->name(); }
+    void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) override {
+        inner_->set_coarse_statuses(M);
+    }
+    void prepare(const std::vector<Eigen::Matrix2d>& M) override { inner_->prepare(M); }
+    const solvers::Multigrid* multigrid() const override { return inner_->multigrid(); }
+
+protected:
+    NewtonSystemSolver& inner() { return *inner_; }
+
+private:
+    std::unique_ptr<NewtonSystemSolver> inner_;
+};
+
 /// Assembles J(M) (pattern fixed per level) and calls `solver` on it. `level` must outlive it.
 std::unique_ptr<NewtonSystemSolver>
 make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> solver);

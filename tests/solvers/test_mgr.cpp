@@ -23,11 +23,11 @@ struct CapturedSystem {
 };
 
 // Forwards to the run's solver and keeps a copy of every Newton system it is given.
-class Capture final : public levels::NewtonSystemSolver {
+class Capture final : public levels::ForwardingSystemSolver {
 public:
     Capture(std::unique_ptr<levels::NewtonSystemSolver> inner, const levels::Level& L,
             std::vector<CapturedSystem>& out)
-        : inner_(std::move(inner)), jac_(L), out_(out) {}
+        : ForwardingSystemSolver(std::move(inner)), jac_(L), out_(out) {}
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
                       double forcing) override {
         jac_.assemble(M);
@@ -35,17 +35,10 @@ public:
         for (const auto& m : M)
             s.stick += m(0, 0) == 1.0 && m(1, 1) == 1.0;
         out_.push_back(std::move(s));
-        return inner_->solve(M, b, dx, forcing);
+        return inner().solve(M, b, dx, forcing);
     }
-    std::string name() const override { return inner_->name(); }
-    void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) override {
-        inner_->set_coarse_statuses(M);
-    }
-    void prepare(const std::vector<Eigen::Matrix2d>& M) override { inner_->prepare(M); }
-    const solvers::Multigrid* multigrid() const override { return inner_->multigrid(); }
 
 private:
-    std::unique_ptr<levels::NewtonSystemSolver> inner_;
     levels::JacobianAssembler jac_;
     std::vector<CapturedSystem>& out_;
 };
