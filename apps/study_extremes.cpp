@@ -379,8 +379,13 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
             levels::choose_solver(sq, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}));
     } else {
         solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}}));
-        if (opt.levels >= 1)
+        if (opt.levels >= 1) {
+            // CGS + mg (one body) and BiCGStab + mg (what the default takes with a two-body
+            // pair, as in the contrast cases, above its crossover).
             solvers.push_back(levels::choose_solver(sq, {{}, {}, std::string("mg"), {}}));
+            solvers.push_back(
+                levels::choose_solver(sq, {{}, std::string("bicgstab"), std::string("mg"), {}}));
+        }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "
        << opt.seconds_per_case << " s per case, " << solvers.size() << " Newton-system solver(s)\n";
