@@ -56,6 +56,13 @@ std::string json_string(const std::string& s) {
     return out + "\"";
 }
 
+// The JSON a bench writes: `given`, or out/bench/<prefix><scene>_L<levels>.json.
+std::filesystem::path bench_json_path(const std::string& given, const std::string& prefix,
+                                      const std::string& scene, int levels) {
+    if (!given.empty()) return given;
+    return "out/bench/" + prefix + scene + "_L" + std::to_string(levels) + ".json";
+}
+
 AtomicOfstream open_json(const std::filesystem::path& file) {
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
     AtomicOfstream f(file);
@@ -98,10 +105,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     check_preconditioner_names(opt.pcs, true);
     levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
-    const std::filesystem::path out =
-        opt.out.empty() ? std::filesystem::path("out/bench/" + opt.scene + "_L" +
-                                                std::to_string(opt.levels) + ".json")
-                        : opt.out;
+    const std::filesystem::path out = bench_json_path(opt.out, "", opt.scene, opt.levels);
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
        << ",\n  \"krylov\": " << json_string(opt.krylov) << ",\n  \"rel_tol\": " << opt.rel_tol
@@ -298,10 +302,7 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
     }
     const double diff = (x_amg - x_mg).norm() / std::max(x_amg.norm(), 1e-300);
 
-    const std::filesystem::path out =
-        opt.out.empty() ? std::filesystem::path("out/bench/elastic_" + opt.scene + "_L" +
-                                                std::to_string(opt.levels) + ".json")
-                        : opt.out;
+    const std::filesystem::path out = bench_json_path(opt.out, "elastic_", opt.scene, opt.levels);
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"level\": " << opt.levels
        << ",\n  \"unknowns\": " << n << ",\n  \"nonzeros\": " << fine.K.nonZeros()
@@ -418,8 +419,7 @@ public:
                          const NewtonBenchPass& pass, const std::vector<double>* coarse_setups,
                          std::vector<NewtonSystemRow>& rows)
         : ForwardingSystemSolver(std::move(inner)), level_(level), jac_(level), opt_(opt),
-          pass_(pass),
-          coarse_setups_(coarse_setups), rows_(rows) {
+          pass_(pass), coarse_setups_(coarse_setups), rows_(rows) {
         params_.rel_tol = opt.rel_tol;
         params_.max_iter = opt.max_iter;
         params_.give_up_budget = opt.max_iter;
@@ -693,10 +693,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     const auto is_hypre = [](const std::string& key) {
         return key == "mgr" || key == "mgr+fgmres" || key == "amg";
     };
-    const std::filesystem::path out =
-        opt.out.empty() ? std::filesystem::path("out/bench/newton_" + opt.scene + "_L" +
-                                                std::to_string(opt.levels) + ".json")
-                        : opt.out;
+    const std::filesystem::path out = bench_json_path(opt.out, "newton_", opt.scene, opt.levels);
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"level\": " << opt.levels
        << ",\n  \"unknowns\": " << unknowns << ",\n  \"nonzeros\": " << nonzeros
