@@ -86,6 +86,19 @@ double time_left(const std::vector<Level>& levels, int first, int level, int ste
     return left + (n_steps - step) * all;
 }
 
+/// Empty when the exact schur solver of level l (predicted size `size`) fits in what the process
+/// may still use, else why not (the exact fallback and the r continuation build it on demand).
+std::string schur_does_not_fit(const LevelSize& size, int l) {
+    const double need = estimate_memory({size}, LinearSolverSpec{}, false).solver_bytes;
+    const MemoryLimit limit = process_memory_limit();
+    const double free = limit.bytes - peak_rss_bytes();
+    if (need < free) return {};
+    std::ostringstream os;
+    os << "the exact schur solver of level " << l << " needs an estimated " << format_bytes(need)
+       << ", more than the " << format_bytes(free) << " left (" << limit.source << ")";
+    return os.str();
+}
+
 /// Multiplies the augmentation parameter of every contact element of a level by `factor` for
 /// its lifetime, and restores the exact values after.
 class ScaledAugmentation {
@@ -111,8 +124,9 @@ private:
 
 /// SolveOptions::r_continuation: `failed` is the report of Newton at the scene's r from x0 on
 /// level L (index l), or an empty report (no iteration) when an earlier step of the level
-/// needed the continuation at `first_factor` (tried first; 0: start at 1e-2). Returns the report of the recovered step (x updated) or `failed` with
-/// what was tried appended to its message (x unchanged).
+/// needed the continuation at `first_factor` (tried first; 0: start at 1e-2). Returns the report
+/// of the recovered step (x updated) or `failed` with what was tried appended to its message (x
+/// unchanged).
 StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonParams& params,
                          ContactNewton& nw, double s, const Vector& u_prev, const Vector& x0,
                          Vector& x, StepReport failed, double first_factor,
@@ -124,14 +138,10 @@ StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonPar
     for (const double f : {1e-2, 1e-4})
         if (first_factor <= 0 || f <= first_factor) factors.push_back(f);
     for (const double factor : factors) {
-        const double need = estimate_memory({size}, LinearSolverSpec{}, false).solver_bytes;
-        const MemoryLimit limit = process_memory_limit();
-        const double free = limit.bytes - peak_rss_bytes();
         const bool reuse = kept && factor == first_factor;
-        if (!reuse && need >= free) {
-            tried << "; no r continuation: the exact schur solver of level " << l
-                  << " needs an estimated " << format_bytes(need) << ", more than the "
-                  << format_bytes(free) << " left (" << limit.source << ")";
+        if (const std::string why = reuse ? std::string() : schur_does_not_fit(size, l);
+            !why.empty()) {
+            tried << "; no r continuation: " << why;
             break;
         }
         Vector xc = x0;
@@ -261,14 +271,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             if (options.exact_fallback && spec.method == "krylov") {
                 const LevelSize size = res.predicted_sizes[static_cast<size_t>(l)];
                 newton[static_cast<size_t>(l)]->set_fallback([&L, size, l]() {
-                    const double need =
-                        estimate_memory({size}, LinearSolverSpec{}, false).solver_bytes;
-                    const MemoryLimit limit = process_memory_limit();
-                    const double free = limit.bytes - peak_rss_bytes();
-                    MLC_CHECK(need < free, "the exact schur solver of level "
-                                               << l << " needs an estimated " << format_bytes(need)
-                                               << ", more than the " << format_bytes(free)
-                                               << " left (" << limit.source << ")");
+                    const std::string why = schur_does_not_fit(size, l);
+                    MLC_CHECK(why.empty(), why);
                     return make_schur_system_solver(L);
                 });
             }
