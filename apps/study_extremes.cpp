@@ -380,11 +380,12 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     } else {
         solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}}));
         if (opt.levels >= 1) {
-            // CGS + mg (one body) and BiCGStab + mg (what the default takes with a two-body
-            // pair, as in the contrast cases, above its crossover).
-            solvers.push_back(levels::choose_solver(sq, {{}, {}, std::string("mg"), {}}));
-            solvers.push_back(
-                levels::choose_solver(sq, {{}, std::string("bicgstab"), std::string("mg"), {}}));
+            // CGS + mg (one body) and BiCGStab + damped mg (what the default takes with a
+            // two-body pair, as in the contrast cases, above its crossover).
+            solvers.push_back(levels::choose_solver(
+                sq, {{}, {}, std::string(levels::kMgDefaultOneBody), {}}));
+            solvers.push_back(levels::choose_solver(
+                sq, {{}, std::string("bicgstab"), std::string(levels::kMgDefaultTwoBody), {}}));
         }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "

@@ -107,10 +107,13 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             MLC_CHECK(has_levels || !entry->needs_level_below,
                       "--pc " << s.pc << " needs the level below: use --levels >= 1");
         } else {
-            s.pc = has_levels ? "mg" : "ilu:0";
-            c.reason = has_levels ? "--linear krylov: multilevel mg over the levels"
-                                  : "--linear krylov on a single level (no level below for mg): "
-                                    "ilu:0";
+            const bool two_body = mg_crossover_unknowns(problem) == kMgCrossoverTwoBody;
+            s.pc = !has_levels ? "ilu:0" : two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
+            c.reason = !has_levels ? "--linear krylov on a single level (no level below for mg): "
+                                     "ilu:0"
+                       : two_body ? "--linear krylov: multilevel mg over the levels, damped "
+                                    "(omega = 0.8) with a two-body pair"
+                                  : "--linear krylov: multilevel mg over the levels";
         }
     } else {
         c.automatic = true;
@@ -121,17 +124,17 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
         os << std::setprecision(3);
         if (has_levels && n > crossover) {
             s.method = "krylov";
-            s.pc = "mg";
-            // Two-body pairs: BiCGStab needs fewer V-cycles than CGS (dovetail level 3: 4.6
-            // against 5.3 s, level 4: 29.8 against 35.4 s, README "Choosing the Newton-system
-            // solver").
+            // Two-body pairs: BiCGStab and damped sweeps need fewer V-cycles than CGS and
+            // undamped ones (README "Choosing the Newton-system solver").
             const bool two_body = crossover == kMgCrossoverTwoBody;
+            s.pc = two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
             if (two_body) s.krylov = "bicgstab";
             os << "default: " << n << " unknowns on the finest level exceed the crossover "
-               << crossover << ": " << (two_body ? "BiCGStab" : "CGS")
-               << " + mg (smaller than schur there"
-               << (two_body ? ", and BiCGStab faster than CGS with a two-body pair)"
-                            : " and faster)");
+               << crossover << ": " << (two_body ? "BiCGStab + mg:omega=0.8" : "CGS + mg")
+               << " (faster and smaller than schur there"
+               << (two_body ? "; with a two-body pair BiCGStab and damped sweeps need fewer "
+                              "V-cycles)"
+                            : ")");
         } else {
             s.method = "schur";
             if (!has_levels && n > crossover)

@@ -35,13 +35,20 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem);
 
 /// Finest-level unknowns above which the default Newton-system solver is Krylov + mg rather
 /// than the exact `schur` (measured, see the README: "Choosing the Newton-system solver"): with
-/// rigid obstacles only, mg is faster and smaller from the first refined level of the built-in
-/// scenes on (2 208 unknowns on the square); with a two-body pair (node on facet or node on
-/// node) mg needs about twice as many Krylov iterations and overtakes schur between dovetail
-/// levels 2 and 3 (56 181 and 222 373 unknowns), where schur also stays within 1.15x of mg's
-/// memory below.
-inline constexpr double kMgCrossoverOneBody = 2000;
+/// rigid obstacles only, schur is faster up to square level 2 (8 512 unknowns) and mg from
+/// hertz level 2 (21 420) and square level 3 (33 408) on, both within a few per cent in memory
+/// there; with a two-body pair (node on facet or node on node) mg needs about twice as many
+/// Krylov iterations and overtakes schur between dovetail levels 2 and 3 (56 181 and 222 373
+/// unknowns), where schur also stays within 1.15x of mg's memory below.
+inline constexpr double kMgCrossoverOneBody = 15000;
 inline constexpr double kMgCrossoverTwoBody = 100000;
+
+/// The preconditioner the driver takes for `mg` when nobody named one: with a two-body pair the
+/// vertex-block Gauss-Seidel sweeps are damped (omega = 0.8), which halves BiCGStab's iterations
+/// on dovetail level 4 (55 -> 27 per load step) and keeps them on levels 2 and 3; with rigid
+/// obstacles only they are not (the square's and hertz's CGS iterations grow with omega = 0.8).
+inline constexpr const char* kMgDefaultOneBody = "mg";
+inline constexpr const char* kMgDefaultTwoBody = "mg:omega=0.8";
 
 /// The crossover that applies to `problem` (two-body pairs or not).
 double mg_crossover_unknowns(const Problem& problem);
@@ -62,10 +69,11 @@ struct SolverChoice {
 };
 
 /// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
-/// without `pc` uses `mg` where a level below exists (problem.levels >= 1) and `ilu:0` on a
-/// single level; nothing at all chooses by size: `schur` up to mg_crossover_unknowns(problem)
-/// unknowns on the finest level, Krylov + `mg` above it when levels exist (CGS; BiCGStab with a
-/// two-body pair, where it needs fewer V-cycles). A Krylov
+/// without `pc` uses `mg` where a level below exists (problem.levels >= 1; damped, kMgDefaultTwoBody,
+/// with a two-body pair) and `ilu:0` on a single level; nothing at all chooses by size: `schur` up
+/// to mg_crossover_unknowns(problem) unknowns on the finest level, Krylov + `mg` above it when
+/// levels exist (CGS + mg; BiCGStab + damped mg with a two-body pair, where it needs fewer
+/// V-cycles). A Krylov
 /// option next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying
 /// so.
 /// `sizes`: predict_level_sizes(problem) when the caller has it already (it builds level 0).

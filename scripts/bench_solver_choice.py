@@ -2,7 +2,7 @@
 """The default Newton-system solver against both candidates (issue 11, "a fast default at every
 size"): for each scene and level, `mlcontact run SCENE --levels L --quiet` with no solver flag,
 with `--linear schur` and with the Krylov + mg candidate (`--pc mg`, that is CGS + mg; --mg sets
-other flags), REPEAT times each in turn. Wall time (perf_counter, ms resolution) and the peak
+other flags; none on level 0, where mg has no level below), REPEAT times each in turn. Wall time (perf_counter, ms resolution) and the peak
 RSS of each process (wait4). Prints the medians, the solver the default chose and its ratios to
 the faster and to the smaller candidate (the bar: both at most 1.15), and writes
 out/bench/solver_choice.csv and .json. Run it on an idle machine: it measures wall time.
@@ -57,18 +57,23 @@ def main():
     for case in a.cases:
         scene, levels = case.split(":")
         for level in (int(x) for x in levels.split(",")):
-            runs = {k: [] for k in candidates}
+            # On level 0 there is no level below for mg: schur is the only candidate.
+            names = [k for k in candidates if level > 0 or k != "mg"]
+            runs = {k: [] for k in names}
             chosen = ""
             for _ in range(a.repeat):
-                for name, flags in candidates.items():
+                for name in names:
+                    flags = candidates[name]
                     s, mib, c = run_once(scene, level, flags)
                     runs[name].append((s, mib))
                     if name == "default":
                         chosen = c
             med = {k: (statistics.median(s for s, _ in v), statistics.median(m for _, m in v))
                    for k, v in runs.items()}
-            best_t = min(med["schur"][0], med["mg"][0])
-            best_m = min(med["schur"][1], med["mg"][1])
+            if "mg" not in med:
+                med["mg"] = (float("nan"), float("nan"))
+            best_t = min(t for t, _ in (med["schur"], med["mg"]) if t == t)
+            best_m = min(m for _, m in (med["schur"], med["mg"]) if m == m)
             row = {"scene": scene, "level": level,
                    "default": "schur" if chosen.startswith("schur") else "mg",
                    "default_solver": chosen,
@@ -77,7 +82,7 @@ def main():
                    "runs": {k: [{"seconds": s, "peak_MiB": m} for s, m in v]
                             for k, v in runs.items()}}
             for k in candidates:
-                row[f"{k}_s"], row[f"{k}_MiB"] = med[k]
+                row[f"{k}_s"], row[f"{k}_MiB"] = (None, None) if med[k][0] != med[k][0] else med[k]
             row["within_1.15"] = row["time_ratio"] <= 1.15 and row["memory_ratio"] <= 1.15
             rows.append(row)
             print(f"{scene:9} L{level}  schur {med['schur'][0]:7.3f} s {med['schur'][1]:6.0f} MiB"

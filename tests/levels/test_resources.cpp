@@ -99,28 +99,43 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
             EXPECT_FALSE(c.reason.empty());
             if (L >= 1 && n > crossover) {
                 EXPECT_EQ(c.spec.method, "krylov");
-                EXPECT_EQ(c.spec.pc, "mg");
+                EXPECT_EQ(c.spec.pc, crossover == levels::kMgCrossoverTwoBody ? "mg:omega=0.8"
+                                                                              : "mg");
             } else {
                 EXPECT_EQ(c.spec.method, "schur");
             }
         }
     }
-    // Rigid obstacles: mg from the first refined level (square: 2 208 unknowns); two bodies
-    // (dovetail: 56 181 and 222 373 unknowns on levels 2 and 3): from level 3.
+    // Rigid obstacles: mg from square level 3 (33 408 unknowns; 8 512 on level 2) and hertz
+    // level 2 (21 420; 5 459 on level 1); two bodies (dovetail: 56 181 and 222 373 unknowns on
+    // levels 2 and 3): from level 3.
     auto sq = scene::load_scene("square");
     EXPECT_EQ(levels::mg_crossover_unknowns(sq), levels::kMgCrossoverOneBody);
-    sq.levels = 0;
+    sq.levels = 2;
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.method, "schur");
-    sq.levels = 1;
+    sq.levels = 3;
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.pc, "mg");
+    auto hz = scene::load_scene("hertz");
+    hz.levels = 1;
+    EXPECT_EQ(levels::choose_solver(hz, {}).spec.method, "schur");
+    hz.levels = 2;
+    EXPECT_EQ(levels::choose_solver(hz, {}).spec.pc, "mg");
     auto dt = scene::load_scene("dovetail");
     EXPECT_EQ(levels::mg_crossover_unknowns(dt), levels::kMgCrossoverTwoBody);
     dt.levels = 2;
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
     dt.levels = 3;
-    EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg");
-    // With a two-body pair the Krylov method is BiCGStab (fewer V-cycles there), else CGS.
+    // With a two-body pair the Krylov method is BiCGStab and the sweeps are damped (fewer
+    // V-cycles there), else CGS and undamped sweeps; --linear krylov alone damps them too.
+    EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg:omega=0.8");
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.krylov, "bicgstab");
+    EXPECT_NE(levels::choose_solver(dt, {}).reason.find("BiCGStab + mg:omega=0.8"),
+              std::string::npos);
+    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.pc,
+              "mg:omega=0.8");
+    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.krylov, "cgs");
+    // A named preconditioner is taken as given.
+    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}}).spec.pc, "mg");
     sq.levels = 3;
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.krylov, "cgs");
 }
