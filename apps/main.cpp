@@ -157,6 +157,9 @@ int main(int argc, char** argv) {
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
     bsq->add_option("--repeat", bso.repeat, "runs per solver, times are medians (default 1)");
     bsq->add_option("--out,-o", bso_out, "JSON file (default out/bench/<scene>_L<L>.json)");
+    bsq->add_option("--stream-doubles", bso.stream_doubles,
+                    "STREAM array length in doubles (default 2^25 = 33554432: 256 MiB each)")
+        ->check(CLI::PositiveNumber);
     mlc::apps::BenchElasticOptions beo;
     std::string beo_out;
     auto* bel = bench->add_subcommand("elastic", "elastic block: BoomerAMG-PCG vs mg-CG/GMRES");
