@@ -108,6 +108,10 @@ int main(int argc, char** argv) {
         study->add_subcommand("error-vs-time", "error against wall time over levels and solvers");
     ev->add_option("scene", evo_scene, "scene file or built-in name (default square)");
     ev->add_option("--levels,-l", evo.max_level, "configurations on levels 0..L (default 3)");
+    ev->add_option("--ilu-levels", evo.ilu_max_level,
+                   "the ILU(0) configurations only up to this level (default 3)");
+    ev->add_option("--only", evo.only,
+                   "run only the configurations whose name contains this text (e.g. mg)");
     ev->add_option("--out,-o", evo_out,
                    "output folder (default out/studies/<scene>_error_vs_time)");
     ev->add_flag("!--no-plot", evo.plot, "do not draw the PNG");
