@@ -4,7 +4,12 @@
 /// - `bench square`: the full coarse-to-fine solve of a scene (all levels, all load steps) with
 ///   each requested Newton-system solver; per level: unknowns, Jacobian nonzeros, Newton steps,
 ///   Krylov iterations per Newton step, Jacobian assembly, preconditioner setup and solve seconds,
-///   and per run the wall time and peak resident memory (getrusage ru_maxrss).
+///   and per run the wall time and peak resident memory (getrusage ru_maxrss). Beside it the
+///   bandwidth account: the compulsory bytes of every counted pass (core/traffic.hpp) of each
+///   level's Newton solves by kind, their time and GB/s, a STREAM copy/triad measured by the same
+///   binary after the first solver's runs, the time of one CSR mat-vec of the finest Jacobian
+///   (same threads) and a fine Newton step in those mat-vecs; and per level the RSS growth of
+///   building its solver and running its first Newton solve, per unknown.
 /// - `bench elastic`: the elastic block alone (K on the free displacement unknowns of the finest
 ///   level, right-hand side the full load) solved to the same relative tolerance by hypre
 ///   BoomerAMG-PCG and by our geometric V-cycle (vertex-block Gauss–Seidel, P / P^T, sparse LU
@@ -20,6 +25,7 @@
 /// All print a table and write JSON.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <ostream>
 #include <string>
@@ -37,6 +43,9 @@ struct BenchSquareOptions {
     int max_iter = 5000;                   ///< Krylov iterations per Newton step
     int repeat = 1;                        ///< runs per solver; times are medians over them
     std::filesystem::path out;             ///< JSON file (default out/bench/square_L<L>.json)
+    /// STREAM (core/traffic.hpp) array length in doubles, and its repetitions (best taken).
+    std::size_t stream_doubles = std::size_t(1) << 25;
+    int stream_repeats = 5;
 };
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every run converged).

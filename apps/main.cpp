@@ -108,6 +108,10 @@ int main(int argc, char** argv) {
         study->add_subcommand("error-vs-time", "error against wall time over levels and solvers");
     ev->add_option("scene", evo_scene, "scene file or built-in name (default square)");
     ev->add_option("--levels,-l", evo.max_level, "configurations on levels 0..L (default 3)");
+    ev->add_option("--ilu-levels", evo.ilu_max_level,
+                   "the ILU(0) configurations only up to this level (default 3)");
+    ev->add_option("--only", evo.only,
+                   "run only the configurations whose name contains this text (e.g. mg)");
     ev->add_option("--out,-o", evo_out,
                    "output folder (default out/studies/<scene>_error_vs_time)");
     ev->add_flag("!--no-plot", evo.plot, "do not draw the PNG");
@@ -157,6 +161,9 @@ int main(int argc, char** argv) {
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
     bsq->add_option("--repeat", bso.repeat, "runs per solver, times are medians (default 1)");
     bsq->add_option("--out,-o", bso_out, "JSON file (default out/bench/<scene>_L<L>.json)");
+    bsq->add_option("--stream-doubles", bso.stream_doubles,
+                    "STREAM array length in doubles (default 2^25 = 33554432: 256 MiB each)")
+        ->check(CLI::PositiveNumber);
     mlc::apps::BenchElasticOptions beo;
     std::string beo_out;
     auto* bel = bench->add_subcommand("elastic", "elastic block: BoomerAMG-PCG vs mg-CG/GMRES");

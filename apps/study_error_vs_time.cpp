@@ -24,10 +24,25 @@ struct Config {
     bool coarse_to_fine = true;
     levels::LinearSolverSpec linear;
     double newton_tol = 1e-10;
+    /// What bounds the levels it runs on: none (0..L), ILU(0) (0..min(L, ilu_max_level)) or the
+    /// multigrid (1..L: it needs a level below).
+    enum class Family { exact, ilu, mg } family = Family::exact;
 };
 
 std::vector<Config> configurations() {
     std::vector<Config> c;
+    using F = Config::Family;
+    // The multilevel solvers (the run's default above the crossover, `--pc mg`, and hypre's MGR
+    // with `--pc mgr`), CGS to the run's default linear tolerance.
+    const levels::LinearSolverSpec mg{
+        .method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-10};
+    c.push_back({"c2f cgs+mg", true, mg, 1e-10, F::mg});
+    c.push_back({"cold cgs+mg", false, mg, 1e-10, F::mg});
+#if defined(MLC_HAVE_HYPRE)
+    const levels::LinearSolverSpec mgr{
+        .method = "krylov", .krylov = "cgs", .pc = "mgr", .rel_tol = 1e-10};
+    c.push_back({"c2f cgs+mgr", true, mgr, 1e-10, F::exact});
+#endif
     c.push_back({"c2f schur", true, {}, 1e-10});
     c.push_back({"cold schur", false, {}, 1e-10});
     c.push_back({"c2f schur newton 1e-6", true, {}, 1e-6});
@@ -36,15 +51,18 @@ std::vector<Config> configurations() {
     c.push_back({"c2f gmres+ilu0 1e-8",
                  true,
                  {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8},
-                 1e-8});
+                 1e-8,
+                 F::ilu});
     c.push_back({"cold gmres+ilu0 1e-8",
                  false,
                  {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8},
-                 1e-8});
+                 1e-8,
+                 F::ilu});
     c.push_back({"c2f cgs+ilu0 1e-6",
                  true,
                  {.method = "krylov", .krylov = "cgs", .pc = "ilu:0", .rel_tol = 1e-6},
-                 1e-6});
+                 1e-6,
+                 F::ilu});
     return c;
 }
 
@@ -137,6 +155,7 @@ Errors errors_against(const levels::RunResult& ref, int l, const levels::RunResu
 int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOptions& opt,
                         std::ostream& os) {
     MLC_CHECK(opt.max_level >= 0 && opt.max_level <= 6, "--levels must lie in [0, 6]");
+    MLC_CHECK(opt.ilu_max_level >= 0, "--ilu-levels must be >= 0");
     MLC_CHECK(opt.reference_offset >= 1 && opt.reference_offset <= 2,
               "reference offset must be 1 or 2");
     levels::Problem problem = problem_in;
@@ -172,8 +191,12 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
     if (problem.name == "hertz") os << std::setw(14) << "vs closed form";
     os << std::setw(8) << "newton" << std::setw(9) << "krylov"
        << "\n";
-    for (const auto& c : configurations())
-        for (int l = 0; l <= opt.max_level; ++l) {
+    for (const auto& c : configurations()) {
+        if (!opt.only.empty() && c.name.find(opt.only) == std::string::npos) continue;
+        const int lo = c.family == Config::Family::mg ? 1 : 0;
+        const int hi = c.family == Config::Family::ilu ? std::min(opt.max_level, opt.ilu_max_level)
+                                                       : opt.max_level;
+        for (int l = lo; l <= hi; ++l) {
             levels::Problem p = problem;
             p.levels = l;
             p.newton.rel_tol = c.newton_tol;
@@ -181,8 +204,18 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
             so.coarse_to_fine = c.coarse_to_fine;
             so.linear = c.linear;
             const double t0 = wall_seconds();
-            const levels::RunResult r = levels::solve(p, so);
-            Row row{c.name, l, r.finest().n_unknowns(), wall_seconds() - t0, r.converged, {}, 0, 0};
+            levels::RunResult r;
+            try {
+                r = levels::solve(p, so);
+            } catch (const std::exception& e) {
+                // A configuration that cannot run here (memory, a singular system) is a row
+                // that did not converge, not the end of the study.
+                r.converged = false;
+                r.failure = e.what();
+            }
+            const Index unknowns =
+                r.levels().empty() ? 0 : static_cast<Index>(r.finest().n_unknowns());
+            Row row{c.name, l, unknowns, wall_seconds() - t0, r.converged, {}, 0, 0};
             for (const auto& ls : r.level_steps)
                 for (const auto& st : ls) {
                     row.newton += st.report.iterations;
@@ -201,6 +234,7 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
             os << std::setw(8) << row.newton << std::setw(9) << row.krylov << "\n" << std::flush;
             rows.push_back(row);
         }
+    }
     // Pareto front on (seconds, primary error): a run is on the front unless another is at least
     // as fast and at least as accurate. Errors within 1% of each other count as equal: runs
     // that solve the same level to tolerance differ only in the digits the solver tolerance

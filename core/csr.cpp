@@ -21,13 +21,14 @@ bool equal_pattern(Index rows, Index cols, const int* outer, const int* inner, I
 
 } // namespace
 
-void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add) {
+void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add, traffic::Kind kind) {
     MLC_CHECK(x.size() == A.cols() && (!add || y.size() == A.rows()),
               "csr_multiply: A is " << A.rows() << " x " << A.cols() << ", x has " << x.size()
                                     << ", y has " << y.size());
     MLC_CHECK(A.isCompressed(), "csr_multiply: A must be compressed");
     const Index n = A.rows();
     if (!add) y.resize(n);
+    const traffic::Pass pass(kind, traffic::csr_bytes(n, A.cols(), A.nonZeros(), add));
     const int* outer = A.outerIndexPtr();
     const int* inner = A.innerIndexPtr();
     const double* val = A.valuePtr();

@@ -4,6 +4,7 @@
 /// decides whether a preconditioner may only refresh its values.
 #pragma once
 
+#include "core/traffic.hpp"
 #include "core/types.hpp"
 
 #include <algorithm>
@@ -43,8 +44,10 @@ inline double row_dot(const int* inner, const double* val, const double* x, int 
 /// row is summed the same way
 /// whatever the thread count, so the result does not depend on it). Without `add`, y is
 /// resized; with it, y must have A.rows() entries. Throws mlc::InvalidInput on a size mismatch
-/// or an uncompressed A. Does not allocate once y has its size.
-void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = false);
+/// or an uncompressed A. Does not allocate once y has its size. Counts one pass of `kind`
+/// (core/traffic.hpp: traffic::csr_bytes(A.rows(), A.cols(), A.nonZeros(), add) bytes).
+void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = false,
+                  traffic::Kind kind = traffic::Kind::matvec);
 
 /// True when A and B have identical sizes and identical compressed patterns (outer and inner
 /// index arrays compared entry by entry); values are ignored. False if either is uncompressed.

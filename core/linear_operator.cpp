@@ -14,6 +14,8 @@ void MatrixOperator::apply(const Vector& x, Vector& y) const {
         csr_multiply(A_, x, y);
         return;
     }
+    const traffic::Pass pass(traffic::Kind::matvec,
+                             traffic::csr_bytes(A_.rows(), A_.cols(), A_.nonZeros(), false));
     y.noalias() = A_ * x;
 }
 

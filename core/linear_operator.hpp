@@ -38,6 +38,7 @@ enum class MatVec {
 
 /// The CSR matrix as a LinearOperator: y = A x by the kernel `kind`, y = A^T x by a scatter over
 /// the rows. The matrix must outlive this object. Neither product allocates once y has its size.
+/// `apply` counts one mat-vec pass (core/traffic.hpp), whichever kernel runs it.
 class MatrixOperator final : public LinearOperator {
 public:
     explicit MatrixOperator(const SparseMatrix& A, MatVec kind = MatVec::in_order)

@@ -3,6 +3,9 @@
 #include "core/memory.hpp"
 
 #include <sys/resource.h>
+#include <unistd.h>
+
+#include <fstream>
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -23,6 +26,13 @@ double peak_rss_bytes() {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
     return static_cast<double>(u.ru_maxrss) * 1024.0; // ru_maxrss is in KiB on Linux
+}
+
+double current_rss_bytes() {
+    std::ifstream in("/proc/self/statm");
+    double size = 0, resident = 0;
+    if (!(in >> size >> resident)) return 0.0;
+    return resident * static_cast<double>(sysconf(_SC_PAGESIZE));
 }
 
 } // namespace mlc

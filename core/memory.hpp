@@ -15,4 +15,7 @@ void keep_freed_memory();
 /// Peak resident memory of this process so far, in bytes (getrusage ru_maxrss).
 double peak_rss_bytes();
 
+/// Resident memory of this process now, in bytes (/proc/self/statm; 0 where it cannot be read).
+double current_rss_bytes();
+
 } // namespace mlc

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Draws error_vs_time.png from error_vs_time.csv (`mlcontact study error-vs-time`).
 
-Log-log: wall seconds (x) against the primary error (y), one marker style per configuration,
-the level written next to each point, the Pareto front as a black step line.
+Log-log: wall seconds (x) against the primary error (y), one marker style and colour per
+configuration (the multilevel ones, mg and mgr, drawn with thicker lines), the level written
+next to each point, the Pareto front as a black step line.
 Usage: plot_error_vs_time.py DIR
 """
 import csv
@@ -21,11 +22,14 @@ by = defaultdict(list)
 for r in rows:
     by[r["configuration"]].append(r)
 markers = "os^vD<>pPX*h"
-fig, ax = plt.subplots(figsize=(9, 6))
+colors = plt.get_cmap("tab20").colors
+fig, ax = plt.subplots(figsize=(10, 6.5))
 for i, (name, rs) in enumerate(by.items()):
     xs = [float(r["seconds"]) for r in rs]
     ys = [float(r["primary_error"]) for r in rs]
-    ax.plot(xs, ys, markers[i % len(markers)] + "-", alpha=0.8, label=name, linewidth=0.8)
+    multilevel = "+mg" in name
+    ax.plot(xs, ys, markers[i % len(markers)] + "-", alpha=0.9 if multilevel else 0.7, label=name,
+            linewidth=2.0 if multilevel else 0.8, color=colors[(2 * i) % 20 + (i // 10) % 2])
     for r in rs:
         ax.annotate(r["level"], (float(r["seconds"]), float(r["primary_error"])), fontsize=7,
                     xytext=(3, 3), textcoords="offset points")

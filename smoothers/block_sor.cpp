@@ -395,7 +395,13 @@ void BlockSOR::sweep_part(const double* bp, double* xp, Index b0, Index b1, bool
     }
 }
 
-void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero) const {
+void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero,
+                          bool count) const {
+    const traffic::Pass pass(traffic::Kind::smoother,
+                             count ? traffic::sweep_bytes(A_->rows(), A_->nonZeros(), n_blocks(),
+                                                          static_cast<Index>(dinv_.size()))
+                                   : 0.0,
+                             count ? 1 : 0);
     double* xp = x.data();
     double* sp = snap_.data();
     for (const int j : interface_) // empty with one part
@@ -425,9 +431,13 @@ void BlockSOR::forward_from_zero(const Vector& b, Vector& x, Vector& res) const 
     const int* outer = A_->outerIndexPtr();
     const int* inner = A_->innerIndexPtr();
     const double* val = A_->valuePtr();
+    const traffic::Pass pass(traffic::Kind::smoother,
+                             traffic::sweep_from_zero_bytes(n, A_->nonZeros(), n_blocks(),
+                                                            static_cast<Index>(dinv_.size())),
+                             2);
     if (params_.kernel == Kernel::in_order) {
         x.setZero(n);
-        half_sweep(b, x, true, true);
+        half_sweep(b, x, true, true, false);
         res.resize(n);
         for (Index i = 0; i < n; ++i) {
             double acc = b[i];

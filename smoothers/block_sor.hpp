@@ -134,6 +134,8 @@ std::vector<Index> uniform_block_starts(Index n, Index block_size);
 /// (core's SparsityPattern). `apply`, `apply_transpose`, `smooth`, `sweep` and
 /// `forward_from_zero` do not allocate once sizes are set; they use mutable work vectors, so one
 /// object must not be used from two threads at once. r and z (b and x) must be distinct objects.
+/// Every half-sweep counts one smoother pass of traffic::sweep_bytes, `forward_from_zero` two
+/// passes of traffic::sweep_from_zero_bytes together (core/traffic.hpp).
 class BlockSOR final : public Smoother {
 public:
     /// Validates `params`.
@@ -180,7 +182,9 @@ private:
     void invert_blocks();
     // D^{-1} of a block the kernel's fast path rejected (equilibrated full-pivot LU); throws.
     void robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, InverseMap inv) const;
-    void half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero) const;
+    // One half-sweep; `count`: one smoother pass of traffic::sweep_bytes (core/traffic.hpp).
+    void half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero,
+                    bool count = true) const;
     // One part's sweep (blocks [b0, b1)), other parts' unknowns read from snap_.
     void sweep_part(const double* bp, double* xp, Index b0, Index b1, bool forward, bool from_zero,
                     double* t) const;

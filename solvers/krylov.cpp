@@ -5,6 +5,7 @@
 
 #include "core/check.hpp"
 #include "core/timer.hpp"
+#include "core/traffic.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -108,6 +109,7 @@ public:
     // t = b - A x; returns ||t||.
     double true_residual(Vector& t) const {
         A_.apply(x_, t);
+        traffic::vectors(b_.size(), 4); // t = b - t, ||t||
         t = b_ - t;
         return t.norm();
     }
@@ -169,6 +171,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
 
     double rn = run.true_residual(t);
     r = t;
+    traffic::vectors(n, 2);
     run.initial(rn);
     if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
 
@@ -181,6 +184,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
             p = z0;
             q = z0;
             rho = z0.squaredNorm();
+            traffic::vectors(n, 5);
             if (bad(rho))
                 return run.finish(StopReason::breakdown, it, run.true_residual(t),
                                   at("(z0, z0) with z0 = C^{-1} r0", it, rho));
@@ -205,6 +209,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
         r -= a * t;
         ++it;
         rn = r.norm();
+        traffic::vectors(n, 15); // (z0, y), h, w, x, r, ||r||
         run.record(rn);
         if (!std::isfinite(rn))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
@@ -213,6 +218,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
             const double tr = run.true_residual(t);
             if (run.ok(tr) || !std::isfinite(tr)) return run.finish(StopReason::converged, it, tr);
             r = t; // recursive residual drifted: restart from the true one
+            traffic::vectors(n, 2);
             restart = true;
             continue;
         }
@@ -225,6 +231,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
         rho = rho_new;
         p = z + beta * h;
         q = p + beta * (h + beta * q);
+        traffic::vectors(n, 9); // (z0, z), p, q
     }
 }
 
@@ -238,6 +245,7 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
     double rn = run.true_residual(t);
     r = t;
     rt = r;
+    traffic::vectors(n, 4);
     run.initial(rn);
     if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
 
@@ -257,10 +265,12 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
             p = z;
             pt = zt;
             restart = false;
+            traffic::vectors(n, 6); // (z, r~), p, p~
         } else {
             const double beta = rho / rho_old;
             p = z + beta * p;
             pt = zt + beta * pt;
+            traffic::vectors(n, 8);
         }
         A.apply(p, q);
         A.apply_transpose(pt, qt);
@@ -275,6 +285,7 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
         rho_old = rho;
         ++it;
         rn = r.norm();
+        traffic::vectors(n, 12); // (p~, q), x, r, r~, ||r||
         run.record(rn);
         if (!std::isfinite(rn) || !std::isfinite(alpha))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
@@ -284,6 +295,7 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
             if (run.ok(tr) || !std::isfinite(tr)) return run.finish(StopReason::converged, it, tr);
             r = t;
             rt = r;
+            traffic::vectors(n, 4);
             restart = true;
         }
     }
@@ -298,6 +310,7 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
 
     double rn = run.true_residual(t);
     r = t;
+    traffic::vectors(n, 2);
     run.initial(rn);
     if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
 
@@ -313,6 +326,7 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
             return;
         }
         r = t;
+        traffic::vectors(t.size(), 2);
         restart = true;
     };
     while (true) {
@@ -322,6 +336,7 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
             v.setZero();
             p.setZero();
             restart = false;
+            traffic::vectors(n, 4);
         }
         if (const auto stop = run.should_stop(it))
             return run.finish(StopReason::max_iter, it, run.true_residual(t), *stop);
@@ -340,11 +355,13 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
         alpha = rho / d;
         r -= alpha * v; // r now holds s
         const double sn = r.norm();
+        traffic::vectors(n, 12); // (r^, r), p, (r^, v), s, ||s||
         if (!std::isfinite(sn) || !std::isfinite(alpha))
             return run.finish(StopReason::breakdown, it + 1, run.true_residual(t),
                               at("half-step residual norm", it + 1, sn));
         if (run.ok(sn)) { // converged at the half step: x += alpha p^
             x += alpha * ph;
+            traffic::vectors(n, 3);
             ++it;
             run.record(sn);
             bool done = false;
@@ -368,6 +385,7 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
         rho_old = rho;
         ++it;
         rn = r.norm();
+        traffic::vectors(n, 11); // (t, t), (t, s), x, r, ||r||
         run.record(rn);
         if (!std::isfinite(rn))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
@@ -399,6 +417,7 @@ SolveResult gmres(const LinearOperator& A, const Preconditioner& M, const Vector
             return run.finish(StopReason::max_iter, it, beta, *stop);
 
         V.col(0) = w / beta;
+        traffic::vectors(n, 2);
         g.setZero();
         g(0) = beta;
         Index k = 0; // Arnoldi columns done in this cycle
@@ -420,6 +439,8 @@ SolveResult gmres(const LinearOperator& A, const Preconditioner& M, const Vector
                 break;
             }
             if (hn > 0.0) V.col(j + 1) = w / hn;
+            // t = v_j, j + 1 dots and axpys, ||w||, v_{j+1}
+            traffic::vectors(n, 2 + 5 * static_cast<int>(j + 1) + 1 + 2);
             for (Index i = 0; i < j; ++i) { // previous Givens rotations
                 const double hi = H(i, j), hi1 = H(i + 1, j);
                 H(i, j) = cs(i) * hi + sn(i) * hi1;
@@ -454,6 +475,7 @@ SolveResult gmres(const LinearOperator& A, const Preconditioner& M, const Vector
             t.noalias() = V.leftCols(k) * y.head(k);
             M.apply(t, u);
             x += u;
+            traffic::vectors(n, static_cast<int>(k) + 1 + 3);
         }
         const double beta_old = beta;
         beta = run.true_residual(w);

@@ -181,6 +181,7 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
     if (k == 0) {
         MLC_CHECK(L.A != nullptr || L.coarse_replaced,
                   "Multigrid: the coarsest operator is not set");
+        const traffic::Pass pass(traffic::Kind::coarse, 0.0);
         L.coarse->apply(r, z);
         return;
     }
@@ -194,13 +195,16 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
         for (int s = 1; s < p.pre_sweeps; ++s)
             L.smoother.sweep(r, z, smoothers::Sweep::forward);
         if (p.pre_sweeps > 1) {
+            const traffic::Pass pass(
+                traffic::Kind::matvec,
+                traffic::csr_bytes(L.A->rows(), L.A->cols(), L.A->nonZeros(), true));
             L.res = r;
             L.res.noalias() -= *L.A * z;
         }
     }
-    csr_multiply(*L.R, L.res, L.rc);
+    csr_multiply(*L.R, L.res, L.rc, false, traffic::Kind::transfer);
     cycle(k - 1, L.rc, L.ec);
-    csr_multiply(*L.T, L.ec, z, true);
+    csr_multiply(*L.T, L.ec, z, true, traffic::Kind::transfer);
     for (int s = 0; s < p.post_sweeps; ++s)
         L.smoother.sweep(r, z, smoothers::Sweep::backward);
 }

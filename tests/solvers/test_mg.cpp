@@ -3,6 +3,7 @@
 // the cycle as a stationary iteration contracts the residual by a fixed factor per cycle, and
 // mg-CG and BoomerAMG-PCG both reach the tolerance and agree with a sparse direct solve.
 #include "core/check.hpp"
+#include "core/traffic.hpp"
 #include "levels/elastic_block.hpp"
 #include "levels/hierarchy.hpp"
 #include "scene/scene.hpp"
@@ -317,4 +318,32 @@ TEST(Multigrid, TheLevelAboveSharesTheLevelsBelowAndAppliesTheSameCycle) {
     EXPECT_THROW(gal.set_operator(0, e.blocks[0].K), InvalidInput);
     EXPECT_THROW(solvers::Multigrid({data(1)}, {}), InvalidInput);          // one level
     EXPECT_THROW(solvers::Multigrid({data(1), data(2)}, {}), InvalidInput); // coarsest with T
+}
+
+TEST(Multigrid, OneVCycleCountsItsPasses) {
+    // Levels 0..2: per level above 0 a forward sweep from zero with its residual (two smoother
+    // passes), a backward sweep (one), a restriction and a prolongation (two transfer passes);
+    // one coarse solve; nothing else (no mat-vec, no Krylov vector operation).
+    ElasticHierarchy e(2);
+    const Vector r = e.b;
+    Vector z;
+    const traffic::Account a0 = traffic::snapshot();
+    e.mg->finest().apply(r, z);
+    const traffic::Account d = traffic::snapshot() - a0;
+    EXPECT_EQ(d.p(traffic::Kind::smoother), 6.0);
+    EXPECT_EQ(d.p(traffic::Kind::transfer), 4.0);
+    EXPECT_EQ(d.p(traffic::Kind::coarse), 1.0);
+    EXPECT_EQ(d.p(traffic::Kind::matvec), 0.0);
+    EXPECT_EQ(d.p(traffic::Kind::vector), 0.0);
+    EXPECT_EQ(d.b(traffic::Kind::coarse), 0.0);
+    // The transfers read at least the nonzeros of T and R once each (12 bytes an entry).
+    const solvers::MultigridReport rep = e.mg->finest().report();
+    ASSERT_EQ(rep.levels.size(), 3u);
+    EXPECT_GT(d.b(traffic::Kind::transfer), 0.0);
+    // The smoother reads each level's operator twice (12 bytes an entry: once over the two
+    // passes of the sweep from zero, once in the backward sweep), plus the row offsets, block
+    // inverses and vectors (about 18 entries a row: less than the matrix again).
+    const double ops = 12.0 * static_cast<double>(rep.levels[1].nonzeros + rep.levels[2].nonzeros);
+    EXPECT_GT(d.b(traffic::Kind::smoother), 2 * ops);
+    EXPECT_LT(d.b(traffic::Kind::smoother), 4 * ops);
 }
