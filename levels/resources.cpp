@@ -104,7 +104,7 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
                       "unknown preconditioner '"
                           << s.pc << "'; valid: " << solvers::preconditioner_names(", ")
                           << " (`mlcontact preconditioners` lists their options)");
-            MLC_CHECK(has_levels || !entry->needs_level_below,
+            MLC_CHECK(has_levels || !entry->needs_level_below || entry->single_level_too,
                       "--pc " << s.pc << " needs the level below: use --levels >= 1");
         } else {
             s.pc = has_levels ? "mg" : "ilu:0";

@@ -1,0 +1,183 @@
+// SPDX-License-Identifier: MIT
+// The algebraic hierarchy of mg (solvers/aggregation.hpp) on the square's level 2: the tentative
+// prolongation reproduces a constant per displacement component, Q shares each coarse force out
+// so that the resultant is preserved, the smoothed T still reproduces constants where K does
+// not see the supports, the coarse K is T^T K T, and the levels coarsen down to the coarse size.
+#include "core/check.hpp"
+#include "levels/hierarchy.hpp"
+#include "levels/krylov_system.hpp"
+#include "scene/scene.hpp"
+#include "solvers/aggregation.hpp"
+#include "solvers/mg.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <set>
+
+using namespace mlc;
+using solvers::UnknownKind;
+
+namespace {
+
+struct SquareLevel {
+    levels::Hierarchy h;
+    solvers::AggregationInput in;
+    explicit SquareLevel(int level) {
+        auto p = scene::load_scene("square");
+        p.levels = level;
+        h = levels::build_hierarchy(p);
+        in = levels::aggregation_input(h.finest());
+    }
+};
+
+// The coarse vector that is 1 on every coarse unknown of `kind`, 0 elsewhere.
+Vector indicator(const std::vector<UnknownKind>& kinds, UnknownKind kind) {
+    Vector c = Vector::Zero(static_cast<Index>(kinds.size()));
+    for (size_t i = 0; i < kinds.size(); ++i)
+        if (kinds[i] == kind) c[static_cast<Index>(i)] = 1.0;
+    return c;
+}
+
+} // namespace
+
+TEST(Aggregation, TentativeProlongationReproducesAConstantPerComponent) {
+    const SquareLevel s(2);
+    const auto step = solvers::aggregate_once(s.in, {});
+    const Index nf = s.in.K->rows();
+    ASSERT_EQ(step.P_tentative.rows(), nf);
+    EXPECT_LT(step.n_aggregates * 6, s.h.finest().mesh.n_vertices()); // about 9 vertices each
+    for (UnknownKind k : {UnknownKind::ux, UnknownKind::uy}) {
+        const Vector f = step.P_tentative * indicator(step.coarse_kind, k);
+        for (Index i = 0; i < nf; ++i)
+            EXPECT_EQ(f[i], s.in.kind[static_cast<size_t>(i)] == k ? 1.0 : 0.0) << i;
+    }
+    // Every fine unknown has exactly one coarse parent, of its own kind, in its aggregate.
+    for (Index i = 0; i < nf; ++i) {
+        int n = 0;
+        for (SparseMatrix::InnerIterator it(step.P_tentative, i); it; ++it, ++n) {
+            EXPECT_EQ(step.coarse_kind[static_cast<size_t>(it.col())],
+                      s.in.kind[static_cast<size_t>(i)]);
+        }
+        EXPECT_EQ(n, 1) << i;
+    }
+}
+
+TEST(Aggregation, MultipliersAreSharedOutAlongTheContactBoundaryPreservingTheResultant) {
+    const SquareLevel s(2);
+    const auto step = solvers::aggregate_once(s.in, {});
+    const SparseMatrix PtT = step.P_tentative.transpose();
+    int n_coarse_multipliers = 0, n_fine_multipliers = 0;
+    for (UnknownKind k : s.in.kind)
+        n_fine_multipliers += k >= UnknownKind::lambda_t;
+    std::set<int> contact_aggregates;
+    for (Index J = 0; J < PtT.rows(); ++J) {
+        if (step.coarse_kind[static_cast<size_t>(J)] < UnknownKind::lambda_t) continue;
+        ++n_coarse_multipliers;
+        contact_aggregates.insert(step.coarse_vertex[static_cast<size_t>(J)]);
+        double sum = 0.0;
+        int members = 0;
+        for (SparseMatrix::InnerIterator it(PtT, J); it; ++it) {
+            sum += it.value();
+            ++members;
+        }
+        EXPECT_NEAR(sum, 1.0, 1e-15) << "coarse multiplier " << J;
+        EXPECT_GE(members, 1);
+    }
+    // 64 contact nodes on level 2 (t and n each), about three per aggregate (a node and its two
+    // neighbours along the boundary; 22 aggregates measured), and the smoothed T keeps the
+    // multiplier rows as they were (Q is not smoothed).
+    EXPECT_GT(n_coarse_multipliers, 0);
+    EXPECT_LE(5 * n_coarse_multipliers, 2 * n_fine_multipliers);
+    for (Index i = 0; i < s.in.K->rows(); ++i) {
+        if (s.in.kind[static_cast<size_t>(i)] < UnknownKind::lambda_t) continue;
+        for (SparseMatrix::InnerIterator it(step.T, i); it; ++it)
+            EXPECT_EQ(it.value(), step.P_tentative.coeff(i, it.col()));
+    }
+    // The coarse unknowns of each aggregate are contiguous: x, y, then its multipliers.
+    for (size_t J = 1; J < step.coarse_vertex.size(); ++J) {
+        if (step.coarse_vertex[J] == step.coarse_vertex[J - 1])
+            EXPECT_LT(step.coarse_kind[J - 1], step.coarse_kind[J]);
+        else
+            EXPECT_EQ(step.coarse_vertex[J], step.coarse_vertex[J - 1] + 1);
+    }
+}
+
+TEST(Aggregation, SmoothedProlongationReproducesConstantsAwayFromTheSupports) {
+    const SquareLevel s(2);
+    const auto step = solvers::aggregate_once(s.in, {});
+    EXPECT_GT(step.omega, 0.0);
+    const SparseMatrix& K = *s.in.K;
+    int checked = 0;
+    for (UnknownKind k : {UnknownKind::ux, UnknownKind::uy}) {
+        Vector one = Vector::Zero(K.rows());
+        for (Index i = 0; i < K.rows(); ++i)
+            if (s.in.kind[static_cast<size_t>(i)] == k) one[i] = 1.0;
+        const Vector K1 = K * one; // zero where the row does not couple to a support
+        const Vector f = step.T * indicator(step.coarse_kind, k);
+        // D^-1 mixes the two components of a vertex: both rows must see no support.
+        for (Index i = 0; i < K.rows(); ++i) {
+            if (s.in.kind[static_cast<size_t>(i)] >= UnknownKind::lambda_t) continue;
+            bool near_support = false;
+            for (Index j = std::max<Index>(0, i - 3); j < std::min<Index>(K.rows(), i + 4); ++j)
+                if (s.in.vertex[static_cast<size_t>(j)] == s.in.vertex[static_cast<size_t>(i)] &&
+                    s.in.kind[static_cast<size_t>(j)] < UnknownKind::lambda_t &&
+                    std::abs(K1[j]) > 1e-12 * K.coeff(j, j))
+                    near_support = true;
+            if (near_support) continue;
+            EXPECT_NEAR(f[i], s.in.kind[static_cast<size_t>(i)] == k ? 1.0 : 0.0, 1e-12) << i;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, s.in.K->rows() / 2);
+    // Smoothing widens the basis functions beyond their aggregate.
+    EXPECT_GT(step.T.nonZeros(), 2 * step.P_tentative.nonZeros());
+}
+
+TEST(Aggregation, CoarseStiffnessIsTheGalerkinProductComputedDensely) {
+    const SquareLevel s(1);
+    const auto step = solvers::aggregate_once(s.in, {});
+    const Eigen::MatrixXd K = Eigen::MatrixXd(*s.in.K);
+    const Eigen::MatrixXd T = Eigen::MatrixXd(step.T);
+    const Eigen::MatrixXd Kc = T.transpose() * K * T;
+    EXPECT_LT((Eigen::MatrixXd(step.K_coarse) - Kc).norm(), 1e-12 * Kc.norm());
+    // The coarse K has empty multiplier rows, as the fine one does: it is the next step's input.
+    const solvers::AggregationInput next{&step.K_coarse, step.coarse_vertex, step.coarse_kind};
+    EXPECT_NO_THROW(next.validate());
+}
+
+TEST(Aggregation, LevelsCoarsenToTheCoarseSizeAndOwnTheirTransfers) {
+    const SquareLevel s(3);
+    const auto levels = solvers::aggregation_levels(s.in, {.coarse_size = 300});
+    ASSERT_GE(levels.size(), 3u);
+    EXPECT_EQ(levels.front().T, nullptr);
+    for (size_t k = 1; k < levels.size(); ++k) {
+        ASSERT_NE(levels[k].T_storage, nullptr);
+        EXPECT_EQ(levels[k].T, levels[k].T_storage.get());
+        EXPECT_EQ(levels[k].R->rows(), levels[k].T->cols());
+        if (k >= 2) {
+            EXPECT_GT(levels[k].T->cols(), 300);
+        }
+    }
+    EXPECT_LE(levels[1].T->cols(), 300);
+    EXPECT_EQ(levels.back().T->rows(), s.in.K->rows());
+    // A Multigrid takes them (Galerkin) and outlives the vector that held them.
+    solvers::Multigrid mg(levels, {}, solvers::CoarseOperators::galerkin);
+    SparseMatrix A = *s.in.K;
+    for (Index i = 0; i < A.rows(); ++i)
+        if (s.in.kind[static_cast<size_t>(i)] >= UnknownKind::lambda_t) A.coeffRef(i, i) = -1.0;
+    A.makeCompressed();
+    mg.setup(A);
+    EXPECT_EQ(static_cast<size_t>(mg.report().levels.size()), levels.size());
+    EXPECT_NE(mg.report().coarse_operators.find("aggregates"), std::string::npos);
+}
+
+TEST(Aggregation, BadInputIsRejected) {
+    const SquareLevel s(0);
+    solvers::AggregationInput bad = s.in;
+    bad.kind.pop_back();
+    EXPECT_THROW(solvers::aggregate_once(bad, {}), InvalidInput);
+    EXPECT_THROW(solvers::aggregate_once(s.in, {.smoothing = 2.0}), InvalidInput);
+    EXPECT_THROW(solvers::aggregate_once(s.in, {.max_levels = 1}), InvalidInput);
+}
