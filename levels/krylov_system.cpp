@@ -320,6 +320,23 @@ solvers::AggregationInput aggregation_input(const Level& L) {
     for (int v = 0; v < L.dofs.n_vertices(); ++v)
         if (const int i = L.dofs.u_dof(v, 1); i >= 0)
             in.kind[static_cast<size_t>(i)] = solvers::UnknownKind::uy;
+    // Rigid modes about the centroid (for conditioning): (1, 0), (0, 1), (-(y - yc), x - xc).
+    Vec2 c(0.0, 0.0);
+    for (const auto& p : L.mesh.vertices)
+        c += p;
+    c /= std::max(1, L.mesh.n_vertices());
+    in.near_null = Eigen::MatrixXd::Zero(L.n_unknowns(), 3);
+    for (int v = 0; v < L.dofs.n_vertices(); ++v) {
+        const Vec2 d = L.mesh.vertices[static_cast<size_t>(v)] - c;
+        if (const int i = L.dofs.u_dof(v, 0); i >= 0) {
+            in.near_null(i, 0) = 1.0;
+            in.near_null(i, 2) = -d.y();
+        }
+        if (const int i = L.dofs.u_dof(v, 1); i >= 0) {
+            in.near_null(i, 1) = 1.0;
+            in.near_null(i, 2) = d.x();
+        }
+    }
     for (size_t e = 0; e < L.contacts.size(); ++e) {
         const int m = L.contacts[e].n_multipliers();
         for (int k = 0; k < m; ++k)

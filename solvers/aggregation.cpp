@@ -33,15 +33,15 @@ void AggregationInput::validate() const {
                   static_cast<Index>(kind.size()) == K->rows(),
               "AggregationInput: K has " << K->rows() << " rows, vertex " << vertex.size()
                                          << " and kind " << kind.size() << " entries");
+    MLC_CHECK(near_null.size() == 0 || near_null.rows() == K->rows(),
+              "AggregationInput: near_null has " << near_null.rows() << " rows, K " << K->rows());
     for (Index i = 0; i < K->rows(); ++i)
-        if (kind[static_cast<size_t>(i)] >= UnknownKind::lambda_t)
+        if (is_multiplier(kind[static_cast<size_t>(i)]))
             MLC_CHECK(K->outerIndexPtr()[i + 1] == K->outerIndexPtr()[i],
                       "AggregationInput: K has entries in multiplier row " << i);
 }
 
 namespace {
-
-constexpr int kKinds = 4;
 
 // The nodes of a level: runs of unknowns of one owner.
 struct Nodes {
@@ -172,63 +172,107 @@ AggregationStep aggregate_once(const AggregationInput& in, const AggregationPara
     const auto adj = node_graph(K, nodes);
     std::vector<char> is_contact(static_cast<size_t>(nodes.size()), 0);
     for (size_t i = 0; i < in.kind.size(); ++i)
-        if (in.kind[i] >= UnknownKind::lambda_t)
-            is_contact[static_cast<size_t>(nodes.of_unknown[i])] = 1;
+        if (is_multiplier(in.kind[i])) is_contact[static_cast<size_t>(nodes.of_unknown[i])] = 1;
 
     AggregationStep s;
     s.aggregate_of_node = aggregate_nodes(adj, is_contact, s.n_aggregates);
     const size_t na = static_cast<size_t>(s.n_aggregates);
 
-    // Coarse unknowns: per aggregate the kinds its members have, in kind order.
-    std::vector<std::array<int, kKinds>> members(na, std::array<int, kKinds>{});
-    for (size_t i = 0; i < in.kind.size(); ++i) {
-        const int a = s.aggregate_of_node[static_cast<size_t>(nodes.of_unknown[i])];
-        ++members[static_cast<size_t>(a)][static_cast<size_t>(in.kind[i])];
+    // Near-null space of the displacements: the input's rigid modes, or the translations.
+    Eigen::MatrixXd B = in.near_null;
+    if (B.size() == 0) {
+        B = Eigen::MatrixXd::Zero(K.rows(), 2);
+        for (size_t i = 0; i < in.kind.size(); ++i)
+            if (in.kind[i] == UnknownKind::ux || in.kind[i] == UnknownKind::uy)
+                B(static_cast<Index>(i), static_cast<Index>(in.kind[i])) = 1.0;
     }
-    std::vector<std::array<int, kKinds>> coarse_dof(na);
-    int nc = 0;
-    for (size_t a = 0; a < na; ++a)
-        for (int k = 0; k < kKinds; ++k) {
-            coarse_dof[a][static_cast<size_t>(k)] =
-                members[a][static_cast<size_t>(k)] > 0 ? nc : -1;
-            if (members[a][static_cast<size_t>(k)] > 0) {
-                s.coarse_vertex.push_back(static_cast<int>(a));
-                s.coarse_kind.push_back(static_cast<UnknownKind>(k));
-                ++nc;
-            }
-        }
+    const Index nb = B.cols();
 
-    // Tentative P (displacements: 1) and Q (multipliers: 1 / m, the force shared out).
-    std::vector<Eigen::Triplet<double, int>> tp;
-    tp.reserve(in.kind.size());
+    // Unknowns of each aggregate: displacements, and multipliers per component.
+    std::vector<std::vector<Index>> u_of(na);
+    std::vector<std::array<std::vector<Index>, 2>> lambda_of(na);
     for (size_t i = 0; i < in.kind.size(); ++i) {
-        const size_t a =
+        const auto a =
             static_cast<size_t>(s.aggregate_of_node[static_cast<size_t>(nodes.of_unknown[i])]);
-        const auto k = static_cast<size_t>(in.kind[i]);
-        const double w = in.kind[i] >= UnknownKind::lambda_t ? 1.0 / members[a][k] : 1.0;
-        tp.emplace_back(static_cast<int>(i), coarse_dof[a][k], w);
+        if (is_multiplier(in.kind[i]))
+            lambda_of[a][in.kind[i] == UnknownKind::lambda_t ? 0 : 1].push_back(
+                static_cast<Index>(i));
+        else
+            u_of[a].push_back(static_cast<Index>(i));
+    }
+
+    // Tentative P per aggregate: B restricted to its displacements = Q_a R_a (QR with column
+    // pivoting, columns beyond the numerical rank dropped); its coarse displacements are the
+    // coefficients of Q_a's columns and the coarse near-null space is R_a. Then Q (the
+    // multipliers: 1 / m, the force shared out), lambda_t before lambda_n.
+    std::vector<Eigen::Triplet<double, int>> tp;
+    tp.reserve(in.kind.size() * static_cast<size_t>(nb));
+    std::vector<Eigen::MatrixXd> Rc(na);
+    int nc = 0;
+    for (size_t a = 0; a < na; ++a) {
+        const auto& u = u_of[a];
+        if (!u.empty()) {
+            const auto m = static_cast<Index>(u.size());
+            Eigen::MatrixXd Ba(m, nb);
+            for (Index r = 0; r < m; ++r)
+                Ba.row(r) = B.row(u[static_cast<size_t>(r)]);
+            Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Ba);
+            qr.setThreshold(1e-10);
+            const Index rank = qr.rank();
+            const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(m, rank);
+            const Eigen::MatrixXd R =
+                qr.matrixR().topRows(rank).template triangularView<Eigen::Upper>();
+            Rc[a] = R * qr.colsPermutation().transpose();
+            for (Index r = 0; r < m; ++r)
+                for (Index c = 0; c < rank; ++c)
+                    if (Q(r, c) != 0.0)
+                        tp.emplace_back(static_cast<int>(u[static_cast<size_t>(r)]),
+                                        nc + static_cast<int>(c), Q(r, c));
+            for (Index c = 0; c < rank; ++c) {
+                s.coarse_vertex.push_back(static_cast<int>(a));
+                s.coarse_kind.push_back(UnknownKind::rigid_mode);
+            }
+            nc += static_cast<int>(rank);
+        }
+        for (int c = 0; c < 2; ++c) {
+            const auto& l = lambda_of[a][static_cast<size_t>(c)];
+            if (l.empty()) continue;
+            for (Index i : l)
+                tp.emplace_back(static_cast<int>(i), nc, 1.0 / static_cast<double>(l.size()));
+            s.coarse_vertex.push_back(static_cast<int>(a));
+            s.coarse_kind.push_back(c == 0 ? UnknownKind::lambda_t : UnknownKind::lambda_n);
+            ++nc;
+        }
     }
     s.P_tentative.resize(K.rows(), nc);
     s.P_tentative.setFromTriplets(tp.begin(), tp.end());
     s.P_tentative.makeCompressed();
+    s.near_null_coarse = Eigen::MatrixXd::Zero(nc, nb);
+    for (Index J = 0, a_prev = -1, r = 0; J < nc; ++J) {
+        const auto a = static_cast<Index>(s.coarse_vertex[static_cast<size_t>(J)]);
+        if (a != a_prev) r = 0;
+        a_prev = a;
+        if (s.coarse_kind[static_cast<size_t>(J)] == UnknownKind::rigid_mode)
+            s.near_null_coarse.row(J) = Rc[static_cast<size_t>(a)].row(r++);
+    }
 
-    // D^-1: the inverse of each vertex's displacement block of K (1 x 1 or 2 x 2); zero on
+    // D^-1: the inverse of each vertex's displacement block of K (up to 3 x 3); zero on
     // multiplier rows, so that they stay unsmoothed.
     std::vector<Eigen::Triplet<double, int>> td;
     for (int v = 0; v < nodes.size(); ++v) {
         std::vector<Index> u;
         for (Index i = nodes.start[static_cast<size_t>(v)];
              i < nodes.start[static_cast<size_t>(v) + 1]; ++i)
-            if (in.kind[static_cast<size_t>(i)] < UnknownKind::lambda_t) u.push_back(i);
+            if (!is_multiplier(in.kind[static_cast<size_t>(i)])) u.push_back(i);
         if (u.empty()) continue;
         const auto m = static_cast<Index>(u.size());
-        Eigen::MatrixXd B(m, m);
+        Eigen::MatrixXd Kv(m, m);
         for (Index a = 0; a < m; ++a)
             for (Index b = 0; b < m; ++b)
-                B(a, b) = K.coeff(u[static_cast<size_t>(a)], u[static_cast<size_t>(b)]);
-        Eigen::FullPivLU<Eigen::MatrixXd> lu(B);
+                Kv(a, b) = K.coeff(u[static_cast<size_t>(a)], u[static_cast<size_t>(b)]);
+        Eigen::FullPivLU<Eigen::MatrixXd> lu(Kv);
         MLC_CHECK(lu.isInvertible(), "aggregation: the displacement block of K at unknown "
-                                         << u.front() << " is singular (" << B.norm()
+                                         << u.front() << " is singular (" << Kv.norm()
                                          << "); every free displacement needs stiffness");
         const Eigen::MatrixXd Binv = lu.inverse();
         for (Index a = 0; a < m; ++a)
@@ -266,7 +310,7 @@ std::vector<MultigridLevelData> aggregation_levels(const AggregationInput& in,
     MultigridLevelData finest;
     finest.block_starts = vertex_block_starts(in.vertex);
     out.push_back(std::move(finest));
-    AggregationInput level{in.K, in.vertex, in.kind};
+    AggregationInput level = in;
     SparseMatrix K_level;
     Index rows = in.K->rows();
     double shrink = 2.0;
@@ -286,7 +330,8 @@ std::vector<MultigridLevelData> aggregation_levels(const AggregationInput& in,
         shrink = static_cast<double>(rows) / static_cast<double>(T->cols());
         rows = T->cols();
         K_level = std::move(s.K_coarse);
-        level = AggregationInput{&K_level, std::move(s.coarse_vertex), std::move(s.coarse_kind)};
+        level = AggregationInput{&K_level, std::move(s.coarse_vertex), std::move(s.coarse_kind),
+                                 std::move(s.near_null_coarse)};
     }
     std::reverse(out.begin(), out.end());
     return out;

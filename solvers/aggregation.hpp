@@ -4,10 +4,13 @@
 /// aggregate becomes one coarse "vertex" carrying the displacement components and contact
 /// multipliers of its members, and the prolongation T from the coarse unknowns is
 ///
-///     displacements:  T_u = (I - omega D^-1 K) P_tent,   P_tent(i, J) = 1 when fine unknown i
-///                     is component c of a vertex of aggregate a and J is component c of a
-///                     (smoothed aggregation, Vanek, Mandel & Brezina 1996; D the vertex-block
-///                     diagonal of K, omega = smoothing / rho(D^-1 K));
+///     displacements:  T_u = (I - omega D^-1 K) P_tent,   P_tent = blockdiag(Q_a), B_a = Q_a R_a
+///                     (smoothed aggregation, Vanek, Mandel & Brezina 1996): B_a is the near-null
+///                     space of K (the rigid modes: translations and rotation) on the
+///                     displacements of aggregate a, Q_a its orthonormal basis, so P_tent
+///                     reproduces every rigid mode of every aggregate, and the coarse near-null
+///                     space is R_a; D the vertex-block diagonal of K, omega = smoothing /
+///                     rho(D^-1 K);
 ///     multipliers:    Q(i, J) = 1 / m_{a,c} when fine unknown i is multiplier component c
 ///                     (lambda_t or lambda_n) of a contact node of aggregate a, J that component of
 ///                     a, and m_{a,c} the number of contact nodes of a with component c.
@@ -23,22 +26,31 @@
 /// (Multigrid with CoarseOperators::galerkin, R = T^T), so T's column scaling (the 1 / m) does not
 /// change the preconditioner; it makes T^T map fine forces to their coarse resultant.
 ///
-/// The coarse unknowns of an aggregate are contiguous, in the order u_x, u_y, lambda_t, lambda_n
-/// (those its members have), so the coarse vertex-block Gauss–Seidel sees the aggregate's
-/// displacements and multipliers in one block, as the geometric levels see a contact vertex's.
-/// Coarsening stops when a level has at most `coarse_size` unknowns (solved by sparse LU).
+/// The coarse unknowns of an aggregate are contiguous, in the order rigid modes (3, fewer when
+/// the aggregate cannot carry them), lambda_t, lambda_n (those its members have), so the coarse
+/// vertex-block Gauss–Seidel sees the aggregate's displacements and multipliers in one block, as
+/// the geometric levels see a contact vertex's. Coarsening stops when a level has at most
+/// `coarse_size` unknowns (solved by sparse LU).
 #pragma once
 
 #include "core/types.hpp"
 #include "solvers/mg.hpp"
+
+#include <Eigen/Dense>
 
 #include <ostream>
 #include <vector>
 
 namespace mlc::solvers {
 
-/// What an unknown is: a displacement component or a contact multiplier component.
-enum class UnknownKind : int { ux = 0, uy = 1, lambda_t = 2, lambda_n = 3 };
+/// What an unknown is: a displacement component, a contact multiplier component, or on a coarse
+/// level the coefficient of one of an aggregate's rigid modes (a displacement too).
+enum class UnknownKind : int { ux = 0, uy = 1, lambda_t = 2, lambda_n = 3, rigid_mode = 4 };
+
+/// True for lambda_t and lambda_n.
+inline bool is_multiplier(UnknownKind k) {
+    return k == UnknownKind::lambda_t || k == UnknownKind::lambda_n;
+}
 
 /// Parameters of the aggregation hierarchy.
 struct AggregationParams {
@@ -65,9 +77,13 @@ struct AggregationInput {
     /// Owner of each unknown (any ids; each vertex's unknowns contiguous, as fem::DofMap numbers
     /// them): one smoother block and one aggregation node per run of equal owners.
     std::vector<int> vertex;
-    /// Kind of each unknown; within a vertex u_x, u_y, lambda_t, lambda_n in that order (those
-    /// it has).
+    /// Kind of each unknown; within a vertex its displacements (u_x, u_y, or rigid modes), then
+    /// lambda_t, lambda_n (those it has).
     std::vector<UnknownKind> kind;
+    /// Near-null space of K on the displacements (rows of multipliers zero), one column per mode:
+    /// on a mesh the translations and the rotation (1, 0), (0, 1), (-y, x). Empty: the
+    /// translations, from the kinds u_x and u_y.
+    Eigen::MatrixXd near_null;
     /// Throws mlc::InvalidInput when the sizes disagree, K is not square or not compressed, or
     /// a multiplier row of K holds an entry.
     void validate() const;
@@ -84,7 +100,10 @@ struct AggregationStep {
     SparseMatrix K_coarse;          ///< T^T K T (multiplier rows and columns empty)
     std::vector<int> coarse_vertex; ///< aggregate of each coarse unknown
     std::vector<UnknownKind> coarse_kind; ///< kind of each coarse unknown
-    double omega = 0.0;                   ///< the smoothing factor used (smoothing / rho)
+    /// The near-null space on the coarse unknowns: P_tentative near_null_coarse equals the
+    /// input's near-null space (R_a of each aggregate's QR; zero rows on multipliers).
+    Eigen::MatrixXd near_null_coarse;
+    double omega = 0.0; ///< the smoothing factor used (smoothing / rho)
 };
 
 /// Aggregates the nodes of `in` and builds the step (see the file comment). Validates both.
