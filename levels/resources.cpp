@@ -132,11 +132,20 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
                << " + mg (smaller than schur there"
                << (two_body ? ", and BiCGStab faster than CGS with a two-body pair)"
                             : " and faster)");
+        } else if (!has_levels && n > crossover && crossover == kMgCrossoverOneBody) {
+            // A fine mesh without levels (e.g. from Gmsh): mg over its aggregation hierarchy
+            // (solvers/aggregation.hpp; README "mg on a mesh without levels": on the square
+            // exported from level 4 it needs 16.0 CGS iterations per Newton step, geometric mg
+            // --levels 4 --cold 18.7).
+            s.method = "krylov";
+            s.pc = "mg";
+            os << "default: " << n << " unknowns on a single level exceed the crossover "
+               << crossover << ": CGS + mg over an algebraic hierarchy (vertex aggregates)";
         } else {
             s.method = "schur";
             if (!has_levels && n > crossover)
-                os << "default: " << n << " unknowns but a single level (no hierarchy for mg): "
-                   << "exact schur";
+                os << "default: " << n << " unknowns on a single level with a two-body pair "
+                   << "(mg's aggregation hierarchy not measured there): exact schur";
             else
                 os << "default: " << n << " unknowns on the finest level, at most the crossover "
                    << crossover << ": exact schur (faster there)";

@@ -65,7 +65,8 @@ struct SolverChoice {
 /// without `pc` uses `mg` where a level below exists (problem.levels >= 1) and `ilu:0` on a
 /// single level; nothing at all chooses by size: `schur` up to mg_crossover_unknowns(problem)
 /// unknowns on the finest level, Krylov + `mg` above it when levels exist (CGS; BiCGStab with a
-/// two-body pair, where it needs fewer V-cycles). A Krylov
+/// two-body pair, where it needs fewer V-cycles), and CGS + `mg` over its aggregation hierarchy
+/// on a single level with rigid obstacles only (with a two-body pair, schur). A Krylov
 /// option next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying
 /// so.
 /// `sizes`: predict_level_sizes(problem) when the caller has it already (it builds level 0).

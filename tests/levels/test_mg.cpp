@@ -291,3 +291,22 @@ TEST(AlgebraicMultigrid, SolvesHertzGmshAtLevel0LikeSchur) {
     p.levels = 0;
     expect_algebraic_mg_solves_like_schur(p, "mg:csize=100", 20);
 }
+
+TEST(AlgebraicMultigrid, IsTheDefaultOnASingleLevelAboveTheCrossover) {
+    // The square exported from level 2: 8 512 unknowns on level 0, rigid obstacle only.
+    const Problem p = exported_square(2);
+    const SolverChoice c = choose_solver(p, {});
+    EXPECT_TRUE(c.automatic);
+    EXPECT_EQ(c.spec.method, "krylov");
+    EXPECT_EQ(c.spec.pc, "mg");
+    EXPECT_EQ(c.spec.krylov, "cgs");
+    EXPECT_NE(c.reason.find("algebraic hierarchy"), std::string::npos) << c.reason;
+    // Below the crossover (the square's own level 0, 592 unknowns) schur stays.
+    auto q = scene::load_scene("square");
+    q.levels = 0;
+    EXPECT_EQ(choose_solver(q, {}).spec.method, "schur");
+    // --linear krylov alone keeps ILU(0) on a single level.
+    SolverRequest krylov;
+    krylov.linear = "krylov";
+    EXPECT_EQ(choose_solver(p, krylov).spec.pc, "ilu:0");
+}
