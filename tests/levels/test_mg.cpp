@@ -305,6 +305,13 @@ TEST(AlgebraicMultigrid, IsTheDefaultOnASingleLevelAboveTheCrossover) {
     auto q = scene::load_scene("square");
     q.levels = 0;
     EXPECT_EQ(choose_solver(q, {}).spec.method, "schur");
+    // Its memory estimate counts the aggregation hierarchy (prolongations, Galerkin operators:
+    // about as much again as the Krylov solve's own), which ILU(0) does not have.
+    const auto sizes = predict_level_sizes(p);
+    const double with_mg = estimate_memory(sizes, c.spec, false).solver_bytes;
+    LinearSolverSpec ilu = c.spec;
+    ilu.pc = "ilu:0";
+    EXPECT_GT(with_mg, 2.0 * estimate_memory(sizes, ilu, false).solver_bytes);
     // --linear krylov alone keeps ILU(0) on a single level.
     SolverRequest krylov;
     krylov.linear = "krylov";
