@@ -18,6 +18,7 @@
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
+#include "mesh/io/gmsh.hpp"
 #include "scene/scene.hpp"
 
 #include <CLI/CLI.hpp>
@@ -201,6 +202,11 @@ int main(int argc, char** argv) {
     show->add_option("name", show_name,
                      "built-in scene name, or a mesh file name such as hertz_gmsh.msh")
         ->required();
+    int show_msh_level = -1;
+    show->add_option("--msh-level", show_msh_level,
+                     "print the scene's mesh refined L times as a Gmsh 2.2 file instead (a fine "
+                     "mesh with no levels: `show square --msh-level 4 > square_L4.msh`)")
+        ->check(CLI::NonNegativeNumber);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -258,6 +264,14 @@ int main(int argc, char** argv) {
         if (*scenes) {
             for (const auto& n : mlc::scene::builtin_scene_names())
                 std::cout << n << "\n";
+            return 0;
+        }
+        if (*show && show_msh_level >= 0) {
+            // The scene's level-L mesh as a level-0 Gmsh file (its tags as physical curves).
+            mlc::mesh::Mesh m = mlc::scene::load_scene(show_name).mesh0;
+            for (int l = 0; l < show_msh_level; ++l)
+                m = mlc::mesh::refine(m);
+            mlc::mesh::write_gmsh(m, std::cout);
             return 0;
         }
         if (*show) {

@@ -22,9 +22,12 @@ void print_preconditioners(std::ostream& os) {
             os << (i ? ", " : "") << e.options[i];
         if (!e.positional_key.empty()) os << " (a bare value is " << e.positional_key << ")";
         os << "\n      built from: "
-           << (e.needs_level_below ? "this level and the level below (--levels >= 1)"
-               : e.level_aware     ? "this level's element matrices"
-                                   : "the assembled Jacobian")
+           << (e.needs_level_below && e.single_level_too
+                   ? "this level and the level below; on a single level (--levels 0) this "
+                     "level's K and unknowns (aggregation hierarchy)"
+               : e.needs_level_below ? "this level and the level below (--levels >= 1)"
+               : e.level_aware       ? "this level's element matrices"
+                                     : "the assembled Jacobian")
            << "\n";
     }
 }

@@ -165,6 +165,7 @@ private:
                         f[static_cast<size_t>(i)] = c;
             return f;
         };
+        d.aggregation = [this]() { return aggregation_input(level_); };
         if (below_ == nullptr || entry == nullptr || !entry->needs_level_below) return d;
         d.has_level_below = true;
         d.coarse_fine_split = [this](solvers::MultiplierScale scale) {
@@ -306,6 +307,43 @@ std::unique_ptr<NewtonSystemSolver> make_krylov_system_solver(const Level& level
                                                               const LinearSolverSpec& spec,
                                                               const LevelBelow* below) {
     return std::make_unique<KrylovSystemSolver>(level, spec, below);
+}
+
+solvers::AggregationInput aggregation_input(const Level& L) {
+    solvers::AggregationInput in;
+    in.K = &L.elastic.K;
+    const auto n = static_cast<size_t>(L.n_unknowns());
+    in.vertex.resize(n);
+    in.kind.assign(n, solvers::UnknownKind::ux);
+    for (Index i = 0; i < L.n_unknowns(); ++i)
+        in.vertex[static_cast<size_t>(i)] = L.dofs.vertex_of(i);
+    for (int v = 0; v < L.dofs.n_vertices(); ++v)
+        if (const int i = L.dofs.u_dof(v, 1); i >= 0)
+            in.kind[static_cast<size_t>(i)] = solvers::UnknownKind::uy;
+    // Rigid modes about the centroid (for conditioning): (1, 0), (0, 1), (-(y - yc), x - xc).
+    Vec2 c(0.0, 0.0);
+    for (const auto& p : L.mesh.vertices)
+        c += p;
+    c /= std::max(1, L.mesh.n_vertices());
+    in.near_null = Eigen::MatrixXd::Zero(L.n_unknowns(), 3);
+    for (int v = 0; v < L.dofs.n_vertices(); ++v) {
+        const Vec2 d = L.mesh.vertices[static_cast<size_t>(v)] - c;
+        if (const int i = L.dofs.u_dof(v, 0); i >= 0) {
+            in.near_null(i, 0) = 1.0;
+            in.near_null(i, 2) = -d.y();
+        }
+        if (const int i = L.dofs.u_dof(v, 1); i >= 0) {
+            in.near_null(i, 1) = 1.0;
+            in.near_null(i, 2) = d.x();
+        }
+    }
+    for (size_t e = 0; e < L.contacts.size(); ++e) {
+        const int m = L.contacts[e].n_multipliers();
+        for (int k = 0; k < m; ++k)
+            in.kind[static_cast<size_t>(L.lambda_dof[e] + k)] =
+                k + 1 == m ? solvers::UnknownKind::lambda_n : solvers::UnknownKind::lambda_t;
+    }
+    return in;
 }
 
 std::vector<smoothers::ElementMatrix> elastic_element_matrices(const Level& level) {

@@ -6,6 +6,7 @@
 
 #include "levels/newton_system.hpp"
 #include "smoothers/ebe.hpp"
+#include "solvers/aggregation.hpp"
 #include "solvers/coarse_fine.hpp"
 
 #include <memory>
@@ -68,6 +69,12 @@ namespace mlc::levels {
 std::unique_ptr<NewtonSystemSolver> make_krylov_system_solver(const Level& level,
                                                               const LinearSolverSpec& spec,
                                                               const LevelBelow* below);
+
+/// The algebraic hierarchy's view of a level (solvers/aggregation.hpp): its elastic operator K
+/// (borrowed: `level` must outlive the result), the vertex of each unknown and its kind (x, y,
+/// and the contact multipliers lambda_t, lambda_n). mg builds its aggregation hierarchy from it
+/// on a level without the level below.
+solvers::AggregationInput aggregation_input(const Level& level);
 
 /// The elastic element matrices of a level for EBE: one per triangle, the 6x6 stiffness
 /// fem::element_stiffness restricted to the free displacement unknowns (is_contact false).

@@ -152,16 +152,35 @@ std::unique_ptr<Preconditioner> build_ebe(SpecOptions& o, const LevelData* level
 }
 
 std::unique_ptr<Preconditioner> build_mg(SpecOptions& o, const LevelData* level) {
-    const LevelData& L = require_level(level, "mg", true);
+    const LevelData& L = require_level(level, "mg", false);
     MultigridParams p;
     p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
     p.post_sweeps = o.get_int("post", p.post_sweeps);
     p.omega = o.get_double("omega", p.omega);
-    const std::string coarse = o.get_string("coarse", "rediscretize");
-    MLC_CHECK(coarse == "rediscretize" || coarse == "galerkin",
-              "option coarse=" << coarse << " of mg: valid rediscretize, galerkin");
+    // Without the level below, the algebraic hierarchy (aggregation) is the only one there is.
+    const bool below = L.has_level_below;
+    const std::string coarse = o.get_string("coarse", below ? "rediscretize" : "aggregation");
+    MLC_CHECK(coarse == "rediscretize" || coarse == "galerkin" || coarse == "aggregation",
+              "option coarse=" << coarse << " of mg: valid rediscretize, galerkin, aggregation");
+    AggregationParams ap;
+    ap.coarse_size = o.get_int("csize", ap.coarse_size);
+    ap.smoothing = o.get_double("smooth", ap.smoothing);
     o.finish();
     p.validate();
+    if (coarse == "aggregation") {
+        ap.validate();
+        MLC_CHECK(L.aggregation != nullptr,
+                  "mg needs the level below (use with --levels >= 1 and the coarse-to-fine "
+                  "solve) or the level's unknowns for its algebraic hierarchy, and the level "
+                  "data gives neither");
+        const AggregationInput in = L.aggregation();
+        return std::make_unique<Multigrid>(aggregation_levels(in, ap), p,
+                                           CoarseOperators::galerkin);
+    }
+    MLC_CHECK(below, "mg needs the level below for coarse=" << coarse
+                                                            << ": use with --levels >= 1 and the "
+                                                               "coarse-to-fine solve, or "
+                                                               "coarse=aggregation");
     if (coarse == "galerkin") {
         MLC_CHECK(L.hierarchy_from_level0,
                   "mg:coarse=galerkin needs every level below in the coarse-to-fine solve");
@@ -171,9 +190,10 @@ std::unique_ptr<Preconditioner> build_mg(SpecOptions& o, const LevelData* level)
     // Two levels: the level below (its operator set by the caller, factored) and this one.
     std::vector<MultigridLevelData> h = L.hierarchy();
     MLC_CHECK(h.size() >= 2, "mg: the level data holds " << h.size() << " level(s), at least two");
-    MultigridLevelData below = std::move(h[h.size() - 2]);
-    below.T = below.R = nullptr;
-    return std::make_unique<Multigrid>(std::vector<MultigridLevelData>{std::move(below), L.top}, p);
+    MultigridLevelData below_level = std::move(h[h.size() - 2]);
+    below_level.T = below_level.R = nullptr;
+    return std::make_unique<Multigrid>(
+        std::vector<MultigridLevelData>{std::move(below_level), L.top}, p);
 }
 
 std::unique_ptr<Preconditioner> build_amg(SpecOptions& o, const LevelData* level) {
@@ -267,13 +287,16 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          false,
          &build_ebe},
         {"mg",
-         "mg[:pre=N,post=N,omega=W,coarse=rediscretize|galerkin] (multilevel V-cycle over all "
-         "levels, vertex-block Gauss-Seidel; needs the level below)",
+         "mg[:pre=N,post=N,omega=W,coarse=rediscretize|galerkin|aggregation,csize=N,smooth=S] "
+         "(multilevel V-cycle over all levels, vertex-block Gauss-Seidel; on a single level, "
+         "or with coarse=aggregation, over an algebraic hierarchy of vertex aggregates coarsened "
+         "to at most N = 3000 unknowns, prolongation smoothing S = 4/3)",
          "",
-         {"pre", "post", "omega", "coarse"},
+         {"pre", "post", "omega", "coarse", "csize", "smooth"},
          true,
          true,
-         &build_mg},
+         &build_mg,
+         true},
         {"amg",
          "amg[:fn=2,nodal=0,theta=0.25,agg=0] (hypre BoomerAMG V-cycle, for the elastic "
          "block: symmetric positive definite, fn interleaved components per vertex)",

@@ -7,6 +7,7 @@
 
 #include "core/linear_operator.hpp"
 #include "smoothers/ebe.hpp"
+#include "solvers/aggregation.hpp"
 #include "solvers/coarse_fine.hpp"
 #include "solvers/mg.hpp"
 
@@ -70,6 +71,11 @@ struct LevelData {
     /// mgr: the function of every unknown of the level, 0 / 1 the x / y displacement component,
     /// 2 (kMultiplierFunction) a contact multiplier; asking computes it.
     std::function<std::vector<int>()> unknown_functions;
+    /// mg without the level below (or with coarse=aggregation): the level's elastic operator
+    /// and the owner and kind of each unknown, for the algebraic hierarchy
+    /// (solvers/aggregation.hpp); asking computes it (K is borrowed from the level: it must
+    /// outlive the preconditioner). Empty: mg needs the level below.
+    std::function<AggregationInput()> aggregation;
 
     // The level below (for the entries that need it).
     bool has_level_below = false; ///< the fields below are set
@@ -107,6 +113,9 @@ struct PreconditionerEntry {
     /// Builds the (not yet set up) preconditioner from the parsed options and, for the
     /// level-aware entries, the level data (null when there is none: they throw).
     std::unique_ptr<Preconditioner> (*build)(SpecOptions& options, const LevelData* level);
+    /// Uses the level below when there is one, and builds without it on a single level (mg:
+    /// the algebraic aggregation hierarchy): `--levels 0` accepts it.
+    bool single_level_too = false;
 };
 
 /// All registered names, in the order they are listed in help and error messages. To add one,

@@ -46,9 +46,11 @@ smoothers::BlockSORParams smoother_params(const MultigridParams& params,
 // smoother and the work vectors of the cycle.
 struct Multigrid::Level {
     Level(const MultigridLevelData& d, const MultigridParams& p)
-        : T(d.T), R(d.R), params(p), smoother(smoother_params(p, d.block_starts)) {}
+        : T(d.T), R(d.R), T_storage(d.T_storage), R_storage(d.R_storage), params(p),
+          smoother(smoother_params(p, d.block_starts)) {}
     const SparseMatrix* T = nullptr;
     const SparseMatrix* R = nullptr;
+    std::shared_ptr<const SparseMatrix> T_storage, R_storage; // owned transfers, or null
     MultigridParams params;
     smoothers::BlockSOR smoother;           // levels >= 1
     std::unique_ptr<Preconditioner> coarse; // level 0
@@ -251,8 +253,10 @@ MultigridReport Multigrid::report() const {
     const Level& L0 = *levels_.front();
     r.coarse_solver =
         L0.coarse_replaced ? L0.coarse->name() + " (the coarse LU was singular)" : "sparse LU";
-    r.coarse_operators =
-        coarse_operators_ == CoarseOperators::galerkin ? "Galerkin (R A T)" : "rediscretized";
+    const bool aggregates = levels_.size() >= 2 && levels_[1]->T_storage != nullptr;
+    r.coarse_operators = coarse_operators_ != CoarseOperators::galerkin ? "rediscretized"
+                         : aggregates ? "Galerkin (R A T) on vertex aggregates"
+                                      : "Galerkin (R A T)";
     return r;
 }
 

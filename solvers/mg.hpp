@@ -61,6 +61,9 @@ struct MultigridLevelData {
     /// Smoother blocks (smoothers::BlockSORParams::block_starts; empty: blocks of 2 rows).
     /// Unused on the coarsest level.
     std::vector<Index> block_starts;
+    /// When set, the level keeps T and R alive (an algebraic hierarchy built for this multigrid
+    /// alone, solvers/aggregation.hpp); T and R then point to them.
+    std::shared_ptr<const SparseMatrix> T_storage, R_storage;
 };
 
 /// How the coarse operators are obtained.

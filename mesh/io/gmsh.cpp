@@ -608,4 +608,35 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
     return m;
 }
 
+void write_gmsh(const Mesh& m, std::ostream& os) {
+    std::set<int> surfaces;
+    for (int a : m.attribute)
+        surfaces.insert(a);
+    os << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n"
+       << m.tag_names.size() + surfaces.size() << "\n";
+    for (const auto& [name, tag] : m.tag_names)
+        os << "1 " << tag + 1 << " \"" << name << "\"\n";
+    for (int a : surfaces)
+        os << "2 " << a + 1 << " \"body" << a << "\"\n";
+    os << "$EndPhysicalNames\n$Nodes\n" << m.n_vertices() << "\n";
+    os.precision(17);
+    for (int v = 0; v < m.n_vertices(); ++v)
+        os << v + 1 << " " << m.vertices[static_cast<size_t>(v)].x() << " "
+           << m.vertices[static_cast<size_t>(v)].y() << " 0\n";
+    os << "$EndNodes\n$Elements\n"
+       << m.boundary.size() + m.lines.size() + m.triangles.size() << "\n";
+    int id = 1;
+    for (const auto* edges : {&m.boundary, &m.lines})
+        for (const BoundaryEdge& e : *edges)
+            os << id++ << " 1 2 " << e.tag + 1 << " " << e.tag + 1 << " " << e.v0 + 1 << " "
+               << e.v1 + 1 << "\n";
+    for (int t = 0; t < m.n_triangles(); ++t) {
+        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        const int phys = m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)] + 1;
+        os << id++ << " 2 2 " << phys << " " << std::max(phys, 1) << " " << tri[0] + 1 << " "
+           << tri[1] + 1 << " " << tri[2] + 1 << "\n";
+    }
+    os << "$EndElements\n";
+}
+
 } // namespace mlc::mesh

@@ -5,6 +5,7 @@
 #include "mesh/mesh.hpp"
 
 #include <filesystem>
+#include <ostream>
 #include <string>
 
 namespace mlc::mesh {
@@ -39,5 +40,13 @@ Mesh read_gmsh(const std::filesystem::path& file, const std::string& surface = "
 /// messages only.
 Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
                     const std::string& surface = "");
+
+/// Writes `m` as an ASCII Gmsh 2.2 file that read_gmsh reads back to the same mesh: its vertices
+/// (z = 0) and triangles, and its tagged boundary edges and interior lines as 2-node lines in
+/// physical curves named after their tags (physical tag = tag id + 1). Triangles carry physical
+/// surface 1 + their attribute (named "body<attribute>") when the mesh has attributes, none
+/// otherwise. Circles (curved-boundary data) and refinement parents are not written: the file
+/// is a level-0 mesh. Used to export a refined level as a fine mesh with no levels.
+void write_gmsh(const Mesh& m, std::ostream& os);
 
 } // namespace mlc::mesh

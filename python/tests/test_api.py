@@ -229,7 +229,7 @@ def test_bad_solve_options_raise_value_error():
     with pytest.raises(ValueError, match="--mu must be >= 0"):
         mlcontact.solve(s, mu=-1.0)
     with pytest.raises(ValueError, match="mg needs the level below"):
-        mlcontact.solve(s, levels=0, solver="krylov", pc="mg")
+        mlcontact.solve(s, levels=0, solver="krylov", pc="mg:coarse=galerkin")
     with pytest.raises(TypeError):
         mlcontact.solve("square")
 

@@ -60,6 +60,10 @@ TEST(Registry, NamesAreUniqueAndEveryEntryIsComplete) {
     EXPECT_TRUE(solvers::find_preconditioner("mgr")->level_aware);
     EXPECT_FALSE(solvers::find_preconditioner("mgr")->needs_level_below);
     EXPECT_EQ(solvers::find_preconditioner("MG:pre=2")->name, "mg");
+    // mg also builds on a single level (its aggregation hierarchy); cf and sorcf do not.
+    EXPECT_TRUE(solvers::find_preconditioner("mg")->single_level_too);
+    EXPECT_FALSE(solvers::find_preconditioner("cf")->single_level_too);
+    EXPECT_FALSE(solvers::find_preconditioner("sorcf")->single_level_too);
     EXPECT_EQ(solvers::find_preconditioner("amgx"), nullptr);
 }
 
@@ -154,12 +158,13 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
             ASSERT_NE(e, nullptr) << c.spec.pc;
             EXPECT_EQ(e->needs_level_below, L >= 1) << c.spec.pc << " at levels " << L;
         }
-        // A name that needs the level below, asked for without one: refused before building.
+        // A name that needs the level below, asked for without one: refused before building,
+        // unless it builds on a single level too (mg: its aggregation hierarchy).
         for (const auto& e : reg) {
             if (!e.needs_level_below) continue;
             levels::SolverRequest req;
             req.pc = e.name;
-            if (L == 0)
+            if (L == 0 && !e.single_level_too)
                 EXPECT_THROW(levels::choose_solver(p, req), InvalidInput) << e.name;
             else
                 EXPECT_EQ(levels::choose_solver(p, req).spec.pc, e.name);
