@@ -6,7 +6,9 @@
 #include "core/check.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <map>
+#include <stdexcept>
 #include <unordered_map>
 
 namespace mlc::mesh {
@@ -250,6 +252,91 @@ DistributedHierarchy distribute(const Mesh& level_p, int n_refinements, const Co
         H.levels.push_back(std::move(f));
     }
     return H;
+}
+
+std::filesystem::path piece_path(const std::filesystem::path& file, int rank) {
+    return file.parent_path() / (file.stem().string() + "_" + std::to_string(rank) + ".vtu");
+}
+
+namespace {
+
+/// Runs write() on every process; if it threw on any, rethrows there and throws elsewhere.
+template <class Write>
+void on_every_process(const Communicator& comm, const char* what, Write&& write) {
+    std::exception_ptr error;
+    try {
+        write();
+    } catch (...) {
+        error = std::current_exception();
+    }
+    if (comm.max(error ? 1 : 0) == 0) return;
+    if (error) std::rethrow_exception(error);
+    throw std::runtime_error(std::string(what) + ": another process failed (see its message)");
+}
+
+} // namespace
+
+void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& L,
+                           const std::vector<Field>& point_fields,
+                           const std::vector<Field>& cell_fields, const Communicator& comm,
+                           VtuFormat format) {
+    on_every_process(comm, "write_distributed_vtu (pieces)", [&] {
+        const int nv = L.mesh.n_vertices(), nt = L.mesh.n_triangles();
+        for (const Field& f : point_fields)
+            MLC_CHECK(f.n_components >= 1 &&
+                          f.values.size() == static_cast<size_t>(nv * f.n_components),
+                      "write_distributed_vtu: point field '"
+                          << f.name << "' has " << f.values.size() << " values for " << nv
+                          << " local vertices");
+        for (const Field& f : cell_fields)
+            MLC_CHECK(f.n_components >= 1 &&
+                          f.values.size() == static_cast<size_t>(nt * f.n_components),
+                      "write_distributed_vtu: cell field '" << f.name << "' has " << f.values.size()
+                                                            << " values for " << nt
+                                                            << " local triangles");
+        Mesh piece;
+        std::vector<int> piece_of(static_cast<size_t>(nv), -1), vertices, triangles;
+        for (int t = 0; t < nt; ++t)
+            if (L.triangle_owned[static_cast<size_t>(t)]) {
+                triangles.push_back(t);
+                for (int v : L.mesh.triangles[static_cast<size_t>(t)])
+                    piece_of[static_cast<size_t>(v)] = 0;
+            }
+        for (int v = 0; v < nv; ++v)
+            if (piece_of[static_cast<size_t>(v)] == 0) {
+                piece_of[static_cast<size_t>(v)] = static_cast<int>(vertices.size());
+                vertices.push_back(v);
+                piece.vertices.push_back(L.mesh.vertices[static_cast<size_t>(v)]);
+            }
+        for (int t : triangles) {
+            const auto& tri = L.mesh.triangles[static_cast<size_t>(t)];
+            piece.triangles.push_back({piece_of[static_cast<size_t>(tri[0])],
+                                       piece_of[static_cast<size_t>(tri[1])],
+                                       piece_of[static_cast<size_t>(tri[2])]});
+        }
+        auto subset = [](const std::vector<Field>& fields, const std::vector<int>& entities) {
+            std::vector<Field> out;
+            for (const Field& f : fields) {
+                Field g{f.name, f.n_components, {}};
+                const auto nc = static_cast<size_t>(f.n_components);
+                g.values.reserve(entities.size() * nc);
+                for (int e : entities)
+                    for (size_t c = 0; c < nc; ++c)
+                        g.values.push_back(f.values[static_cast<size_t>(e) * nc + c]);
+                out.push_back(std::move(g));
+            }
+            return out;
+        };
+        write_vtu(piece_path(file, comm.rank()), piece, subset(point_fields, vertices),
+                  subset(cell_fields, triangles), format);
+    });
+    on_every_process(comm, "write_distributed_vtu (.pvtu)", [&] {
+        if (comm.rank() != 0) return;
+        std::vector<std::string> pieces;
+        for (int r = 0; r < comm.size(); ++r)
+            pieces.push_back(piece_path(file, r).filename().string());
+        write_pvtu(file, pieces, point_fields, cell_fields);
+    });
 }
 
 } // namespace mlc::mesh

@@ -29,10 +29,12 @@
 #pragma once
 
 #include "core/communicator.hpp"
+#include "mesh/io/vtu.hpp"
 #include "mesh/mesh.hpp"
 #include "mesh/partition.hpp"
 
 #include <cstdint>
+#include <filesystem>
 #include <vector>
 
 namespace mlc::mesh {
@@ -88,5 +90,28 @@ struct DistributedHierarchy {
 /// triangles, on every process alike.
 DistributedHierarchy distribute(const Mesh& level_p, int n_refinements, const Communicator& comm,
                                 const std::vector<int>& weights = {});
+
+/// The name of process `rank`'s piece of the parallel file `file`: "<stem>_<rank>.vtu" in the
+/// folder of `file` (solution.pvtu -> solution_0.vtu, solution_1.vtu, ...).
+std::filesystem::path piece_path(const std::filesystem::path& file, int rank);
+
+/// Writes a distributed level as one mesh: `file` (a .pvtu, issue 12 item 5) and one .vtu piece
+/// per process (piece_path), which ParaView and vtkXMLPUnstructuredGridReader open as one mesh.
+///
+/// Each process writes its owned triangles (triangle_owned) and the vertices they use, with
+/// write_vtu and `format`; `point_fields` hold values on the local vertices of `L` and
+/// `cell_fields` on its local triangles (as write_vtu expects them on L.mesh), and each piece
+/// gets the values of what it holds. A vertex on a cut between processes appears in the pieces of
+/// every process with a triangle around it, with the same coordinates and the values each
+/// process holds for it. Once every piece is written, process 0 writes `file` listing the pieces
+/// in rank order (its appearance means the set is complete).
+///
+/// Collective. If writing fails on any process, every process throws: the failing ones their own
+/// error (InvalidInput for bad fields, std::runtime_error for I/O), the others a
+/// std::runtime_error saying that another process failed; `file` is then not written.
+void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& L,
+                           const std::vector<Field>& point_fields,
+                           const std::vector<Field>& cell_fields, const Communicator& comm,
+                           VtuFormat format = VtuFormat::binary);
 
 } // namespace mlc::mesh

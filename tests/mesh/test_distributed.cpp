@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <map>
 #include <set>
 
@@ -216,4 +217,26 @@ TEST(Distributed, RejectsNegativeRefinementsAndTooManyProcesses) {
     if (W().size() > 2) {
         EXPECT_THROW(mesh::distribute(two, 1, W()), InvalidInput);
     }
+}
+
+// A bad field on one process fails the write on every process, and no .pvtu appears.
+TEST(Distributed, WriteFailsEverywhereWhenOneProcessFails) {
+    const DistributedHierarchy H = mesh::distribute(curved_rectangle(), 1, W());
+    const LocalLevel& L = H.levels.back();
+    const auto dir = std::filesystem::temp_directory_path() / "mlc_test_distributed_write";
+    if (W().rank() == 0) std::filesystem::create_directories(dir);
+    W().barrier();
+    const auto file = dir / ("bad_np" + std::to_string(W().size()) + ".pvtu");
+    // The last process passes one value too few.
+    const size_t n = static_cast<size_t>(L.mesh.n_vertices()) - (W().rank() + 1 == W().size());
+    const mesh::Field f{"f", 1, std::vector<double>(n, 1.0)};
+    EXPECT_ANY_THROW(mesh::write_distributed_vtu(file, L, {f}, {}, W()));
+    W().barrier();
+    EXPECT_FALSE(std::filesystem::exists(file));
+    EXPECT_THROW(mesh::write_pvtu(dir / "x.pvtu", {}, {}, {}), InvalidInput);
+    EXPECT_THROW(mesh::write_pvtu(dir / "x.pvtu", {"a.vtu"}, {mesh::Field{"", 1, {}}}, {}),
+                 InvalidInput);
+    EXPECT_THROW(mesh::write_pvtu(dir / "x.pvtu", {""}, {}, {}), InvalidInput);
+    EXPECT_EQ(mesh::piece_path("out/solution.pvtu", 2),
+              std::filesystem::path("out/solution_2.vtu"));
 }
