@@ -189,6 +189,10 @@ private:
         return recv;
     }
 
+public:
+    MPI_Comm comm() const { return comm_; }
+
+private:
     MPI_Comm comm_ = MPI_COMM_WORLD;
     int rank_ = 0;
     int size_ = 1;
@@ -211,6 +215,13 @@ std::unique_ptr<Communicator> make_world() {
 }
 
 } // namespace
+
+int mpi_handle(const Communicator& c) {
+    if (const auto* m = dynamic_cast<const MpiCommunicator*>(&c)) return MPI_Comm_c2f(m->comm());
+    MLC_CHECK(dynamic_cast<const SerialCommunicator*>(&c) != nullptr,
+              "comm::mpi_handle: not a communicator of comm::world() or a SerialCommunicator");
+    return MPI_Comm_c2f(MPI_COMM_SELF);
+}
 
 const Communicator& world() {
     static const std::unique_ptr<Communicator> w = make_world();

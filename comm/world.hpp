@@ -28,4 +28,11 @@ bool launched_by_mpirun();
 /// Must be called first from the main thread.
 const Communicator& world();
 
+/// The MPI communicator behind `c` as MPI's Fortran handle (MPI_Comm_c2f; convert back with
+/// MPI_Comm_f2c), for the engines that take an MPI_Comm (hypre, in solvers/hypre/) without this
+/// header naming MPI types: MPI_COMM_WORLD for world() under MPI, MPI_COMM_SELF for a
+/// SerialCommunicator. Throws InvalidInput without MPI (no engine needs it then) and for a
+/// communicator of another kind.
+int mpi_handle(const Communicator& c);
+
 } // namespace mlc::comm
