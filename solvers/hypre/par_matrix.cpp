@@ -150,14 +150,37 @@ std::int64_t ParMatrix::n_global() const {
     return impl_->n_global;
 }
 
+namespace {
+
+template <class Product>
+void owned_product(const char* who, HYPRE_IJVector ij_x, HYPRE_IJVector ij_y,
+                   const std::vector<HYPRE_BigInt>& rows, const Vector& x, Vector& y,
+                   Product&& product) {
+    const auto n = static_cast<Index>(rows.size());
+    MLC_CHECK(x.size() == n,
+              who << ": x has " << x.size() << " entries for " << n << " owned rows");
+    y.resize(n);
+    check(HYPRE_IJVectorSetValues(ij_x, static_cast<HYPRE_Int>(n), rows.data(), x.data()),
+          "HYPRE_IJVectorSetValues");
+    product();
+    check(HYPRE_IJVectorGetValues(ij_y, static_cast<HYPRE_Int>(n), rows.data(), y.data()),
+          "HYPRE_IJVectorGetValues");
+}
+
+} // namespace
+
 void ParMatrix::apply(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
-    MLC_CHECK(x.size() == m.n && y.size() == m.n, "ParMatrix::apply: x has "
-                                                      << x.size() << " and y " << y.size()
-                                                      << " entries for " << m.n << " owned rows");
-    check(HYPRE_IJVectorSetValues(m.ij_x, m.n, m.rows.data(), x.data()), "HYPRE_IJVectorSetValues");
-    check(HYPRE_ParCSRMatrixMatvec(1.0, m.A, m.x, 0.0, m.y), "HYPRE_ParCSRMatrixMatvec");
-    check(HYPRE_IJVectorGetValues(m.ij_y, m.n, m.rows.data(), y.data()), "HYPRE_IJVectorGetValues");
+    owned_product("ParMatrix::apply", m.ij_x, m.ij_y, m.rows, x, y, [&] {
+        check(HYPRE_ParCSRMatrixMatvec(1.0, m.A, m.x, 0.0, m.y), "HYPRE_ParCSRMatrixMatvec");
+    });
+}
+
+void ParMatrix::apply_transpose(const Vector& x, Vector& y) const {
+    const Impl& m = *impl_;
+    owned_product("ParMatrix::apply_transpose", m.ij_x, m.ij_y, m.rows, x, y, [&] {
+        check(HYPRE_ParCSRMatrixMatvecT(1.0, m.A, m.x, 0.0, m.y), "HYPRE_ParCSRMatrixMatvecT");
+    });
 }
 
 void ParMatrix::update_values(const std::vector<double>& values) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "core/communicator.hpp"
+#include "core/linear_operator.hpp"
 #include "core/types.hpp"
 
 #include <cstdint>
@@ -31,8 +32,10 @@ struct DistributedRows {
 ///
 /// Every process owns the rows (and the entries of vectors) [first_row, first_row + n_rows) of
 /// its DistributedRows; the blocks of the processes follow each other in rank order and cover
-/// [0, n_global). Vectors passed to apply() hold the owned entries only. Not thread-safe.
-class ParMatrix {
+/// [0, n_global). Vectors passed to apply() hold the owned entries only, so that, as a
+/// LinearOperator, it is the square n_rows() x n_rows() operator each process sees: the Krylov
+/// methods run on it with KrylovParams::comm set to the same communicator. Not thread-safe.
+class ParMatrix final : public LinearOperator {
 public:
     /// Collective. Copies `rows` into a hypre IJ matrix on the MPI communicator of `comm`
     /// (comm::mpi_handle; `comm` must outlive this object). Throws InvalidInput, on every
@@ -40,7 +43,7 @@ public:
     /// [0, n_global), when sizes disagree or a value is not finite (the last two are checked per
     /// process: a process with bad input throws, the others then fail in the next collective).
     ParMatrix(const Communicator& comm, const DistributedRows& rows);
-    ~ParMatrix();
+    ~ParMatrix() override;
     ParMatrix(const ParMatrix&) = delete;
     ParMatrix& operator=(const ParMatrix&) = delete;
 
@@ -48,10 +51,16 @@ public:
     int n_rows() const;            ///< owned rows
     std::int64_t n_global() const; ///< rows over all processes
 
-    /// Collective: y = A x on the owned entries (x and y of size n_rows(); y overwritten). The
-    /// entries of x owned elsewhere come from their processes (hypre's halo exchange).
-    /// Allocates nothing.
-    void apply(const Vector& x, Vector& y) const;
+    /// Owned rows (the local view's size).
+    Index rows() const override { return n_rows(); }
+    Index cols() const override { return n_rows(); }
+
+    /// Collective: y = A x on the owned entries (x of size n_rows(); y resized to it and
+    /// overwritten). The entries of x owned elsewhere come from their processes (hypre's halo
+    /// exchange). Allocates nothing when y has the size already.
+    void apply(const Vector& x, Vector& y) const override;
+    /// Collective: y = A^T x on the owned entries (hypre's transposed ParCSR mat-vec).
+    void apply_transpose(const Vector& x, Vector& y) const override;
 
     /// Collective: new values for the same pattern (values.size() == the number of entries given
     /// to the constructor, in the same order), written in place into the ParCSR matrix, without
