@@ -16,6 +16,7 @@
 #include "apps/study_extremes.hpp"
 #include "apps/study_preconditioners.hpp"
 #include "apps/study_status_transfer.hpp"
+#include "comm/world.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "mesh/io/gmsh.hpp"
@@ -211,6 +212,17 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
+    }
+    // Started by mpirun with several processes: the driver does not distribute its work yet
+    // (issue 12; README, "Distributed building blocks"), and N copies of a one-process run would
+    // write the same files. One process, with or without mpirun, runs as always.
+    if (mlc::comm::launched_by_mpirun() && mlc::comm::world().size() > 1) {
+        if (mlc::comm::world().rank() == 0)
+            std::cerr << "mlcontact: error: started as " << mlc::comm::world().size()
+                      << " MPI processes, but the driver runs as one process so far (the "
+                         "distributed solve of issue 12 is not in it yet): run it without mpirun "
+                         "or with mpirun -np 1\n";
+        return 1;
     }
     try {
         if (*run) {

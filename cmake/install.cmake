@@ -13,7 +13,7 @@
 # cmake/rewrite_includes.cmake), a mechanical rewrite of the #include lines only.
 include(CMakePackageConfigHelpers)
 include(GNUInstallDirs)
-set(_mlc_folders core mesh fem contact transfer smoothers solvers levels scene apps)
+set(_mlc_folders core comm mesh fem contact transfer smoothers solvers levels scene apps)
 set(_mlc_targets)
 foreach(f ${_mlc_folders})
   list(APPEND _mlc_targets mlc_${f})

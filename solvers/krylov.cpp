@@ -30,7 +30,8 @@ void KrylovParams::validate() const {
 std::ostream& operator<<(std::ostream& os, const KrylovParams& p) {
     return os << "KrylovParams{rel_tol=" << p.rel_tol << ", abs_tol=" << p.abs_tol
               << ", max_iter=" << p.max_iter << ", restart=" << p.restart
-              << ", record_history=" << (p.record_history ? "true" : "false") << "}";
+              << ", record_history=" << (p.record_history ? "true" : "false")
+              << ", processes=" << (p.comm ? p.comm->size() : 1) << "}";
 }
 
 namespace {
@@ -61,7 +62,7 @@ public:
             throw SolverBreakdown(os.str());
         }
         MLC_CHECK(x.allFinite(), who << ": the initial guess x contains NaN or Inf");
-        bnorm_ = b.norm();
+        bnorm_ = norm(b);
         tol_ = std::max(p.rel_tol * bnorm_, p.abs_tol);
         if (p.record_history) res_.history.reserve(static_cast<size_t>(p.max_iter) + 2);
     }
@@ -75,6 +76,21 @@ public:
         if (p_.record_history) res_.history.push_back(0.0);
         res_.solve_seconds = wall_seconds() - t0_;
         return true;
+    }
+
+    // Inner products and norms of distributed vectors: the local part, summed over the
+    // processes of params().comm (the global reduction of every iteration). Without comm, the
+    // plain Eigen reductions, bit for bit as before.
+    double dot(const Eigen::Ref<const Vector>& a, const Eigen::Ref<const Vector>& b) const {
+        const double d = a.dot(b);
+        return p_.comm ? p_.comm->sum(d) : d;
+    }
+    double squared_norm(const Eigen::Ref<const Vector>& a) const {
+        const double d = a.squaredNorm();
+        return p_.comm ? p_.comm->sum(d) : d;
+    }
+    double norm(const Eigen::Ref<const Vector>& a) const {
+        return p_.comm ? std::sqrt(p_.comm->sum(a.squaredNorm())) : a.norm();
     }
 
     bool ok(double rnorm) const { return rnorm <= tol_; }
@@ -111,7 +127,7 @@ public:
         A_.apply(x_, t);
         traffic::vectors(b_.size(), 4); // t = b - t, ||t||
         t = b_ - t;
-        return t.norm();
+        return norm(t);
     }
 
     // Ends the solve: the reported residual is the true one, `true_rnorm` = ||b - A x||.
@@ -183,7 +199,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
             M.apply(r, z0);
             p = z0;
             q = z0;
-            rho = z0.squaredNorm();
+            rho = run.squared_norm(z0);
             traffic::vectors(n, 5);
             if (bad(rho))
                 return run.finish(StopReason::breakdown, it, run.true_residual(t),
@@ -195,7 +211,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
 
         A.apply(q, t);
         M.apply(t, y); // y = C^{-1} A q
-        const double sigma = z0.dot(y);
+        const double sigma = run.dot(z0, y);
         if (bad(sigma))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("(z0, C^{-1} A q)", it, sigma));
@@ -208,7 +224,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
         A.apply(w, t);
         r -= a * t;
         ++it;
-        rn = r.norm();
+        rn = run.norm(r);
         traffic::vectors(n, 15); // (z0, y), h, w, x, r, ||r||
         run.record(rn);
         if (!std::isfinite(rn))
@@ -223,7 +239,7 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
             continue;
         }
         M.apply(r, z);
-        const double rho_new = z0.dot(z);
+        const double rho_new = run.dot(z0, z);
         if (bad(rho_new))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("(z0, C^{-1} r)", it, rho_new));
@@ -257,7 +273,7 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
             return run.finish(StopReason::max_iter, it, run.true_residual(t), *stop);
         M.apply(r, z);
         M.apply_transpose(rt, zt);
-        const double rho = z.dot(rt);
+        const double rho = run.dot(z, rt);
         if (bad(rho))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("rho = (C^{-1} r, r~)", it, rho));
@@ -274,7 +290,7 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
         }
         A.apply(p, q);
         A.apply_transpose(pt, qt);
-        const double d = pt.dot(q);
+        const double d = run.dot(pt, q);
         if (bad(d))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("(p~, A p)", it, d));
@@ -284,7 +300,7 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
         rt -= alpha * qt;
         rho_old = rho;
         ++it;
-        rn = r.norm();
+        rn = run.norm(r);
         traffic::vectors(n, 12); // (p~, q), x, r, r~, ||r||
         run.record(rn);
         if (!std::isfinite(rn) || !std::isfinite(alpha))
@@ -340,7 +356,7 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
         }
         if (const auto stop = run.should_stop(it))
             return run.finish(StopReason::max_iter, it, run.true_residual(t), *stop);
-        const double rho = rh.dot(r);
+        const double rho = run.dot(rh, r);
         if (bad(rho))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("rho = (r^, r)", it, rho));
@@ -348,13 +364,13 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
         p = r + beta * (p - omega * v);
         M.apply(p, ph);
         A.apply(ph, v);
-        const double d = rh.dot(v);
+        const double d = run.dot(rh, v);
         if (bad(d))
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("(r^, A C^{-1} p)", it, d));
         alpha = rho / d;
         r -= alpha * v; // r now holds s
-        const double sn = r.norm();
+        const double sn = run.norm(r);
         traffic::vectors(n, 12); // (r^, r), p, (r^, v), s, ||s||
         if (!std::isfinite(sn) || !std::isfinite(alpha))
             return run.finish(StopReason::breakdown, it + 1, run.true_residual(t),
@@ -372,8 +388,8 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
         }
         M.apply(r, sh);
         A.apply(sh, t);
-        const double tt = t.squaredNorm();
-        const double ts = t.dot(r);
+        const double tt = run.squared_norm(t);
+        const double ts = run.dot(t, r);
         omega = ts / tt;
         if (bad(tt) || bad(omega)) {
             x += alpha * ph; // the half step is still a valid update
@@ -384,7 +400,7 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
         r -= omega * t;
         rho_old = rho;
         ++it;
-        rn = r.norm();
+        rn = run.norm(r);
         traffic::vectors(n, 11); // (t, t), (t, s), x, r, ||r||
         run.record(rn);
         if (!std::isfinite(rn))
@@ -428,11 +444,11 @@ SolveResult gmres(const LinearOperator& A, const Preconditioner& M, const Vector
             M.apply(t, u);
             A.apply(u, w);                   // w = A C^{-1} v_j
             for (Index i = 0; i <= j; ++i) { // modified Gram-Schmidt
-                const double hij = w.dot(V.col(i));
+                const double hij = run.dot(w, V.col(i));
                 w -= hij * V.col(i);
                 H(i, j) = hij;
             }
-            const double hn = w.norm();
+            const double hn = run.norm(w);
             H(j + 1, j) = hn;
             if (!std::isfinite(hn)) {
                 failure = at("Arnoldi norm h(j+1,j)", it + 1, hn);

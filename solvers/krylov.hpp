@@ -3,6 +3,7 @@
 /// sect. 4), BiCG, BiCGStab and restarted GMRES, all reporting the true final residual.
 #pragma once
 
+#include "core/communicator.hpp"
 #include "core/linear_operator.hpp"
 
 #include <ostream>
@@ -37,6 +38,11 @@ struct KrylovParams {
     /// Store the monitored residual norm of every iteration in SolveResult::history.
     /// Default false: no allocation proportional to the iteration count.
     bool record_history = false;
+    /// The processes the vectors are distributed over (each process passes its owned entries of
+    /// b and x and an operator and preconditioner on them): every inner product and norm is
+    /// summed over them, so all processes take the same steps and stop together. Borrowed, must
+    /// outlive the solve. Default null: one process, the vectors are whole.
+    const Communicator* comm = nullptr;
 
     /// Throws mlc::InvalidInput naming the first field out of range.
     void validate() const;

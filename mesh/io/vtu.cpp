@@ -477,4 +477,52 @@ void write_pvd(const std::filesystem::path& file,
     });
 }
 
+void write_pvtu(const std::filesystem::path& file, const std::vector<std::string>& pieces,
+                const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields) {
+    MLC_CHECK(!pieces.empty(), "write_pvtu: no pieces for " << file);
+    for (std::size_t i = 0; i < pieces.size(); ++i)
+        MLC_CHECK(!pieces[i].empty(), "write_pvtu: piece " << i << " has an empty file name");
+    for (const auto* fields : {&point_fields, &cell_fields})
+        for (const Field& f : *fields) {
+            MLC_CHECK(!f.name.empty(), "write_pvtu: a field has an empty name");
+            MLC_CHECK(f.n_components >= 1, "write_pvtu: field '" << f.name << "' has "
+                                                                 << f.n_components
+                                                                 << " components");
+        }
+    // The arrays as write_vtu declares them: Float64, two components written as three.
+    auto put_arrays = [](BufferedFile& out, const std::vector<Field>& fields, const char* tag) {
+        out.put("    <");
+        out.put(tag);
+        out.put(">\n");
+        for (const Field& f : fields) {
+            out.put("      <PDataArray type=\"Float64\" Name=\"");
+            out.put(xml_escape(f.name));
+            out.put("\" NumberOfComponents=\"");
+            out.put(std::to_string(f.n_components == 2 ? 3 : f.n_components));
+            out.put("\"/>\n");
+        }
+        out.put("    </");
+        out.put(tag);
+        out.put(">\n");
+    };
+    write_atomically(file, "write_pvtu", [&](BufferedFile& out) {
+        out.put("<?xml version=\"1.0\"?>\n"
+                "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" "
+                "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                "  <PUnstructuredGrid GhostLevel=\"0\">\n");
+        put_arrays(out, point_fields, "PPointData");
+        put_arrays(out, cell_fields, "PCellData");
+        out.put("    <PPoints>\n"
+                "      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n"
+                "    </PPoints>\n");
+        for (const auto& piece : pieces) {
+            out.put("    <Piece Source=\"");
+            out.put(xml_escape(piece));
+            out.put("\"/>\n");
+        }
+        out.put("  </PUnstructuredGrid>\n"
+                "</VTKFile>\n");
+    });
+}
+
 } // namespace mlc::mesh

@@ -64,4 +64,14 @@ void write_vtu(const std::filesystem::path& file, const Mesh& m,
 void write_pvd(const std::filesystem::path& file,
                const std::vector<std::pair<double, std::string>>& steps);
 
+/// Writes a parallel UnstructuredGrid (.pvtu): one mesh made of the .vtu pieces `pieces` (paths
+/// as ParaView should find them; a relative path is relative to the folder of the .pvtu), as
+/// VTK's vtkXMLPUnstructuredGridReader and ParaView read it. The pieces are write_vtu files
+/// written with fields of the names and component counts of `point_fields` and `cell_fields`
+/// (only those two are read here: the values may be empty). Checks before touching the file:
+/// at least one piece, non-empty piece names and field names, n_components >= 1; throws
+/// InvalidInput otherwise. Written atomically, like write_vtu.
+void write_pvtu(const std::filesystem::path& file, const std::vector<std::string>& pieces,
+                const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields);
+
 } // namespace mlc::mesh

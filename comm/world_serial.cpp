@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: MIT
+// comm::world() in a build without MPI: always one process.
+#include "comm/world.hpp"
+
+#include "core/check.hpp"
+
+namespace mlc::comm {
+
+bool have_mpi() {
+    return false;
+}
+
+int mpi_handle(const Communicator&) {
+    MLC_CHECK(false, "comm::mpi_handle: this build has no MPI (configure with MLC_WITH_HYPRE=ON)");
+    return 0;
+}
+
+const Communicator& world() {
+    static const SerialCommunicator serial;
+    return serial;
+}
+
+} // namespace mlc::comm

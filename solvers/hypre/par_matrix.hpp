@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: MIT
+/// @file A square matrix distributed by rows over the processes of a Communicator, held once as
+/// hypre's ParCSR matrix (per process a diagonal and an off-diagonal block; hypre exchanges the
+/// halo of a mat-vec), built and refreshed through hypre's IJ interface (issue 12, item 3).
+/// Compiled only with MLC_WITH_HYPRE (MLC_HAVE_HYPRE defined); without it the constructor throws
+/// InvalidInput saying so. hypre and MPI stay in the .cpp.
+#pragma once
+
+#include "core/communicator.hpp"
+#include "core/linear_operator.hpp"
+#include "core/types.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace mlc::solvers {
+
+/// This process's rows of a distributed matrix, in compressed sparse row form with global
+/// column indices. The rows are the global rows [first_row, first_row + n_rows()), the same
+/// contiguous block as the columns this process owns (the row and column partitions agree, as
+/// for the operators of a distributed level: mesh::LocalLevel::first_row).
+struct DistributedRows {
+    std::int64_t first_row = 0;
+    std::vector<int> row_ptr = {0}; ///< n_rows() + 1 offsets into cols and values
+    std::vector<std::int64_t> cols; ///< global column of every entry
+    std::vector<double> values;     ///< value of every entry
+    int n_rows() const { return static_cast<int>(row_ptr.size()) - 1; }
+};
+
+/// A square ParCSR matrix whose rows are spread over the processes of `comm`.
+///
+/// Every process owns the rows (and the entries of vectors) [first_row, first_row + n_rows) of
+/// its DistributedRows; the blocks of the processes follow each other in rank order and cover
+/// [0, n_global). Vectors passed to apply() hold the owned entries only, so that, as a
+/// LinearOperator, it is the square n_rows() x n_rows() operator each process sees: the Krylov
+/// methods run on it with KrylovParams::comm set to the same communicator. Not thread-safe.
+class ParMatrix final : public LinearOperator {
+public:
+    /// Collective. Copies `rows` into a hypre IJ matrix on the MPI communicator of `comm`
+    /// (comm::mpi_handle; `comm` must outlive this object). Throws InvalidInput, on every
+    /// process alike, when the blocks do not follow each other, when a column lies outside
+    /// [0, n_global), when sizes disagree or a value is not finite (the last two are checked per
+    /// process: a process with bad input throws, the others then fail in the next collective).
+    ParMatrix(const Communicator& comm, const DistributedRows& rows);
+    ~ParMatrix() override;
+    ParMatrix(const ParMatrix&) = delete;
+    ParMatrix& operator=(const ParMatrix&) = delete;
+
+    std::int64_t first_row() const;
+    int n_rows() const;            ///< owned rows
+    std::int64_t n_global() const; ///< rows over all processes
+
+    /// Owned rows (the local view's size).
+    Index rows() const override { return n_rows(); }
+    Index cols() const override { return n_rows(); }
+
+    /// Collective: y = A x on the owned entries (x of size n_rows(); y resized to it and
+    /// overwritten). The entries of x owned elsewhere come from their processes (hypre's halo
+    /// exchange). Allocates nothing when y has the size already.
+    void apply(const Vector& x, Vector& y) const override;
+    /// Collective: y = A^T x on the owned entries (hypre's transposed ParCSR mat-vec).
+    void apply_transpose(const Vector& x, Vector& y) const override;
+
+    /// Collective: new values for the same pattern (values.size() == the number of entries given
+    /// to the constructor, in the same order), written in place into the ParCSR matrix, without
+    /// building a new one: what a Newton step needs when only the values change.
+    void update_values(const std::vector<double>& values);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace mlc::solvers
