@@ -219,6 +219,21 @@ SparseMatrix serial_shifted(const mesh::Mesh& m, double shift) {
     return A;
 }
 
+namespace {
+
+// The owned rows of K + shift I on one process's part of a level.
+solvers::DistributedRows shifted_owned_rows(const mesh::LocalLevel& L, double shift) {
+    auto rows = owned_rows(L);
+    for (int i = 0; i < rows.n_rows(); ++i)
+        for (int k = rows.row_ptr[static_cast<size_t>(i)];
+             k < rows.row_ptr[static_cast<size_t>(i) + 1]; ++k)
+            if (rows.cols[static_cast<size_t>(k)] == rows.first_row + i)
+                rows.values[static_cast<size_t>(k)] += shift;
+    return rows;
+}
+
+} // namespace
+
 // CGS, BiCG, BiCGStab and GMRES with global reductions (KrylovParams::comm) on the distributed
 // operator K + 0.05 I of level 2: the owned entries of the solution equal the one-process
 // (Eigen) solve's to 1e-8 relative, vertex by vertex, in about as many iterations.
@@ -227,12 +242,7 @@ TEST(ParMatrix, KrylovWithGlobalReductionsMatchesOneProcess) {
     const mesh::Mesh m0 = curved_rectangle();
     const auto H = mesh::distribute(m0, 2, W());
     const mesh::LocalLevel& L = H.levels.back();
-    auto rows = owned_rows(L);
-    for (int i = 0; i < rows.n_rows(); ++i)
-        for (int k = rows.row_ptr[static_cast<size_t>(i)];
-             k < rows.row_ptr[static_cast<size_t>(i) + 1]; ++k)
-            if (rows.cols[static_cast<size_t>(k)] == rows.first_row + i)
-                rows.values[static_cast<size_t>(k)] += shift;
+    const auto rows = shifted_owned_rows(L, shift);
     const solvers::ParMatrix A(W(), rows);
     const Vector b = owned_field(L);
     const mesh::Mesh serial = mesh::refine(mesh::refine(m0));
@@ -288,12 +298,7 @@ TEST(ParMatrix, ProcessBlockIluPreconditionsCgs) {
     const mesh::Mesh m0 = curved_rectangle();
     const auto H = mesh::distribute(m0, 2, W());
     const mesh::LocalLevel& L = H.levels.back();
-    auto rows = owned_rows(L);
-    for (int i = 0; i < rows.n_rows(); ++i)
-        for (int k = rows.row_ptr[static_cast<size_t>(i)];
-             k < rows.row_ptr[static_cast<size_t>(i) + 1]; ++k)
-            if (rows.cols[static_cast<size_t>(k)] == rows.first_row + i)
-                rows.values[static_cast<size_t>(k)] += shift;
+    const auto rows = shifted_owned_rows(L, shift);
     const solvers::ParMatrix A(W(), rows);
     solvers::ProcessBlockPreconditioner M(solvers::make_preconditioner("ilu:0"));
     M.setup_rows(rows);
