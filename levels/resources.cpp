@@ -138,8 +138,8 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
         } else {
             s.method = "schur";
             if (!has_levels && n > crossover)
-                os << "default: " << n << " unknowns on a single level with a two-body pair "
-                   << "(mg's aggregation hierarchy not measured there): exact schur";
+                os << "default: " << n << " unknowns on a single level: exact schur (faster "
+                   << "there than mg over an aggregation hierarchy, which --pc mg builds)";
             else
                 os << "default: " << n << " unknowns on the finest level, at most the crossover "
                    << crossover << ": exact schur (faster there)";
