@@ -72,8 +72,9 @@ solvers::DistributedRows owned_rows(const mesh::LocalLevel& L) {
     return rows;
 }
 
-/// Serial stiffness of the whole mesh times the field below, by vertex coordinates.
-std::map<Point, Vec2> serial_product(const mesh::Mesh& m) {
+/// The serial stiffness of the whole mesh plus shift I (symmetric positive definite for
+/// shift > 0), vertices in index order.
+SparseMatrix serial_shifted(const mesh::Mesh& m, double shift) {
     const int n = 2 * m.n_vertices();
     std::vector<Eigen::Triplet<double>> trip;
     for (const auto& t : m.triangles) {
@@ -84,8 +85,17 @@ std::map<Point, Vec2> serial_product(const mesh::Mesh& m) {
             for (int b = 0; b < 6; ++b)
                 trip.emplace_back(2 * t[a / 2] + a % 2, 2 * t[b / 2] + b % 2, K(a, b));
     }
+    for (int i = 0; i < n; ++i)
+        trip.emplace_back(i, i, shift);
     SparseMatrix A(n, n);
     A.setFromTriplets(trip.begin(), trip.end());
+    return A;
+}
+
+/// Serial stiffness of the whole mesh times the field below, by vertex coordinates.
+std::map<Point, Vec2> serial_product(const mesh::Mesh& m) {
+    const SparseMatrix A = serial_shifted(m, 0.0);
+    const int n = 2 * m.n_vertices();
     Vector x(n);
     for (int v = 0; v < m.n_vertices(); ++v) {
         const Vec2& p = m.vertices[static_cast<size_t>(v)];
@@ -198,25 +208,6 @@ TEST(ParMatrix, RejectsBlocksOutOfOrderAndColumnsOutOfRangeOnEveryProcess) {
     auto bad = rows;
     if (W().rank() + 1 == W().size() && !bad.cols.empty()) bad.cols.back() = -1;
     EXPECT_THROW(solvers::ParMatrix(W(), bad), InvalidInput);
-}
-/// The serial stiffness of the whole mesh plus shift I (symmetric positive definite for
-/// shift > 0), vertices in index order.
-SparseMatrix serial_shifted(const mesh::Mesh& m, double shift) {
-    const int n = 2 * m.n_vertices();
-    std::vector<Eigen::Triplet<double>> trip;
-    for (const auto& t : m.triangles) {
-        const auto K = fem::element_stiffness(m.vertices[static_cast<size_t>(t[0])],
-                                              m.vertices[static_cast<size_t>(t[1])],
-                                              m.vertices[static_cast<size_t>(t[2])], steel);
-        for (int a = 0; a < 6; ++a)
-            for (int b = 0; b < 6; ++b)
-                trip.emplace_back(2 * t[a / 2] + a % 2, 2 * t[b / 2] + b % 2, K(a, b));
-    }
-    for (int i = 0; i < n; ++i)
-        trip.emplace_back(i, i, shift);
-    SparseMatrix A(n, n);
-    A.setFromTriplets(trip.begin(), trip.end());
-    return A;
 }
 
 namespace {
