@@ -92,17 +92,22 @@ SparseMatrix serial_shifted(const mesh::Mesh& m, double shift) {
     return A;
 }
 
-/// Serial stiffness of the whole mesh times the field below, by vertex coordinates.
-std::map<Point, Vec2> serial_product(const mesh::Mesh& m) {
-    const SparseMatrix A = serial_shifted(m, 0.0);
-    const int n = 2 * m.n_vertices();
-    Vector x(n);
+/// The test field at every vertex of a whole mesh, (sin 3x + y, xy - 1/2), vertices in index
+/// order (owned_field gives the same values at a process's owned vertices).
+Vector serial_field(const mesh::Mesh& m) {
+    Vector x(2 * m.n_vertices());
     for (int v = 0; v < m.n_vertices(); ++v) {
         const Vec2& p = m.vertices[static_cast<size_t>(v)];
         x[2 * v] = std::sin(3 * p.x()) + p.y();
         x[2 * v + 1] = p.x() * p.y() - 0.5;
     }
-    const Vector y = A * x;
+    return x;
+}
+
+/// Serial stiffness of the whole mesh times serial_field, by vertex coordinates.
+std::map<Point, Vec2> serial_product(const mesh::Mesh& m) {
+    const SparseMatrix A = serial_shifted(m, 0.0);
+    const Vector y = A * serial_field(m);
     std::map<Point, Vec2> out;
     for (int v = 0; v < m.n_vertices(); ++v)
         out[{m.vertices[static_cast<size_t>(v)].x(), m.vertices[static_cast<size_t>(v)].y()}] =
@@ -238,12 +243,7 @@ TEST(ParMatrix, KrylovWithGlobalReductionsMatchesOneProcess) {
     const Vector b = owned_field(L);
     const mesh::Mesh serial = mesh::refine(mesh::refine(m0));
     const SparseMatrix As = serial_shifted(serial, shift);
-    Vector bs(As.rows());
-    for (int v = 0; v < serial.n_vertices(); ++v) {
-        const Vec2& p = serial.vertices[static_cast<size_t>(v)];
-        bs[2 * v] = std::sin(3 * p.x()) + p.y();
-        bs[2 * v + 1] = p.x() * p.y() - 0.5;
-    }
+    const Vector bs = serial_field(serial);
     std::map<Point, int> serial_vertex;
     for (int v = 0; v < serial.n_vertices(); ++v)
         serial_vertex[{serial.vertices[static_cast<size_t>(v)].x(),
@@ -312,12 +312,8 @@ TEST(ParMatrix, ProcessBlockIluPreconditionsCgs) {
     // One process: the serial ILU(0) solve.
     const mesh::Mesh serial = mesh::refine(mesh::refine(m0));
     const SparseMatrix As = serial_shifted(serial, shift);
-    Vector bs(As.rows()), xs;
-    for (int v = 0; v < serial.n_vertices(); ++v) {
-        const Vec2& p = serial.vertices[static_cast<size_t>(v)];
-        bs[2 * v] = std::sin(3 * p.x()) + p.y();
-        bs[2 * v + 1] = p.x() * p.y() - 0.5;
-    }
+    const Vector bs = serial_field(serial);
+    Vector xs;
     auto Ms = solvers::make_preconditioner("ilu:0");
     Ms->setup(As);
     const auto rs = solvers::cgs(MatrixOperator(As), *Ms, bs, xs,
