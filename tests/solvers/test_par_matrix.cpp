@@ -104,6 +104,25 @@ Vector serial_field(const mesh::Mesh& m) {
     return x;
 }
 
+/// Largest difference, over all processes, between the owned entries of a distributed vector x
+/// and the entries of the serial vector xs at the same vertices (matched by coordinates).
+double max_owned_difference(const mesh::LocalLevel& L, const Vector& x, const mesh::Mesh& serial,
+                            const Vector& xs) {
+    std::map<Point, int> serial_vertex;
+    for (int v = 0; v < serial.n_vertices(); ++v)
+        serial_vertex[{serial.vertices[static_cast<size_t>(v)].x(),
+                       serial.vertices[static_cast<size_t>(v)].y()}] = v;
+    double diff = 0;
+    for (int i = 0; i < L.n_owned_vertices(); ++i) {
+        const Vec2& p =
+            L.mesh.vertices[static_cast<size_t>(L.owned_vertices[static_cast<size_t>(i)])];
+        const int v = serial_vertex.at({p.x(), p.y()});
+        diff = std::max(
+            {diff, std::abs(x[2 * i] - xs[2 * v]), std::abs(x[2 * i + 1] - xs[2 * v + 1])});
+    }
+    return W().max(diff);
+}
+
 /// Serial stiffness of the whole mesh times serial_field, by vertex coordinates.
 std::map<Point, Vec2> serial_product(const mesh::Mesh& m) {
     const SparseMatrix A = serial_shifted(m, 0.0);
@@ -266,15 +285,7 @@ TEST(ParMatrix, KrylovWithGlobalReductionsMatchesOneProcess) {
         EXPECT_LE(std::abs(r.iterations - rs.iterations), std::max(2, rs.iterations / 10))
             << r.iterations << " vs " << rs.iterations;
         EXPECT_GT(r.iterations, 10); // a real solve, not a trivial one
-        double diff = 0;
-        for (int i = 0; i < L.n_owned_vertices(); ++i) {
-            const Vec2& p =
-                L.mesh.vertices[static_cast<size_t>(L.owned_vertices[static_cast<size_t>(i)])];
-            const int v = serial_vertex.at({p.x(), p.y()});
-            diff = std::max(
-                {diff, std::abs(x[2 * i] - xs[2 * v]), std::abs(x[2 * i + 1] - xs[2 * v + 1])});
-        }
-        EXPECT_LT(W().max(diff), 1e-8 * xs.cwiseAbs().maxCoeff());
+        EXPECT_LT(max_owned_difference(L, x, serial, xs), 1e-8 * xs.cwiseAbs().maxCoeff());
         // Every process stopped at the same iteration with the same residual.
         EXPECT_EQ(W().max(r.iterations), W().min(r.iterations));
         EXPECT_EQ(W().max(r.final_residual), W().min(r.final_residual));
@@ -322,18 +333,6 @@ TEST(ParMatrix, ProcessBlockIluPreconditionsCgs) {
     if (W().size() == 1) {
         EXPECT_LE(std::abs(r.iterations - rs.iterations), std::max(2, rs.iterations / 10));
     }
-    std::map<Point, int> serial_vertex;
-    for (int v = 0; v < serial.n_vertices(); ++v)
-        serial_vertex[{serial.vertices[static_cast<size_t>(v)].x(),
-                       serial.vertices[static_cast<size_t>(v)].y()}] = v;
-    double diff = 0;
-    for (int i = 0; i < L.n_owned_vertices(); ++i) {
-        const Vec2& p =
-            L.mesh.vertices[static_cast<size_t>(L.owned_vertices[static_cast<size_t>(i)])];
-        const int v = serial_vertex.at({p.x(), p.y()});
-        diff = std::max(
-            {diff, std::abs(x[2 * i] - xs[2 * v]), std::abs(x[2 * i + 1] - xs[2 * v + 1])});
-    }
-    EXPECT_LT(W().max(diff), 1e-8 * xs.cwiseAbs().maxCoeff());
+    EXPECT_LT(max_owned_difference(L, x, serial, xs), 1e-8 * xs.cwiseAbs().maxCoeff());
 }
 #endif
