@@ -16,6 +16,7 @@
 #include "apps/study_extremes.hpp"
 #include "apps/study_preconditioners.hpp"
 #include "apps/study_status_transfer.hpp"
+#include "apps/run_distributed.hpp"
 #include "comm/world.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
@@ -58,6 +59,11 @@ int main(int argc, char** argv) {
                   "a load step whose Newton fails at the scene's r ends the run, instead of being "
                   "solved again at r/100 (then r/1e4) with the exact schur solver and finished "
                   "at r from there (the default; reported)");
+    run->add_option("--partition-level", ro.partition_level,
+                    "under mpirun with several processes: the level whose mesh is partitioned "
+                    "(default: the coarsest with 2000 triangles per process, at most --levels - 1; "
+                    "README, \"Running on several processes\")")
+        ->check(CLI::NonNegativeNumber);
     run->add_option("--linear-tol", ro.linear_rel_tol,
                     "relative tolerance of each Krylov solve (implies a Krylov solve; default "
                     "1e-10)");
@@ -213,15 +219,17 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
-    // Started by mpirun with several processes: the driver does not distribute its work yet
-    // (issue 12; README, "Distributed building blocks"), and N copies of a one-process run would
-    // write the same files. One process, with or without mpirun, runs as always.
-    if (mlc::comm::launched_by_mpirun() && mlc::comm::world().size() > 1) {
-        if (mlc::comm::world().rank() == 0)
+    // Started by mpirun with several processes: `run` and `bench square|elastic` are distributed
+    // (issue 12); the other commands are one process only and say so (N copies of a one-process
+    // run would write the same files). One process, with or without mpirun, runs as always.
+    const bool distributed = mlc::comm::launched_by_mpirun() && mlc::comm::world().size() > 1;
+    const int rank = distributed ? mlc::comm::world().rank() : 0;
+    if (distributed && !*run) {
+        if (rank == 0)
             std::cerr << "mlcontact: error: started as " << mlc::comm::world().size()
-                      << " MPI processes, but the driver runs as one process so far (the "
-                         "distributed solve of issue 12 is not in it yet): run it without mpirun "
-                         "or with mpirun -np 1\n";
+                      << " MPI processes, but this command runs as one process: on several "
+                         "processes run `mlcontact run` (one-body scenes, Krylov + mg); run the "
+                         "others without mpirun or with mpirun -np 1\n";
         return 1;
     }
     try {
@@ -229,6 +237,10 @@ int main(int argc, char** argv) {
             mlc::apps::install_stop_handlers();
             ro.stop = &mlc::apps::stop_flag();
             ro.progress_eta = ::isatty(STDOUT_FILENO) == 1;
+            if (distributed) return mlc::apps::run_scene_distributed(ro, mlc::comm::world(), std::cout);
+            if (ro.partition_level)
+                throw mlc::InvalidInput("--partition-level applies to runs on several processes "
+                                        "(mpirun -np N, N > 1); this run is one process");
             return mlc::apps::run_scene(ro, std::cout);
         }
         if (*bsq) {
@@ -295,13 +307,16 @@ int main(int argc, char** argv) {
             return 0;
         }
     } catch (const mlc::InvalidInput& e) {
-        std::cerr << "mlcontact: error: " << e.what() << "\n";
+        // Several processes: input errors are found by every process alike; rank 0 says it.
+        if (rank == 0) std::cerr << "mlcontact: error: " << e.what() << "\n";
         return 1;
     } catch (const mlc::SolverBreakdown& e) {
-        std::cerr << "mlcontact: numerical breakdown: " << e.what() << "\n";
+        std::cerr << "mlcontact: numerical breakdown" << (distributed ? " (process " + std::to_string(rank) + ")" : "") << ": " << e.what() << "\n";
+        if (distributed) mlc::comm::abort_all(3); // the others may wait in a collective
         return 3;
     } catch (const std::exception& e) {
-        std::cerr << "mlcontact: error: " << e.what() << "\n";
+        std::cerr << "mlcontact: error" << (distributed ? " (process " + std::to_string(rank) + ")" : "") << ": " << e.what() << "\n";
+        if (distributed) mlc::comm::abort_all(1);
         return 1;
     }
     return 0;

@@ -125,15 +125,8 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
     r.timings.print(os);
 }
 
-void write_solution_vtu(const std::filesystem::path& file, const levels::Level& L,
-                        const Vector& u_full, const std::vector<levels::ContactNodeState>& nodes,
-                        mesh::VtuFormat format) {
-    for (Index i = 0; i < u_full.size(); ++i)
-        require_finite(u_full[i], "displacement");
-    for (const auto& n : nodes) {
-        require_finite(n.lambda_t, "lambda_t");
-        require_finite(n.lambda_n, "lambda_n");
-    }
+SolutionFields solution_fields(const levels::Level& L, const Vector& u_full,
+                               const std::vector<levels::ContactNodeState>& nodes) {
     const auto stresses = fem::triangle_stresses(L.mesh, L.materials, u_full);
     for (double v : stresses)
         require_finite(v, "stress");
@@ -173,7 +166,20 @@ void write_solution_vtu(const std::filesystem::path& file, const levels::Level& 
         if (!L.mesh.attribute.empty())
             body.values[static_cast<size_t>(t)] = L.mesh.attribute[static_cast<size_t>(t)];
     }
-    mesh::write_vtu(file, L.mesh, {disp, status, force, lt, ln}, {stress, vm, body}, format);
+    return {{disp, status, force, lt, ln}, {stress, vm, body}};
+}
+
+void write_solution_vtu(const std::filesystem::path& file, const levels::Level& L,
+                        const Vector& u_full, const std::vector<levels::ContactNodeState>& nodes,
+                        mesh::VtuFormat format) {
+    for (Index i = 0; i < u_full.size(); ++i)
+        require_finite(u_full[i], "displacement");
+    for (const auto& n : nodes) {
+        require_finite(n.lambda_t, "lambda_t");
+        require_finite(n.lambda_n, "lambda_n");
+    }
+    const auto f = solution_fields(L, u_full, nodes);
+    mesh::write_vtu(file, L.mesh, f.point, f.cell, format);
 }
 
 ContactGeometry contact_geometry(const levels::Problem& p, const levels::Level& L) {

@@ -34,6 +34,13 @@ struct OutputOptions {
     mesh::VtuFormat vtu = mesh::VtuFormat::binary; ///< --vtu binary|ascii
 };
 
+/// The fields write_solution_vtu writes (see there), on the vertices and triangles of L.mesh.
+struct SolutionFields {
+    std::vector<mesh::Field> point, cell;
+};
+SolutionFields solution_fields(const levels::Level& L, const Vector& u_full,
+                               const std::vector<levels::ContactNodeState>& nodes);
+
 /// Writes one level's state as a VTU: point fields displacement, contact_status (-1 off the
 /// contact boundary, else contact::Status), contact_force (the force the target exerts on the
 /// node, -(lambda_t t + lambda_n n)), lambda_t, lambda_n; cell fields stress (xx, yy, xy),

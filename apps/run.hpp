@@ -44,6 +44,9 @@ struct RunOptions {
     /// current Newton iteration, writes the files of the completed steps and returns 128 +
     /// stop_signal() (apps/interrupt.hpp). Null: never stops.
     const std::atomic<bool>* stop = nullptr;
+    /// Several processes: the partition level (levels::partition_level when unset). A flag
+    /// that cannot take effect on one process: refused there.
+    std::optional<int> partition_level;
 };
 
 /// Applies the overrides of `opt` (levels, load steps, mu and r of every pair) to `p`, each checked

@@ -223,6 +223,14 @@ int mpi_handle(const Communicator& c) {
     return MPI_Comm_c2f(MPI_COMM_SELF);
 }
 
+void abort_all(int code) {
+    int up = 0, down = 0;
+    MPI_Initialized(&up);
+    MPI_Finalized(&down);
+    if (up && !down) MPI_Abort(MPI_COMM_WORLD, code);
+    std::exit(code);
+}
+
 const Communicator& world() {
     static const std::unique_ptr<Communicator> w = make_world();
     return *w;

@@ -34,5 +34,9 @@ const Communicator& world();
 /// SerialCommunicator. Throws InvalidInput without MPI (no engine needs it then) and for a
 /// communicator of another kind.
 int mpi_handle(const Communicator& c);
+/// Ends every process of the run with exit code `code` (MPI_Abort on MPI_COMM_WORLD when MPI is
+/// initialised, std::exit otherwise): what a process does after an error the others cannot know
+/// of, so that none waits forever in a collective call.
+[[noreturn]] void abort_all(int code);
 
 } // namespace mlc::comm

@@ -4,6 +4,8 @@
 
 #include "core/check.hpp"
 
+#include <cstdlib>
+
 namespace mlc::comm {
 
 bool have_mpi() {
@@ -13,6 +15,10 @@ bool have_mpi() {
 int mpi_handle(const Communicator&) {
     MLC_CHECK(false, "comm::mpi_handle: this build has no MPI (configure with MLC_WITH_HYPRE=ON)");
     return 0;
+}
+
+void abort_all(int code) {
+    std::exit(code);
 }
 
 const Communicator& world() {

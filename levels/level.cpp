@@ -38,6 +38,11 @@ Vector Level::f_nodal_at(double s) const {
 }
 
 Level build_level(const Problem& problem, mesh::Mesh m) {
+    return build_level(problem, std::move(m), nullptr);
+}
+
+Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
+    auto owned = [part](int v) { return !part || part->owned[static_cast<size_t>(v)] != 0; };
     // A refined mesh (of a checked one, as the hierarchy builds them) only needs its areas checked.
     if (m.n_coarse_vertices > 0)
         mesh::check_refined_quality(m);
@@ -62,6 +67,8 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
         if (s.point) {
             const int v = mesh.nearest_vertex(*s.point);
             const double d = (mesh.vertices[static_cast<size_t>(v)] - *s.point).norm();
+            // A part holds the point only where it is near (its owner checks it is a vertex).
+            if (part && (d > 1e-8 * diam || !owned(v))) continue;
             MLC_CHECK(d <= 1e-8 * diam, "support point (" << s.point->x() << ", " << s.point->y()
                                                           << ") is not a mesh vertex (nearest at "
                                                              "distance "
@@ -94,8 +101,11 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
                 continue;
             if (L.fixed[static_cast<size_t>(v)][0] && L.fixed[static_cast<size_t>(v)][1]) continue;
             if (L.contact_of_vertex[static_cast<size_t>(v)] >= 0) continue;
+            if (!owned(v)) continue; // a part's contact nodes are those of its own vertices
             nodes.push_back(v);
         }
+        // A part may hold no node of a pair: the distributed build checks the pair over all parts.
+        if (part && nodes.empty()) continue;
         MLC_CHECK(!nodes.empty(), "contact '" << pair.name << "' has no contactor node on '"
                                               << pair.contactor << "'");
         std::vector<contact::ContactElement> elems;
@@ -144,7 +154,10 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     // Unknowns numbered along a Hilbert curve: refinement appends the new vertices after the
     // coarse ones, and in that order the mat-vecs and sweeps of the large levels gather x from
     // all over memory (at level 6 of the square one mat-vec took 1.4 times as long).
-    L.dofs = fem::DofMap(L.fixed, n_extra, mesh::hilbert_order(L.mesh.vertices));
+    if (part && part->complete) part->complete(L, n_extra);
+    L.dofs = fem::DofMap(L.fixed, n_extra,
+                         part && !part->order.empty() ? part->order
+                                                      : mesh::hilbert_order(L.mesh.vertices));
     L.lambda_dof.reserve(L.contacts.size());
     for (const auto& e : L.contacts)
         L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));

@@ -9,6 +9,7 @@
 #include "levels/problem.hpp"
 #include "mesh/mesh.hpp"
 
+#include <functional>
 #include <vector>
 
 namespace mlc::levels {
@@ -59,5 +60,24 @@ struct Level {
 /// a pair with no contact node. The mesh is checked with mesh::check_quality, or, when it was
 /// made by mesh::refine (of a checked mesh), with mesh::check_refined_quality.
 Level build_level(const Problem& problem, mesh::Mesh m);
+
+/// What build_level needs to know to build one process's part of a distributed level
+/// (levels/distributed.hpp): which vertices this process owns, and how to complete what it cannot
+/// know of the others.
+struct LevelPart {
+    std::vector<char> owned; ///< per vertex of the part's mesh: 1 where this process owns it
+    /// Called once the supports and contact nodes of the owned vertices are known, before the
+    /// unknowns are numbered: sets the fixed flags and path values (Level::fixed,
+    /// path_u_fixed, u_fixed) and the multiplier counts (n_extra) of the vertices owned by other
+    /// processes to their owners' (a part's mesh may lack the boundary edges that decide them).
+    std::function<void(Level&, std::vector<int>& n_extra)> complete;
+    std::vector<int> order; ///< numbering order of the vertices (empty: Hilbert order)
+};
+
+/// build_level for one process's part (`part` non-null): contact nodes only at owned vertices (a
+/// pair may have none in the part; the caller checks the pairs over all parts), support points
+/// held only by the part that owns them, and `part->complete` before numbering. Null `part`:
+/// build_level(problem, m).
+Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part);
 
 } // namespace mlc::levels

@@ -7,6 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <tuple>
+#include <array>
+#include <span>
 
 namespace mlc::levels {
 
@@ -35,25 +38,44 @@ ContactNewton::ContactNewton(const Level& level, NewtonParams params,
     MLC_CHECK(solver_ != nullptr, "ContactNewton needs a linear solver");
 }
 
+void ContactNewton::set_distribution(NewtonDistribution d) {
+    MLC_CHECK(!d.comm || (d.K && d.n_owned >= 0 && d.n_owned <= level_.n_unknowns() &&
+                          d.K->rows() == d.n_owned),
+              "ContactNewton: inconsistent distribution (" << d.n_owned << " owned unknowns of "
+                                                           << level_.n_unknowns() << ")");
+    dist_ = d;
+}
+
+const Vector& ContactNewton::padded(const Vector& x, Vector& work) const {
+    if (!dist_.comm) return x;
+    work = Vector::Zero(level_.n_unknowns());
+    work.head(x.size()) = x;
+    return work;
+}
+
 double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector& x, Vector& R,
                                std::vector<contact::Status>* st, std::vector<Eigen::Matrix2d>* M,
                                double* scale) const {
     const Level& L = level_;
     const Vector u_fixed = L.u_fixed_at(s);
-    Vector u_full;
-    L.dofs.expand(x, u_fixed, u_full);
-    R.noalias() = L.elastic.K * x;
-    const double internal = R.norm();
-    const Vector f = L.f_at(s);
+    Vector u_full, work;
+    const Vector& xl = padded(x, work);
+    L.dofs.expand(xl, u_fixed, u_full);
+    if (dist_.comm)
+        dist_.K->apply(x, R);
+    else
+        R.noalias() = L.elastic.K * x;
+    double internal2 = R.squaredNorm();
+    const Vector f = dist_.comm ? Vector(L.f_at(s).head(x.size())) : L.f_at(s);
     R -= f;
-    const double load = f.norm();
+    double load2 = f.squaredNorm();
     Vector contact_force = Vector::Zero(R.size());
     double lambda_res2 = 0.0;
     if (st) st->resize(L.contacts.size());
     if (M) M->resize(L.contacts.size());
     for (size_t e = 0; e < L.contacts.size(); ++e) {
         const auto& el = L.contacts[e];
-        const auto es = contact::evaluate(el, u_full, u_prev_full, x, L.lambda_dof[e]);
+        const auto es = contact::evaluate(el, u_full, u_prev_full, xl, L.lambda_dof[e]);
         contact::add_residual(el, es, L.dofs, L.lambda_dof[e], contact_force);
         // add_residual wrote the multiplier rows of contact_force; move them into R.
         for (int q = 0; q < el.n_multipliers(); ++q) {
@@ -70,7 +92,14 @@ double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector
     double ru2 = 0.0;
     for (Index i = 0; i < R.size(); ++i)
         if (L.dofs.is_displacement(i)) ru2 += R[i] * R[i];
-    if (scale) *scale = std::max({load, internal, contact_force.norm()});
+    double contact2 = contact_force.squaredNorm();
+    if (dist_.comm) {
+        std::array<double, 5> sums{internal2, load2, contact2, ru2, lambda_res2};
+        dist_.comm->allreduce(sums, ReduceOp::sum);
+        std::tie(internal2, load2, contact2, ru2, lambda_res2) =
+            std::tuple(sums[0], sums[1], sums[2], sums[3], sums[4]);
+    }
+    if (scale) *scale = std::sqrt(std::max({load2, internal2, contact2}));
     return std::sqrt(ru2 + lambda_res2);
 }
 
@@ -95,7 +124,7 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
     const double t_start = wall_seconds();
     StepReport rep;
     rep.load_factor = s;
-    const Index n = level_.n_unknowns();
+    const Index n = n_iterate();
     MLC_CHECK(x.size() == n, "Newton initial guess has " << x.size() << " entries, expected " << n);
     Vector R(n), dx(n);
     std::vector<contact::Status> st, st_prev;
@@ -117,13 +146,19 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
         if (k > 0)
             for (size_t e = 0; e < st.size(); ++e)
                 changes += st[e] != st_prev[e];
+        if (dist_.comm) changes = dist_.comm->sum(changes);
         if (k > 0) rep.status_changes.push_back(changes);
         // Status cycling: the status vector returns to one seen two or more iterates ago. The
         // generalized Newton map can cycle between status sets (Alart & Curnier's method is only
         // locally convergent); from then on each step is damped by backtracking on ||R||.
-        if (!damped && k > 0 && changes > 0) {
+        if (!damped && k > 0 && changes > 0 && history.size() >= 2) {
+            // Distributed: a status vector is seen again only if every process's part is.
+            std::vector<int> differ(history.size() - 1);
             for (size_t j = 0; j + 1 < history.size(); ++j)
-                if (history[j] == st) {
+                differ[j] = history[j] == st ? 0 : 1;
+            if (dist_.comm) dist_.comm->allreduce(std::span<int>(differ), ReduceOp::max);
+            for (size_t j = 0; j + 1 < history.size(); ++j)
+                if (differ[j] == 0) {
                     damped = true;
                     rep.cycling_detected_at = k;
                     break;
@@ -257,16 +292,18 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
 std::vector<ContactNodeState> ContactNewton::node_states(double s, const Vector& u_prev_full,
                                                          const Vector& x) const {
     const Level& L = level_;
-    Vector u_full;
-    L.dofs.expand(x, L.u_fixed_at(s), u_full);
+    Vector u_full, work;
+    const Vector& xl = padded(x, work);
+    L.dofs.expand(xl, L.u_fixed_at(s), u_full);
     // Threshold below which a frictionless node is said not to move: relative to the largest
     // displacement of the step (no absolute tolerance).
-    const double umax = (u_full - u_prev_full).cwiseAbs().maxCoeff();
+    double umax = (u_full - u_prev_full).cwiseAbs().maxCoeff();
+    if (dist_.comm) umax = dist_.comm->max(umax);
     std::vector<ContactNodeState> out;
     out.reserve(L.contacts.size());
     for (size_t e = 0; e < L.contacts.size(); ++e) {
         const auto& el = L.contacts[e];
-        const auto es = contact::evaluate(el, u_full, u_prev_full, x, L.lambda_dof[e]);
+        const auto es = contact::evaluate(el, u_full, u_prev_full, xl, L.lambda_dof[e]);
         ContactNodeState ns;
         ns.vertex = el.vertex[0];
         ns.x = L.mesh.vertices[static_cast<size_t>(ns.vertex)];

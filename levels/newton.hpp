@@ -4,6 +4,7 @@
 #pragma once
 
 #include "contact/law.hpp"
+#include "core/communicator.hpp"
 #include "core/linear_operator.hpp"
 #include "core/timer.hpp"
 #include "levels/level.hpp"
@@ -69,6 +70,17 @@ struct ContactNodeState {
     contact::Status status = contact::Status::gap;
 };
 
+/// One process's share of the Newton of a distributed level (levels/distributed.hpp): the
+/// level is this process's part, whose first `n_owned` unknowns are the ones it owns (its contact
+/// elements are all at owned vertices); iterates, residuals and Newton systems hold the owned
+/// entries only, K x is the distributed stiffness's product, and every norm, count and decision is
+/// reduced over `comm`, so that all processes take the same steps.
+struct NewtonDistribution {
+    const Communicator* comm = nullptr; ///< borrowed; null: one process (the default)
+    Index n_owned = 0;
+    const LinearOperator* K = nullptr; ///< the stiffness on the owned unknowns, borrowed
+};
+
 /// Generalized Newton on one level.
 class ContactNewton {
 public:
@@ -102,6 +114,8 @@ public:
                     double* scale) const;
 
     const Level& level() const { return level_; }
+    /// Makes this Newton one process's share of a distributed level's (see NewtonDistribution).
+    void set_distribution(NewtonDistribution d);
     /// Hands the Newton-system solver back (this object cannot solve afterwards).
     std::unique_ptr<NewtonSystemSolver> release_solver() { return std::move(solver_); }
 
@@ -131,6 +145,10 @@ private:
     std::unique_ptr<NewtonSystemSolver> fallback_;
     const std::atomic<bool>* stop_ = nullptr;
     std::function<bool()> interrupt_;
+    NewtonDistribution dist_;
+    Index n_iterate() const { return dist_.comm ? dist_.n_owned : level_.n_unknowns(); }
+    // The iterate padded to the level's unknowns (zeros past the owned ones) when distributed.
+    const Vector& padded(const Vector& x, Vector& work) const;
 };
 
 } // namespace mlc::levels

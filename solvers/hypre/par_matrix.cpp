@@ -18,6 +18,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 namespace mlc::solvers {
 
@@ -50,7 +51,9 @@ template <class Check> void on_every_process(const Communicator& comm, Check&& c
 struct ParMatrix::Impl {
     std::int64_t first = 0, n_global = 0;
     int n = 0;
-    std::vector<HYPRE_BigInt> rows, cols;
+    std::int64_t first_col = 0, n_global_cols = 0;
+    int n_cols = 0;
+    std::vector<HYPRE_BigInt> rows, col_ids, cols; // owned rows, owned columns, entries' columns
     std::vector<HYPRE_Int> ncols;
     HYPRE_IJMatrix ij_A = nullptr;
     HYPRE_ParCSRMatrix A = nullptr;
@@ -64,23 +67,40 @@ struct ParMatrix::Impl {
     }
 };
 
+namespace {
+/// The size of a partition whose blocks [first, first + n) must follow each other in rank order.
+std::int64_t partition_size(const Communicator& comm, std::int64_t first, std::int64_t n,
+                            const char* what) {
+    const auto firsts = comm.allgather(std::span<const std::int64_t>(&first, 1));
+    const auto counts = comm.allgather(std::span<const std::int64_t>(&n, 1));
+    std::int64_t next = 0;
+    for (size_t q = 0; q < firsts.size(); ++q) {
+        MLC_CHECK(counts[q] >= 0 && firsts[q] == next,
+                  "ParMatrix: the " << what << " of process " << q << " start at " << firsts[q]
+                                    << " instead of " << next
+                                    << " (blocks must follow each other in rank order)");
+        next += counts[q];
+    }
+    return next;
+}
+} // namespace
+
 ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r)
+    : ParMatrix(comm, r, r.first_row, r.n_rows()) {}
+
+ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r, std::int64_t first_col,
+                     int n_cols)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.first = r.first_row;
     m.n = r.n_rows();
     const std::int64_t n = m.n;
-    const auto firsts = comm.allgather(std::span<const std::int64_t>(&r.first_row, 1));
-    const auto counts = comm.allgather(std::span<const std::int64_t>(&n, 1));
-    std::int64_t next = 0;
-    for (size_t q = 0; q < firsts.size(); ++q) {
-        MLC_CHECK(counts[q] >= 0 && firsts[q] == next,
-                  "ParMatrix: the rows of process "
-                      << q << " start at " << firsts[q] << " instead of " << next
-                      << " (blocks must follow each other in rank order)");
-        next += counts[q];
-    }
-    m.n_global = next;
+    m.n_global = partition_size(comm, m.first, n, "rows");
+    m.first_col = first_col;
+    m.n_cols = n_cols;
+    m.n_global_cols = partition_size(comm, first_col, n_cols, "columns");
+    MLC_CHECK(m.n_global_cols <= std::numeric_limits<HYPRE_BigInt>::max(),
+              "ParMatrix: " << m.n_global_cols << " columns exceed hypre's index type");
     MLC_CHECK(m.n_global <= std::numeric_limits<HYPRE_BigInt>::max(),
               "ParMatrix: " << m.n_global << " rows exceed hypre's index type (32-bit build)");
     on_every_process(comm, [&] {
@@ -94,8 +114,9 @@ ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r)
                   "ParMatrix: " << r.cols.size() << " columns and " << r.values.size()
                                 << " values for " << nnz << " entries");
         for (size_t k = 0; k < nnz; ++k) {
-            MLC_CHECK(r.cols[k] >= 0 && r.cols[k] < m.n_global,
-                      "ParMatrix: column " << r.cols[k] << " outside [0, " << m.n_global << ")");
+            MLC_CHECK(r.cols[k] >= 0 && r.cols[k] < m.n_global_cols,
+                      "ParMatrix: column " << r.cols[k] << " outside [0, " << m.n_global_cols
+                                           << ")");
             MLC_CHECK(std::isfinite(r.values[k]),
                       "ParMatrix: entry " << k << " is " << r.values[k]);
         }
@@ -104,8 +125,12 @@ ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r)
     const MPI_Comm c = MPI_Comm_f2c(comm::mpi_handle(comm));
     const auto lo = static_cast<HYPRE_BigInt>(m.first);
     const auto hi = static_cast<HYPRE_BigInt>(m.first + n - 1);
+    const auto clo = static_cast<HYPRE_BigInt>(m.first_col);
+    const auto chi = static_cast<HYPRE_BigInt>(m.first_col + m.n_cols - 1);
     m.rows.resize(static_cast<size_t>(m.n));
     std::iota(m.rows.begin(), m.rows.end(), lo);
+    m.col_ids.resize(static_cast<size_t>(m.n_cols));
+    std::iota(m.col_ids.begin(), m.col_ids.end(), clo);
     m.cols.assign(r.cols.begin(), r.cols.end());
     m.ncols.resize(static_cast<size_t>(m.n));
     std::vector<HYPRE_Int> diag(static_cast<size_t>(m.n), 0), offd(static_cast<size_t>(m.n), 0);
@@ -114,10 +139,11 @@ ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r)
         const auto e = static_cast<size_t>(r.row_ptr[static_cast<size_t>(i) + 1]);
         m.ncols[static_cast<size_t>(i)] = static_cast<HYPRE_Int>(e - b);
         for (size_t k = b; k < e; ++k)
-            ++(r.cols[k] >= m.first && r.cols[k] < m.first + n ? diag
-                                                               : offd)[static_cast<size_t>(i)];
+            ++(r.cols[k] >= m.first_col && r.cols[k] < m.first_col + m.n_cols
+                   ? diag
+                   : offd)[static_cast<size_t>(i)];
     }
-    check(HYPRE_IJMatrixCreate(c, lo, hi, lo, hi, &m.ij_A), "HYPRE_IJMatrixCreate");
+    check(HYPRE_IJMatrixCreate(c, lo, hi, clo, chi, &m.ij_A), "HYPRE_IJMatrixCreate");
     check(HYPRE_IJMatrixSetObjectType(m.ij_A, HYPRE_PARCSR), "HYPRE_IJMatrixSetObjectType");
     check(HYPRE_IJMatrixSetDiagOffdSizes(m.ij_A, diag.data(), offd.data()),
           "HYPRE_IJMatrixSetDiagOffdSizes");
@@ -128,8 +154,9 @@ ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r)
     check(HYPRE_IJMatrixAssemble(m.ij_A), "HYPRE_IJMatrixAssemble");
     check(HYPRE_IJMatrixGetObject(m.ij_A, reinterpret_cast<void**>(&m.A)),
           "HYPRE_IJMatrixGetObject");
-    for (auto [ij, par] : {std::pair{&m.ij_x, &m.x}, std::pair{&m.ij_y, &m.y}}) {
-        check(HYPRE_IJVectorCreate(c, lo, hi, ij), "HYPRE_IJVectorCreate");
+    // x in the column space, y in the row space.
+    for (auto [ij, par, a, b] : {std::tuple{&m.ij_x, &m.x, clo, chi}, std::tuple{&m.ij_y, &m.y, lo, hi}}) {
+        check(HYPRE_IJVectorCreate(c, a, b, ij), "HYPRE_IJVectorCreate");
         check(HYPRE_IJVectorSetObjectType(*ij, HYPRE_PARCSR), "HYPRE_IJVectorSetObjectType");
         check(HYPRE_IJVectorInitialize(*ij), "HYPRE_IJVectorInitialize");
         check(HYPRE_IJVectorAssemble(*ij), "HYPRE_IJVectorAssemble");
@@ -146,6 +173,12 @@ std::int64_t ParMatrix::first_row() const {
 int ParMatrix::n_rows() const {
     return impl_->n;
 }
+std::int64_t ParMatrix::first_col() const {
+    return impl_->first_col;
+}
+int ParMatrix::n_cols() const {
+    return impl_->n_cols;
+}
 std::int64_t ParMatrix::n_global() const {
     return impl_->n_global;
 }
@@ -154,16 +187,15 @@ namespace {
 
 template <class Product>
 void owned_product(const char* who, HYPRE_IJVector ij_x, HYPRE_IJVector ij_y,
-                   const std::vector<HYPRE_BigInt>& rows, const Vector& x, Vector& y,
-                   Product&& product) {
-    const auto n = static_cast<Index>(rows.size());
-    MLC_CHECK(x.size() == n,
-              who << ": x has " << x.size() << " entries for " << n << " owned rows");
-    y.resize(n);
-    check(HYPRE_IJVectorSetValues(ij_x, static_cast<HYPRE_Int>(n), rows.data(), x.data()),
+                   const std::vector<HYPRE_BigInt>& in, const std::vector<HYPRE_BigInt>& out,
+                   const Vector& x, Vector& y, Product&& product) {
+    const auto n = static_cast<Index>(in.size());
+    MLC_CHECK(x.size() == n, who << ": x has " << x.size() << " entries for " << n << " owned");
+    y.resize(static_cast<Index>(out.size()));
+    check(HYPRE_IJVectorSetValues(ij_x, static_cast<HYPRE_Int>(n), in.data(), x.data()),
           "HYPRE_IJVectorSetValues");
     product();
-    check(HYPRE_IJVectorGetValues(ij_y, static_cast<HYPRE_Int>(n), rows.data(), y.data()),
+    check(HYPRE_IJVectorGetValues(ij_y, static_cast<HYPRE_Int>(out.size()), out.data(), y.data()),
           "HYPRE_IJVectorGetValues");
 }
 
@@ -171,15 +203,15 @@ void owned_product(const char* who, HYPRE_IJVector ij_x, HYPRE_IJVector ij_y,
 
 void ParMatrix::apply(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
-    owned_product("ParMatrix::apply", m.ij_x, m.ij_y, m.rows, x, y, [&] {
+    owned_product("ParMatrix::apply", m.ij_x, m.ij_y, m.col_ids, m.rows, x, y, [&] {
         check(HYPRE_ParCSRMatrixMatvec(1.0, m.A, m.x, 0.0, m.y), "HYPRE_ParCSRMatrixMatvec");
     });
 }
 
 void ParMatrix::apply_transpose(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
-    owned_product("ParMatrix::apply_transpose", m.ij_x, m.ij_y, m.rows, x, y, [&] {
-        check(HYPRE_ParCSRMatrixMatvecT(1.0, m.A, m.x, 0.0, m.y), "HYPRE_ParCSRMatrixMatvecT");
+    owned_product("ParMatrix::apply_transpose", m.ij_y, m.ij_x, m.rows, m.col_ids, x, y, [&] {
+        check(HYPRE_ParCSRMatrixMatvecT(1.0, m.A, m.y, 0.0, m.x), "HYPRE_ParCSRMatrixMatvecT");
     });
 }
 

@@ -43,23 +43,32 @@ public:
     /// [0, n_global), when sizes disagree or a value is not finite (the last two are checked per
     /// process: a process with bad input throws, the others then fail in the next collective).
     ParMatrix(const Communicator& comm, const DistributedRows& rows);
+    /// Collective. A rectangular matrix: the rows as above, the columns split into blocks
+    /// [first_col, first_col + n_cols) that follow each other in rank order (e.g. a prolongation
+    /// from a coarse level's unknowns, owned as that level's rows are). apply() maps vectors of
+    /// n_cols() owned entries to n_rows(), apply_transpose() back.
+    ParMatrix(const Communicator& comm, const DistributedRows& rows, std::int64_t first_col,
+              int n_cols);
     ~ParMatrix() override;
     ParMatrix(const ParMatrix&) = delete;
     ParMatrix& operator=(const ParMatrix&) = delete;
 
     std::int64_t first_row() const;
     int n_rows() const;            ///< owned rows
+    std::int64_t first_col() const; ///< first owned column (first_row() when square)
+    int n_cols() const;             ///< owned columns (n_rows() when square)
     std::int64_t n_global() const; ///< rows over all processes
 
     /// Owned rows (the local view's size).
     Index rows() const override { return n_rows(); }
-    Index cols() const override { return n_rows(); }
+    Index cols() const override { return n_cols(); }
 
-    /// Collective: y = A x on the owned entries (x of size n_rows(); y resized to it and
+    /// Collective: y = A x on the owned entries (x of size n_cols(); y resized to n_rows() and
     /// overwritten). The entries of x owned elsewhere come from their processes (hypre's halo
     /// exchange). Allocates nothing when y has the size already.
     void apply(const Vector& x, Vector& y) const override;
-    /// Collective: y = A^T x on the owned entries (hypre's transposed ParCSR mat-vec).
+    /// Collective: y = A^T x on the owned entries (x of size n_rows(), y of n_cols(); hypre's
+    /// transposed ParCSR mat-vec).
     void apply_transpose(const Vector& x, Vector& y) const override;
 
     /// Collective: new values for the same pattern (values.size() == the number of entries given

@@ -1,0 +1,245 @@
+// SPDX-License-Identifier: MIT
+// A process's part of a distributed level: ghost data from the owners, numbering, ParCSR rows.
+#include "levels/distributed.hpp"
+
+#include "core/check.hpp"
+#include "levels/hierarchy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace mlc::levels {
+
+// ---------------------------------------------------------------------------------------------
+GhostExchange::GhostExchange(const mesh::LocalLevel& part, const Communicator& comm)
+    : comm_(&comm) {
+    const int np = comm.size();
+    const int me = comm.rank();
+    recv_.assign(static_cast<size_t>(np), {});
+    std::vector<std::vector<std::int64_t>> ask(static_cast<size_t>(np));
+    for (int v = 0; v < part.mesh.n_vertices(); ++v) {
+        const int o = part.vertex_owner[static_cast<size_t>(v)];
+        if (o == me) continue;
+        recv_[static_cast<size_t>(o)].push_back(v);
+        ask[static_cast<size_t>(o)].push_back(part.global_vertex[static_cast<size_t>(v)]);
+    }
+    const auto asked = comm.exchange(ask);
+    send_.assign(static_cast<size_t>(np), {});
+    for (int q = 0; q < np; ++q)
+        for (const std::int64_t g : asked[static_cast<size_t>(q)]) {
+            const std::int64_t i = g - part.first_vertex;
+            MLC_CHECK(i >= 0 && i < part.n_owned_vertices(),
+                      "GhostExchange: process " << q << " asks for vertex " << g
+                                                << ", which process " << me << " does not own");
+            send_[static_cast<size_t>(q)].push_back(part.owned_vertices[static_cast<size_t>(i)]);
+        }
+}
+
+void GhostExchange::vertex_records(std::vector<double>& rec, int width) const {
+    const auto w = static_cast<size_t>(width);
+    std::vector<std::vector<double>> out(send_.size());
+    for (size_t q = 0; q < send_.size(); ++q)
+        for (const int v : send_[q])
+            out[q].insert(out[q].end(), rec.begin() + static_cast<std::ptrdiff_t>(v * w),
+                          rec.begin() + static_cast<std::ptrdiff_t>((v + 1) * w));
+    const auto in = comm_->exchange(out);
+    for (size_t q = 0; q < recv_.size(); ++q) {
+        MLC_CHECK(in[q].size() == recv_[q].size() * w,
+                  "GhostExchange: process " << q << " sent " << in[q].size() << " values for "
+                                            << recv_[q].size() << " vertices");
+        for (size_t i = 0; i < recv_[q].size(); ++i)
+            std::copy_n(in[q].begin() + static_cast<std::ptrdiff_t>(i * w), w,
+                        rec.begin() + static_cast<std::ptrdiff_t>(recv_[q][i] * w));
+    }
+}
+
+namespace {
+/// The unknowns of vertex v in a fixed order: u_x, u_y (when free), then its multipliers.
+template <class F> void for_vertex_dofs(const fem::DofMap& dofs, int v, int n_extra, F&& f) {
+    for (int c = 0; c < 2; ++c)
+        if (const int d = dofs.u_dof(v, c); d >= 0) f(d);
+    for (int k = 0; k < n_extra; ++k)
+        f(dofs.extra_dof(v) + k);
+}
+int n_extra_of(const fem::DofMap& dofs, int v) {
+    const int e = dofs.extra_dof(v);
+    if (e < 0) return 0;
+    int k = 0;
+    while (e + k < dofs.n_dofs() && dofs.vertex_of(e + k) == v && !dofs.is_displacement(e + k))
+        ++k;
+    return k;
+}
+} // namespace
+
+void GhostExchange::update(const fem::DofMap& dofs, Vector& x) const {
+    std::vector<std::vector<double>> out(send_.size());
+    for (size_t q = 0; q < send_.size(); ++q)
+        for (const int v : send_[q])
+            for_vertex_dofs(dofs, v, n_extra_of(dofs, v), [&](int d) { out[q].push_back(x[d]); });
+    const auto in = comm_->exchange(out);
+    for (size_t q = 0; q < recv_.size(); ++q) {
+        size_t i = 0;
+        for (const int v : recv_[q])
+            for_vertex_dofs(dofs, v, n_extra_of(dofs, v), [&](int d) {
+                MLC_CHECK(i < in[q].size(), "GhostExchange: process " << q << " sent too few values");
+                x[d] = in[q][i++];
+            });
+        MLC_CHECK(i == in[q].size(), "GhostExchange: process " << q << " sent too many values");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+solvers::DistributedRows DistributedLevel::owned_rows(const SparseMatrix& A) const {
+    solvers::DistributedRows r;
+    r.first_row = first_dof;
+    const int n = static_cast<int>(n_owned);
+    const int nnz = A.outerIndexPtr()[n];
+    r.row_ptr.assign(A.outerIndexPtr(), A.outerIndexPtr() + n + 1);
+    r.cols.resize(static_cast<size_t>(nnz));
+    for (int k = 0; k < nnz; ++k)
+        r.cols[static_cast<size_t>(k)] = global_dof[static_cast<size_t>(A.innerIndexPtr()[k])];
+    r.values.assign(A.valuePtr(), A.valuePtr() + nnz);
+    return r;
+}
+
+transfer::ContactNodes DistributedLevel::contact_nodes() const {
+    transfer::ContactNodes c;
+    for (int v = 0; v < local.mesh.n_vertices(); ++v)
+        if (n_extra[static_cast<size_t>(v)] > 0) {
+            c.vertex.push_back(v);
+            c.lambda_dof.push_back(local.dofs.extra_dof(v));
+            c.n_multipliers.push_back(n_extra[static_cast<size_t>(v)]);
+        }
+    return c;
+}
+
+DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLevel part,
+                                         const Communicator& comm) {
+    for (const auto& c : problem.contacts)
+        MLC_CHECK(c.element == ContactElementKind::node_on_rigid,
+                  "contact '" << c.name
+                              << "' is two-body; only rigid obstacles (node-on-rigid pairs) are "
+                                 "solved on several processes so far");
+    DistributedLevel d;
+    const int me = comm.rank();
+    const int nv = part.mesh.n_vertices();
+    d.ghosts = GhostExchange(part, comm);
+    LevelPart lp;
+    lp.owned.resize(static_cast<size_t>(nv));
+    for (int v = 0; v < nv; ++v)
+        lp.owned[static_cast<size_t>(v)] = part.vertex_owner[static_cast<size_t>(v)] == me;
+    lp.order = mesh::hilbert_order(part.mesh.vertices);
+    std::stable_partition(lp.order.begin(), lp.order.end(),
+                          [&](int v) { return lp.owned[static_cast<size_t>(v)] != 0; });
+    lp.complete = [&](Level& L, std::vector<int>& n_extra) {
+        // Owners send: fixed x, fixed y, multipliers, then the prescribed values at every path
+        // point.
+        const int K = static_cast<int>(L.path_u_fixed.size());
+        const int w = 3 + 2 * K;
+        std::vector<double> rec(static_cast<size_t>(nv) * static_cast<size_t>(w), 0.0);
+        for (int v = 0; v < nv; ++v) {
+            double* r = rec.data() + static_cast<size_t>(v) * static_cast<size_t>(w);
+            r[0] = L.fixed[static_cast<size_t>(v)][0];
+            r[1] = L.fixed[static_cast<size_t>(v)][1];
+            r[2] = n_extra[static_cast<size_t>(v)];
+            for (int k = 0; k < K; ++k)
+                for (int c = 0; c < 2; ++c)
+                    r[3 + 2 * k + c] = L.path_u_fixed[static_cast<size_t>(k)][2 * v + c];
+        }
+        d.ghosts.vertex_records(rec, w);
+        for (int v = 0; v < nv; ++v) {
+            if (lp.owned[static_cast<size_t>(v)]) continue;
+            const double* r = rec.data() + static_cast<size_t>(v) * static_cast<size_t>(w);
+            L.fixed[static_cast<size_t>(v)] = {r[0] != 0.0, r[1] != 0.0};
+            n_extra[static_cast<size_t>(v)] = static_cast<int>(r[2]);
+            for (int k = 0; k < K; ++k)
+                for (int c = 0; c < 2; ++c)
+                    L.path_u_fixed[static_cast<size_t>(k)][2 * v + c] = r[3 + 2 * k + c];
+        }
+        L.u_fixed = L.path_u_fixed.back();
+        d.n_extra = n_extra;
+    };
+    // Errors of one part (e.g. a support point no process holds) must stop every process.
+    std::string error;
+    try {
+        d.local = build_level(problem, std::move(part.mesh), &lp);
+    } catch (const InvalidInput& e) {
+        error = e.what();
+    }
+    if (comm.max(error.empty() ? 0 : 1) > 0)
+        throw InvalidInput(error.empty() ? "another process could not build its part of the level"
+                                         : error);
+    part.mesh = mesh::Mesh{};
+    d.part = std::move(part);
+    // Pairs with no contact node anywhere; support points held by no process.
+    std::vector<int> per_pair(problem.contacts.size(), 0);
+    for (const auto& e : d.local.contacts)
+        ++per_pair[static_cast<size_t>(e.pair)];
+    comm.allreduce(std::span<int>(per_pair), ReduceOp::sum);
+    for (size_t p = 0; p < per_pair.size(); ++p)
+        MLC_CHECK(per_pair[p] > 0, "contact '" << problem.contacts[p].name
+                                               << "' has no contactor node on '"
+                                               << problem.contacts[p].contactor << "'");
+    d.n_global_contacts = comm.sum(d.local.n_contact_nodes());
+
+    // Owned unknowns first (the order puts the owned vertices first).
+    const auto& dofs = d.local.dofs;
+    d.n_owned = 0;
+    for (int v = 0; v < nv; ++v)
+        if (lp.owned[static_cast<size_t>(v)])
+            for_vertex_dofs(dofs, v, d.n_extra[static_cast<size_t>(v)], [&](int) { ++d.n_owned; });
+    for (int v = 0; v < nv; ++v)
+        if (lp.owned[static_cast<size_t>(v)])
+            for_vertex_dofs(dofs, v, d.n_extra[static_cast<size_t>(v)], [&](int dof) {
+                MLC_ASSERT(dof < d.n_owned, "an owned unknown is numbered after a ghost one");
+            });
+    d.first_dof = comm.exclusive_sum(static_cast<std::int64_t>(d.n_owned));
+    d.n_global_dofs = comm.sum(static_cast<std::int64_t>(d.n_owned));
+    Vector g = Vector::Constant(dofs.n_dofs(), -1.0);
+    for (Index i = 0; i < d.n_owned; ++i)
+        g[i] = static_cast<double>(d.first_dof + i);
+    d.ghosts.update(dofs, g);
+    d.global_dof.resize(static_cast<size_t>(dofs.n_dofs()));
+    for (Index i = 0; i < dofs.n_dofs(); ++i) {
+        MLC_CHECK(g[i] >= 0, "internal error: unknown " << i << " has no global number");
+        d.global_dof[static_cast<size_t>(i)] = std::llround(g[i]);
+    }
+    d.K = std::make_unique<solvers::ParMatrix>(comm, d.owned_rows(d.local.elastic.K));
+    return d;
+}
+
+DistributedTransfer build_distributed_transfer(const DistributedLevel& coarse,
+                                               const DistributedLevel& fine,
+                                               const Communicator& comm, transfer::QRule rule) {
+    DistributedTransfer t;
+    t.local = transfer::build_transfer(fine.local.mesh, coarse.local.dofs, fine.local.dofs,
+                                       coarse.contact_nodes(), fine.contact_nodes(), rule);
+    solvers::DistributedRows r;
+    const SparseMatrix& T = t.local.T;
+    r.first_row = fine.first_dof;
+    const int n = static_cast<int>(fine.n_owned);
+    const int nnz = T.outerIndexPtr()[n];
+    r.row_ptr.assign(T.outerIndexPtr(), T.outerIndexPtr() + n + 1);
+    r.cols.resize(static_cast<size_t>(nnz));
+    for (int k = 0; k < nnz; ++k)
+        r.cols[static_cast<size_t>(k)] =
+            coarse.global_dof[static_cast<size_t>(T.innerIndexPtr()[k])];
+    r.values.assign(T.valuePtr(), T.valuePtr() + nnz);
+    t.T = std::make_unique<solvers::ParMatrix>(comm, r, coarse.first_dof,
+                                               static_cast<int>(coarse.n_owned));
+    return t;
+}
+
+int partition_level(std::int64_t level0_triangles, int finest, int n_processes) {
+    MLC_CHECK(n_processes >= 1, "partition_level: " << n_processes << " processes");
+    int p = 0;
+    std::int64_t t = level0_triangles;
+    while (p < finest - 1 && t < static_cast<std::int64_t>(kTrianglesPerProcess) * n_processes) {
+        ++p;
+        t *= 4;
+    }
+    return std::max(0, std::min(p, finest - 1));
+}
+
+} // namespace mlc::levels

@@ -1,0 +1,509 @@
+// SPDX-License-Identifier: MIT
+// Coarse-to-fine Newton over the distributed levels, with the distributed multigrid.
+#include "levels/distributed_solve.hpp"
+
+#include "contact/element.hpp"
+#include "core/check.hpp"
+#include "levels/newton.hpp"
+#include "levels/newton_system.hpp"
+#include "solvers/factory.hpp"
+#include "solvers/krylov.hpp"
+#include "smoothers/block_sor.hpp"
+
+#include <Eigen/SparseLU>
+
+#include <atomic>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace mlc::levels {
+
+namespace {
+
+/// The Newton systems of the distributed levels and their multigrid (distributed_solve.hpp).
+class DistributedMultigridSolver {
+public:
+    DistributedMultigridSolver(const std::vector<DistributedLevel>& levels,
+                               const std::vector<DistributedTransfer>& transfers,
+                               const Communicator& comm, LinearSolverSpec spec,
+                               solvers::MultigridParams mg)
+        : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
+          op_(levels.size()) {
+        for (size_t k = 1; k < levels.size(); ++k)
+            op_[k].assembler = std::make_unique<JacobianAssembler>(levels[k].local);
+    }
+
+    /// Level p at its converged statuses: the gathered coarse solve (map built on first use).
+    void set_coarse(const Level& Lp, const std::vector<Eigen::Matrix2d>& M) {
+        if (coarse_level_ != &Lp) {
+            coarse_level_ = &Lp;
+            coarse_asm_ = std::make_unique<JacobianAssembler>(Lp);
+            build_coarse_map(Lp);
+            analyzed_ = false;
+        }
+        coarse_asm_->assemble(M);
+        const SparseMatrixCol A = coarse_asm_->matrix();
+        if (!analyzed_) {
+            lu_.analyzePattern(A);
+            analyzed_ = true;
+        }
+        lu_.factorize(A);
+        MLC_CHECK(lu_.info() == Eigen::Success,
+                  "the coarse Jacobian of level p is singular (sparse LU failed)");
+    }
+
+    /// J_k(M) assembled, its ParCSR values refreshed, the smoother set up on the diagonal block.
+    void prepare(size_t k, const std::vector<Eigen::Matrix2d>& M) {
+        Op& o = op_[k];
+        // Unchanged on every process (the refresh below is collective).
+        const bool same = o.prepared && M.size() == o.last_M.size() &&
+                          std::equal(M.begin(), M.end(), o.last_M.begin());
+        if (comm_.min(same ? 1 : 0) == 1) return;
+        o.assembler->assemble(M);
+        const SparseMatrix& J = o.assembler->matrix();
+        const DistributedLevel& L = levels_[k];
+        if (!o.J) {
+            o.J = std::make_unique<solvers::ParMatrix>(comm_, L.owned_rows(J));
+        } else {
+            const int nnz = J.outerIndexPtr()[L.n_owned];
+            o.values.assign(J.valuePtr(), J.valuePtr() + nnz);
+            o.J->update_values(o.values);
+        }
+        o.diag = J.topLeftCorner(L.n_owned, L.n_owned);
+        o.diag.makeCompressed();
+        if (!o.smoother) {
+            std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
+            for (Index i = 0; i < L.n_owned; ++i)
+                vertex_of[static_cast<size_t>(i)] = L.local.dofs.vertex_of(i);
+            o.smoother = std::make_unique<smoothers::BlockSOR>(smoothers::BlockSORParams{
+                .omega = mg_.omega,
+                .block_size = 2,
+                .block_starts = solvers::vertex_block_starts(vertex_of),
+                .parts = 1,
+                .kernel = smoothers::Kernel::unrolled});
+            o.smoother->setup(o.diag);
+        } else {
+            o.smoother->update_values(o.diag);
+        }
+        o.last_M = M;
+        o.prepared = true;
+    }
+
+    SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b,
+                      Vector& dx, double forcing) {
+        const double t0 = wall_seconds();
+        prepare(k, M);
+        const double t1 = wall_seconds();
+        solvers::KrylovParams kp;
+        kp.rel_tol = std::max(forcing, spec_.rel_tol);
+        kp.max_iter = spec_.max_iter;
+        kp.restart = spec_.restart;
+        kp.give_up_budget = spec_.give_up_budget;
+        kp.comm = &comm_;
+        const Cycle pc(*this, k);
+        SolveResult r =
+            solvers::solve(solvers::parse_krylov(spec_.krylov), *op_[k].J, pc, b, dx, kp);
+        r.setup_seconds = t1 - t0;
+        r.solve_seconds = wall_seconds() - t1;
+        return r;
+    }
+
+    std::string name() const {
+        std::ostringstream os;
+        os << spec_.krylov << " + distributed mg(pre=" << mg_.pre_sweeps
+           << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega << ")";
+        return os.str();
+    }
+
+private:
+    struct Op {
+        std::unique_ptr<JacobianAssembler> assembler;
+        std::unique_ptr<solvers::ParMatrix> J;
+        SparseMatrix diag;
+        std::unique_ptr<smoothers::BlockSOR> smoother;
+        std::vector<double> values;
+        std::vector<Eigen::Matrix2d> last_M;
+        bool prepared = false;
+        mutable Vector res, t, rc, ec, d;
+    };
+
+    /// One V-cycle from level k as a Preconditioner.
+    class Cycle final : public Preconditioner {
+    public:
+        Cycle(const DistributedMultigridSolver& s, size_t k) : s_(s), k_(k) {}
+        void setup(const SparseMatrix&) override {}
+        void apply(const Vector& r, Vector& z) const override { s_.cycle(k_, r, z); }
+        std::string name() const override { return s_.name(); }
+
+    private:
+        const DistributedMultigridSolver& s_;
+        size_t k_;
+    };
+
+    void build_coarse_map(const Level& Lp) {
+        const DistributedLevel& D = levels_[0];
+        std::vector<std::int64_t> mine(static_cast<size_t>(D.n_owned), -1);
+        const auto& dofs = D.local.dofs;
+        for (int v = 0; v < D.local.mesh.n_vertices(); ++v) {
+            const auto& loc = D.part.vertex_location[static_cast<size_t>(v)];
+            MLC_CHECK(loc.kind == mesh::Location::Kind::vertex,
+                      "internal error: a vertex of level p's part is not a level-p vertex");
+            for (int c = 0; c < 2; ++c) {
+                const int d = dofs.u_dof(v, c);
+                if (d >= 0 && d < D.n_owned) mine[static_cast<size_t>(d)] = Lp.dofs.u_dof(loc.id, c);
+            }
+            const int e = dofs.extra_dof(v);
+            for (int q = 0; e >= 0 && q < D.n_extra[static_cast<size_t>(v)]; ++q)
+                if (e + q < D.n_owned)
+                    mine[static_cast<size_t>(e + q)] = Lp.dofs.extra_dof(loc.id) + q;
+        }
+        coarse_map_ = comm_.allgather(std::span<const std::int64_t>(mine));
+        MLC_CHECK(static_cast<Index>(coarse_map_.size()) == Lp.n_unknowns(),
+                  "internal error: level p has " << Lp.n_unknowns() << " unknowns, its parts "
+                                                 << coarse_map_.size());
+        std::vector<char> seen(coarse_map_.size(), 0);
+        for (const auto s : coarse_map_) {
+            MLC_CHECK(s >= 0 && s < Lp.n_unknowns() && !seen[static_cast<size_t>(s)],
+                      "internal error: the parts of level p do not number its unknowns once");
+            seen[static_cast<size_t>(s)] = 1;
+        }
+        coarse_rhs_.resize(Lp.n_unknowns());
+    }
+
+    void cycle(size_t k, const Vector& r, Vector& z) const {
+        if (k == 0) {
+            const auto full = comm_.allgather(std::span<const double>(r.data(), r.size()));
+            for (size_t g = 0; g < full.size(); ++g)
+                coarse_rhs_[coarse_map_[g]] = full[g];
+            const Vector zs = lu_.solve(coarse_rhs_);
+            const DistributedLevel& D = levels_[0];
+            z.resize(D.n_owned);
+            for (Index i = 0; i < D.n_owned; ++i)
+                z[i] = zs[coarse_map_[static_cast<size_t>(D.first_dof + i)]];
+            return;
+        }
+        const Op& o = op_[k];
+        const solvers::ParMatrix& T = *transfers_[k - 1].T;
+        auto residual = [&] { // o.res = r - J z
+            o.J->apply(z, o.t);
+            o.res = r - o.t;
+        };
+        if (mg_.pre_sweeps == 0) {
+            z.setZero(r.size());
+            o.res = r;
+        } else {
+            o.smoother->forward_from_zero(r, z, o.res);
+            for (int s = 1; s < mg_.pre_sweeps; ++s) {
+                residual();
+                o.d.setZero(r.size());
+                o.smoother->sweep(o.res, o.d, smoothers::Sweep::forward);
+                z += o.d;
+            }
+            residual();
+        }
+        T.apply_transpose(o.res, o.rc);
+        cycle(k - 1, o.rc, o.ec);
+        T.apply(o.ec, o.t);
+        z += o.t;
+        for (int s = 0; s < mg_.post_sweeps; ++s) {
+            residual();
+            o.d.setZero(r.size());
+            o.smoother->sweep(o.res, o.d, smoothers::Sweep::backward);
+            z += o.d;
+        }
+    }
+
+    const std::vector<DistributedLevel>& levels_;
+    const std::vector<DistributedTransfer>& transfers_;
+    const Communicator& comm_;
+    LinearSolverSpec spec_;
+    solvers::MultigridParams mg_;
+    std::vector<Op> op_;
+    const Level* coarse_level_ = nullptr;
+    std::unique_ptr<JacobianAssembler> coarse_asm_;
+    Eigen::SparseLU<SparseMatrixCol> lu_;
+    bool analyzed_ = false;
+    std::vector<std::int64_t> coarse_map_;
+    mutable Vector coarse_rhs_;
+};
+
+/// The NewtonSystemSolver of distributed level k.
+class DistributedSystem final : public NewtonSystemSolver {
+public:
+    DistributedSystem(DistributedMultigridSolver& s, size_t k) : s_(s), k_(k) {}
+    using NewtonSystemSolver::solve;
+    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                      double forcing) override {
+        return s_.solve(k_, M, b, dx, forcing);
+    }
+    std::string name() const override { return s_.name(); }
+    void prepare(const std::vector<Eigen::Matrix2d>& M) override { s_.prepare(k_, M); }
+
+private:
+    DistributedMultigridSolver& s_;
+    size_t k_;
+};
+
+solvers::MultigridParams parse_mg(const LinearSolverSpec& spec) {
+    MLC_CHECK(spec.method == "krylov",
+              "on several processes the Newton systems are solved by a Krylov method with mg "
+              "(--linear krylov --pc mg); '"
+                  << spec.method << "' has no distributed form (schur, lu, cf and sorcf need the "
+                                    "whole level on one process)");
+    const auto ps = solvers::parse_preconditioner_spec(spec.pc);
+    MLC_CHECK(ps.name == "mg", "on several processes the preconditioner is mg; '"
+                                   << spec.pc
+                                   << "' has no distributed form (run it on one process)");
+    solvers::MultigridParams p;
+    solvers::SpecOptions o(ps);
+    p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
+    p.post_sweeps = o.get_int("post", p.post_sweeps);
+    p.omega = o.get_double("omega", p.omega);
+    const std::string coarse = o.get_string("coarse", "rediscretize");
+    MLC_CHECK(coarse == "rediscretize",
+              "mg:coarse=" << coarse
+                           << " has no distributed form; on several processes mg rediscretizes "
+                              "(coarse=rediscretize)");
+    o.finish();
+    p.validate();
+    return p;
+}
+
+/// Sums a confusion table over the processes.
+void reduce_confusion(const Communicator& comm, Confusion& c) {
+    std::array<int, 16> flat{};
+    for (size_t i = 0; i < 4; ++i)
+        for (size_t j = 0; j < 4; ++j)
+            flat[4 * i + j] = c[i][j];
+    comm.allreduce(std::span<int>(flat), ReduceOp::sum);
+    for (size_t i = 0; i < 4; ++i)
+        for (size_t j = 0; j < 4; ++j)
+            c[i][j] = flat[4 * i + j];
+}
+
+StatusCounts reduce_counts(const Communicator& comm, StatusCounts c) {
+    std::array<int, 4> v{c.gap, c.stick, c.slip_forward, c.slip_backward};
+    comm.allreduce(std::span<int>(v), ReduceOp::sum);
+    return {v[0], v[1], v[2], v[3]};
+}
+
+} // namespace
+
+DistributedRunResult solve_distributed(const Problem& problem, const SolveOptions& options,
+                                       const Communicator& comm, int p) {
+    const double t_start = wall_seconds();
+    problem.validate();
+    DistributedRunResult res;
+    res.n_processes = comm.size();
+    res.partition_level = p;
+    const int L = problem.levels;
+    MLC_CHECK(p >= 0 && p < L, "the partition level must lie in [0, " << L - 1 << "] for --levels "
+                                                                      << L << ", found " << p);
+    MLC_CHECK(options.coarse_to_fine,
+              "on several processes the levels are solved coarse to fine (--cold is one process "
+              "only)");
+    for (int step = 2; step <= problem.load_steps; ++step)
+        MLC_CHECK(problem.same_supports(step, 1),
+                  "supports released or taken up along the loading path are solved on one "
+                  "process only so far (load step "
+                      << step << ")");
+    for (const auto& c : problem.contacts)
+        MLC_CHECK(c.element == ContactElementKind::node_on_rigid,
+                  "contact '" << c.name
+                              << "' is two-body; only rigid obstacles (node-on-rigid pairs) are "
+                                 "solved on several processes so far: run this scene on one "
+                                 "process");
+    res.mg = parse_mg(options.linear);
+
+    // The partitioned level p and this process's part of it and of the levels above.
+    mesh::Mesh mp = problem.mesh0;
+    for (int l = 0; l < p; ++l)
+        mp = mesh::refine(mp);
+    {
+        ScopedTimer t(&res.timings, "setup/distribute");
+        auto dh = mesh::distribute(mp, L - p, comm);
+        mp = mesh::Mesh{};
+        for (auto& lv : dh.levels)
+            res.levels.push_back(build_distributed_level(problem, std::move(lv), comm));
+    }
+    const size_t m = res.levels.size() - 1; // distributed levels above p: 1..m
+    {
+        ScopedTimer t(&res.timings, "setup/transfers");
+        for (size_t k = 1; k <= m; ++k)
+            res.transfers.push_back(build_distributed_transfer(res.levels[k - 1], res.levels[k],
+                                                               comm, options.q_rule));
+    }
+    DistributedMultigridSolver mg(res.levels, res.transfers, comm, options.linear, res.mg);
+    std::vector<std::unique_ptr<ContactNewton>> newton(m + 1);
+    for (size_t k = 1; k <= m; ++k) {
+        newton[k] = std::make_unique<ContactNewton>(
+            res.levels[k].local, problem.newton, std::make_unique<DistributedSystem>(mg, k),
+            &res.timings);
+        newton[k]->set_distribution({&comm, res.levels[k].n_owned, res.levels[k].K.get()});
+        newton[k]->set_interrupt(options.interrupt_requested);
+    }
+    res.level_steps.resize(m + 1);
+
+    // Per level: the state of the last converged step (local unknowns with ghosts, nodal
+    // displacements of the part's vertices).
+    std::vector<Vector> x(m + 1), u_prev(m + 1), u_now(m + 1);
+    for (size_t k = 0; k <= m; ++k) {
+        x[k] = Vector::Zero(res.levels[k].local.n_unknowns());
+        u_prev[k] = Vector::Zero(2 * res.levels[k].local.mesh.n_vertices());
+    }
+    Vector u_prev_p; // level p's (serial) nodal displacements at the previous step
+    std::atomic<bool> stop{false};
+    bool failed = false;
+    std::ostream* progress = comm.rank() == 0 ? options.progress : nullptr;
+
+    SolveOptions so = options;
+    so.progress = progress;
+    so.stop = &stop;
+    so.keep_step_states = false;
+    so.on_level_step = [&](const LevelStepState& st) {
+        if (st.level != p || failed) return;
+        const double t0 = wall_seconds();
+        const Level& Lp = *st.L;
+        const double s = st.s;
+        if (u_prev_p.size() != st.u_full->size()) u_prev_p = Vector::Zero(st.u_full->size());
+        // Level p's converged state on its unknowns, and its statuses.
+        Vector xs = Vector::Zero(Lp.n_unknowns());
+        for (int v = 0; v < Lp.mesh.n_vertices(); ++v)
+            for (int c = 0; c < 2; ++c)
+                if (const int d = Lp.dofs.u_dof(v, c); d >= 0) xs[d] = (*st.u_full)[2 * v + c];
+        for (size_t e = 0; e < Lp.contacts.size(); ++e) {
+            const auto& ns = (*st.nodes)[e];
+            const int d = Lp.lambda_dof[e];
+            if (Lp.contacts[e].n_multipliers() == 2) {
+                xs[d] = ns.lambda_t;
+                xs[d + 1] = ns.lambda_n;
+            } else {
+                xs[d] = ns.lambda_n;
+            }
+        }
+        std::vector<Eigen::Matrix2d> Mp(Lp.contacts.size());
+        for (size_t e = 0; e < Lp.contacts.size(); ++e)
+            Mp[e] = contact::evaluate(Lp.contacts[e], *st.u_full, u_prev_p, xs, Lp.lambda_dof[e])
+                        .proj.M;
+        {
+            ScopedTimer t(&res.timings, "distributed/coarse_setup");
+            mg.set_coarse(Lp, Mp);
+        }
+        // Level p's part: its local unknowns and nodal values, from the serial state.
+        {
+            const DistributedLevel& D = res.levels[0];
+            const auto& dofs = D.local.dofs;
+            u_now[0].resize(2 * D.local.mesh.n_vertices());
+            for (int v = 0; v < D.local.mesh.n_vertices(); ++v) {
+                const int vp = D.part.vertex_location[static_cast<size_t>(v)].id;
+                for (int c = 0; c < 2; ++c) {
+                    u_now[0][2 * v + c] = (*st.u_full)[2 * vp + c];
+                    if (const int d = dofs.u_dof(v, c); d >= 0) x[0][d] = xs[Lp.dofs.u_dof(vp, c)];
+                }
+                const int e = dofs.extra_dof(v);
+                for (int q = 0; e >= 0 && q < D.n_extra[static_cast<size_t>(v)]; ++q)
+                    x[0][e + q] = xs[Lp.dofs.extra_dof(vp) + q];
+            }
+        }
+        // The distributed levels, coarse to fine.
+        for (size_t k = 1; k <= m && !failed; ++k) {
+            const DistributedLevel& D = res.levels[k];
+            const Level& Lk = D.local;
+            ContactNewton& nw = *newton[k];
+            LevelStep ls;
+            ls.level = p + static_cast<int>(k);
+            Vector xo(D.n_owned);
+            {
+                ScopedTimer t(&res.timings, "newton/interpolate");
+                const auto& T = res.transfers[k - 1].local;
+                Vector uf;
+                T.interpolate_nodal(u_now[k - 1], uf);
+                const Vector q = T.Q * x[k - 1];
+                for (int v = 0; v < Lk.mesh.n_vertices(); ++v)
+                    for (int c = 0; c < 2; ++c)
+                        if (const int d = Lk.dofs.u_dof(v, c); d >= 0 && d < D.n_owned)
+                            xo[d] = uf[2 * v + c];
+                for (size_t e = 0; e < Lk.contacts.size(); ++e)
+                    for (int j = 0; j < Lk.contacts[e].n_multipliers(); ++j) {
+                        const Index d = Lk.lambda_dof[e] + j;
+                        xo[d] = q[d];
+                    }
+            }
+            ls.predicted = true;
+            ls.predicted_statuses = nw.statuses(s, u_prev[k], xo);
+            ls.report = nw.solve(s, u_prev[k], xo);
+            ls.report.step = st.step;
+            ls.report.counts = reduce_counts(comm, ls.report.counts);
+            ls.final_statuses = nw.statuses(s, u_prev[k], xo);
+            for (size_t e = 0; e < ls.final_statuses.size(); ++e)
+                ++ls.confusion[static_cast<size_t>(ls.predicted_statuses[e])]
+                              [static_cast<size_t>(ls.final_statuses[e])];
+            reduce_confusion(comm, ls.confusion);
+            if (progress) {
+                const auto& r = ls.report;
+                *progress << "  level " << ls.level << " step " << st.step << "/"
+                          << problem.load_steps << ": " << (r.converged ? "converged" : "FAILED")
+                          << " in " << r.iterations << " Newton it, " << r.linear_iterations
+                          << " Krylov it, final residual " << std::scientific
+                          << std::setprecision(2)
+                          << (r.residuals.empty() ? 0.0 : r.residuals.back())
+                          << std::defaultfloat << std::setprecision(6) << ", "
+                          << std::fixed << std::setprecision(2) << r.seconds << " s"
+                          << std::defaultfloat << std::setprecision(6) << " (" << comm.size()
+                          << " processes)" << std::endl;
+            }
+            const bool ok = ls.report.converged;
+            if (k == m) res.steps.push_back(ls.report);
+            res.level_steps[k].push_back(std::move(ls));
+            if (!ok) {
+                const auto& r = res.level_steps[k].back().report;
+                std::ostringstream os;
+                os << "load step " << st.step << " (load factor " << s << ") on level "
+                   << p + static_cast<int>(k) << " did not converge: " << r.message
+                   << "; residual history:";
+                for (double v : r.residuals)
+                    os << " " << std::scientific << std::setprecision(2) << v;
+                res.failure = os.str();
+                failed = true;
+                stop = true;
+                break;
+            }
+            // The part's whole state (ghost unknowns from their owners) for the level above and
+            // the output; this level's operator at its converged statuses for the multigrid.
+            x[k].setZero();
+            x[k].head(D.n_owned) = xo;
+            D.ghosts.update(Lk.dofs, x[k]);
+            Lk.dofs.expand(x[k], Lk.u_fixed_at(s), u_now[k]);
+            if (k < m) {
+                Vector R;
+                std::vector<Eigen::Matrix2d> converged;
+                nw.residual(s, u_prev[k], xo, R, nullptr, &converged, nullptr);
+                mg.prepare(k, converged);
+            }
+        }
+        if (!failed) {
+            res.nodes = newton[m]->node_states(s, u_prev[m], x[m].head(res.levels[m].n_owned));
+            for (size_t k = 1; k <= m; ++k)
+                u_prev[k] = u_now[k];
+            u_prev_p = *st.u_full;
+            res.completed_steps = st.step;
+        }
+        res.distributed_seconds += wall_seconds() - t0;
+    };
+    res.serial = solve([&] {
+        Problem sp = problem;
+        sp.levels = p;
+        return sp;
+    }(), so);
+    res.x = x[m];
+    res.u_full = u_now[m];
+    res.converged = !failed && res.serial.converged && res.completed_steps == problem.load_steps;
+    if (!failed && !res.serial.converged)
+        res.failure = res.serial.failure.empty() ? "the levels up to p did not converge"
+                                                 : res.serial.failure;
+    res.seconds = wall_seconds() - t_start;
+    return res;
+}
+
+} // namespace mlc::levels

@@ -1,0 +1,157 @@
+# SPDX-License-Identifier: MIT
+"""`mlcontact run` on several processes (issue 12): mpirun -np 2 and 3 give the one-process
+answer (displacements and multipliers to 1e-8 relative, the same status at every contact node)
+with the Newton and Krylov tolerances at 1e-12; solution.pvtu opens in VTK's own parallel reader
+(python3-vtk9) as one mesh whose displacements are the one-process solution.vtu's; summary.json
+records the processes; what has no distributed form is refused with a message.
+
+Run by ctest as `/usr/bin/python3 -m pytest`; MLCONTACT is the driver, MPIEXEC the launcher.
+"""
+import csv
+import json
+import os
+import re
+import subprocess
+
+import numpy as np
+import pytest
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+MLCONTACT = os.environ["MLCONTACT"]
+MPIEXEC = os.environ.get("MPIEXEC", "mpiexec")
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def scene_file(tmp_path, name):
+    """The built-in scene with the Newton tolerance at 1e-12."""
+    text = subprocess.run([MLCONTACT, "show", name], capture_output=True, text=True,
+                          env=dict(ENV, OMPI_MCA_ess_singleton_isolated="1"), check=True).stdout
+    assert "[newton]" not in text
+    f = tmp_path / f"{name}.toml"
+    f.write_text(text + "\n[newton]\nrel_tol = 1e-12\n")
+    return f
+
+
+def run(tmp_path, scene, levels, np_, *extra, expect=0):
+    out = tmp_path / f"out_np{np_}"
+    cmd = [MLCONTACT, "run", str(scene), "--levels", str(levels), "--pc", "mg",
+           "--linear-tol", "1e-12", "--quiet", "--out", str(out), *extra]
+    env = dict(ENV)
+    if np_ > 1:
+        cmd = [MPIEXEC, "-n", str(np_), "--oversubscribe", *cmd]
+    else:
+        env["OMPI_MCA_ess_singleton_isolated"] = "1"
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
+    assert p.returncode == expect, p.stdout + p.stderr
+    return out, p
+
+
+def contact_rows(path):
+    with open(path) as f:
+        return {(round(float(r["x"]), 12), round(float(r["y"]), 12)): r for r in csv.DictReader(f)}
+
+
+def points_and_displacements(grid):
+    pts = vtk_to_numpy(grid.GetPoints().GetData())[:, :2]
+    u = vtk_to_numpy(grid.GetPointData().GetArray("displacement"))[:, :2]
+    return {(round(x, 12), round(y, 12)): d for (x, y), d in zip(pts, u)}
+
+
+def read(path, parallel):
+    r = vtk.vtkXMLPUnstructuredGridReader() if parallel else vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(str(path))
+    r.Update()
+    assert r.GetErrorCode() == 0, f"VTK could not read {path}"
+    return r.GetOutput()
+
+
+def compare(serial, dist):
+    a, b = contact_rows(serial / "contact.csv"), contact_rows(dist / "contact.csv")
+    assert a.keys() == b.keys()
+    u_scale = max(abs(float(r[c])) for r in a.values() for c in ("ux", "uy"))
+    l_scale = max(abs(float(r[c])) for r in a.values() for c in ("lambda_t", "lambda_n"))
+    assert u_scale > 0 and l_scale > 0
+    for k, r in a.items():
+        s = b[k]
+        assert r["status"] == s["status"], (k, r["status"], s["status"])
+        for c in ("ux", "uy"):
+            assert abs(float(r[c]) - float(s[c])) <= 1e-8 * u_scale, (k, c, r[c], s[c])
+        for c in ("lambda_t", "lambda_n"):
+            assert abs(float(r[c]) - float(s[c])) <= 1e-8 * l_scale, (k, c, r[c], s[c])
+    # Every vertex's displacement, read by VTK's readers.
+    g1 = read(serial / "solution.vtu", parallel=False)
+    gp = read(dist / "solution.pvtu", parallel=True)
+    u1, up = points_and_displacements(g1), points_and_displacements(gp)
+    assert u1.keys() == up.keys()
+    scale = max(np.abs(v).max() for v in u1.values())
+    worst = max(np.abs(u1[k] - up[k]).max() for k in u1)
+    assert worst <= 1e-8 * scale, worst / scale
+    return gp
+
+
+@pytest.mark.parametrize("scene,levels", [("square", 3), ("hertz", 2)])
+def test_several_processes_give_the_one_process_answer(tmp_path, scene, levels):
+    f = scene_file(tmp_path, scene)
+    serial, _ = run(tmp_path, f, levels, 1)
+    s1 = json.loads((serial / "summary.json").read_text())
+    for np_ in (2, 3):
+        dist, p = run(tmp_path, f, levels, np_)
+        gp = compare(serial, dist)
+        assert gp.GetNumberOfCells() == s1["triangles"]
+        pieces = sorted(x.name for x in dist.glob("solution_*.vtu"))
+        assert pieces == [f"solution_{r}.vtu" for r in range(np_)]
+        s = json.loads((dist / "summary.json").read_text())
+        assert s["processes"] == np_ and len(s["per_process"]) == np_
+        assert s["unknowns"] == s1["unknowns"] and s["contact_nodes"] == s1["contact_nodes"]
+        assert sum(q["owned_unknowns"] for q in s["per_process"]) == s1["unknowns"]
+        assert sum(q["contact_nodes"] for q in s["per_process"]) == s1["contact_nodes"]
+        assert s["converged"] and s["completed_steps"] == s1["load_steps"]
+        # The report: every process and what it owns, once.
+        assert len(re.findall(r"^processes: %d$" % np_, p.stdout, re.M)) == 1
+
+
+def test_a_partition_level_given_on_the_command_line_gives_the_same_answer(tmp_path):
+    f = scene_file(tmp_path, "square")
+    serial, _ = run(tmp_path, f, 3, 1)
+    dist, p = run(tmp_path, f, 3, 2, "--partition-level", "1")
+    assert "partition level 1 (--partition-level)" in p.stdout
+    compare(serial, dist)
+    s = json.loads((dist / "summary.json").read_text())
+    assert s["partition_level"] == 1
+    assert [lv["level"] for lv in s["levels"]] == [2, 3]
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--linear", "schur"], "--linear schur has no distributed form"),
+    (["--pc", "sorcf"], "'sorcf' has no distributed form"),
+    (["--cold"], "--cold is one process only"),
+    (["--partition-level", "3"], "--partition-level must lie in [0, 2] for --levels 3"),
+])
+def test_what_has_no_distributed_form_is_refused_once(tmp_path, args, message):
+    out = tmp_path / "o"
+    cmd = [MPIEXEC, "-n", "2", "--oversubscribe", MLCONTACT, "run", "square", "--levels", "3",
+           "--quiet", "--out", str(out), *args]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert p.stderr.count("mlcontact: error:") == 1, p.stderr
+    assert message in p.stderr, p.stderr
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_two_body_scene_is_refused(tmp_path):
+    cmd = [MPIEXEC, "-n", "2", "--oversubscribe", MLCONTACT, "run", "dovetail", "--levels", "2",
+           "--quiet", "--out", str(tmp_path / "o")]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert "is two-body; only rigid obstacles" in p.stderr, p.stderr
+    assert p.stderr.count("mlcontact: error:") == 1, p.stderr
+
+
+def test_partition_level_is_refused_on_one_process(tmp_path):
+    p = subprocess.run([MLCONTACT, "run", "square", "--levels", "2", "--partition-level", "1",
+                        "--quiet", "--out", str(tmp_path / "o")], capture_output=True,
+                       text=True, env=dict(ENV, OMPI_MCA_ess_singleton_isolated="1"),
+                       timeout=300)
+    assert p.returncode == 1
+    assert "--partition-level applies to runs on several processes" in p.stderr
