@@ -103,6 +103,39 @@ solvers::DistributedRows DistributedLevel::owned_rows(const SparseMatrix& A) con
     return r;
 }
 
+solvers::RowBlocks DistributedLevel::row_blocks(const SparseMatrix& A) const {
+    solvers::RowBlocks b;
+    b.first_row = b.first_col = first_dof;
+    const int n = static_cast<int>(n_owned);
+    // The ghost columns referenced, in increasing global order.
+    std::vector<int> ghost_cols;
+    for (int k = 0; k < A.outerIndexPtr()[n]; ++k)
+        if (A.innerIndexPtr()[k] >= n) ghost_cols.push_back(A.innerIndexPtr()[k]);
+    std::sort(ghost_cols.begin(), ghost_cols.end(), [&](int a, int c) {
+        return global_dof[static_cast<size_t>(a)] < global_dof[static_cast<size_t>(c)];
+    });
+    ghost_cols.erase(std::unique(ghost_cols.begin(), ghost_cols.end()), ghost_cols.end());
+    std::vector<int> offd_col(static_cast<size_t>(A.cols()), -1);
+    for (size_t j = 0; j < ghost_cols.size(); ++j) {
+        offd_col[static_cast<size_t>(ghost_cols[j])] = static_cast<int>(j);
+        b.col_map.push_back(global_dof[static_cast<size_t>(ghost_cols[j])]);
+    }
+    std::vector<Eigen::Triplet<double>> td, to;
+    for (int i = 0; i < n; ++i)
+        for (SparseMatrix::InnerIterator it(A, i); it; ++it)
+            if (it.col() < n)
+                td.emplace_back(i, it.col(), it.value());
+            else
+                to.emplace_back(i, offd_col[static_cast<size_t>(it.col())], it.value());
+    b.diag.resize(n, n);
+    b.diag.setFromTriplets(td.begin(), td.end());
+    b.diag.makeCompressed();
+    b.offd.resize(n, static_cast<Index>(ghost_cols.size()));
+    b.offd.setFromTriplets(to.begin(), to.end());
+    b.offd.makeCompressed();
+    return b;
+}
+
 transfer::ContactNodes DistributedLevel::contact_nodes() const {
     transfer::ContactNodes c;
     for (int v = 0; v < local.mesh.n_vertices(); ++v)
@@ -205,7 +238,9 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
         MLC_CHECK(g[i] >= 0, "internal error: unknown " << i << " has no global number");
         d.global_dof[static_cast<size_t>(i)] = std::llround(g[i]);
     }
-    d.K = std::make_unique<solvers::ParMatrix>(comm, d.owned_rows(d.local.elastic.K));
+    d.K_blocks = std::make_unique<solvers::RowBlocks>(d.row_blocks(d.local.elastic.K));
+    d.local.elastic.K = SparseMatrix(); // its owned rows are in K_blocks
+    d.K = std::make_unique<solvers::ParMatrix>(comm, *d.K_blocks);
     return d;
 }
 
@@ -228,6 +263,8 @@ DistributedTransfer build_distributed_transfer(const DistributedLevel& coarse,
     r.values.assign(T.valuePtr(), T.valuePtr() + nnz);
     t.T = std::make_unique<solvers::ParMatrix>(comm, r, coarse.first_dof,
                                                static_cast<int>(coarse.n_owned));
+    // Kept: P_nodal and Q (the coarse-to-fine initial guess); T lives in the ParMatrix.
+    t.local.T = t.local.R = t.local.P_vertex = SparseMatrix();
     return t;
 }
 

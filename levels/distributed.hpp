@@ -66,11 +66,17 @@ struct DistributedLevel {
     std::int64_t n_global_dofs = 0; ///< unknowns of the level over all processes
     int n_global_contacts = 0;      ///< contact nodes of the level over all processes
     std::vector<std::int64_t> global_dof; ///< global number of every local unknown
-    std::unique_ptr<solvers::ParMatrix> K; ///< the stiffness, owned rows
+    /// The stiffness's owned rows, the one copy of it (local.elastic.K is freed once they are
+    /// cut from it), and K, the ParCSR matrix on their arrays.
+    std::unique_ptr<solvers::RowBlocks> K_blocks; ///< (held by pointer: K points into its arrays)
+    std::unique_ptr<solvers::ParMatrix> K;
 
     /// The owned rows of a matrix on the part's unknowns (rows and columns in local numbering,
     /// owned rows first) with global column numbers.
     solvers::DistributedRows owned_rows(const SparseMatrix& A) const;
+    /// The owned rows of A split as hypre stores them: owned columns (local numbers, which are
+    /// global - first_dof) and the others (compacted, in increasing global order).
+    solvers::RowBlocks row_blocks(const SparseMatrix& A) const;
     /// Contact nodes of every local vertex with multipliers (ghosts included), for transfer/.
     transfer::ContactNodes contact_nodes() const;
 };

@@ -31,7 +31,7 @@ public:
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
           op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k)
-            op_[k].assembler = std::make_unique<JacobianAssembler>(levels[k].local);
+            build_jacobian(k);
     }
 
     /// Level p at its converged statuses: the gathered coarse solve (map built on first use).
@@ -60,18 +60,20 @@ public:
         const bool same = o.prepared && M.size() == o.last_M.size() &&
                           std::equal(M.begin(), M.end(), o.last_M.begin());
         if (comm_.min(same ? 1 : 0) == 1) return;
-        o.assembler->assemble(M);
-        const SparseMatrix& J = o.assembler->matrix();
+        // J = K + the contact tangents, in place in J's blocks (hypre's matrix reads them there):
+        // the contact entries are all in owned rows and columns, so the off-diagonal block is
+        // K's, copied once.
         const DistributedLevel& L = levels_[k];
-        if (!o.J) {
-            o.J = std::make_unique<solvers::ParMatrix>(comm_, L.owned_rows(J));
-        } else {
-            const int nnz = J.outerIndexPtr()[L.n_owned];
-            o.values.assign(J.valuePtr(), J.valuePtr() + nnz);
-            o.J->update_values(o.values);
-        }
-        o.diag = J.topLeftCorner(L.n_owned, L.n_owned);
-        o.diag.makeCompressed();
+        double* v = o.blocks->diag.valuePtr();
+        std::fill(v, v + o.blocks->diag.nonZeros(), 0.0);
+        const double* kv = L.K_blocks->diag.valuePtr();
+        for (size_t q = 0; q < o.kpos.size(); ++q)
+            v[o.kpos[q]] += kv[q];
+        size_t c = 0;
+        for (size_t e = 0; e < L.local.contacts.size(); ++e)
+            contact::for_each_tangent_entry(L.local.contacts[e], M[e], L.local.dofs,
+                                            L.local.lambda_dof[e],
+                                            [&](int, int, double value) { v[o.cpos[c++]] += value; });
         if (!o.smoother) {
             std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
             for (Index i = 0; i < L.n_owned; ++i)
@@ -82,9 +84,9 @@ public:
                 .block_starts = solvers::vertex_block_starts(vertex_of),
                 .parts = 1,
                 .kernel = smoothers::Kernel::unrolled});
-            o.smoother->setup(o.diag);
+            o.smoother->setup(o.blocks->diag);
         } else {
-            o.smoother->update_values(o.diag);
+            o.smoother->update_values(o.blocks->diag);
         }
         o.last_M = M;
         o.prepared = true;
@@ -118,14 +120,15 @@ public:
 
 private:
     struct Op {
-        std::unique_ptr<JacobianAssembler> assembler;
+        /// J's owned rows (the one copy of J: hypre's J and the smoother read them in place).
+        std::unique_ptr<solvers::RowBlocks> blocks;
+        std::vector<int> kpos; ///< position in blocks->diag of every entry of K's diagonal block
+        std::vector<int> cpos; ///< position of every contact tangent entry, in visiting order
         std::unique_ptr<solvers::ParMatrix> J;
-        SparseMatrix diag;
         std::unique_ptr<smoothers::BlockSOR> smoother;
-        std::vector<double> values;
         std::vector<Eigen::Matrix2d> last_M;
         bool prepared = false;
-        mutable Vector res, t, rc, ec, d;
+        mutable Vector res, t, rc, ec, d, ghost;
     };
 
     /// One V-cycle from level k as a Preconditioner.
@@ -140,6 +143,55 @@ private:
         const DistributedMultigridSolver& s_;
         size_t k_;
     };
+
+    void build_jacobian(size_t k) {
+        const DistributedLevel& D = levels_[k];
+        const solvers::RowBlocks& Kb = *D.K_blocks;
+        const Level& L = D.local;
+        const int n = static_cast<int>(D.n_owned);
+        Op& o = op_[k];
+        o.blocks = std::make_unique<solvers::RowBlocks>();
+        solvers::RowBlocks& B = *o.blocks;
+        B.first_row = Kb.first_row;
+        B.first_col = Kb.first_col;
+        B.offd = Kb.offd;
+        B.col_map = Kb.col_map;
+        std::vector<Eigen::Triplet<double>> trip;
+        trip.reserve(static_cast<size_t>(Kb.diag.nonZeros()) + 16 * L.contacts.size());
+        for (int i = 0; i < n; ++i)
+            for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
+                trip.emplace_back(i, it.col(), 0.0);
+        std::vector<std::pair<int, int>> centries;
+        const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+        for (size_t e = 0; e < L.contacts.size(); ++e)
+            contact::for_each_tangent_entry(L.contacts[e], I, L.dofs, L.lambda_dof[e],
+                                            [&](int row, int col, double) {
+                                                MLC_ASSERT(row < n && col < n,
+                                                           "a contact entry outside the owned "
+                                                           "unknowns");
+                                                trip.emplace_back(row, col, 0.0);
+                                                centries.emplace_back(row, col);
+                                            });
+        B.diag.resize(n, n);
+        B.diag.setFromTriplets(trip.begin(), trip.end());
+        B.diag.makeCompressed();
+        trip = {};
+        auto position = [&](int row, int col) {
+            const int* begin = B.diag.innerIndexPtr() + B.diag.outerIndexPtr()[row];
+            const int* end = B.diag.innerIndexPtr() + B.diag.outerIndexPtr()[row + 1];
+            const int* it = std::lower_bound(begin, end, col);
+            MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
+            return static_cast<int>(it - B.diag.innerIndexPtr());
+        };
+        o.kpos.reserve(static_cast<size_t>(Kb.diag.nonZeros()));
+        for (int i = 0; i < n; ++i)
+            for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
+                o.kpos.push_back(position(i, static_cast<int>(it.col())));
+        o.cpos.reserve(centries.size());
+        for (auto [r, c] : centries)
+            o.cpos.push_back(position(r, c));
+        o.J = std::make_unique<solvers::ParMatrix>(comm_, B);
+    }
 
     void build_coarse_map(const Level& Lp) {
         const DistributedLevel& D = levels_[0];
@@ -185,32 +237,37 @@ private:
         }
         const Op& o = op_[k];
         const solvers::ParMatrix& T = *transfers_[k - 1].T;
-        auto residual = [&] { // o.res = r - J z
-            o.J->apply(z, o.t);
-            o.res = r - o.t;
+        // Hybrid Gauss-Seidel: the sweeps run on the process's diagonal block with the other
+        // processes' unknowns held at their values (hypre's halo exchange brings them).
+        auto minus_offdiagonal = [&](Vector& y) { // y -= A_offd z
+            o.J->ghost_values(z, o.ghost);
+            o.J->subtract_offdiagonal(o.ghost, y);
         };
         if (mg_.pre_sweeps == 0) {
             z.setZero(r.size());
             o.res = r;
         } else {
-            o.smoother->forward_from_zero(r, z, o.res);
+            o.smoother->forward_from_zero(r, z, o.res); // res = r - A_diag z
             for (int s = 1; s < mg_.pre_sweeps; ++s) {
-                residual();
-                o.d.setZero(r.size());
-                o.smoother->sweep(o.res, o.d, smoothers::Sweep::forward);
-                z += o.d;
+                o.d = r;
+                minus_offdiagonal(o.d);
+                o.smoother->sweep(o.d, z, smoothers::Sweep::forward);
             }
-            residual();
+            if (mg_.pre_sweeps > 1) {
+                o.J->apply(z, o.t);
+                o.res = r - o.t;
+            } else {
+                minus_offdiagonal(o.res);
+            }
         }
         T.apply_transpose(o.res, o.rc);
         cycle(k - 1, o.rc, o.ec);
         T.apply(o.ec, o.t);
         z += o.t;
         for (int s = 0; s < mg_.post_sweeps; ++s) {
-            residual();
-            o.d.setZero(r.size());
-            o.smoother->sweep(o.res, o.d, smoothers::Sweep::backward);
-            z += o.d;
+            o.d = r;
+            minus_offdiagonal(o.d);
+            o.smoother->sweep(o.d, z, smoothers::Sweep::backward);
         }
     }
 

@@ -9,8 +9,10 @@
 #include <HYPRE.h>
 #include <HYPRE_IJ_mv.h>
 #include <HYPRE_parcsr_mv.h>
+#include <_hypre_parcsr_mv.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -59,8 +61,23 @@ struct ParMatrix::Impl {
     HYPRE_ParCSRMatrix A = nullptr;
     HYPRE_IJVector ij_x = nullptr, ij_y = nullptr;
     HYPRE_ParVector x = nullptr, y = nullptr;
+    /// Where every entry given to the constructor lives in the ParCSR blocks: p >= 0 at the
+    /// diagonal block's data[p], p < 0 at the off-diagonal block's data[-p - 1].
+    std::vector<HYPRE_Int> position;
+    mutable std::vector<double> send; ///< ghost_values' send buffer
+
+    hypre_ParCSRMatrix* view = nullptr; ///< a matrix on RowBlocks' arrays (not IJ's)
 
     ~Impl() {
+        if (view) {
+            // The arrays are RowBlocks'; hypre frees its own objects only.
+            for (hypre_CSRMatrix* b : {hypre_ParCSRMatrixDiag(view), hypre_ParCSRMatrixOffd(view)}) {
+                hypre_CSRMatrixI(b) = nullptr;
+                hypre_CSRMatrixJ(b) = nullptr;
+                hypre_CSRMatrixData(b) = nullptr;
+            }
+            hypre_ParCSRMatrixDestroy(view);
+        }
         if (ij_A) HYPRE_IJMatrixDestroy(ij_A);
         if (ij_x) HYPRE_IJVectorDestroy(ij_x);
         if (ij_y) HYPRE_IJVectorDestroy(ij_y);
@@ -163,6 +180,99 @@ ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r, std::in
         check(HYPRE_IJVectorGetObject(*ij, reinterpret_cast<void**>(par)),
               "HYPRE_IJVectorGetObject");
     }
+    // The positions of the entries in hypre's blocks (hypre keeps the diagonal entry first in
+    // the rows of a square diagonal block, so the input order is not the stored one).
+    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
+    hypre_CSRMatrix* D = hypre_ParCSRMatrixDiag(A);
+    hypre_CSRMatrix* O = hypre_ParCSRMatrixOffd(A);
+    const HYPRE_Int* DI = hypre_CSRMatrixI(D);
+    const HYPRE_Int* DJ = hypre_CSRMatrixJ(D);
+    const HYPRE_Int* OI = hypre_CSRMatrixI(O);
+    const HYPRE_Int* OJ = hypre_CSRMatrixJ(O);
+    const HYPRE_BigInt* cmap = hypre_ParCSRMatrixColMapOffd(A);
+    m.position.resize(m.cols.size());
+    for (int i = 0; i < m.n; ++i)
+        for (int k = r.row_ptr[static_cast<size_t>(i)]; k < r.row_ptr[static_cast<size_t>(i) + 1];
+             ++k) {
+            const std::int64_t col = r.cols[static_cast<size_t>(k)];
+            HYPRE_Int pos = 0;
+            bool found = false;
+            if (col >= m.first_col && col < m.first_col + m.n_cols) {
+                for (HYPRE_Int j = DI[i]; j < DI[i + 1] && !found; ++j)
+                    if (DJ[j] == col - m.first_col) pos = j, found = true;
+            } else {
+                for (HYPRE_Int j = OI[i]; j < OI[i + 1] && !found; ++j)
+                    if (cmap[OJ[j]] == col) pos = -j - 1, found = true;
+            }
+            MLC_CHECK(found, "ParMatrix: hypre's blocks lack entry (" << m.first + i << ", " << col
+                                                                      << ")");
+            m.position[static_cast<size_t>(k)] = pos;
+        }
+    if (!hypre_ParCSRMatrixCommPkg(A)) hypre_MatvecCommPkgCreate(A);
+}
+
+ParMatrix::ParMatrix(const Communicator& comm, RowBlocks& b) : impl_(std::make_unique<Impl>()) {
+    Impl& m = *impl_;
+    m.first = b.first_row;
+    m.n = static_cast<int>(b.diag.rows());
+    m.first_col = b.first_col;
+    m.n_cols = static_cast<int>(b.diag.cols());
+    m.n_global = partition_size(comm, m.first, m.n, "rows");
+    m.n_global_cols = partition_size(comm, m.first_col, m.n_cols, "columns");
+    on_every_process(comm, [&] {
+        MLC_CHECK(b.diag.isCompressed() && b.offd.isCompressed(),
+                  "ParMatrix: the blocks must be compressed");
+        MLC_CHECK(b.offd.rows() == m.n && b.offd.cols() == static_cast<Index>(b.col_map.size()),
+                  "ParMatrix: the off-diagonal block is " << b.offd.rows() << " x "
+                                                          << b.offd.cols() << " for " << m.n
+                                                          << " rows and " << b.col_map.size()
+                                                          << " columns");
+        for (size_t j = 0; j < b.col_map.size(); ++j) {
+            MLC_CHECK(b.col_map[j] >= 0 && b.col_map[j] < m.n_global_cols &&
+                          (b.col_map[j] < m.first_col || b.col_map[j] >= m.first_col + m.n_cols),
+                      "ParMatrix: off-diagonal column " << b.col_map[j]
+                                                        << " is owned here or out of range");
+            MLC_CHECK(j == 0 || b.col_map[j] > b.col_map[j - 1],
+                      "ParMatrix: the off-diagonal columns must increase");
+        }
+    });
+    ensure_hypre_initialized();
+    const MPI_Comm c = MPI_Comm_f2c(comm::mpi_handle(comm));
+    HYPRE_BigInt rs[2] = {static_cast<HYPRE_BigInt>(m.first),
+                          static_cast<HYPRE_BigInt>(m.first + m.n)};
+    HYPRE_BigInt cs[2] = {static_cast<HYPRE_BigInt>(m.first_col),
+                          static_cast<HYPRE_BigInt>(m.first_col + m.n_cols)};
+    const auto ncols_offd = static_cast<HYPRE_Int>(b.col_map.size());
+    hypre_ParCSRMatrix* A = hypre_ParCSRMatrixCreate(
+        c, static_cast<HYPRE_BigInt>(m.n_global), static_cast<HYPRE_BigInt>(m.n_global_cols), rs,
+        cs, ncols_offd, static_cast<HYPRE_Int>(b.diag.nonZeros()),
+        static_cast<HYPRE_Int>(b.offd.nonZeros()));
+    m.view = A;
+    for (auto [blk, src] : {std::pair{hypre_ParCSRMatrixDiag(A), &b.diag},
+                            std::pair{hypre_ParCSRMatrixOffd(A), &b.offd}}) {
+        hypre_CSRMatrixI(blk) = src->outerIndexPtr();
+        hypre_CSRMatrixJ(blk) = src->innerIndexPtr();
+        hypre_CSRMatrixData(blk) = src->valuePtr();
+        hypre_CSRMatrixOwnsData(blk) = 0;
+        hypre_CSRMatrixMemoryLocation(blk) = HYPRE_MEMORY_HOST;
+    }
+    HYPRE_BigInt* cmap = hypre_CTAlloc(HYPRE_BigInt, ncols_offd, HYPRE_MEMORY_HOST);
+    for (HYPRE_Int j = 0; j < ncols_offd; ++j)
+        cmap[j] = static_cast<HYPRE_BigInt>(b.col_map[static_cast<size_t>(j)]);
+    hypre_ParCSRMatrixColMapOffd(A) = cmap;
+    hypre_ParCSRMatrixSetNumNonzeros(A);
+    hypre_MatvecCommPkgCreate(A);
+    m.A = reinterpret_cast<HYPRE_ParCSRMatrix>(A);
+    const auto lo = rs[0], hi = rs[1] - 1, clo = cs[0], chi = cs[1] - 1;
+    for (auto [ij, par, a, e] :
+         {std::tuple{&m.ij_x, &m.x, clo, chi}, std::tuple{&m.ij_y, &m.y, lo, hi}}) {
+        check(HYPRE_IJVectorCreate(c, a, e, ij), "HYPRE_IJVectorCreate");
+        check(HYPRE_IJVectorSetObjectType(*ij, HYPRE_PARCSR), "HYPRE_IJVectorSetObjectType");
+        check(HYPRE_IJVectorInitialize(*ij), "HYPRE_IJVectorInitialize");
+        check(HYPRE_IJVectorAssemble(*ij), "HYPRE_IJVectorAssemble");
+        check(HYPRE_IJVectorGetObject(*ij, reinterpret_cast<void**>(par)),
+              "HYPRE_IJVectorGetObject");
+    }
 }
 
 ParMatrix::~ParMatrix() = default;
@@ -185,46 +295,107 @@ std::int64_t ParMatrix::n_global() const {
 
 namespace {
 
-template <class Product>
-void owned_product(const char* who, HYPRE_IJVector ij_x, HYPRE_IJVector ij_y,
-                   const std::vector<HYPRE_BigInt>& in, const std::vector<HYPRE_BigInt>& out,
-                   const Vector& x, Vector& y, Product&& product) {
-    const auto n = static_cast<Index>(in.size());
-    MLC_CHECK(x.size() == n, who << ": x has " << x.size() << " entries for " << n << " owned");
-    y.resize(static_cast<Index>(out.size()));
-    check(HYPRE_IJVectorSetValues(ij_x, static_cast<HYPRE_Int>(n), in.data(), x.data()),
-          "HYPRE_IJVectorSetValues");
-    product();
-    check(HYPRE_IJVectorGetValues(ij_y, static_cast<HYPRE_Int>(out.size()), out.data(), y.data()),
-          "HYPRE_IJVectorGetValues");
+/// Runs f with the local data of hypre's vectors x and y pointing at the given arrays (no copy),
+/// restoring hypre's own arrays afterwards.
+template <class F> void on_arrays(HYPRE_ParVector x, const double* xp, HYPRE_ParVector y,
+                                  double* yp, F&& f) {
+    hypre_Vector* lx = hypre_ParVectorLocalVector(reinterpret_cast<hypre_ParVector*>(x));
+    hypre_Vector* ly = hypre_ParVectorLocalVector(reinterpret_cast<hypre_ParVector*>(y));
+    double* const ox = hypre_VectorData(lx);
+    double* const oy = hypre_VectorData(ly);
+    hypre_VectorData(lx) = const_cast<double*>(xp);
+    hypre_VectorData(ly) = yp;
+    try {
+        f();
+    } catch (...) {
+        hypre_VectorData(lx) = ox;
+        hypre_VectorData(ly) = oy;
+        throw;
+    }
+    hypre_VectorData(lx) = ox;
+    hypre_VectorData(ly) = oy;
 }
 
 } // namespace
 
 void ParMatrix::apply(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
-    owned_product("ParMatrix::apply", m.ij_x, m.ij_y, m.col_ids, m.rows, x, y, [&] {
+    MLC_CHECK(x.size() == m.n_cols, "ParMatrix::apply: x has " << x.size() << " entries for "
+                                                               << m.n_cols << " owned columns");
+    y.resize(m.n);
+    on_arrays(m.x, x.data(), m.y, y.data(), [&] {
         check(HYPRE_ParCSRMatrixMatvec(1.0, m.A, m.x, 0.0, m.y), "HYPRE_ParCSRMatrixMatvec");
     });
 }
 
 void ParMatrix::apply_transpose(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
-    owned_product("ParMatrix::apply_transpose", m.ij_y, m.ij_x, m.rows, m.col_ids, x, y, [&] {
+    MLC_CHECK(x.size() == m.n, "ParMatrix::apply_transpose: x has "
+                                   << x.size() << " entries for " << m.n << " owned rows");
+    y.resize(m.n_cols);
+    on_arrays(m.y, x.data(), m.x, y.data(), [&] {
         check(HYPRE_ParCSRMatrixMatvecT(1.0, m.A, m.y, 0.0, m.x), "HYPRE_ParCSRMatrixMatvecT");
     });
 }
 
+void ParMatrix::ghost_values(const Vector& x, Vector& ghost) const {
+    const Impl& m = *impl_;
+    MLC_CHECK(x.size() == m.n_cols, "ParMatrix::ghost_values: x has "
+                                        << x.size() << " entries for " << m.n_cols
+                                        << " owned columns");
+    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
+    hypre_ParCSRCommPkg* pkg = hypre_ParCSRMatrixCommPkg(A);
+    const HYPRE_Int sends = hypre_ParCSRCommPkgNumSends(pkg);
+    const HYPRE_Int begin = hypre_ParCSRCommPkgSendMapStart(pkg, 0);
+    const HYPRE_Int end = hypre_ParCSRCommPkgSendMapStart(pkg, sends);
+    m.send.resize(static_cast<size_t>(end - begin));
+    for (HYPRE_Int i = begin; i < end; ++i)
+        m.send[static_cast<size_t>(i - begin)] = x[hypre_ParCSRCommPkgSendMapElmt(pkg, i)];
+    ghost.resize(hypre_CSRMatrixNumCols(hypre_ParCSRMatrixOffd(A)));
+    hypre_ParCSRCommHandle* h =
+        hypre_ParCSRCommHandleCreate(1, pkg, m.send.data(), ghost.data());
+    hypre_ParCSRCommHandleDestroy(h);
+}
+
+void ParMatrix::subtract_offdiagonal(const Vector& ghost, Vector& y) const {
+    const Impl& m = *impl_;
+    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
+    const hypre_CSRMatrix* O = hypre_ParCSRMatrixOffd(A);
+    MLC_CHECK(ghost.size() == hypre_CSRMatrixNumCols(O) && y.size() == m.n,
+              "ParMatrix::subtract_offdiagonal: " << ghost.size() << " ghost values and "
+                                                  << y.size() << " rows");
+    const HYPRE_Int* I = hypre_CSRMatrixI(O);
+    const HYPRE_Int* J = hypre_CSRMatrixJ(O);
+    const double* a = hypre_CSRMatrixData(O);
+    if (hypre_CSRMatrixNumNonzeros(O) == 0) return;
+    for (int i = 0; i < m.n; ++i) {
+        double s = 0.0;
+        for (HYPRE_Int k = I[i]; k < I[i + 1]; ++k)
+            s += a[k] * ghost[J[k]];
+        y[i] -= s;
+    }
+}
+
 void ParMatrix::update_values(const std::vector<double>& values) {
     Impl& m = *impl_;
+    MLC_CHECK(!m.view, "ParMatrix::update_values: this matrix is a view of RowBlocks; write the "
+                       "new values into its blocks");
     MLC_CHECK(values.size() == m.cols.size(),
               "ParMatrix::update_values: " << values.size() << " values for " << m.cols.size()
                                            << " entries");
-    // Rows owned here, pattern unchanged: hypre writes into its diagonal and off-diagonal blocks.
-    check(HYPRE_IJMatrixSetValues(m.ij_A, m.n, m.ncols.data(), m.rows.data(), m.cols.data(),
-                                  values.data()),
-          "HYPRE_IJMatrixSetValues");
-    check(HYPRE_IJMatrixAssemble(m.ij_A), "HYPRE_IJMatrixAssemble");
+    // Pattern unchanged: the values go straight into hypre's diagonal and off-diagonal blocks
+    // (no IJ pass, no communication: every entry is in an owned row).
+    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
+    hypre_CSRMatrix* D = hypre_ParCSRMatrixDiag(A);
+    hypre_CSRMatrix* O = hypre_ParCSRMatrixOffd(A);
+    double* dd = hypre_CSRMatrixData(D);
+    double* od = hypre_CSRMatrixData(O);
+    std::fill(dd, dd + hypre_CSRMatrixNumNonzeros(D), 0.0);
+    if (od) std::fill(od, od + hypre_CSRMatrixNumNonzeros(O), 0.0);
+    for (size_t k = 0; k < values.size(); ++k) {
+        const HYPRE_Int p = m.position[k];
+        (p >= 0 ? dd[p] : od[-p - 1]) += values[k]; // repeated entries add, as IJ does
+    }
 }
 
 } // namespace mlc::solvers

@@ -28,6 +28,16 @@ struct DistributedRows {
     int n_rows() const { return static_cast<int>(row_ptr.size()) - 1; }
 };
 
+/// This process's rows of a distributed matrix split as hypre's ParCSR stores them: the block of
+/// the owned columns and the block of the others (the process's couplings across the cuts).
+struct RowBlocks {
+    std::int64_t first_row = 0; ///< global number of row 0
+    std::int64_t first_col = 0; ///< global number of the first owned column
+    SparseMatrix diag; ///< rows x owned columns (column j is global first_col + j), compressed
+    SparseMatrix offd; ///< rows x col_map.size(), compressed (may have no entries)
+    std::vector<std::int64_t> col_map; ///< global column of every offd column, increasing
+};
+
 /// A square ParCSR matrix whose rows are spread over the processes of `comm`.
 ///
 /// Every process owns the rows (and the entries of vectors) [first_row, first_row + n_rows) of
@@ -49,6 +59,13 @@ public:
     /// n_cols() owned entries to n_rows(), apply_transpose() back.
     ParMatrix(const Communicator& comm, const DistributedRows& rows, std::int64_t first_col,
               int n_cols);
+    /// Collective. A ParCSR matrix on `blocks`' arrays, not a copy: hypre reads blocks.diag and
+    /// blocks.offd where they are, so values written into them later are the matrix's (what the
+    /// smoother of a process's diagonal block and the Newton assembly write into; issue 12,
+    /// "one copy of each operator"). `blocks` must outlive this object and keep its patterns.
+    /// The row and column partitions follow the blocks in rank order, as above. update_values()
+    /// throws InvalidInput on such a matrix (write into the blocks).
+    ParMatrix(const Communicator& comm, RowBlocks& blocks);
     ~ParMatrix() override;
     ParMatrix(const ParMatrix&) = delete;
     ParMatrix& operator=(const ParMatrix&) = delete;
@@ -70,6 +87,15 @@ public:
     /// Collective: y = A^T x on the owned entries (x of size n_rows(), y of n_cols(); hypre's
     /// transposed ParCSR mat-vec).
     void apply_transpose(const Vector& x, Vector& y) const override;
+
+    /// Collective: the values of the columns this process's rows reference but does not own
+    /// (hypre's off-diagonal columns, in its column-map order), fetched from their owners by
+    /// hypre's halo exchange. With subtract_offdiagonal: y - A_offd x_ghost, the right-hand side
+    /// of a process's diagonal block when the other processes' unknowns are held fixed (Jacobi
+    /// across the cuts).
+    void ghost_values(const Vector& x, Vector& ghost) const;
+    /// y -= A_offd ghost on the owned rows (no communication; ghost from ghost_values).
+    void subtract_offdiagonal(const Vector& ghost, Vector& y) const;
 
     /// Collective: new values for the same pattern (values.size() == the number of entries given
     /// to the constructor, in the same order), written in place into the ParCSR matrix, without

@@ -23,6 +23,9 @@ ParMatrix::ParMatrix(const Communicator&, const DistributedRows&) {
 ParMatrix::ParMatrix(const Communicator&, const DistributedRows&, std::int64_t, int) {
     unavailable();
 }
+ParMatrix::ParMatrix(const Communicator&, RowBlocks&) {
+    unavailable();
+}
 ParMatrix::~ParMatrix() = default;
 std::int64_t ParMatrix::first_row() const {
     unavailable();
@@ -43,6 +46,12 @@ void ParMatrix::apply(const Vector&, Vector&) const {
     unavailable();
 }
 void ParMatrix::apply_transpose(const Vector&, Vector&) const {
+    unavailable();
+}
+void ParMatrix::ghost_values(const Vector&, Vector&) const {
+    unavailable();
+}
+void ParMatrix::subtract_offdiagonal(const Vector&, Vector&) const {
     unavailable();
 }
 void ParMatrix::update_values(const std::vector<double>&) {
