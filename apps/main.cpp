@@ -16,6 +16,7 @@
 #include "apps/study_extremes.hpp"
 #include "apps/study_preconditioners.hpp"
 #include "apps/study_status_transfer.hpp"
+#include "apps/bench_distributed.hpp"
 #include "apps/run_distributed.hpp"
 #include "comm/world.hpp"
 #include "core/check.hpp"
@@ -224,12 +225,12 @@ int main(int argc, char** argv) {
     // run would write the same files). One process, with or without mpirun, runs as always.
     const bool distributed = mlc::comm::launched_by_mpirun() && mlc::comm::world().size() > 1;
     const int rank = distributed ? mlc::comm::world().rank() : 0;
-    if (distributed && !*run) {
+    if (distributed && !*run && !*bsq) {
         if (rank == 0)
             std::cerr << "mlcontact: error: started as " << mlc::comm::world().size()
                       << " MPI processes, but this command runs as one process: on several "
-                         "processes run `mlcontact run` (one-body scenes, Krylov + mg); run the "
-                         "others without mpirun or with mpirun -np 1\n";
+                         "processes run `mlcontact run` (one-body scenes, Krylov + mg) or `mlcontact "
+                         "bench square`; run the others without mpirun or with mpirun -np 1\n";
         return 1;
     }
     try {
@@ -245,6 +246,8 @@ int main(int argc, char** argv) {
         }
         if (*bsq) {
             bso.out = bso_out;
+            if (distributed)
+                return mlc::apps::bench_square_distributed(bso, mlc::comm::world(), std::cout);
             return mlc::apps::bench_square(bso, std::cout);
         }
         if (*bnw) {

@@ -4,6 +4,7 @@
 
 #include "comm/world.hpp"
 #include "core/check.hpp"
+#include "core/csr.hpp"
 #include "solvers/hypre/boomeramg.hpp"
 
 #include <HYPRE.h>
@@ -67,6 +68,8 @@ struct ParMatrix::Impl {
     mutable std::vector<double> send; ///< ghost_values' send buffer
 
     hypre_ParCSRMatrix* view = nullptr; ///< a matrix on RowBlocks' arrays (not IJ's)
+    const RowBlocks* blocks = nullptr;  ///< its blocks
+    mutable Vector ghost;               ///< apply's ghost values (view matrices)
 
     ~Impl() {
         if (view) {
@@ -248,6 +251,7 @@ ParMatrix::ParMatrix(const Communicator& comm, RowBlocks& b) : impl_(std::make_u
         cs, ncols_offd, static_cast<HYPRE_Int>(b.diag.nonZeros()),
         static_cast<HYPRE_Int>(b.offd.nonZeros()));
     m.view = A;
+    m.blocks = &b;
     for (auto [blk, src] : {std::pair{hypre_ParCSRMatrixDiag(A), &b.diag},
                             std::pair{hypre_ParCSRMatrixOffd(A), &b.offd}}) {
         hypre_CSRMatrixI(blk) = src->outerIndexPtr();
@@ -322,6 +326,34 @@ void ParMatrix::apply(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
     MLC_CHECK(x.size() == m.n_cols, "ParMatrix::apply: x has " << x.size() << " entries for "
                                                                << m.n_cols << " owned columns");
+    if (m.view) {
+        // Our row kernel on the diagonal block while hypre's halo exchange is under way, then
+        // the off-diagonal block on the ghost values (the result is hypre's product's).
+        auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
+        hypre_ParCSRCommPkg* pkg = hypre_ParCSRMatrixCommPkg(A);
+        const HYPRE_Int sends = hypre_ParCSRCommPkgNumSends(pkg);
+        const HYPRE_Int begin = hypre_ParCSRCommPkgSendMapStart(pkg, 0);
+        const HYPRE_Int end = hypre_ParCSRCommPkgSendMapStart(pkg, sends);
+        m.send.resize(static_cast<size_t>(end - begin));
+        for (HYPRE_Int i = begin; i < end; ++i)
+            m.send[static_cast<size_t>(i - begin)] = x[hypre_ParCSRCommPkgSendMapElmt(pkg, i)];
+        m.ghost.resize(m.blocks->offd.cols());
+        hypre_ParCSRCommHandle* h =
+            hypre_ParCSRCommHandleCreate(1, pkg, m.send.data(), m.ghost.data());
+        csr_multiply(m.blocks->diag, x, y);
+        hypre_ParCSRCommHandleDestroy(h);
+        const SparseMatrix& O = m.blocks->offd;
+        const int* oi = O.outerIndexPtr();
+        const int* oj = O.innerIndexPtr();
+        const double* ov = O.valuePtr();
+        for (int i = 0; i < m.n; ++i) {
+            double s = 0.0;
+            for (int k = oi[i]; k < oi[i + 1]; ++k)
+                s += ov[k] * m.ghost[oj[k]];
+            y[i] += s;
+        }
+        return;
+    }
     y.resize(m.n);
     on_arrays(m.x, x.data(), m.y, y.data(), [&] {
         check(HYPRE_ParCSRMatrixMatvec(1.0, m.A, m.x, 0.0, m.y), "HYPRE_ParCSRMatrixMatvec");
