@@ -54,6 +54,7 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     std::vector<double> walls;
     levels::DistributedRunResult last;
     for (int rep = 0; rep < opt.repeat; ++rep) {
+        last = levels::DistributedRunResult{}; // one run's data alive at a time, as on one process
         comm.barrier();
         const double t0 = wall_seconds();
         levels::DistributedRunResult r = levels::solve_distributed(p, so, comm, plevel);

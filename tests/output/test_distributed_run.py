@@ -155,3 +155,14 @@ def test_partition_level_is_refused_on_one_process(tmp_path):
                        timeout=300)
     assert p.returncode == 1
     assert "--partition-level applies to runs on several processes" in p.stderr
+
+
+@pytest.mark.parametrize("scene,levels", [("square", 4), ("hertz", 3)])
+def test_ladder_one_to_four_processes_agree(tmp_path, scene, levels):
+    """Issue 12's judged case (ctest label slow: `ctest -L slow -R ladder`): N = 2, 3, 4 against
+    one process on square level 4 and hertz level 3, to 1e-8 with tolerances 1e-12."""
+    f = scene_file(tmp_path, scene)
+    serial, _ = run(tmp_path, f, levels, 1)
+    for np_ in (2, 3, 4):
+        dist, _ = run(tmp_path, f, levels, np_)
+        compare(serial, dist)
