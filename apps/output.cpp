@@ -91,6 +91,20 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
     os << "; Newton " << p.newton << "\n";
 }
 
+void print_checks(std::ostream& os, const levels::Problem& p, const levels::StateChecks& c,
+                  const std::vector<PairResultant>& resultants) {
+    os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1)
+       << c.force_balance << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| "
+       << c.slip_equality << "  complementarity " << c.complementarity << "  penetration "
+       << c.penetration << std::defaultfloat << "\n";
+    // Per pair: the resultant force the target exerts on the contactor nodes (global axes),
+    // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
+    for (size_t k = 0; k < p.contacts.size() && k < resultants.size(); ++k)
+        os << "contact '" << p.contacts[k].name << "': resultant on the contactor ("
+           << std::setprecision(6) << resultants[k].force.x() << ", " << resultants[k].force.y()
+           << "), " << resultants[k].in_contact << " nodes in contact\n";
+}
+
 void print_summary(std::ostream& os, const levels::Problem& p, const levels::RunResult& r) {
     os << "\n step   load  newton  lin.it  residual    gap  stick  slip+  slip-   time[s]\n";
     for (const auto& s : r.steps)
@@ -106,20 +120,13 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
            << "\n";
     os << std::defaultfloat;
     if (r.converged) {
-        const levels::StateChecks c = levels::check_state(p, r);
-        os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1)
-           << c.force_balance << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| "
-           << c.slip_equality << "  complementarity " << c.complementarity << "  penetration "
-           << c.penetration << std::defaultfloat << "\n";
-        // Per pair: the resultant force the target exerts on the contactor nodes (global axes),
-        // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
+        std::vector<PairResultant> res;
         for (size_t k = 0; k < p.contacts.size(); ++k) {
-            int closed = 0;
-            const Vec2 f = levels::contact_resultant(r, static_cast<int>(k), &closed);
-            os << "contact '" << p.contacts[k].name << "': resultant on the contactor ("
-               << std::setprecision(6) << f.x() << ", " << f.y() << "), " << closed
-               << " nodes in contact\n";
+            PairResultant q;
+            q.force = levels::contact_resultant(r, static_cast<int>(k), &q.in_contact);
+            res.push_back(q);
         }
+        print_checks(os, p, levels::check_state(p, r), res);
     }
     os << "\ntimings\n";
     r.timings.print(os);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "levels/problem.hpp"
+#include "levels/checks.hpp"
 #include "levels/solve.hpp"
 #include "mesh/io/vtu.hpp"
 
@@ -26,6 +27,15 @@ void print_not_found(std::ostream& os, const levels::Problem& p, const levels::L
 /// Prints the report header (scene, mesh, unknowns, contact pairs, and the contactor nodes that
 /// found no target on the finest level).
 void print_header(std::ostream& os, const levels::Problem& p, const levels::RunResult& r);
+/// The resultant force the target exerts on a contact pair's contactor nodes, and how many of
+/// them are in contact (levels::contact_resultant).
+struct PairResultant {
+    Vec2 force = Vec2::Zero();
+    int in_contact = 0;
+};
+/// Prints the checks line and one resultant line per contact pair.
+void print_checks(std::ostream& os, const levels::Problem& p, const levels::StateChecks& c,
+                  const std::vector<PairResultant>& resultants);
 /// Prints the per-step table, checks (force balance, Coulomb, complementarity) and timings.
 void print_summary(std::ostream& os, const levels::Problem& p, const levels::RunResult& r);
 

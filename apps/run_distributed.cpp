@@ -7,6 +7,7 @@
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/parallel.hpp"
+#include "levels/checks.hpp"
 #include "levels/distributed_solve.hpp"
 #include "mesh/distributed.hpp"
 #include "scene/scene.hpp"
@@ -15,6 +16,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <iomanip>
 #include <numeric>
 
@@ -139,6 +141,22 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
                << std::setprecision(6) << "  " << c.gap << "/" << c.stick << "/"
                << c.slip_forward + c.slip_backward << "\n";
         }
+    levels::StateChecks checks;
+    std::vector<PairResultant> resultants(p.contacts.size());
+    if (r.converged) {
+        checks = levels::check_state(p, r, comm);
+        std::vector<double> sums;
+        for (size_t k = 0; k < p.contacts.size(); ++k) {
+            int closed = 0;
+            const Vec2 f = levels::contact_resultant(F.local, r.nodes, static_cast<int>(k), &closed);
+            sums.insert(sums.end(), {f.x(), f.y(), static_cast<double>(closed)});
+        }
+        comm.allreduce(std::span<double>(sums), ReduceOp::sum);
+        for (size_t k = 0; k < p.contacts.size(); ++k)
+            resultants[k] = {Vec2(sums[3 * k], sums[3 * k + 1]),
+                             static_cast<int>(std::lround(sums[3 * k + 2]))};
+        print_checks(os, p, checks, resultants);
+    }
     os << "\ntimings of process 0 (the distributed levels):\n";
     if (root) r.timings.print(os);
     os << "\ntime: " << std::fixed << std::setprecision(2) << r.seconds << " s"
@@ -279,6 +297,22 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
             lv.push_back(t);
         }
         root_t.insert("levels", lv);
+        toml::array cs;
+        for (size_t k = 0; k < p.contacts.size(); ++k) {
+            toml::table c;
+            c.insert("name", p.contacts[k].name);
+            c.insert("resultant", toml::array{resultants[k].force.x(), resultants[k].force.y()});
+            c.insert("nodes_in_contact", static_cast<int64_t>(resultants[k].in_contact));
+            cs.push_back(c);
+        }
+        root_t.insert("contacts", cs);
+        toml::table ct;
+        ct.insert("force_balance", checks.force_balance);
+        ct.insert("coulomb_excess", checks.coulomb_excess);
+        ct.insert("slip_equality", checks.slip_equality);
+        ct.insert("complementarity", checks.complementarity);
+        ct.insert("penetration", checks.penetration);
+        root_t.insert("checks", ct);
         toml::table sv;
         sv.insert("method", spec.method);
         sv.insert("krylov", spec.krylov);

@@ -5,12 +5,19 @@
 #include "fem/assembly.hpp"
 
 #include <algorithm>
+#include <array>
+#include <span>
 #include <cmath>
 
 namespace mlc::levels {
 
-double force_balance_error(const Level& level, double s, const Vector& u_full,
-                           const std::vector<ContactNodeState>& nodes) {
+namespace {
+
+/// Per axis: the resultant of loads, contact forces and support reactions, and the sum of their
+/// magnitudes, over the vertices `count` accepts (all, or a process's own).
+template <class Count>
+std::array<double, 4> balance_sums(const Level& level, double s, const Vector& u_full,
+                                   const std::vector<ContactNodeState>& nodes, Count&& count) {
     // External forces on the body: loads F, contact forces -C (C = sum_j w_j (lambda_t t +
     // lambda_n n), the multiplier being the force the body exerts), and support reactions
     // Rs = K u - F + C on the fixed components (nodal equilibrium K u = F - C + Rs). The
@@ -25,45 +32,58 @@ double force_balance_error(const Level& level, double s, const Vector& u_full,
             C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
                 el.weight[static_cast<size_t>(j)] * f;
     }
-    double err = 0.0, total = 0.0;
-    for (int a = 0; a < 2; ++a) {
-        double resultant = 0.0, magnitude = 0.0;
+    std::array<double, 4> sums{}; // resultant x, y, magnitude x, y
+    for (int a = 0; a < 2; ++a)
         for (int v = 0; v < level.mesh.n_vertices(); ++v) {
+            if (!count(v)) continue;
             const int i = 2 * v + a;
             const double Rs = level.fixed[static_cast<size_t>(v)][static_cast<size_t>(a)]
                                   ? Ku[i] - F[i] + C[i]
                                   : 0.0;
-            resultant += F[i] - C[i] + Rs;
-            magnitude += std::abs(F[i]) + std::abs(C[i]) + std::abs(Rs);
+            sums[static_cast<size_t>(a)] += F[i] - C[i] + Rs;
+            sums[static_cast<size_t>(2 + a)] += std::abs(F[i]) + std::abs(C[i]) + std::abs(Rs);
         }
-        err = std::max(err, std::abs(resultant));
-        total = std::max(total, magnitude);
-    }
+    return sums;
+}
+
+double balance_error(const std::array<double, 4>& sums) {
+    const double err = std::max(std::abs(sums[0]), std::abs(sums[1]));
+    const double total = std::max(sums[2], sums[3]);
     return total > 0 ? err / total : err;
 }
 
-StateChecks check_state(const Problem& p, const RunResult& r) {
-    StateChecks c;
-    const auto& L = r.finest();
-    c.force_balance = force_balance_error(L, 1.0, r.u_full, r.nodes);
-    double lmax = 0.0;
-    for (const auto& n : r.nodes)
-        lmax = std::max(lmax, std::abs(n.lambda_n));
-    const double umax = r.u_full.size() ? r.u_full.cwiseAbs().maxCoeff() : 0.0;
-    for (size_t e = 0; e < r.nodes.size(); ++e) {
-        const auto& n = r.nodes[e];
+/// The unnormalised contact figures: max |lambda_n|, max |u|, then the six maxima of StateChecks.
+std::array<double, 8> node_maxima(const Problem& p, const Level& L, const Vector& u_full,
+                                  const std::vector<ContactNodeState>& nodes) {
+    std::array<double, 8> m{};
+    for (const auto& n : nodes)
+        m[0] = std::max(m[0], std::abs(n.lambda_n));
+    m[1] = u_full.size() ? u_full.cwiseAbs().maxCoeff() : 0.0;
+    for (size_t e = 0; e < nodes.size(); ++e) {
+        const auto& n = nodes[e];
         const double mu = p.contacts[static_cast<size_t>(L.contacts[e].pair)].mu;
         const double excess = std::abs(n.lambda_t) - mu * std::abs(n.lambda_n);
         // At open nodes lambda = 0 up to round-off: the cone test is meaningful in contact only.
-        if (n.status != contact::Status::gap)
-            c.coulomb_excess = std::max(c.coulomb_excess, std::max(excess, 0.0));
+        if (n.status != contact::Status::gap) m[2] = std::max(m[2], std::max(excess, 0.0));
         if (L.contacts[e].frictional() && (n.status == contact::Status::slip_forward ||
                                            n.status == contact::Status::slip_backward))
-            c.slip_equality = std::max(c.slip_equality, std::abs(excess));
-        c.complementarity = std::max(c.complementarity, std::abs(n.lambda_n * n.d_n));
-        c.penetration = std::max(c.penetration, std::max(-n.d_n, 0.0));
-        c.tension = std::max(c.tension, std::max(n.lambda_n, 0.0));
+            m[3] = std::max(m[3], std::abs(excess));
+        m[4] = std::max(m[4], std::abs(n.lambda_n * n.d_n));
+        m[5] = std::max(m[5], std::max(-n.d_n, 0.0));
+        m[6] = std::max(m[6], std::max(n.lambda_n, 0.0));
     }
+    return m;
+}
+
+StateChecks normalised(const std::array<double, 8>& m, double force_balance) {
+    StateChecks c;
+    c.force_balance = force_balance;
+    const double lmax = m[0], umax = m[1];
+    c.coulomb_excess = m[2];
+    c.slip_equality = m[3];
+    c.complementarity = m[4];
+    c.penetration = m[5];
+    c.tension = m[6];
     if (lmax > 0) {
         c.coulomb_excess /= lmax;
         c.slip_equality /= lmax;
@@ -74,17 +94,47 @@ StateChecks check_state(const Problem& p, const RunResult& r) {
     return c;
 }
 
-Vec2 contact_resultant(const RunResult& r, int pair, int* in_contact) {
+} // namespace
+
+double force_balance_error(const Level& level, double s, const Vector& u_full,
+                           const std::vector<ContactNodeState>& nodes) {
+    return balance_error(balance_sums(level, s, u_full, nodes, [](int) { return true; }));
+}
+
+StateChecks check_state(const Problem& p, const RunResult& r) {
     const auto& L = r.finest();
+    return normalised(node_maxima(p, L, r.u_full, r.nodes),
+                      force_balance_error(L, 1.0, r.u_full, r.nodes));
+}
+
+StateChecks check_state(const Problem& p, const DistributedRunResult& r,
+                        const Communicator& comm) {
+    const DistributedLevel& F = r.finest();
+    const int me = comm.rank();
+    auto sums = balance_sums(F.local, 1.0, r.u_full, r.nodes, [&](int v) {
+        return F.part.vertex_owner[static_cast<size_t>(v)] == me;
+    });
+    comm.allreduce(std::span<double>(sums), ReduceOp::sum);
+    auto m = node_maxima(p, F.local, r.u_full, r.nodes);
+    comm.allreduce(std::span<double>(m), ReduceOp::max);
+    return normalised(m, balance_error(sums));
+}
+
+Vec2 contact_resultant(const Level& L, const std::vector<ContactNodeState>& nodes, int pair,
+                       int* in_contact) {
     Vec2 f = Vec2::Zero();
     int closed = 0;
-    for (size_t e = 0; e < L.contacts.size() && e < r.nodes.size(); ++e) {
+    for (size_t e = 0; e < L.contacts.size() && e < nodes.size(); ++e) {
         if (L.contacts[e].pair != pair) continue;
-        f -= r.nodes[e].lambda_t * L.contacts[e].t + r.nodes[e].lambda_n * L.contacts[e].n;
-        closed += r.nodes[e].status != contact::Status::gap;
+        f -= nodes[e].lambda_t * L.contacts[e].t + nodes[e].lambda_n * L.contacts[e].n;
+        closed += nodes[e].status != contact::Status::gap;
     }
     if (in_contact) *in_contact = closed;
     return f;
+}
+
+Vec2 contact_resultant(const RunResult& r, int pair, int* in_contact) {
+    return contact_resultant(r.finest(), r.nodes, pair, in_contact);
 }
 
 } // namespace mlc::levels

@@ -7,6 +7,7 @@
 #include "levels/level.hpp"
 #include "levels/newton.hpp"
 #include "levels/problem.hpp"
+#include "levels/distributed_solve.hpp"
 #include "levels/solve.hpp"
 
 #include <vector>
@@ -34,10 +35,16 @@ struct StateChecks {
 /// force balance as force_balance_error; the contact figures over all contact nodes, the Coulomb
 /// excess only at nodes in contact and the slip equality only at slipping frictional nodes.
 StateChecks check_state(const Problem& p, const RunResult& r);
+/// Collective: the same checks of a distributed run's final state, each process summing (force
+/// balance) or maximising (the contact figures) over what it owns, reduced over `comm`.
+StateChecks check_state(const Problem& p, const DistributedRunResult& r, const Communicator& comm);
 
 /// The resultant force the target exerts on the contactor nodes of contact pair `pair` in the
 /// final state of a run (finest level, global axes): -sum (lambda_t t + lambda_n n) over the pair's
 /// nodes. `in_contact`, if given, receives the number of those nodes not in gap.
 Vec2 contact_resultant(const RunResult& r, int pair, int* in_contact = nullptr);
+/// The same over the contact nodes `nodes` of level L (L.contacts order), e.g. a process's own.
+Vec2 contact_resultant(const Level& L, const std::vector<ContactNodeState>& nodes, int pair,
+                       int* in_contact = nullptr);
 
 } // namespace mlc::levels
