@@ -19,12 +19,9 @@
 
 namespace mlc::levels {
 
-namespace {
-
 /// The Newton systems of the distributed levels and their multigrid (distributed_solve.hpp).
-class DistributedMultigridSolver {
-public:
-    DistributedMultigridSolver(const std::vector<DistributedLevel>& levels,
+struct DistributedMultigrid::Impl {
+    Impl(const std::vector<DistributedLevel>& levels,
                                const std::vector<DistributedTransfer>& transfers,
                                const Communicator& comm, LinearSolverSpec spec,
                                solvers::MultigridParams mg)
@@ -118,7 +115,6 @@ public:
         return os.str();
     }
 
-private:
     struct Op {
         /// J's owned rows (the one copy of J: hypre's J and the smoother read them in place).
         std::unique_ptr<solvers::RowBlocks> blocks;
@@ -134,13 +130,13 @@ private:
     /// One V-cycle from level k as a Preconditioner.
     class Cycle final : public Preconditioner {
     public:
-        Cycle(const DistributedMultigridSolver& s, size_t k) : s_(s), k_(k) {}
+        Cycle(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
         void setup(const SparseMatrix&) override {}
         void apply(const Vector& r, Vector& z) const override { s_.cycle(k_, r, z); }
         std::string name() const override { return s_.name(); }
 
     private:
-        const DistributedMultigridSolver& s_;
+        const DistributedMultigrid::Impl& s_;
         size_t k_;
     };
 
@@ -285,10 +281,43 @@ private:
     mutable Vector coarse_rhs_;
 };
 
+DistributedMultigrid::DistributedMultigrid(const std::vector<DistributedLevel>& levels,
+                                           const std::vector<DistributedTransfer>& transfers,
+                                           const Communicator& comm, LinearSolverSpec spec,
+                                           solvers::MultigridParams mg)
+    : impl_(std::make_unique<Impl>(levels, transfers, comm, std::move(spec), mg)) {}
+DistributedMultigrid::~DistributedMultigrid() = default;
+void DistributedMultigrid::set_coarse(const Level& level_p,
+                                      const std::vector<Eigen::Matrix2d>& M) {
+    impl_->set_coarse(level_p, M);
+}
+void DistributedMultigrid::prepare(size_t k, const std::vector<Eigen::Matrix2d>& M) {
+    impl_->prepare(k, M);
+}
+SolveResult DistributedMultigrid::solve(size_t k, const std::vector<Eigen::Matrix2d>& M,
+                                        const Vector& b, Vector& dx, double forcing) {
+    return impl_->solve(k, M, b, dx, forcing);
+}
+const solvers::ParMatrix& DistributedMultigrid::matrix(size_t k) const {
+    MLC_CHECK(k >= 1 && k < impl_->op_.size() && impl_->op_[k].prepared,
+              "DistributedMultigrid::matrix: level " << k << " is not prepared");
+    return *impl_->op_[k].J;
+}
+std::unique_ptr<Preconditioner> DistributedMultigrid::preconditioner(size_t k) const {
+    MLC_CHECK(k >= 1 && k < impl_->op_.size(),
+              "DistributedMultigrid::preconditioner: no level " << k);
+    return std::make_unique<Impl::Cycle>(*impl_, k);
+}
+std::string DistributedMultigrid::name() const {
+    return impl_->name();
+}
+
+namespace {
+
 /// The NewtonSystemSolver of distributed level k.
 class DistributedSystem final : public NewtonSystemSolver {
 public:
-    DistributedSystem(DistributedMultigridSolver& s, size_t k) : s_(s), k_(k) {}
+    DistributedSystem(DistributedMultigrid& s, size_t k) : s_(s), k_(k) {}
     using NewtonSystemSolver::solve;
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
                       double forcing) override {
@@ -298,11 +327,13 @@ public:
     void prepare(const std::vector<Eigen::Matrix2d>& M) override { s_.prepare(k_, M); }
 
 private:
-    DistributedMultigridSolver& s_;
+    DistributedMultigrid& s_;
     size_t k_;
 };
 
-solvers::MultigridParams parse_mg(const LinearSolverSpec& spec) {
+} // namespace
+
+solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
     MLC_CHECK(spec.method == "krylov",
               "on several processes the Newton systems are solved by a Krylov method with mg "
               "(--linear krylov --pc mg); '"
@@ -326,6 +357,8 @@ solvers::MultigridParams parse_mg(const LinearSolverSpec& spec) {
     p.validate();
     return p;
 }
+
+namespace {
 
 /// Sums a confusion table over the processes.
 void reduce_confusion(const Communicator& comm, Confusion& c) {
@@ -371,7 +404,7 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
                               << "' is two-body; only rigid obstacles (node-on-rigid pairs) are "
                                  "solved on several processes so far: run this scene on one "
                                  "process");
-    res.mg = parse_mg(options.linear);
+    res.mg = distributed_mg_params(options.linear);
 
     // The partitioned level p and this process's part of it and of the levels above.
     mesh::Mesh mp = problem.mesh0;
@@ -391,7 +424,7 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
             res.transfers.push_back(build_distributed_transfer(res.levels[k - 1], res.levels[k],
                                                                comm, options.q_rule));
     }
-    DistributedMultigridSolver mg(res.levels, res.transfers, comm, options.linear, res.mg);
+    DistributedMultigrid mg(res.levels, res.transfers, comm, options.linear, res.mg);
     std::vector<std::unique_ptr<ContactNewton>> newton(m + 1);
     for (size_t k = 1; k <= m; ++k) {
         newton[k] = std::make_unique<ContactNewton>(
