@@ -278,16 +278,19 @@ double per_length(double lambda, double length) {
     return length > 0.0 ? -lambda / length + 0.0 : 0.0;
 }
 
+} // namespace
+
 void write_contact_steps(const std::filesystem::path& file, const levels::Problem& p,
-                         const levels::RunResult& r) {
-    const auto& L = r.finest();
+                         const levels::Level& L,
+                         const std::vector<std::vector<levels::ContactNodeState>>& step_nodes,
+                         int completed_steps) {
     const ContactGeometry g = contact_geometry(p, L);
     write_file_atomically(file, [&](std::ostream& f) {
         f << "step,s,pair,x,y,ux,uy,lambda_t,lambda_n,length,arc,pressure,traction_t,status\n"
           << std::setprecision(17);
-        for (int k = 0; k < r.completed_steps && k < static_cast<int>(r.step_nodes.size()); ++k) {
+        for (int k = 0; k < completed_steps && k < static_cast<int>(step_nodes.size()); ++k) {
             const double s = static_cast<double>(k + 1) / p.load_steps;
-            const auto& nodes = r.step_nodes[static_cast<size_t>(k)];
+            const auto& nodes = step_nodes[static_cast<size_t>(k)];
             for (size_t e = 0; e < nodes.size(); ++e) {
                 const auto& n = nodes[e];
                 const double len = g.length[e];
@@ -301,8 +304,6 @@ void write_contact_steps(const std::filesystem::path& file, const levels::Proble
         }
     });
 }
-
-} // namespace
 
 std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
                                        const levels::RunResult& r, const OutputOptions& options) {
@@ -331,7 +332,7 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         });
         written.push_back("contact.csv");
     }
-    write_contact_steps(dir / "contact_steps.csv", p, r);
+    write_contact_steps(dir / "contact_steps.csv", p, L, r.step_nodes, r.completed_steps);
     written.push_back("contact_steps.csv");
     { // summary.json
         toml::table root;

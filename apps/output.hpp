@@ -70,6 +70,14 @@ struct ContactGeometry {
 };
 ContactGeometry contact_geometry(const levels::Problem& p, const levels::Level& L);
 
+/// contact_steps.csv: one row per load step (1..completed_steps) and contact node of L (its
+/// L.contacts order; step_nodes[k] in that order), with the node's tributary length and arc
+/// length (contact_geometry), pressure and traction per unit length.
+void write_contact_steps(const std::filesystem::path& file, const levels::Problem& p,
+                         const levels::Level& L,
+                         const std::vector<std::vector<levels::ContactNodeState>>& step_nodes,
+                         int completed_steps);
+
 /// Writes the files of a run into dir (created if needed), each under a temporary name renamed
 /// when complete: when converged, solution.vtu, contact.csv, contact_steps.csv and
 /// summary.json; when stopped on request, contact_steps.csv (the completed steps) and

@@ -15,6 +15,9 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <map>
+#include <set>
+#include <tuple>
 #include <array>
 #include <cmath>
 #include <iomanip>
@@ -39,14 +42,106 @@ levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt) {
 
 namespace {
 
-/// Entries per contact node in the gathered node table.
-constexpr int kNodeWidth = 8; // pair, x, y, ux, uy, lambda_t, lambda_n, status
-
-struct NodeRow {
-    int pair;
-    double x, y, ux, uy, lt, ln;
-    int status;
+/// The contact boundary of a distributed run's finest level, gathered on rank 0 (empty
+/// elsewhere): a Level holding only the contact nodes (sorted by pair, then x, then y) and the
+/// boundary edges carrying a contactor tag, which is what contact_geometry reads, and the node
+/// states of every completed step in the same order.
+struct ContactBoundary {
+    levels::Level level;
+    std::vector<std::vector<levels::ContactNodeState>> step_nodes;
 };
+
+constexpr size_t kNodeWidth = 10; // pair, x, y, ux, uy, lambda_t, lambda_n, d_n, d_t, status
+constexpr size_t kEdgeWidth = 5;  // tag, x0, y0, x1, y1
+
+ContactBoundary gather_contact_boundary(const levels::Problem& p,
+                                        const levels::DistributedRunResult& r,
+                                        const Communicator& comm) {
+    const auto& F = r.finest();
+    const auto& mesh = F.local.mesh;
+    std::set<int> tags;
+    for (const auto& c : p.contacts)
+        if (const auto t = mesh.find_tag(c.contactor)) tags.insert(*t);
+    std::vector<double> edges;
+    for (const auto& be : mesh.boundary)
+        if (tags.count(be.tag) &&
+            F.part.vertex_owner[static_cast<size_t>(be.v0)] == comm.rank()) {
+            const Vec2& a = mesh.vertices[static_cast<size_t>(be.v0)];
+            const Vec2& b = mesh.vertices[static_cast<size_t>(be.v1)];
+            edges.insert(edges.end(), {static_cast<double>(be.tag), a.x(), a.y(), b.x(), b.y()});
+        }
+    std::vector<double> nodes;
+    for (const auto& step : r.step_nodes)
+        for (const auto& n : step) {
+            const int e = F.local.contact_of_vertex[static_cast<size_t>(n.vertex)];
+            nodes.insert(nodes.end(),
+                         {static_cast<double>(F.local.contacts[static_cast<size_t>(e)].pair),
+                          n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n, n.d_n,
+                          n.d_t, static_cast<double>(static_cast<int>(n.status))});
+        }
+    const auto all_edges = comm.gather(std::span<const double>(edges), 0);
+    // Every process holds the same number of steps; its nodes per step are contiguous.
+    const std::int64_t mine = static_cast<std::int64_t>(r.nodes.size());
+    const auto counts = comm.allgather(std::span<const std::int64_t>(&mine, 1));
+    const auto all_nodes = comm.gather(std::span<const double>(nodes), 0);
+    ContactBoundary cb;
+    if (comm.rank() != 0) return cb;
+    levels::Level& L = cb.level;
+    L.mesh.tag_names = mesh.tag_names;
+    std::map<std::pair<double, double>, int> vertex_at;
+    auto vertex = [&](double x, double y) {
+        const auto [it, added] = vertex_at.emplace(std::pair{x, y}, L.mesh.n_vertices());
+        if (added) L.mesh.vertices.emplace_back(x, y);
+        return it->second;
+    };
+    for (size_t i = 0; i + kEdgeWidth <= all_edges.size(); i += kEdgeWidth) {
+        mesh::BoundaryEdge be;
+        be.tag = static_cast<int>(all_edges[i]);
+        be.v0 = vertex(all_edges[i + 1], all_edges[i + 2]);
+        be.v1 = vertex(all_edges[i + 3], all_edges[i + 4]);
+        L.mesh.boundary.push_back(be);
+    }
+    // Per process: steps x its nodes, in rank order; regroup by step.
+    const size_t n_steps = r.step_nodes.size();
+    std::vector<std::vector<const double*>> rows(n_steps);
+    size_t at = 0;
+    for (const std::int64_t c : counts)
+        for (size_t k = 0; k < n_steps; ++k)
+            for (std::int64_t j = 0; j < c; ++j, at += kNodeWidth)
+                rows[k].push_back(all_nodes.data() + at);
+    for (auto& step : rows)
+        std::sort(step.begin(), step.end(), [](const double* a, const double* b) {
+            return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
+        });
+    if (!rows.empty())
+        for (const double* a : rows.front()) {
+            contact::ContactElement e;
+            e.n_nodes = 1;
+            e.pair = static_cast<int>(a[0]);
+            e.vertex[0] = vertex(a[1], a[2]);
+            L.contacts.push_back(e);
+        }
+    L.contact_of_vertex.assign(static_cast<size_t>(L.mesh.n_vertices()), -1);
+    for (size_t e = 0; e < L.contacts.size(); ++e)
+        L.contact_of_vertex[static_cast<size_t>(L.contacts[e].vertex[0])] = static_cast<int>(e);
+    for (const auto& step : rows) {
+        std::vector<levels::ContactNodeState> out;
+        for (const double* a : step) {
+            levels::ContactNodeState n;
+            n.vertex = vertex(a[1], a[2]);
+            n.x = Vec2(a[1], a[2]);
+            n.u = Vec2(a[3], a[4]);
+            n.lambda_t = a[5];
+            n.lambda_n = a[6];
+            n.d_n = a[7];
+            n.d_t = a[8];
+            n.status = static_cast<contact::Status>(static_cast<int>(a[9]));
+            out.push_back(n);
+        }
+        cb.step_nodes.push_back(std::move(out));
+    }
+    return cb;
+}
 
 } // namespace
 
@@ -104,6 +199,14 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
 
     // Per process: what it owns on the finest level.
     const auto& F = r.finest();
+    std::int64_t owned_triangles = 0, owned_displacements = 0;
+    for (const char o : F.part.triangle_owned)
+        owned_triangles += o != 0;
+    for (Index i = 0; i < F.n_owned; ++i)
+        owned_displacements += F.local.dofs.is_displacement(i);
+    std::array<std::int64_t, 3> totals{owned_triangles, owned_displacements,
+                                       F.part.n_owned_vertices()};
+    comm.allreduce(std::span<std::int64_t>(totals), ReduceOp::sum);
     std::vector<double> mine{static_cast<double>(F.n_owned),
                              static_cast<double>(F.local.n_contact_nodes()),
                              static_cast<double>(F.part.n_owned_vertices()),
@@ -197,39 +300,33 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         mesh::write_distributed_vtu(dir / "solution.pvtu", part, fields.point, fields.cell, comm,
                                     vtu);
     }
-    std::vector<double> nodes;
-    for (const auto& n : r.nodes) {
-        const int e = F.local.contact_of_vertex[static_cast<size_t>(n.vertex)];
-        nodes.insert(nodes.end(), {static_cast<double>(F.local.contacts[static_cast<size_t>(e)].pair),
-                                   n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n,
-                                   static_cast<double>(static_cast<int>(n.status))});
-    }
-    const auto gathered = comm.gather(std::span<const double>(nodes), 0);
+    // The contact boundary on rank 0: every process sends the contact-boundary edges that start
+    // at a vertex it owns and its contact nodes after every step.
+    const ContactBoundary cb = gather_contact_boundary(p, r, comm);
     std::vector<std::string> files{"solution.pvtu", "solution_<rank>.vtu (" +
                                                         std::to_string(comm.size()) + " pieces)"};
     if (root) {
-        std::vector<NodeRow> rows;
-        for (size_t i = 0; i + kNodeWidth <= gathered.size(); i += kNodeWidth) {
-            const double* a = gathered.data() + i;
-            rows.push_back({static_cast<int>(a[0]), a[1], a[2], a[3], a[4], a[5], a[6],
-                            static_cast<int>(a[7])});
-        }
-        std::sort(rows.begin(), rows.end(), [](const NodeRow& a, const NodeRow& b) {
-            return std::tie(a.pair, a.x, a.y) < std::tie(b.pair, b.x, b.y);
-        });
         write_file_atomically(dir / "contact.csv", [&](std::ostream& f) {
             f << "x,y,ux,uy,lambda_t,lambda_n,status\n" << std::setprecision(17);
-            for (const auto& n : rows)
-                f << n.x << "," << n.y << "," << n.ux << "," << n.uy << "," << n.lt << "," << n.ln
-                  << "," << contact::to_string(static_cast<contact::Status>(n.status)) << "\n";
+            if (!cb.step_nodes.empty())
+                for (const auto& n : cb.step_nodes.back())
+                    f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << ","
+                      << n.lambda_t << "," << n.lambda_n << "," << contact::to_string(n.status)
+                      << "\n";
         });
         files.push_back("contact.csv");
+        write_contact_steps(dir / "contact_steps.csv", p, cb.level, cb.step_nodes,
+                            r.completed_steps);
+        files.push_back("contact_steps.csv");
         toml::table root_t;
         root_t.insert("scene", p.name);
         root_t.insert("units", p.units);
         root_t.insert("level", static_cast<int64_t>(finest));
         root_t.insert("unknowns", static_cast<int64_t>(F.n_global_dofs));
         root_t.insert("contact_nodes", static_cast<int64_t>(F.n_global_contacts));
+        root_t.insert("displacement_unknowns", static_cast<int64_t>(totals[1]));
+        root_t.insert("vertices", static_cast<int64_t>(totals[2]));
+        root_t.insert("triangles", static_cast<int64_t>(totals[0]));
         root_t.insert("converged", r.converged);
         root_t.insert("load_steps", static_cast<int64_t>(p.load_steps));
         root_t.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
@@ -320,6 +417,16 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         sv.insert("rel_tol", spec.rel_tol);
         sv.insert("distributed", true);
         root_t.insert("solver", sv);
+        double rss_max = 0;
+        for (int q = 0; q < comm.size(); ++q)
+            rss_max = std::max(rss_max, all[static_cast<size_t>(q) * w + 6]);
+        toml::table mt;
+        mt.insert("peak_rss_bytes", rss_max); // the largest process's
+        root_t.insert("memory", mt);
+        toml::table tt; // rank 0's
+        for (const auto& [name, e] : r.timings.table())
+            tt.insert(name, e.seconds);
+        root_t.insert("timings_seconds", tt);
         write_file_atomically(dir / "summary.json",
                               [&](std::ostream& f) { f << toml::json_formatter{root_t} << "\n"; });
         files.push_back("summary.json");

@@ -574,6 +574,7 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
         }
         if (!failed) {
             res.nodes = newton[m]->node_states(s, u_prev[m], x[m].head(res.levels[m].n_owned));
+            res.step_nodes.push_back(res.nodes);
             for (size_t k = 1; k <= m; ++k)
                 u_prev[k] = u_now[k];
             u_prev_p = *st.u_full;

@@ -86,6 +86,8 @@ struct DistributedRunResult {
     Vector x;      ///< the finest level's unknowns on this part (ghost entries from their owners)
     Vector u_full; ///< the finest level's nodal displacements on this part's vertices
     std::vector<ContactNodeState> nodes; ///< the finest level's contact nodes owned here
+    /// The same after every completed load step (nodes is the last).
+    std::vector<std::vector<ContactNodeState>> step_nodes;
     solvers::MultigridParams mg;         ///< the distributed multigrid's cycle
     Timings timings;                     ///< this process's
     double distributed_seconds = 0.0;    ///< this process's time in the distributed levels

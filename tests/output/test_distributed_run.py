@@ -79,6 +79,19 @@ def compare(serial, dist):
             assert abs(float(r[c]) - float(s[c])) <= 1e-8 * u_scale, (k, c, r[c], s[c])
         for c in ("lambda_t", "lambda_n"):
             assert abs(float(r[c]) - float(s[c])) <= 1e-8 * l_scale, (k, c, r[c], s[c])
+    # contact_steps.csv: the same rows (tributary and arc lengths from the gathered boundary).
+    def steps(d):
+        with open(d / "contact_steps.csv") as f:
+            return {(r["step"], round(float(r["x"]), 12), round(float(r["y"]), 12)): r
+                    for r in csv.DictReader(f)}
+    sa, sb = steps(serial), steps(dist)
+    assert sa.keys() == sb.keys()
+    for k, r in sa.items():
+        assert r["status"] == sb[k]["status"]
+        for c in ("length", "arc"):
+            assert abs(float(r[c]) - float(sb[k][c])) <= 1e-12 * (1 + abs(float(r[c]))), (k, c)
+    p_scale = max(abs(float(r["pressure"])) for r in sa.values())
+    assert max(abs(float(sa[k]["pressure"]) - float(sb[k]["pressure"])) for k in sa) <= 1e-8 * p_scale
     # Every vertex's displacement, read by VTK's readers.
     g1 = read(serial / "solution.vtu", parallel=False)
     gp = read(dist / "solution.pvtu", parallel=True)
@@ -103,7 +116,8 @@ def test_several_processes_give_the_one_process_answer(tmp_path, scene, levels):
         assert pieces == [f"solution_{r}.vtu" for r in range(np_)]
         s = json.loads((dist / "summary.json").read_text())
         assert s["processes"] == np_ and len(s["per_process"]) == np_
-        assert s["unknowns"] == s1["unknowns"] and s["contact_nodes"] == s1["contact_nodes"]
+        for key in ("unknowns", "contact_nodes", "vertices", "triangles", "displacement_unknowns"):
+            assert s[key] == s1[key], key
         assert sum(q["owned_unknowns"] for q in s["per_process"]) == s1["unknowns"]
         assert sum(q["contact_nodes"] for q in s["per_process"]) == s1["contact_nodes"]
         assert s["converged"] and s["completed_steps"] == s1["load_steps"]
