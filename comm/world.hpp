@@ -34,6 +34,10 @@ const Communicator& world();
 /// SerialCommunicator. Throws InvalidInput without MPI (no engine needs it then) and for a
 /// communicator of another kind.
 int mpi_handle(const Communicator& c);
+/// The number of processes of this run on this machine (the launcher's OMPI_COMM_WORLD_LOCAL_SIZE,
+/// MPI_LOCALNRANKS or MPI_LOCAL_NRANKS; world().size() when it says nothing; 1 without a launcher):
+/// they share its memory.
+int processes_on_this_machine();
 /// Ends every process of the run with exit code `code` (MPI_Abort on MPI_COMM_WORLD when MPI is
 /// initialised, std::exit otherwise): what a process does after an error the others cannot know
 /// of, so that none waits forever in a collective call.

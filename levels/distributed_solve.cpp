@@ -3,6 +3,7 @@
 #include "levels/distributed_solve.hpp"
 
 #include "contact/element.hpp"
+#include "comm/world.hpp"
 #include "core/check.hpp"
 #include "levels/newton.hpp"
 #include "levels/newton_system.hpp"
@@ -405,6 +406,27 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
                                  "solved on several processes so far: run this scene on one "
                                  "process");
     res.mg = distributed_mg_params(options.linear);
+    {
+        // Memory: a process holds about 1/N of what one process needs for the run (the square at
+        // level 6 on 2 processes: 0.54 of the one-process peak each), and the processes on one
+        // machine share its memory. Decided alike on every process.
+        const auto sizes = predict_level_sizes(problem);
+        const MemoryEstimate one = estimate_memory(sizes, options.linear, true);
+        MemoryEstimate per = one;
+        per.bytes = 1.15 * one.bytes / comm.size() * comm::processes_on_this_machine();
+        const MemoryLimit limit = process_memory_limit();
+        std::string error;
+        try {
+            check_memory_fits(per, limit, sizes);
+        } catch (const InvalidInput& e) {
+            error = std::string(e.what()) + " (the " + std::to_string(comm::processes_on_this_machine()) +
+                    " processes on this machine together; each holds about 1/" +
+                    std::to_string(comm.size()) + " of the run)";
+        }
+        MLC_CHECK(comm.max(error.empty() ? 0 : 1) == 0,
+                  (error.empty() ? std::string("the run does not fit in another process's memory")
+                                 : error));
+    }
 
     // The partitioned level p and this process's part of it and of the levels above.
     mesh::Mesh mp = problem.mesh0;

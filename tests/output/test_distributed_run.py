@@ -187,3 +187,15 @@ def test_ladder_one_to_four_processes_agree(tmp_path, scene, levels):
     for np_ in (2, 3, 4):
         dist, _ = run(tmp_path, f, levels, np_)
         compare(serial, dist)
+
+
+def test_a_run_that_cannot_fit_in_memory_is_refused(tmp_path):
+    # Square level 9: about 180 GiB for one process, so about 90 GiB for each of two processes
+    # on this machine, far beyond its memory: refused before anything is built.
+    cmd = [MPIEXEC, "-n", "2", "--oversubscribe", MLCONTACT, "run", "square", "--levels", "9",
+           "--quiet", "--out", str(tmp_path / "o")]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert p.stderr.count("mlcontact: error:") == 1, p.stderr
+    assert "use fewer --levels (the 2 processes on this machine together" in p.stderr, p.stderr
+    assert not (tmp_path / "o").exists()
