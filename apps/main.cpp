@@ -235,10 +235,13 @@ int main(int argc, char** argv) {
     }
     try {
         if (*run) {
+            // Several processes: Ctrl-C ends them (mpirun forwards it; a stop after the current
+            // Newton iteration would need every process to see it at the same iteration).
+            if (distributed)
+                return mlc::apps::run_scene_distributed(ro, mlc::comm::world(), std::cout);
             mlc::apps::install_stop_handlers();
             ro.stop = &mlc::apps::stop_flag();
             ro.progress_eta = ::isatty(STDOUT_FILENO) == 1;
-            if (distributed) return mlc::apps::run_scene_distributed(ro, mlc::comm::world(), std::cout);
             if (ro.partition_level)
                 throw mlc::InvalidInput("--partition-level applies to runs on several processes "
                                         "(mpirun -np N, N > 1); this run is one process");

@@ -184,7 +184,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     so.exact_fallback = !opt.no_fallback;
     so.r_continuation = !opt.no_continuation;
     so.progress = opt.quiet ? nullptr : &out;
-    so.stop = opt.stop;
+    MLC_CHECK(!opt.stop, "internal error: a distributed run has no stop flag");
     os << "mlcontact: solving '" << p.name << "' on " << comm.size() << " processes\n";
     os << "Newton-system solver: " << spec << " (" << comm.size()
        << " processes: Krylov + distributed mg)\n";
