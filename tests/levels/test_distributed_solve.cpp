@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: MIT
+// The distributed solve (levels/distributed_solve.hpp) against the one-process solve, on any
+// number of processes: ctest runs these tests alone (one process: the distributed code on
+// comm::world(), the serial communicator) and under mpirun -np 2 and -np 3 (label mpi). Every
+// process compares the contact nodes it owns with the one-process run's, matched by their exact
+// coordinates. The partition-level rule is checked against its closed form everywhere.
+#include "levels/distributed.hpp"
+
+#include "core/check.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace mlc;
+
+TEST(PartitionLevel, IsTheCoarsestLevelWithTwoThousandTrianglesPerProcessBelowTheFinest) {
+    // The square's level 0 has 512 triangles; level l has 512 * 4^l.
+    EXPECT_EQ(levels::partition_level(512, 6, 1), 1); // 2 048 >= 2 000
+    EXPECT_EQ(levels::partition_level(512, 6, 2), 2); // 4 000 needed: 8 192
+    EXPECT_EQ(levels::partition_level(512, 6, 4), 2); // 8 000 needed: 8 192
+    EXPECT_EQ(levels::partition_level(512, 6, 5), 3); // 10 000 needed: 32 768
+    EXPECT_EQ(levels::partition_level(512, 3, 1000), 2); // at most finest - 1
+    EXPECT_EQ(levels::partition_level(512, 1, 64), 0);
+    EXPECT_EQ(levels::partition_level(100000, 4, 2), 0); // level 0 is large enough
+    EXPECT_THROW(levels::partition_level(512, 3, 0), InvalidInput);
+}
+
+#if MLC_HAVE_HYPRE
+#include "comm/world.hpp"
+#include "levels/checks.hpp"
+#include "levels/distributed_solve.hpp"
+#include "scene/scene.hpp"
+
+#include <cmath>
+#include <map>
+
+namespace {
+
+using Point = std::pair<double, double>;
+
+void expect_same_answer(const std::string& scene, int levels, int p) {
+    const Communicator& comm = comm::world();
+    levels::Problem prob = scene::load_scene(scene);
+    prob.levels = levels;
+    prob.newton.rel_tol = 1e-12;
+    levels::SolveOptions so;
+    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-12};
+    const levels::RunResult one = levels::solve(prob, so);
+    ASSERT_TRUE(one.converged) << one.failure;
+    const levels::DistributedRunResult d = levels::solve_distributed(prob, so, comm, p);
+    ASSERT_TRUE(d.converged) << d.failure;
+    EXPECT_EQ(d.n_processes, comm.size());
+    EXPECT_EQ(d.completed_steps, prob.load_steps);
+    EXPECT_EQ(d.finest().n_global_dofs, one.finest().n_unknowns());
+    EXPECT_EQ(d.finest().n_global_contacts, one.finest().n_contact_nodes());
+    EXPECT_EQ(comm.sum(static_cast<int>(d.nodes.size())), one.finest().n_contact_nodes());
+    std::map<Point, levels::ContactNodeState> ref;
+    double u_scale = 0, l_scale = 0;
+    for (const auto& n : one.nodes) {
+        ref[{n.x.x(), n.x.y()}] = n;
+        u_scale = std::max(u_scale, n.u.cwiseAbs().maxCoeff());
+        l_scale = std::max({l_scale, std::abs(n.lambda_t), std::abs(n.lambda_n)});
+    }
+    ASSERT_GT(u_scale, 0);
+    ASSERT_GT(l_scale, 0);
+    for (const auto& n : d.nodes) {
+        const auto it = ref.find({n.x.x(), n.x.y()});
+        ASSERT_NE(it, ref.end()) << "no contact node at (" << n.x.x() << ", " << n.x.y() << ")";
+        EXPECT_EQ(n.status, it->second.status);
+        EXPECT_LE((n.u - it->second.u).cwiseAbs().maxCoeff(), 1e-8 * u_scale);
+        EXPECT_LE(std::abs(n.lambda_t - it->second.lambda_t), 1e-8 * l_scale);
+        EXPECT_LE(std::abs(n.lambda_n - it->second.lambda_n), 1e-8 * l_scale);
+    }
+    // The reduced checks and the status counts of every step are the one process's.
+    const levels::StateChecks c1 = levels::check_state(prob, one);
+    const levels::StateChecks cd = levels::check_state(prob, d, comm);
+    EXPECT_LE(cd.force_balance, std::max(10 * c1.force_balance, 1e-11));
+    EXPECT_LE(cd.penetration, std::max(10 * c1.penetration, 1e-12));
+    ASSERT_EQ(d.steps.size(), one.steps.size());
+    for (size_t k = 0; k < d.steps.size(); ++k) {
+        EXPECT_EQ(d.steps[k].counts.gap, one.steps[k].counts.gap) << "step " << k + 1;
+        EXPECT_EQ(d.steps[k].counts.stick, one.steps[k].counts.stick) << "step " << k + 1;
+        EXPECT_EQ(d.steps[k].counts.total(), one.steps[k].counts.total()) << "step " << k + 1;
+    }
+}
+
+} // namespace
+
+TEST(DistributedSolve, SquareLevelThreeIsTheOneProcessAnswer) {
+    expect_same_answer("square", 3, 1);
+}
+
+TEST(DistributedSolve, HertzLevelTwoIsTheOneProcessAnswer) {
+    expect_same_answer("hertz", 2, 1);
+}
+
+TEST(DistributedSolve, RefusesWhatHasNoDistributedForm) {
+    const Communicator& comm = comm::world();
+    levels::Problem prob = scene::load_scene("square");
+    prob.levels = 2;
+    levels::SolveOptions so;
+    so.linear.method = "schur";
+    EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
+    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg:coarse=galerkin"};
+    EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
+    so.linear.pc = "mg";
+    EXPECT_THROW(levels::solve_distributed(prob, so, comm, 2), InvalidInput); // p = L
+    so.coarse_to_fine = false;
+    EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
+    levels::Problem two = scene::load_scene("dovetail");
+    two.levels = 2;
+    so.coarse_to_fine = true;
+    EXPECT_THROW(levels::solve_distributed(two, so, comm, 1), InvalidInput);
+}
+#endif
