@@ -49,8 +49,8 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
                  .max_iter = opt.max_iter};
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
        << p.load_steps << " load steps, " << np << " processes (one thread each), partition level "
-       << plevel << ", Krylov " << opt.krylov << " + distributed " << opt.pcs.front()
-       << " rel_tol " << opt.rel_tol << ", times are medians of " << opt.repeat << " run(s)\n";
+       << plevel << ", Krylov " << opt.krylov << " + distributed " << opt.pcs.front() << " rel_tol "
+       << opt.rel_tol << ", times are medians of " << opt.repeat << " run(s)\n";
     std::vector<double> walls;
     levels::DistributedRunResult last;
     for (int rep = 0; rep < opt.repeat; ++rep) {
@@ -91,8 +91,8 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
         rows.push_back(row);
     };
     for (size_t l = 0; l < last.serial.level_steps.size(); ++l)
-        add(static_cast<int>(l), last.serial.levels()[l].n_unknowns(),
-            last.serial.level_steps[l], false);
+        add(static_cast<int>(l), last.serial.levels()[l].n_unknowns(), last.serial.level_steps[l],
+            false);
     for (size_t k = 1; k < last.level_steps.size(); ++k)
         add(plevel + static_cast<int>(k), last.levels[k].n_global_dofs, last.level_steps[k], true);
     std::vector<double> mine{static_cast<double>(peak_rss_bytes()),
@@ -110,8 +110,8 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
            << std::setw(10) << std::fixed << std::setprecision(2) << r.its_mean << std::setw(6)
            << std::setprecision(0) << r.its_max << std::setw(10) << std::setprecision(3)
            << r.seconds << std::defaultfloat << std::setprecision(6) << "\n";
-    os << "wall " << std::fixed << std::setprecision(3) << wall << " s (median of "
-       << walls.size() << "; runs";
+    os << "wall " << std::fixed << std::setprecision(3) << wall << " s (median of " << walls.size()
+       << "; runs";
     for (double w : walls)
         os << " " << w;
     os << "), peak RSS per process max " << std::setprecision(1) << rss_max / (1024.0 * 1024.0)
@@ -145,10 +145,10 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
             for (size_t i = 0; i < rows.size(); ++i) {
                 const auto& r = rows[i];
                 js << (i ? ",\n    " : "\n    ") << "{\"level\": " << r.level
-                   << ", \"unknowns\": " << r.unknowns << ", \"distributed\": "
-                   << (r.distributed ? "true" : "false") << ", \"newton\": " << r.newton
-                   << ", \"its_per_newton\": " << r.its_mean << ", \"its_max\": " << r.its_max
-                   << ", \"seconds\": " << r.seconds << "}";
+                   << ", \"unknowns\": " << r.unknowns
+                   << ", \"distributed\": " << (r.distributed ? "true" : "false")
+                   << ", \"newton\": " << r.newton << ", \"its_per_newton\": " << r.its_mean
+                   << ", \"its_max\": " << r.its_max << ", \"seconds\": " << r.seconds << "}";
             }
             js << "\n  ]\n}\n";
         });

@@ -8,16 +8,16 @@
 // breakdown; a run stopped by SIGINT / SIGTERM exits 130 / 143 after writing the files of its
 // completed load steps.
 #include "apps/bench.hpp"
+#include "apps/bench_distributed.hpp"
 #include "apps/interrupt.hpp"
 #include "apps/preconditioners.hpp"
 #include "apps/run.hpp"
+#include "apps/run_distributed.hpp"
 #include "apps/study_accuracy.hpp"
 #include "apps/study_error_vs_time.hpp"
 #include "apps/study_extremes.hpp"
 #include "apps/study_preconditioners.hpp"
 #include "apps/study_status_transfer.hpp"
-#include "apps/bench_distributed.hpp"
-#include "apps/run_distributed.hpp"
 #include "comm/world.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
@@ -227,10 +227,11 @@ int main(int argc, char** argv) {
     const int rank = distributed ? mlc::comm::world().rank() : 0;
     if (distributed && !*run && !*bsq) {
         if (rank == 0)
-            std::cerr << "mlcontact: error: started as " << mlc::comm::world().size()
-                      << " MPI processes, but this command runs as one process: on several "
-                         "processes run `mlcontact run` (one-body scenes, Krylov + mg) or `mlcontact "
-                         "bench square`; run the others without mpirun or with mpirun -np 1\n";
+            std::cerr
+                << "mlcontact: error: started as " << mlc::comm::world().size()
+                << " MPI processes, but this command runs as one process: on several "
+                   "processes run `mlcontact run` (one-body scenes, Krylov + mg) or `mlcontact "
+                   "bench square`; run the others without mpirun or with mpirun -np 1\n";
         return 1;
     }
     try {
@@ -317,11 +318,15 @@ int main(int argc, char** argv) {
         if (rank == 0) std::cerr << "mlcontact: error: " << e.what() << "\n";
         return 1;
     } catch (const mlc::SolverBreakdown& e) {
-        std::cerr << "mlcontact: numerical breakdown" << (distributed ? " (process " + std::to_string(rank) + ")" : "") << ": " << e.what() << "\n";
+        std::cerr << "mlcontact: numerical breakdown"
+                  << (distributed ? " (process " + std::to_string(rank) + ")" : "") << ": "
+                  << e.what() << "\n";
         if (distributed) mlc::comm::abort_all(3); // the others may wait in a collective
         return 3;
     } catch (const std::exception& e) {
-        std::cerr << "mlcontact: error" << (distributed ? " (process " + std::to_string(rank) + ")" : "") << ": " << e.what() << "\n";
+        std::cerr << "mlcontact: error"
+                  << (distributed ? " (process " + std::to_string(rank) + ")" : "") << ": "
+                  << e.what() << "\n";
         if (distributed) mlc::comm::abort_all(1);
         return 1;
     }

@@ -4,8 +4,8 @@
 /// Every number is checked finite before a file is written; a NaN/Inf aborts with a diagnosis.
 #pragma once
 
-#include "levels/problem.hpp"
 #include "levels/checks.hpp"
+#include "levels/problem.hpp"
 #include "levels/solve.hpp"
 #include "mesh/io/vtu.hpp"
 

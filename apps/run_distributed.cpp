@@ -15,13 +15,13 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <map>
-#include <set>
-#include <tuple>
 #include <array>
 #include <cmath>
 #include <iomanip>
+#include <map>
 #include <numeric>
+#include <set>
+#include <tuple>
 
 namespace mlc::apps {
 
@@ -64,8 +64,7 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
         if (const auto t = mesh.find_tag(c.contactor)) tags.insert(*t);
     std::vector<double> edges;
     for (const auto& be : mesh.boundary)
-        if (tags.count(be.tag) &&
-            F.part.vertex_owner[static_cast<size_t>(be.v0)] == comm.rank()) {
+        if (tags.count(be.tag) && F.part.vertex_owner[static_cast<size_t>(be.v0)] == comm.rank()) {
             const Vec2& a = mesh.vertices[static_cast<size_t>(be.v0)];
             const Vec2& b = mesh.vertices[static_cast<size_t>(be.v1)];
             edges.insert(edges.end(), {static_cast<double>(be.tag), a.x(), a.y(), b.x(), b.y()});
@@ -76,8 +75,8 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
             const int e = F.local.contact_of_vertex[static_cast<size_t>(n.vertex)];
             nodes.insert(nodes.end(),
                          {static_cast<double>(F.local.contacts[static_cast<size_t>(e)].pair),
-                          n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n, n.d_n,
-                          n.d_t, static_cast<double>(static_cast<int>(n.status))});
+                          n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n, n.d_n, n.d_t,
+                          static_cast<double>(static_cast<int>(n.status))});
         }
     const auto all_edges = comm.gather(std::span<const double>(edges), 0);
     // Every process holds the same number of steps; its nodes per step are contiguous.
@@ -165,12 +164,13 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     int plevel = opt.partition_level
                      ? *opt.partition_level
                      : levels::partition_level(p.mesh0.n_triangles(), finest, comm.size());
-    MLC_CHECK(plevel >= 0 && plevel < finest,
-              "--partition-level must lie in [0, " << finest - 1 << "] for --levels " << finest
-                                                   << ", found " << plevel);
+    MLC_CHECK(plevel >= 0 && plevel < finest, "--partition-level must lie in [0, "
+                                                  << finest - 1 << "] for --levels " << finest
+                                                  << ", found " << plevel);
     // One thread per process: the processes are the parallelism (hybrid runs are not measured).
     parallel::set_num_threads(1);
-    const mesh::VtuFormat vtu = opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
+    const mesh::VtuFormat vtu =
+        opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
 
     levels::SolveOptions so;
@@ -189,10 +189,10 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     os << "Newton-system solver: " << spec << " (" << comm.size()
        << " processes: Krylov + distributed mg)\n";
     os << "partition level " << plevel
-       << (opt.partition_level ? " (--partition-level)"
-                               : " (the coarsest with " +
-                                     std::to_string(levels::kTrianglesPerProcess) +
-                                     " triangles per process, at most --levels - 1)")
+       << (opt.partition_level
+               ? " (--partition-level)"
+               : " (the coarsest with " + std::to_string(levels::kTrianglesPerProcess) +
+                     " triangles per process, at most --levels - 1)")
        << ": levels 0-" << plevel << " on every process, " << plevel + 1 << "-" << finest
        << " distributed\n";
     levels::DistributedRunResult r = levels::solve_distributed(p, so, comm, plevel);
@@ -207,13 +207,14 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     std::array<std::int64_t, 3> totals{owned_triangles, owned_displacements,
                                        F.part.n_owned_vertices()};
     comm.allreduce(std::span<std::int64_t>(totals), ReduceOp::sum);
-    std::vector<double> mine{static_cast<double>(F.n_owned),
-                             static_cast<double>(F.local.n_contact_nodes()),
-                             static_cast<double>(F.part.n_owned_vertices()),
-                             static_cast<double>(F.local.mesh.n_vertices() - F.part.n_owned_vertices()),
-                             static_cast<double>(F.local.mesh.n_triangles()),
-                             r.distributed_seconds,
-                             static_cast<double>(peak_rss_bytes())};
+    std::vector<double> mine{
+        static_cast<double>(F.n_owned),
+        static_cast<double>(F.local.n_contact_nodes()),
+        static_cast<double>(F.part.n_owned_vertices()),
+        static_cast<double>(F.local.mesh.n_vertices() - F.part.n_owned_vertices()),
+        static_cast<double>(F.local.mesh.n_triangles()),
+        r.distributed_seconds,
+        static_cast<double>(peak_rss_bytes())};
     const auto all = comm.allgather(std::span<const double>(mine));
     const size_t w = mine.size();
     os << "\nprocesses: " << comm.size() << "\n"
@@ -251,7 +252,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         std::vector<double> sums;
         for (size_t k = 0; k < p.contacts.size(); ++k) {
             int closed = 0;
-            const Vec2 f = levels::contact_resultant(F.local, r.nodes, static_cast<int>(k), &closed);
+            const Vec2 f =
+                levels::contact_resultant(F.local, r.nodes, static_cast<int>(k), &closed);
             sums.insert(sums.end(), {f.x(), f.y(), static_cast<double>(closed)});
         }
         comm.allreduce(std::span<double>(sums), ReduceOp::sum);
@@ -262,8 +264,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     }
     os << "\ntimings of process 0 (the distributed levels):\n";
     if (root) r.timings.print(os);
-    os << "\ntime: " << std::fixed << std::setprecision(2) << r.seconds << " s"
-       << std::defaultfloat << std::setprecision(6) << "\n";
+    os << "\ntime: " << std::fixed << std::setprecision(2) << r.seconds << " s" << std::defaultfloat
+       << std::setprecision(6) << "\n";
     if (!r.converged) {
         os << "\nerror: " << r.failure << "\n";
         return 2;

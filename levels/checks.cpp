@@ -6,8 +6,8 @@
 
 #include <algorithm>
 #include <array>
-#include <span>
 #include <cmath>
+#include <span>
 
 namespace mlc::levels {
 
@@ -107,8 +107,7 @@ StateChecks check_state(const Problem& p, const RunResult& r) {
                       force_balance_error(L, 1.0, r.u_full, r.nodes));
 }
 
-StateChecks check_state(const Problem& p, const DistributedRunResult& r,
-                        const Communicator& comm) {
+StateChecks check_state(const Problem& p, const DistributedRunResult& r, const Communicator& comm) {
     const DistributedLevel& F = r.finest();
     const int me = comm.rank();
     auto sums = balance_sums(F.local, 1.0, r.u_full, r.nodes, [&](int v) {

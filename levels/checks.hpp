@@ -4,10 +4,10 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "levels/distributed_solve.hpp"
 #include "levels/level.hpp"
 #include "levels/newton.hpp"
 #include "levels/problem.hpp"
-#include "levels/distributed_solve.hpp"
 #include "levels/solve.hpp"
 
 #include <vector>

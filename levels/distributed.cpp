@@ -82,7 +82,8 @@ void GhostExchange::update(const fem::DofMap& dofs, Vector& x) const {
         size_t i = 0;
         for (const int v : recv_[q])
             for_vertex_dofs(dofs, v, n_extra_of(dofs, v), [&](int d) {
-                MLC_CHECK(i < in[q].size(), "GhostExchange: process " << q << " sent too few values");
+                MLC_CHECK(i < in[q].size(),
+                          "GhostExchange: process " << q << " sent too few values");
                 x[d] = in[q][i++];
             });
         MLC_CHECK(i == in[q].size(), "GhostExchange: process " << q << " sent too many values");

@@ -57,14 +57,14 @@ private:
 
 /// One process's part of one level of a distributed run.
 struct DistributedLevel {
-    mesh::LocalLevel part; ///< the local mesh moved into `local`: part.mesh is empty
-    Level local;           ///< the part as a Level (owned unknowns first)
+    mesh::LocalLevel part;    ///< the local mesh moved into `local`: part.mesh is empty
+    Level local;              ///< the part as a Level (owned unknowns first)
     std::vector<int> n_extra; ///< multipliers per local vertex (ghosts: their owners')
     GhostExchange ghosts;
-    Index n_owned = 0;              ///< owned unknowns: local unknowns [0, n_owned)
-    std::int64_t first_dof = 0;     ///< global number of local unknown 0
-    std::int64_t n_global_dofs = 0; ///< unknowns of the level over all processes
-    int n_global_contacts = 0;      ///< contact nodes of the level over all processes
+    Index n_owned = 0;                    ///< owned unknowns: local unknowns [0, n_owned)
+    std::int64_t first_dof = 0;           ///< global number of local unknown 0
+    std::int64_t n_global_dofs = 0;       ///< unknowns of the level over all processes
+    int n_global_contacts = 0;            ///< contact nodes of the level over all processes
     std::vector<std::int64_t> global_dof; ///< global number of every local unknown
     /// The stiffness's owned rows, the one copy of it (local.elastic.K is freed once they are
     /// cut from it), and K, the ParCSR matrix on their arrays.

@@ -2,14 +2,14 @@
 // Coarse-to-fine Newton over the distributed levels, with the distributed multigrid.
 #include "levels/distributed_solve.hpp"
 
-#include "contact/element.hpp"
 #include "comm/world.hpp"
+#include "contact/element.hpp"
 #include "core/check.hpp"
 #include "levels/newton.hpp"
 #include "levels/newton_system.hpp"
+#include "smoothers/block_sor.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/krylov.hpp"
-#include "smoothers/block_sor.hpp"
 
 #include <Eigen/SparseLU>
 
@@ -23,9 +23,8 @@ namespace mlc::levels {
 /// The Newton systems of the distributed levels and their multigrid (distributed_solve.hpp).
 struct DistributedMultigrid::Impl {
     Impl(const std::vector<DistributedLevel>& levels,
-                               const std::vector<DistributedTransfer>& transfers,
-                               const Communicator& comm, LinearSolverSpec spec,
-                               solvers::MultigridParams mg)
+         const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
+         LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
           op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k)
@@ -69,19 +68,19 @@ struct DistributedMultigrid::Impl {
             v[o.kpos[q]] += kv[q];
         size_t c = 0;
         for (size_t e = 0; e < L.local.contacts.size(); ++e)
-            contact::for_each_tangent_entry(L.local.contacts[e], M[e], L.local.dofs,
-                                            L.local.lambda_dof[e],
-                                            [&](int, int, double value) { v[o.cpos[c++]] += value; });
+            contact::for_each_tangent_entry(
+                L.local.contacts[e], M[e], L.local.dofs, L.local.lambda_dof[e],
+                [&](int, int, double value) { v[o.cpos[c++]] += value; });
         if (!o.smoother) {
             std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
             for (Index i = 0; i < L.n_owned; ++i)
                 vertex_of[static_cast<size_t>(i)] = L.local.dofs.vertex_of(i);
-            o.smoother = std::make_unique<smoothers::BlockSOR>(smoothers::BlockSORParams{
-                .omega = mg_.omega,
-                .block_size = 2,
-                .block_starts = solvers::vertex_block_starts(vertex_of),
-                .parts = 1,
-                .kernel = smoothers::Kernel::unrolled});
+            o.smoother = std::make_unique<smoothers::BlockSOR>(
+                smoothers::BlockSORParams{.omega = mg_.omega,
+                                          .block_size = 2,
+                                          .block_starts = solvers::vertex_block_starts(vertex_of),
+                                          .parts = 1,
+                                          .kernel = smoothers::Kernel::unrolled});
             o.smoother->setup(o.blocks->diag);
         } else {
             o.smoother->update_values(o.blocks->diag);
@@ -90,8 +89,8 @@ struct DistributedMultigrid::Impl {
         o.prepared = true;
     }
 
-    SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b,
-                      Vector& dx, double forcing) {
+    SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                      double forcing) {
         const double t0 = wall_seconds();
         prepare(k, M);
         const double t1 = wall_seconds();
@@ -161,14 +160,13 @@ struct DistributedMultigrid::Impl {
         std::vector<std::pair<int, int>> centries;
         const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
         for (size_t e = 0; e < L.contacts.size(); ++e)
-            contact::for_each_tangent_entry(L.contacts[e], I, L.dofs, L.lambda_dof[e],
-                                            [&](int row, int col, double) {
-                                                MLC_ASSERT(row < n && col < n,
-                                                           "a contact entry outside the owned "
-                                                           "unknowns");
-                                                trip.emplace_back(row, col, 0.0);
-                                                centries.emplace_back(row, col);
-                                            });
+            contact::for_each_tangent_entry(
+                L.contacts[e], I, L.dofs, L.lambda_dof[e], [&](int row, int col, double) {
+                    MLC_ASSERT(row < n && col < n, "a contact entry outside the owned "
+                                                   "unknowns");
+                    trip.emplace_back(row, col, 0.0);
+                    centries.emplace_back(row, col);
+                });
         B.diag.resize(n, n);
         B.diag.setFromTriplets(trip.begin(), trip.end());
         B.diag.makeCompressed();
@@ -200,7 +198,8 @@ struct DistributedMultigrid::Impl {
                       "internal error: a vertex of level p's part is not a level-p vertex");
             for (int c = 0; c < 2; ++c) {
                 const int d = dofs.u_dof(v, c);
-                if (d >= 0 && d < D.n_owned) mine[static_cast<size_t>(d)] = Lp.dofs.u_dof(loc.id, c);
+                if (d >= 0 && d < D.n_owned)
+                    mine[static_cast<size_t>(d)] = Lp.dofs.u_dof(loc.id, c);
             }
             const int e = dofs.extra_dof(v);
             for (int q = 0; e >= 0 && q < D.n_extra[static_cast<size_t>(v)]; ++q)
@@ -288,8 +287,7 @@ DistributedMultigrid::DistributedMultigrid(const std::vector<DistributedLevel>& 
                                            solvers::MultigridParams mg)
     : impl_(std::make_unique<Impl>(levels, transfers, comm, std::move(spec), mg)) {}
 DistributedMultigrid::~DistributedMultigrid() = default;
-void DistributedMultigrid::set_coarse(const Level& level_p,
-                                      const std::vector<Eigen::Matrix2d>& M) {
+void DistributedMultigrid::set_coarse(const Level& level_p, const std::vector<Eigen::Matrix2d>& M) {
     impl_->set_coarse(level_p, M);
 }
 void DistributedMultigrid::prepare(size_t k, const std::vector<Eigen::Matrix2d>& M) {
@@ -338,8 +336,9 @@ solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
     MLC_CHECK(spec.method == "krylov",
               "on several processes the Newton systems are solved by a Krylov method with mg "
               "(--linear krylov --pc mg); '"
-                  << spec.method << "' has no distributed form (schur, lu, cf and sorcf need the "
-                                    "whole level on one process)");
+                  << spec.method
+                  << "' has no distributed form (schur, lu, cf and sorcf need the "
+                     "whole level on one process)");
     const auto ps = solvers::parse_preconditioner_spec(spec.pc);
     MLC_CHECK(ps.name == "mg", "on several processes the preconditioner is mg; '"
                                    << spec.pc
@@ -419,7 +418,8 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
         try {
             check_memory_fits(per, limit, sizes);
         } catch (const InvalidInput& e) {
-            error = std::string(e.what()) + " (the " + std::to_string(comm::processes_on_this_machine()) +
+            error = std::string(e.what()) + " (the " +
+                    std::to_string(comm::processes_on_this_machine()) +
                     " processes on this machine together; each holds about 1/" +
                     std::to_string(comm.size()) + " of the run)";
         }
@@ -443,15 +443,15 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
     {
         ScopedTimer t(&res.timings, "setup/transfers");
         for (size_t k = 1; k <= m; ++k)
-            res.transfers.push_back(build_distributed_transfer(res.levels[k - 1], res.levels[k],
-                                                               comm, options.q_rule));
+            res.transfers.push_back(
+                build_distributed_transfer(res.levels[k - 1], res.levels[k], comm, options.q_rule));
     }
     DistributedMultigrid mg(res.levels, res.transfers, comm, options.linear, res.mg);
     std::vector<std::unique_ptr<ContactNewton>> newton(m + 1);
     for (size_t k = 1; k <= m; ++k) {
-        newton[k] = std::make_unique<ContactNewton>(
-            res.levels[k].local, problem.newton, std::make_unique<DistributedSystem>(mg, k),
-            &res.timings);
+        newton[k] = std::make_unique<ContactNewton>(res.levels[k].local, problem.newton,
+                                                    std::make_unique<DistributedSystem>(mg, k),
+                                                    &res.timings);
         newton[k]->set_distribution({&comm, res.levels[k].n_owned, res.levels[k].K.get()});
         newton[k]->set_interrupt(options.interrupt_requested);
     }
@@ -559,11 +559,10 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
                           << " in " << r.iterations << " Newton it, " << r.linear_iterations
                           << " Krylov it, final residual " << std::scientific
                           << std::setprecision(2)
-                          << (r.residuals.empty() ? 0.0 : r.residuals.back())
-                          << std::defaultfloat << std::setprecision(6) << ", "
-                          << std::fixed << std::setprecision(2) << r.seconds << " s"
-                          << std::defaultfloat << std::setprecision(6) << " (" << comm.size()
-                          << " processes)" << std::endl;
+                          << (r.residuals.empty() ? 0.0 : r.residuals.back()) << std::defaultfloat
+                          << std::setprecision(6) << ", " << std::fixed << std::setprecision(2)
+                          << r.seconds << " s" << std::defaultfloat << std::setprecision(6) << " ("
+                          << comm.size() << " processes)" << std::endl;
             }
             const bool ok = ls.report.converged;
             if (k == m) res.steps.push_back(ls.report);
@@ -604,17 +603,19 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
         }
         res.distributed_seconds += wall_seconds() - t0;
     };
-    res.serial = solve([&] {
-        Problem sp = problem;
-        sp.levels = p;
-        return sp;
-    }(), so);
+    res.serial = solve(
+        [&] {
+            Problem sp = problem;
+            sp.levels = p;
+            return sp;
+        }(),
+        so);
     res.x = x[m];
     res.u_full = u_now[m];
     res.converged = !failed && res.serial.converged && res.completed_steps == problem.load_steps;
     if (!failed && !res.serial.converged)
-        res.failure = res.serial.failure.empty() ? "the levels up to p did not converge"
-                                                 : res.serial.failure;
+        res.failure =
+            res.serial.failure.empty() ? "the levels up to p did not converge" : res.serial.failure;
     res.seconds = wall_seconds() - t_start;
     return res;
 }

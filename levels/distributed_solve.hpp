@@ -88,10 +88,10 @@ struct DistributedRunResult {
     std::vector<ContactNodeState> nodes; ///< the finest level's contact nodes owned here
     /// The same after every completed load step (nodes is the last).
     std::vector<std::vector<ContactNodeState>> step_nodes;
-    solvers::MultigridParams mg;         ///< the distributed multigrid's cycle
-    Timings timings;                     ///< this process's
-    double distributed_seconds = 0.0;    ///< this process's time in the distributed levels
-    double seconds = 0.0;                ///< wall time of the whole solve
+    solvers::MultigridParams mg;      ///< the distributed multigrid's cycle
+    Timings timings;                  ///< this process's
+    double distributed_seconds = 0.0; ///< this process's time in the distributed levels
+    double seconds = 0.0;             ///< wall time of the whole solve
     bool converged = false;
     std::string failure;
     int completed_steps = 0;

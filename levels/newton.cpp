@@ -5,11 +5,11 @@
 #include "core/check.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 #include <sstream>
 #include <tuple>
-#include <array>
-#include <span>
 
 namespace mlc::levels {
 

@@ -74,7 +74,8 @@ struct ParMatrix::Impl {
     ~Impl() {
         if (view) {
             // The arrays are RowBlocks'; hypre frees its own objects only.
-            for (hypre_CSRMatrix* b : {hypre_ParCSRMatrixDiag(view), hypre_ParCSRMatrixOffd(view)}) {
+            for (hypre_CSRMatrix* b :
+                 {hypre_ParCSRMatrixDiag(view), hypre_ParCSRMatrixOffd(view)}) {
                 hypre_CSRMatrixI(b) = nullptr;
                 hypre_CSRMatrixJ(b) = nullptr;
                 hypre_CSRMatrixData(b) = nullptr;
@@ -175,7 +176,8 @@ ParMatrix::ParMatrix(const Communicator& comm, const DistributedRows& r, std::in
     check(HYPRE_IJMatrixGetObject(m.ij_A, reinterpret_cast<void**>(&m.A)),
           "HYPRE_IJMatrixGetObject");
     // x in the column space, y in the row space.
-    for (auto [ij, par, a, b] : {std::tuple{&m.ij_x, &m.x, clo, chi}, std::tuple{&m.ij_y, &m.y, lo, hi}}) {
+    for (auto [ij, par, a, b] :
+         {std::tuple{&m.ij_x, &m.x, clo, chi}, std::tuple{&m.ij_y, &m.y, lo, hi}}) {
         check(HYPRE_IJVectorCreate(c, a, b, ij), "HYPRE_IJVectorCreate");
         check(HYPRE_IJVectorSetObjectType(*ij, HYPRE_PARCSR), "HYPRE_IJVectorSetObjectType");
         check(HYPRE_IJVectorInitialize(*ij), "HYPRE_IJVectorInitialize");
@@ -226,10 +228,9 @@ ParMatrix::ParMatrix(const Communicator& comm, RowBlocks& b) : impl_(std::make_u
         MLC_CHECK(b.diag.isCompressed() && b.offd.isCompressed(),
                   "ParMatrix: the blocks must be compressed");
         MLC_CHECK(b.offd.rows() == m.n && b.offd.cols() == static_cast<Index>(b.col_map.size()),
-                  "ParMatrix: the off-diagonal block is " << b.offd.rows() << " x "
-                                                          << b.offd.cols() << " for " << m.n
-                                                          << " rows and " << b.col_map.size()
-                                                          << " columns");
+                  "ParMatrix: the off-diagonal block is " << b.offd.rows() << " x " << b.offd.cols()
+                                                          << " for " << m.n << " rows and "
+                                                          << b.col_map.size() << " columns");
         for (size_t j = 0; j < b.col_map.size(); ++j) {
             MLC_CHECK(b.col_map[j] >= 0 && b.col_map[j] < m.n_global_cols &&
                           (b.col_map[j] < m.first_col || b.col_map[j] >= m.first_col + m.n_cols),
@@ -301,8 +302,8 @@ namespace {
 
 /// Runs f with the local data of hypre's vectors x and y pointing at the given arrays (no copy),
 /// restoring hypre's own arrays afterwards.
-template <class F> void on_arrays(HYPRE_ParVector x, const double* xp, HYPRE_ParVector y,
-                                  double* yp, F&& f) {
+template <class F>
+void on_arrays(HYPRE_ParVector x, const double* xp, HYPRE_ParVector y, double* yp, F&& f) {
     hypre_Vector* lx = hypre_ParVectorLocalVector(reinterpret_cast<hypre_ParVector*>(x));
     hypre_Vector* ly = hypre_ParVectorLocalVector(reinterpret_cast<hypre_ParVector*>(y));
     double* const ox = hypre_VectorData(lx);
@@ -362,8 +363,8 @@ void ParMatrix::apply(const Vector& x, Vector& y) const {
 
 void ParMatrix::apply_transpose(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
-    MLC_CHECK(x.size() == m.n, "ParMatrix::apply_transpose: x has "
-                                   << x.size() << " entries for " << m.n << " owned rows");
+    MLC_CHECK(x.size() == m.n, "ParMatrix::apply_transpose: x has " << x.size() << " entries for "
+                                                                    << m.n << " owned rows");
     y.resize(m.n_cols);
     on_arrays(m.y, x.data(), m.x, y.data(), [&] {
         check(HYPRE_ParCSRMatrixMatvecT(1.0, m.A, m.y, 0.0, m.x), "HYPRE_ParCSRMatrixMatvecT");
@@ -372,9 +373,9 @@ void ParMatrix::apply_transpose(const Vector& x, Vector& y) const {
 
 void ParMatrix::ghost_values(const Vector& x, Vector& ghost) const {
     const Impl& m = *impl_;
-    MLC_CHECK(x.size() == m.n_cols, "ParMatrix::ghost_values: x has "
-                                        << x.size() << " entries for " << m.n_cols
-                                        << " owned columns");
+    MLC_CHECK(x.size() == m.n_cols, "ParMatrix::ghost_values: x has " << x.size() << " entries for "
+                                                                      << m.n_cols
+                                                                      << " owned columns");
     auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
     hypre_ParCSRCommPkg* pkg = hypre_ParCSRMatrixCommPkg(A);
     const HYPRE_Int sends = hypre_ParCSRCommPkgNumSends(pkg);
@@ -384,8 +385,7 @@ void ParMatrix::ghost_values(const Vector& x, Vector& ghost) const {
     for (HYPRE_Int i = begin; i < end; ++i)
         m.send[static_cast<size_t>(i - begin)] = x[hypre_ParCSRCommPkgSendMapElmt(pkg, i)];
     ghost.resize(hypre_CSRMatrixNumCols(hypre_ParCSRMatrixOffd(A)));
-    hypre_ParCSRCommHandle* h =
-        hypre_ParCSRCommHandleCreate(1, pkg, m.send.data(), ghost.data());
+    hypre_ParCSRCommHandle* h = hypre_ParCSRCommHandleCreate(1, pkg, m.send.data(), ghost.data());
     hypre_ParCSRCommHandleDestroy(h);
 }
 

@@ -14,10 +14,10 @@ using namespace mlc;
 
 TEST(PartitionLevel, IsTheCoarsestLevelWithTwoThousandTrianglesPerProcessBelowTheFinest) {
     // The square's level 0 has 512 triangles; level l has 512 * 4^l.
-    EXPECT_EQ(levels::partition_level(512, 6, 1), 1); // 2 048 >= 2 000
-    EXPECT_EQ(levels::partition_level(512, 6, 2), 2); // 4 000 needed: 8 192
-    EXPECT_EQ(levels::partition_level(512, 6, 4), 2); // 8 000 needed: 8 192
-    EXPECT_EQ(levels::partition_level(512, 6, 5), 3); // 10 000 needed: 32 768
+    EXPECT_EQ(levels::partition_level(512, 6, 1), 1);    // 2 048 >= 2 000
+    EXPECT_EQ(levels::partition_level(512, 6, 2), 2);    // 4 000 needed: 8 192
+    EXPECT_EQ(levels::partition_level(512, 6, 4), 2);    // 8 000 needed: 8 192
+    EXPECT_EQ(levels::partition_level(512, 6, 5), 3);    // 10 000 needed: 32 768
     EXPECT_EQ(levels::partition_level(512, 3, 1000), 2); // at most finest - 1
     EXPECT_EQ(levels::partition_level(512, 1, 64), 0);
     EXPECT_EQ(levels::partition_level(100000, 4, 2), 0); // level 0 is large enough
