@@ -143,6 +143,15 @@ def test_a_partition_level_given_on_the_command_line_gives_the_same_answer(tmp_p
     assert [lv["level"] for lv in s["levels"]] == [2, 3]
 
 
+@pytest.mark.parametrize("krylov", ["bicgstab", "gmres"])
+def test_the_other_krylov_methods_give_the_one_process_answer(tmp_path, krylov):
+    f = scene_file(tmp_path, "square")
+    serial, _ = run(tmp_path, f, 3, 1)
+    dist, p = run(tmp_path, f, 3, 2, "--krylov", krylov)
+    assert f"Newton-system solver: {krylov} + mg" in p.stdout
+    compare(serial, dist)
+
+
 @pytest.mark.parametrize("args,message", [
     (["--linear", "schur"], "--linear schur has no distributed form"),
     (["--pc", "sorcf"], "'sorcf' has no distributed form"),
