@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Report and result files of a run.
 #include "apps/output.hpp"
+#include "apps/summary_json.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
@@ -305,6 +306,82 @@ void write_contact_steps(const std::filesystem::path& file, const levels::Proble
     });
 }
 
+toml::array steps_json(const std::vector<levels::StepReport>& steps, int* total_newton) {
+    toml::array out;
+    int total = 0;
+    for (const auto& s : steps) {
+        toml::table t;
+        t.insert("step", static_cast<int64_t>(s.step));
+        t.insert("load_factor", s.load_factor);
+        t.insert("converged", s.converged);
+        t.insert("newton_iterations", static_cast<int64_t>(s.iterations));
+        t.insert("linear_iterations", static_cast<int64_t>(s.linear_iterations));
+        toml::array res;
+        for (double v : s.residuals)
+            res.push_back(v);
+        t.insert("residuals", res);
+        toml::array ch;
+        for (int v : s.status_changes)
+            ch.push_back(static_cast<int64_t>(v));
+        t.insert("status_changes", ch);
+        toml::table st;
+        st.insert("gap", static_cast<int64_t>(s.counts.gap));
+        st.insert("stick", static_cast<int64_t>(s.counts.stick));
+        st.insert("slip_forward", static_cast<int64_t>(s.counts.slip_forward));
+        st.insert("slip_backward", static_cast<int64_t>(s.counts.slip_backward));
+        t.insert("statuses", st);
+        t.insert("seconds", s.seconds);
+        if (!s.message.empty()) t.insert("message", s.message);
+        out.push_back(t);
+        total += s.iterations;
+    }
+    if (total_newton) *total_newton = total;
+    return out;
+}
+
+toml::table level_json(int level, std::int64_t unknowns, std::int64_t contact_nodes,
+                       const std::vector<levels::LevelStep>& steps) {
+    toml::table t;
+    t.insert("level", static_cast<int64_t>(level));
+    t.insert("unknowns", static_cast<int64_t>(unknowns));
+    t.insert("contact_nodes", static_cast<int64_t>(contact_nodes));
+    toml::array ls;
+    for (const auto& st : steps) {
+        toml::table u;
+        u.insert("step", static_cast<int64_t>(st.report.step));
+        u.insert("newton_iterations", static_cast<int64_t>(st.report.iterations));
+        u.insert("linear_iterations", static_cast<int64_t>(st.report.linear_iterations));
+        u.insert("predicted_status_agreement", st.agreement());
+        u.insert("initial_guess", st.predicted ? "interpolated" : "previous step");
+        u.insert("seconds", st.report.seconds);
+        ls.push_back(u);
+    }
+    t.insert("steps", ls);
+    return t;
+}
+
+toml::array contacts_json(const levels::Problem& p, const std::vector<PairResultant>& resultants) {
+    toml::array cs;
+    for (size_t k = 0; k < p.contacts.size() && k < resultants.size(); ++k) {
+        toml::table c;
+        c.insert("name", p.contacts[k].name);
+        c.insert("resultant", toml::array{resultants[k].force.x(), resultants[k].force.y()});
+        c.insert("nodes_in_contact", static_cast<int64_t>(resultants[k].in_contact));
+        cs.push_back(c);
+    }
+    return cs;
+}
+
+toml::table checks_json(const levels::StateChecks& c) {
+    toml::table ct;
+    ct.insert("force_balance", c.force_balance);
+    ct.insert("coulomb_excess", c.coulomb_excess);
+    ct.insert("slip_equality", c.slip_equality);
+    ct.insert("complementarity", c.complementarity);
+    ct.insert("penetration", c.penetration);
+    return ct;
+}
+
 std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
                                        const levels::RunResult& r, const OutputOptions& options) {
     const auto& L = r.finest();
@@ -350,82 +427,27 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         root.insert("load_steps", static_cast<int64_t>(p.load_steps));
         root.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
         root.insert("vtu_format", mesh::to_string(options.vtu));
-        toml::array steps;
         int total_newton = 0;
-        for (const auto& s : r.steps) {
-            toml::table t;
-            t.insert("step", static_cast<int64_t>(s.step));
-            t.insert("load_factor", s.load_factor);
-            t.insert("converged", s.converged);
-            t.insert("newton_iterations", static_cast<int64_t>(s.iterations));
-            t.insert("linear_iterations", static_cast<int64_t>(s.linear_iterations));
-            toml::array res;
-            for (double v : s.residuals)
-                res.push_back(v);
-            t.insert("residuals", res);
-            toml::array ch;
-            for (int v : s.status_changes)
-                ch.push_back(static_cast<int64_t>(v));
-            t.insert("status_changes", ch);
-            toml::table st;
-            st.insert("gap", static_cast<int64_t>(s.counts.gap));
-            st.insert("stick", static_cast<int64_t>(s.counts.stick));
-            st.insert("slip_forward", static_cast<int64_t>(s.counts.slip_forward));
-            st.insert("slip_backward", static_cast<int64_t>(s.counts.slip_backward));
-            t.insert("statuses", st);
-            t.insert("seconds", s.seconds);
-            if (!s.message.empty()) t.insert("message", s.message);
-            steps.push_back(t);
-            total_newton += s.iterations;
-        }
-        root.insert("steps", steps);
+        root.insert("steps", steps_json(r.steps, &total_newton));
         toml::array lv;
         for (size_t l = 0; l < r.level_steps.size(); ++l) {
             if (r.level_steps[l].empty()) continue;
             const auto& Ll = r.levels()[l];
-            toml::table t;
-            t.insert("level", static_cast<int64_t>(l));
-            t.insert("unknowns", static_cast<int64_t>(Ll.n_unknowns()));
-            t.insert("contact_nodes", static_cast<int64_t>(Ll.n_contact_nodes()));
-            toml::array ls;
-            for (const auto& st : r.level_steps[l]) {
-                toml::table u;
-                u.insert("step", static_cast<int64_t>(st.report.step));
-                u.insert("newton_iterations", static_cast<int64_t>(st.report.iterations));
-                u.insert("linear_iterations", static_cast<int64_t>(st.report.linear_iterations));
-                u.insert("predicted_status_agreement", st.agreement());
-                u.insert("initial_guess", st.predicted ? "interpolated" : "previous step");
-                u.insert("seconds", st.report.seconds);
-                ls.push_back(u);
-            }
-            t.insert("steps", ls);
-            lv.push_back(t);
+            lv.push_back(level_json(static_cast<int>(l), Ll.n_unknowns(), Ll.n_contact_nodes(),
+                                    r.level_steps[l]));
         }
         root.insert("levels", lv);
         root.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
         if (r.completed_steps > 0) { // per pair, at the last completed step
-            toml::array cs;
+            std::vector<PairResultant> res;
             for (size_t k = 0; k < p.contacts.size(); ++k) {
-                int closed = 0;
-                const Vec2 f = levels::contact_resultant(r, static_cast<int>(k), &closed);
-                toml::table c;
-                c.insert("name", p.contacts[k].name);
-                c.insert("resultant", toml::array{f.x(), f.y()});
-                c.insert("nodes_in_contact", static_cast<int64_t>(closed));
-                cs.push_back(c);
+                PairResultant q;
+                q.force = levels::contact_resultant(r, static_cast<int>(k), &q.in_contact);
+                res.push_back(q);
             }
-            root.insert("contacts", cs);
+            root.insert("contacts", contacts_json(p, res));
         }
-        if (r.converged) {
-            const levels::StateChecks c = levels::check_state(p, r);
-            toml::table ct;
-            ct.insert("force_balance", c.force_balance);
-            ct.insert("coulomb_excess", c.coulomb_excess);
-            ct.insert("slip_equality", c.slip_equality);
-            ct.insert("complementarity", c.complementarity);
-            ct.insert("penetration", c.penetration);
-            root.insert("checks", ct);
-        }
+        if (r.converged) root.insert("checks", checks_json(levels::check_state(p, r)));
         {
             const auto& sp = r.solver.spec;
             toml::table sv;

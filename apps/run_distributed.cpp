@@ -3,6 +3,7 @@
 #include "apps/run_distributed.hpp"
 
 #include "apps/output.hpp"
+#include "apps/summary_json.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
@@ -351,67 +352,16 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
             procs.push_back(std::move(t));
         }
         root_t.insert("per_process", std::move(procs));
-        toml::array steps;
         int total_newton = 0;
-        for (const auto& s : r.steps) {
-            toml::table t;
-            t.insert("step", static_cast<int64_t>(s.step));
-            t.insert("load_factor", s.load_factor);
-            t.insert("converged", s.converged);
-            t.insert("newton_iterations", static_cast<int64_t>(s.iterations));
-            t.insert("linear_iterations", static_cast<int64_t>(s.linear_iterations));
-            toml::array res;
-            for (double v : s.residuals)
-                res.push_back(v);
-            t.insert("residuals", res);
-            toml::table st;
-            st.insert("gap", static_cast<int64_t>(s.counts.gap));
-            st.insert("stick", static_cast<int64_t>(s.counts.stick));
-            st.insert("slip_forward", static_cast<int64_t>(s.counts.slip_forward));
-            st.insert("slip_backward", static_cast<int64_t>(s.counts.slip_backward));
-            t.insert("statuses", st);
-            t.insert("seconds", s.seconds);
-            steps.push_back(t);
-            total_newton += s.iterations;
-        }
-        root_t.insert("steps", steps);
+        root_t.insert("steps", steps_json(r.steps, &total_newton));
         root_t.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
         toml::array lv;
-        for (size_t k = 1; k < r.level_steps.size(); ++k) {
-            toml::table t;
-            t.insert("level", static_cast<int64_t>(plevel + static_cast<int>(k)));
-            t.insert("unknowns", static_cast<int64_t>(r.levels[k].n_global_dofs));
-            t.insert("contact_nodes", static_cast<int64_t>(r.levels[k].n_global_contacts));
-            toml::array ls;
-            for (const auto& st : r.level_steps[k]) {
-                toml::table u;
-                u.insert("step", static_cast<int64_t>(st.report.step));
-                u.insert("newton_iterations", static_cast<int64_t>(st.report.iterations));
-                u.insert("linear_iterations", static_cast<int64_t>(st.report.linear_iterations));
-                u.insert("predicted_status_agreement", st.agreement());
-                u.insert("seconds", st.report.seconds);
-                ls.push_back(u);
-            }
-            t.insert("steps", ls);
-            lv.push_back(t);
-        }
+        for (size_t k = 1; k < r.level_steps.size(); ++k)
+            lv.push_back(level_json(plevel + static_cast<int>(k), r.levels[k].n_global_dofs,
+                                    r.levels[k].n_global_contacts, r.level_steps[k]));
         root_t.insert("levels", lv);
-        toml::array cs;
-        for (size_t k = 0; k < p.contacts.size(); ++k) {
-            toml::table c;
-            c.insert("name", p.contacts[k].name);
-            c.insert("resultant", toml::array{resultants[k].force.x(), resultants[k].force.y()});
-            c.insert("nodes_in_contact", static_cast<int64_t>(resultants[k].in_contact));
-            cs.push_back(c);
-        }
-        root_t.insert("contacts", cs);
-        toml::table ct;
-        ct.insert("force_balance", checks.force_balance);
-        ct.insert("coulomb_excess", checks.coulomb_excess);
-        ct.insert("slip_equality", checks.slip_equality);
-        ct.insert("complementarity", checks.complementarity);
-        ct.insert("penetration", checks.penetration);
-        root_t.insert("checks", ct);
+        root_t.insert("contacts", contacts_json(p, resultants));
+        root_t.insert("checks", checks_json(checks));
         toml::table sv;
         sv.insert("method", spec.method);
         sv.insert("krylov", spec.krylov);

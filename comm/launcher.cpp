@@ -11,4 +11,13 @@ bool launched_by_mpirun() {
            std::getenv("PMIX_RANK");
 }
 
+int processes_on_this_machine() {
+    for (const char* name : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "MPI_LOCAL_NRANKS"})
+        if (const char* v = std::getenv(name)) {
+            const int n = std::atoi(v);
+            if (n >= 1) return n;
+        }
+    return launched_by_mpirun() ? world().size() : 1;
+}
+
 } // namespace mlc::comm

@@ -223,15 +223,6 @@ int mpi_handle(const Communicator& c) {
     return MPI_Comm_c2f(MPI_COMM_SELF);
 }
 
-int processes_on_this_machine() {
-    for (const char* name : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS", "MPI_LOCAL_NRANKS"})
-        if (const char* v = std::getenv(name)) {
-            const int n = std::atoi(v);
-            if (n >= 1) return n;
-        }
-    return launched_by_mpirun() ? world().size() : 1;
-}
-
 void abort_all(int code) {
     int up = 0, down = 0;
     MPI_Initialized(&up);

@@ -323,6 +323,42 @@ void on_arrays(HYPRE_ParVector x, const double* xp, HYPRE_ParVector y, double* y
 
 } // namespace
 
+namespace {
+/// Starts hypre's halo exchange of x (owned columns) into ghost (the off-diagonal columns, in
+/// the column map's order); the caller ends it with hypre_ParCSRCommHandleDestroy.
+template <class Impl>
+hypre_ParCSRCommHandle* start_halo(const Impl& m, const Vector& x, Vector& ghost) {
+    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
+    hypre_ParCSRCommPkg* pkg = hypre_ParCSRMatrixCommPkg(A);
+    const HYPRE_Int sends = hypre_ParCSRCommPkgNumSends(pkg);
+    const HYPRE_Int begin = hypre_ParCSRCommPkgSendMapStart(pkg, 0);
+    const HYPRE_Int end = hypre_ParCSRCommPkgSendMapStart(pkg, sends);
+    m.send.resize(static_cast<size_t>(end - begin));
+    for (HYPRE_Int i = begin; i < end; ++i)
+        m.send[static_cast<size_t>(i - begin)] = x[hypre_ParCSRCommPkgSendMapElmt(pkg, i)];
+    ghost.resize(hypre_CSRMatrixNumCols(hypre_ParCSRMatrixOffd(A)));
+    return hypre_ParCSRCommHandleCreate(1, pkg, m.send.data(), ghost.data());
+}
+/// y += sign A_offd ghost on the owned rows (hypre's off-diagonal block).
+template <class Impl>
+void add_offdiagonal(const Impl& m, const Vector& ghost, Vector& y, double sign) {
+    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
+    const hypre_CSRMatrix* O = hypre_ParCSRMatrixOffd(A);
+    MLC_CHECK(ghost.size() == hypre_CSRMatrixNumCols(O) && y.size() == m.n,
+              "ParMatrix: " << ghost.size() << " ghost values and " << y.size() << " rows");
+    if (hypre_CSRMatrixNumNonzeros(O) == 0) return;
+    const HYPRE_Int* I = hypre_CSRMatrixI(O);
+    const HYPRE_Int* J = hypre_CSRMatrixJ(O);
+    const double* a = hypre_CSRMatrixData(O);
+    for (int i = 0; i < m.n; ++i) {
+        double s = 0.0;
+        for (HYPRE_Int k = I[i]; k < I[i + 1]; ++k)
+            s += a[k] * ghost[J[k]];
+        y[i] += sign * s;
+    }
+}
+} // namespace
+
 void ParMatrix::apply(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
     MLC_CHECK(x.size() == m.n_cols, "ParMatrix::apply: x has " << x.size() << " entries for "
@@ -330,29 +366,10 @@ void ParMatrix::apply(const Vector& x, Vector& y) const {
     if (m.view) {
         // Our row kernel on the diagonal block while hypre's halo exchange is under way, then
         // the off-diagonal block on the ghost values (the result is hypre's product's).
-        auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
-        hypre_ParCSRCommPkg* pkg = hypre_ParCSRMatrixCommPkg(A);
-        const HYPRE_Int sends = hypre_ParCSRCommPkgNumSends(pkg);
-        const HYPRE_Int begin = hypre_ParCSRCommPkgSendMapStart(pkg, 0);
-        const HYPRE_Int end = hypre_ParCSRCommPkgSendMapStart(pkg, sends);
-        m.send.resize(static_cast<size_t>(end - begin));
-        for (HYPRE_Int i = begin; i < end; ++i)
-            m.send[static_cast<size_t>(i - begin)] = x[hypre_ParCSRCommPkgSendMapElmt(pkg, i)];
-        m.ghost.resize(m.blocks->offd.cols());
-        hypre_ParCSRCommHandle* h =
-            hypre_ParCSRCommHandleCreate(1, pkg, m.send.data(), m.ghost.data());
+        hypre_ParCSRCommHandle* h = start_halo(m, x, m.ghost);
         csr_multiply(m.blocks->diag, x, y);
         hypre_ParCSRCommHandleDestroy(h);
-        const SparseMatrix& O = m.blocks->offd;
-        const int* oi = O.outerIndexPtr();
-        const int* oj = O.innerIndexPtr();
-        const double* ov = O.valuePtr();
-        for (int i = 0; i < m.n; ++i) {
-            double s = 0.0;
-            for (int k = oi[i]; k < oi[i + 1]; ++k)
-                s += ov[k] * m.ghost[oj[k]];
-            y[i] += s;
-        }
+        add_offdiagonal(m, m.ghost, y, 1.0);
         return;
     }
     y.resize(m.n);
@@ -376,36 +393,11 @@ void ParMatrix::ghost_values(const Vector& x, Vector& ghost) const {
     MLC_CHECK(x.size() == m.n_cols, "ParMatrix::ghost_values: x has " << x.size() << " entries for "
                                                                       << m.n_cols
                                                                       << " owned columns");
-    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
-    hypre_ParCSRCommPkg* pkg = hypre_ParCSRMatrixCommPkg(A);
-    const HYPRE_Int sends = hypre_ParCSRCommPkgNumSends(pkg);
-    const HYPRE_Int begin = hypre_ParCSRCommPkgSendMapStart(pkg, 0);
-    const HYPRE_Int end = hypre_ParCSRCommPkgSendMapStart(pkg, sends);
-    m.send.resize(static_cast<size_t>(end - begin));
-    for (HYPRE_Int i = begin; i < end; ++i)
-        m.send[static_cast<size_t>(i - begin)] = x[hypre_ParCSRCommPkgSendMapElmt(pkg, i)];
-    ghost.resize(hypre_CSRMatrixNumCols(hypre_ParCSRMatrixOffd(A)));
-    hypre_ParCSRCommHandle* h = hypre_ParCSRCommHandleCreate(1, pkg, m.send.data(), ghost.data());
-    hypre_ParCSRCommHandleDestroy(h);
+    hypre_ParCSRCommHandleDestroy(start_halo(m, x, ghost));
 }
 
 void ParMatrix::subtract_offdiagonal(const Vector& ghost, Vector& y) const {
-    const Impl& m = *impl_;
-    auto* A = reinterpret_cast<hypre_ParCSRMatrix*>(m.A);
-    const hypre_CSRMatrix* O = hypre_ParCSRMatrixOffd(A);
-    MLC_CHECK(ghost.size() == hypre_CSRMatrixNumCols(O) && y.size() == m.n,
-              "ParMatrix::subtract_offdiagonal: " << ghost.size() << " ghost values and "
-                                                  << y.size() << " rows");
-    const HYPRE_Int* I = hypre_CSRMatrixI(O);
-    const HYPRE_Int* J = hypre_CSRMatrixJ(O);
-    const double* a = hypre_CSRMatrixData(O);
-    if (hypre_CSRMatrixNumNonzeros(O) == 0) return;
-    for (int i = 0; i < m.n; ++i) {
-        double s = 0.0;
-        for (HYPRE_Int k = I[i]; k < I[i + 1]; ++k)
-            s += a[k] * ghost[J[k]];
-        y[i] -= s;
-    }
+    add_offdiagonal(*impl_, ghost, y, -1.0);
 }
 
 void ParMatrix::update_values(const std::vector<double>& values) {
