@@ -12,6 +12,7 @@
 #include "levels/distributed_solve.hpp"
 #include "mesh/distributed.hpp"
 #include "scene/scene.hpp"
+#include "solvers/factory.hpp"
 
 #include <toml++/toml.h>
 
@@ -187,8 +188,12 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     so.progress = opt.quiet ? nullptr : &out;
     MLC_CHECK(!opt.stop, "internal error: a distributed run has no stop flag");
     os << "mlcontact: solving '" << p.name << "' on " << comm.size() << " processes\n";
-    os << "Newton-system solver: " << spec << " (" << comm.size()
-       << " processes: Krylov + distributed mg)\n";
+    const bool mg = solvers::parse_preconditioner_spec(spec.pc).name == "mg";
+    os << "Newton-system solver: " << spec << " (" << comm.size() << " processes: "
+       << (mg ? std::string("Krylov + distributed mg")
+              : "Krylov + " + spec.pc +
+                    " on each process's diagonal block, Jacobi across the cuts; levels 0-p on "
+                    "every process") << ")\n";
     os << "partition level " << plevel
        << (opt.partition_level
                ? " (--partition-level)"

@@ -26,6 +26,7 @@ struct DistributedMultigrid::Impl {
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
          LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
+          use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"),
           op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k)
             build_jacobian(k);
@@ -33,6 +34,7 @@ struct DistributedMultigrid::Impl {
 
     /// Level p at its converged statuses: the gathered coarse solve (map built on first use).
     void set_coarse(const Level& Lp, const std::vector<Eigen::Matrix2d>& M) {
+        if (!use_mg_) return; // no coarse level without mg
         if (coarse_level_ != &Lp) {
             coarse_level_ = &Lp;
             coarse_asm_ = std::make_unique<JacobianAssembler>(Lp);
@@ -71,7 +73,14 @@ struct DistributedMultigrid::Impl {
             contact::for_each_tangent_entry(
                 L.local.contacts[e], M[e], L.local.dofs, L.local.lambda_dof[e],
                 [&](int, int, double value) { v[o.cpos[c++]] += value; });
-        if (!o.smoother) {
+        if (!use_mg_) {
+            if (!o.block_pc) {
+                o.block_pc = solvers::make_preconditioner(spec_.pc);
+                o.block_pc->setup(o.blocks->diag);
+            } else {
+                o.block_pc->update_values(o.blocks->diag);
+            }
+        } else if (!o.smoother) {
             std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
             for (Index i = 0; i < L.n_owned; ++i)
                 vertex_of[static_cast<size_t>(i)] = L.local.dofs.vertex_of(i);
@@ -100,7 +109,9 @@ struct DistributedMultigrid::Impl {
         kp.restart = spec_.restart;
         kp.give_up_budget = spec_.give_up_budget;
         kp.comm = &comm_;
-        const Cycle pc(*this, k);
+        const Cycle cycle(*this, k);
+        const BlockPc block(*this, k);
+        const Preconditioner& pc = use_mg_ ? static_cast<const Preconditioner&>(cycle) : block;
         SolveResult r =
             solvers::solve(solvers::parse_krylov(spec_.krylov), *op_[k].J, pc, b, dx, kp);
         r.setup_seconds = t1 - t0;
@@ -110,6 +121,7 @@ struct DistributedMultigrid::Impl {
 
     std::string name() const {
         std::ostringstream os;
+        if (!use_mg_) return spec_.krylov + " + " + spec_.pc + " on each process's diagonal block";
         os << spec_.krylov << " + distributed mg(pre=" << mg_.pre_sweeps
            << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega << ")";
         return os.str();
@@ -122,9 +134,25 @@ struct DistributedMultigrid::Impl {
         std::vector<int> cpos; ///< position of every contact tangent entry, in visiting order
         std::unique_ptr<solvers::ParMatrix> J;
         std::unique_ptr<smoothers::BlockSOR> smoother;
+        std::unique_ptr<Preconditioner> block_pc; ///< without mg: spec.pc on the diagonal block
         std::vector<Eigen::Matrix2d> last_M;
         bool prepared = false;
         mutable Vector res, t, rc, ec, d, ghost;
+    };
+
+    /// Without mg: the preconditioner of each process's diagonal block (Jacobi across the cuts).
+    class BlockPc final : public Preconditioner {
+    public:
+        BlockPc(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
+        void setup(const SparseMatrix&) override {}
+        void apply(const Vector& r, Vector& z) const override {
+            s_.op_[k_].block_pc->apply(r, z);
+        }
+        std::string name() const override { return s_.name(); }
+
+    private:
+        const DistributedMultigrid::Impl& s_;
+        size_t k_;
     };
 
     /// One V-cycle from level k as a Preconditioner.
@@ -272,6 +300,7 @@ struct DistributedMultigrid::Impl {
     const Communicator& comm_;
     LinearSolverSpec spec_;
     solvers::MultigridParams mg_;
+    bool use_mg_ = true; ///< else spec_.pc on each process's diagonal block
     std::vector<Op> op_;
     const Level* coarse_level_ = nullptr;
     std::unique_ptr<JacobianAssembler> coarse_asm_;
@@ -340,10 +369,19 @@ solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
                   << "' has no distributed form (schur, lu, cf and sorcf need the "
                      "whole level on one process)");
     const auto ps = solvers::parse_preconditioner_spec(spec.pc);
-    MLC_CHECK(ps.name == "mg", "on several processes the preconditioner is mg; '"
-                                   << spec.pc
-                                   << "' has no distributed form (run it on one process)");
     solvers::MultigridParams p;
+    if (ps.name != "mg") {
+        // A preconditioner of the matrix alone runs on each process's diagonal block.
+        const solvers::PreconditionerEntry* e = solvers::find_preconditioner(spec.pc);
+        MLC_CHECK(e && !e->level_aware,
+                  "on several processes the preconditioner is mg, or one that needs the matrix "
+                  "alone (diag, ilu, sor, ...) on each process's diagonal block; '"
+                      << spec.pc
+                      << "' has no distributed form (cf, sorcf, ebe and mgr need the whole level: "
+                         "run it on one process)");
+        solvers::make_preconditioner(spec.pc); // its options checked here, on every process
+        return p;
+    }
     solvers::SpecOptions o(ps);
     p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
     p.post_sweeps = o.get_int("post", p.post_sweeps);

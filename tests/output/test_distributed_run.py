@@ -35,7 +35,8 @@ def scene_file(tmp_path, name):
 
 def run(tmp_path, scene, levels, np_, *extra, expect=0):
     out = tmp_path / f"out_np{np_}"
-    cmd = [MLCONTACT, "run", str(scene), "--levels", str(levels), "--pc", "mg",
+    pc = [] if "--pc" in extra else ["--pc", "mg"]
+    cmd = [MLCONTACT, "run", str(scene), "--levels", str(levels), *pc,
            "--linear-tol", "1e-12", "--quiet", "--out", str(out), *extra]
     env = dict(ENV)
     if np_ > 1:
@@ -150,6 +151,20 @@ def test_the_other_krylov_methods_give_the_one_process_answer(tmp_path, krylov):
     dist, p = run(tmp_path, f, 3, 2, "--krylov", krylov)
     assert f"Newton-system solver: {krylov} + mg" in p.stdout
     compare(serial, dist)
+
+
+def test_a_preconditioner_of_the_matrix_alone_runs_on_each_process_block(tmp_path):
+    # ILU(0) on each process's diagonal block (Jacobi across the cuts): the one-process answer.
+    f = scene_file(tmp_path, "square")
+    out1 = tmp_path / "one"
+    p1 = subprocess.run([MLCONTACT, "run", str(f), "--levels", "2", "--pc", "ilu:0",
+                         "--linear-tol", "1e-12", "--quiet", "--out", str(out1)],
+                        capture_output=True, text=True, timeout=600,
+                        env=dict(ENV, OMPI_MCA_ess_singleton_isolated="1"))
+    assert p1.returncode == 0, p1.stdout + p1.stderr
+    dist, p = run(tmp_path, f, 2, 2, "--pc", "ilu:0")
+    assert "ilu:0 on each process's diagonal block" in p.stdout
+    compare(out1, dist)
 
 
 @pytest.mark.parametrize("args,message", [
