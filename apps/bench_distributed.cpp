@@ -231,14 +231,14 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
     const Vector b = fine.local.elastic.f.head(n);
     MLC_CHECK(comm.sum(b.squaredNorm()) > 0,
               "bench elastic: the scene has no load on the free unknowns");
-    const std::int64_t nnz = comm.sum(static_cast<std::int64_t>(fine.K_blocks->diag.nonZeros() +
-                                                                fine.K_blocks->offd.nonZeros()));
+    const std::int64_t nnz = comm.sum(
+        static_cast<std::int64_t>(fine.K_blocks->diag.nonZeros() + fine.K_blocks->offd.nonZeros()));
     os << "bench elastic: " << opt.scene << " level " << L << ", elastic block "
        << fine.n_global_dofs << " unknowns, " << nnz << " nonzeros, " << np
        << " processes (one thread each), partition level " << p << ", rel_tol " << opt.rel_tol
        << ", times are medians of " << opt.repeat
-       << " run(s) of the slowest process (levels built in " << std::fixed
-       << std::setprecision(2) << hierarchy_s << std::defaultfloat << " s)\n";
+       << " run(s) of the slowest process (levels built in " << std::fixed << std::setprecision(2)
+       << hierarchy_s << std::defaultfloat << " s)\n";
 
     std::vector<ElasticRow> results;
     std::vector<Vector> solutions;
@@ -283,8 +283,8 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
             const solvers::ParMatrix K(comm, rows);
             const double copy = wall_seconds() - t0;
             x = Vector::Zero(n);
-            const SolveResult s = solvers::boomeramg_pcg_par(K, b, x, opt.rel_tol, opt.max_iter,
-                                                             {}, dof_func);
+            const SolveResult s =
+                solvers::boomeramg_pcg_par(K, b, x, opt.rel_tol, opt.max_iter, {}, dof_func);
             r.setup.push_back(comm.max(copy + s.setup_seconds));
             r.solve.push_back(comm.max(s.solve_seconds));
             r.iterations = s.iterations;
@@ -323,9 +323,8 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
         finish(r, x);
     }
     // Relative difference of the AMG and mg-gmres solutions (the same owned entries).
-    const double diff =
-        std::sqrt(comm.sum((solutions[0] - solutions[1]).squaredNorm())) /
-        std::max(results[0].x_norm, 1e-300);
+    const double diff = std::sqrt(comm.sum((solutions[0] - solutions[1]).squaredNorm())) /
+                        std::max(results[0].x_norm, 1e-300);
 
     std::vector<double> mine{peak_rss_bytes(), static_cast<double>(n)};
     const auto all = comm.allgather(std::span<const double>(mine));
@@ -335,7 +334,8 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
 
     os << std::setw(16) << "solver" << std::setw(10) << "setup s" << std::setw(10) << "solve s"
        << std::setw(10) << "total s" << std::setw(7) << "its" << std::setw(12) << "rel.res"
-       << std::setw(14) << "||x||" << "\n";
+       << std::setw(14) << "||x||"
+       << "\n";
     int code = 0;
     for (const auto& r : results) {
         const double su = median_of(r.setup), so = median_of(r.solve);
@@ -354,10 +354,10 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
     os << "\n";
     if (root) {
         const std::filesystem::path file =
-            !opt.out.empty() ? opt.out
-                             : std::filesystem::path("out/bench/elastic_" + opt.scene + "_L" +
-                                                     std::to_string(L) + "_np" +
-                                                     std::to_string(np) + ".json");
+            !opt.out.empty()
+                ? opt.out
+                : std::filesystem::path("out/bench/elastic_" + opt.scene + "_L" +
+                                        std::to_string(L) + "_np" + std::to_string(np) + ".json");
         if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
         write_file_atomically(file, [&](std::ostream& js) {
             js << std::setprecision(12) << "{\n  \"scene\": \"" << opt.scene
