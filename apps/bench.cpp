@@ -481,6 +481,7 @@ struct ElasticResult {
     std::vector<double> setup, solve;
     int iterations = 0;
     double relative_residual = 0;
+    double x_norm = 0, x_max = 0; ///< 2-norm and max-norm of the last repetition's solution
     bool converged = false;
 };
 
@@ -525,6 +526,8 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
             r.relative_residual = s.relative_residual;
             r.converged = s.converged;
         }
+        r.x_norm = x_amg.norm();
+        r.x_max = x_amg.lpNorm<Eigen::Infinity>();
         results.push_back(r);
     }
     // Our V-cycle over levels 0..L (set up anew in every repetition, like AMG).
@@ -551,6 +554,8 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
             r.relative_residual = s.relative_residual;
             r.converged = s.converged;
         }
+        r.x_norm = x_mg.norm();
+        r.x_max = x_mg.lpNorm<Eigen::Infinity>();
         results.push_back(r);
     }
     const double diff = (x_amg - x_mg).norm() / std::max(x_amg.norm(), 1e-300);
@@ -574,7 +579,9 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
            << ", \"setup_seconds\": " << su << ", \"solve_seconds\": " << so
            << ", \"total_seconds\": " << su + so << ", \"iterations\": " << r.iterations
            << ", \"relative_residual\": " << r.relative_residual
-           << ", \"converged\": " << (r.converged ? "true" : "false") << "}";
+           << ", \"converged\": " << (r.converged ? "true" : "false")
+           << ", \"x_norm\": " << std::setprecision(12) << r.x_norm
+           << ", \"x_max_norm\": " << r.x_max << std::setprecision(6) << "}";
         os << std::setw(16) << r.name << std::fixed << std::setprecision(3) << std::setw(10) << su
            << std::setw(10) << so << std::setw(10) << su + so << std::setw(7) << r.iterations
            << std::scientific << std::setprecision(2) << std::setw(12) << r.relative_residual

@@ -13,7 +13,8 @@
 /// - `bench elastic`: the elastic block alone (K on the free displacement unknowns of the finest
 ///   level, right-hand side the full load) solved to the same relative tolerance by hypre
 ///   BoomerAMG-PCG and by our geometric V-cycle (vertex-block Gauss–Seidel, P / P^T, sparse LU
-///   on level 0) inside CG and GMRES, side by side in one run.
+///   on level 0) inside CG and GMRES, side by side in one run. Under mpirun with N > 1 processes:
+///   apps/bench_distributed.hpp (bench_elastic_distributed).
 /// - `bench newton`: the Newton systems of the finest level, captured from a real coarse-to-fine
 ///   run (one per Newton step, through levels::SolveOptions::wrap_system_solver), each solved
 ///   from zero to the same relative tolerance by our Krylov method with `mg` as the run uses it
@@ -58,7 +59,9 @@ struct BenchElasticOptions {
     double rel_tol = 1e-8;     ///< relative tolerance of every solve
     int max_iter = 1000;       ///< iterations of every solve
     int repeat = 1;            ///< runs per solver; times are medians over them
-    std::filesystem::path out; ///< JSON file (default out/bench/elastic_L<L>.json)
+    /// JSON file (default out/bench/elastic_<scene>_L<L>.json; on N > 1 processes
+    /// out/bench/elastic_<scene>_L<L>_np<N>.json)
+    std::filesystem::path out;
 };
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every solve converged).

@@ -4,6 +4,16 @@
 /// (levels/distributed_solve.hpp), timed `repeat` times; per level the Krylov iterations per
 /// Newton step (mean, max) and per process its unknowns and peak RSS. The JSON
 /// (out/bench/<scene>_L<L>_np<N>.json unless --out) is written by rank 0.
+///
+/// `mlcontact bench elastic` on several processes: the elastic block of the finest level (the
+/// scene without its contact pairs, so that every level's K is the elastic block on the free
+/// displacements; right-hand side the full load), distributed as a run distributes it, solved
+/// from zero to --tol by hypre's ParCSR PCG with BoomerAMG ("boomeramg-pcg", the one-process
+/// bench's settings) and by the distributed V-cycle (levels/distributed_solve.hpp) inside GMRES
+/// and CGS ("mg-gmres", "mg-cgs"). Per solver: setup and solve seconds (medians over --repeat of
+/// the slowest process), iterations, the true relative residual ||b - K x|| / ||b|| and the
+/// 2-norm and max-norm of x (all over the processes). The JSON
+/// (out/bench/elastic_<scene>_L<L>_np<N>.json unless --out) is written by rank 0.
 #pragma once
 
 #include "apps/bench.hpp"
@@ -17,5 +27,10 @@ namespace mlc::apps {
 /// or a scene with no distributed form (two-body pairs). Returns 0 when every run converged.
 int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& comm,
                              std::ostream& os);
+
+/// Collective. Throws InvalidInput for --levels outside 1..8, --repeat < 1, --tol outside (0, 1)
+/// or a scene with no load on the free unknowns. Returns 0 when every solve converged, 2 otherwise.
+int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator& comm,
+                              std::ostream& os);
 
 } // namespace mlc::apps

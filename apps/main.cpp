@@ -225,13 +225,13 @@ int main(int argc, char** argv) {
     // run would write the same files). One process, with or without mpirun, runs as always.
     const bool distributed = mlc::comm::launched_by_mpirun() && mlc::comm::world().size() > 1;
     const int rank = distributed ? mlc::comm::world().rank() : 0;
-    if (distributed && !*run && !*bsq) {
+    if (distributed && !*run && !*bsq && !*bel) {
         if (rank == 0)
             std::cerr
                 << "mlcontact: error: started as " << mlc::comm::world().size()
                 << " MPI processes, but this command runs as one process: on several "
                    "processes run `mlcontact run` (one-body scenes, Krylov + mg) or `mlcontact "
-                   "bench square`; run the others without mpirun or with mpirun -np 1\n";
+                   "bench square|elastic`; run the others without mpirun or with mpirun -np 1\n";
         return 1;
     }
     try {
@@ -261,6 +261,8 @@ int main(int argc, char** argv) {
         }
         if (*bel) {
             beo.out = beo_out;
+            if (distributed)
+                return mlc::apps::bench_elastic_distributed(beo, mlc::comm::world(), std::cout);
             return mlc::apps::bench_elastic(beo, std::cout);
         }
         if (*ev) {

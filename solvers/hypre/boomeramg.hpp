@@ -15,6 +15,8 @@
 
 namespace mlc::solvers {
 
+class ParMatrix;
+
 /// BoomerAMG settings (names as in hypre's HYPRE_BoomerAMGSet* functions). The defaults are the
 /// usual choice for 2D linear elasticity: systems AMG with the two displacement components as
 /// two functions (unknown-based coarsening, interpolation within each component), HMIS
@@ -74,5 +76,17 @@ private:
 SolveResult boomeramg_pcg(const SparseMatrix& A, const Vector& b, Vector& x, double rel_tol,
                           int max_iter, const BoomerAMGParams& params = {},
                           const std::vector<int>& dof_func = {});
+
+/// Collective (every process of A's communicator): hypre's ParCSR PCG preconditioned by BoomerAMG
+/// on the distributed A x = b to ||b - A x|| <= rel_tol ||b|| (two-norm, over all processes),
+/// with the settings of boomeramg_pcg. b and x hold this process's owned entries (A.n_rows());
+/// x holds the initial guess on entry (resized to zero if its size differs). `dof_func`: the
+/// function of every owned unknown (empty: interleaved). A must be square and built from
+/// DistributedRows (see ParMatrix::hypre_handle); throws InvalidInput on every process otherwise.
+/// The residuals and relative residual are the true ones, computed here with global reductions;
+/// setup (AMG hierarchy) and solve seconds are this process's.
+SolveResult boomeramg_pcg_par(const ParMatrix& A, const Vector& b, Vector& x, double rel_tol,
+                              int max_iter, const BoomerAMGParams& params = {},
+                              const std::vector<int>& dof_func = {});
 
 } // namespace mlc::solvers

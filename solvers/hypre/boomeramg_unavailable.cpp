@@ -43,5 +43,9 @@ SolveResult boomeramg_pcg(const SparseMatrix&, const Vector&, Vector&, double, i
                           const BoomerAMGParams&, const std::vector<int>&) {
     no_hypre();
 }
+SolveResult boomeramg_pcg_par(const ParMatrix&, const Vector&, Vector&, double, int,
+                              const BoomerAMGParams&, const std::vector<int>&) {
+    no_hypre();
+}
 
 } // namespace mlc::solvers

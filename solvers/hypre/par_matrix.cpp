@@ -297,6 +297,9 @@ int ParMatrix::n_cols() const {
 std::int64_t ParMatrix::n_global() const {
     return impl_->n_global;
 }
+void* ParMatrix::hypre_handle() const {
+    return impl_->A;
+}
 
 namespace {
 

@@ -75,6 +75,12 @@ public:
     std::int64_t first_col() const; ///< first owned column (first_row() when square)
     int n_cols() const;             ///< owned columns (n_rows() when square)
     std::int64_t n_global() const; ///< rows over all processes
+    /// hypre's HYPRE_ParCSRMatrix of this matrix (as void*, so that hypre stays out of this
+    /// header), for hypre's own solvers (solvers/hypre/ only). Owned by this object. A matrix
+    /// built from RowBlocks keeps Eigen's column order in its diagonal block (the diagonal entry
+    /// is not first in its row, as BoomerAMG's relaxation expects): give hypre's solvers a matrix
+    /// built from DistributedRows (through IJ, which puts it first).
+    void* hypre_handle() const;
 
     /// Owned rows (the local view's size).
     Index rows() const override { return n_rows(); }

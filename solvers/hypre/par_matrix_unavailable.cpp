@@ -42,6 +42,9 @@ int ParMatrix::n_cols() const {
 std::int64_t ParMatrix::n_global() const {
     unavailable();
 }
+void* ParMatrix::hypre_handle() const {
+    unavailable();
+}
 void ParMatrix::apply(const Vector&, Vector&) const {
     unavailable();
 }

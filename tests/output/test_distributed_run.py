@@ -3,7 +3,8 @@
 answer (displacements and multipliers to 1e-8 relative, the same status at every contact node)
 with the Newton and Krylov tolerances at 1e-12; solution.pvtu opens in VTK's own parallel reader
 (python3-vtk9) as one mesh whose displacements are the one-process solution.vtu's; summary.json
-records the processes; what has no distributed form is refused with a message.
+records the processes; what has no distributed form is refused with a message. `bench elastic`
+on two processes solves the one-process bench's elastic block.
 
 Run by ctest as `/usr/bin/python3 -m pytest`; MLCONTACT is the driver, MPIEXEC the launcher.
 """
@@ -200,6 +201,46 @@ def test_partition_level_is_refused_on_one_process(tmp_path):
                        timeout=300)
     assert p.returncode == 1
     assert "--partition-level applies to runs on several processes" in p.stderr
+
+
+def bench_elastic(tmp_path, np_):
+    out = tmp_path / f"elastic_np{np_}.json"
+    cmd = [MLCONTACT, "bench", "elastic", "square", "--levels", "3", "--tol", "1e-10",
+           "--out", str(out)]
+    env = dict(ENV)
+    if np_ > 1:
+        cmd = [MPIEXEC, "-n", str(np_), "--oversubscribe", *cmd]
+    else:
+        env["OMPI_MCA_ess_singleton_isolated"] = "1"
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
+    assert p.returncode == 0, p.stdout + p.stderr
+    return json.loads(out.read_text()), p
+
+
+def test_bench_elastic_on_two_processes_solves_the_one_process_block(tmp_path):
+    """`mpirun -np 2 mlcontact bench elastic`: hypre's ParCSR BoomerAMG-PCG and the distributed
+    V-cycle in GMRES and CGS solve the same elastic block as the one-process bench, to 1e-10."""
+    s1, _ = bench_elastic(tmp_path, 1)
+    s2, p = bench_elastic(tmp_path, 2)
+    assert p.stdout.count("wrote ") == 1, p.stdout  # rank 0 reports alone
+    assert s2["processes"] == 2 and len(s2["per_process"]) == 2
+    assert s2["unknowns"] == s1["unknowns"] > 0
+    assert sum(q["owned_unknowns"] for q in s2["per_process"]) == s1["unknowns"]
+    assert all(q["owned_unknowns"] > 0 and q["peak_rss_bytes"] > 0 for q in s2["per_process"])
+    solvers = {r["solver"]: r for r in s2["solvers"]}
+    assert sorted(solvers) == ["boomeramg-pcg", "mg-cgs", "mg-gmres"]
+    for r in s2["solvers"] + s1["solvers"]:
+        assert r["converged"] and r["relative_residual"] <= 1e-10, r
+        assert r["iterations"] >= 1 and r["x_norm"] > 0 and r["x_max_norm"] > 0, r
+    # The solutions: the distributed ones agree with each other and with the one-process ones.
+    ref = {r["solver"]: r for r in s1["solvers"]}["boomeramg-pcg"]
+    for r in s2["solvers"]:
+        assert abs(r["x_norm"] - ref["x_norm"]) <= 1e-7 * ref["x_norm"], (r, ref)
+        assert abs(r["x_max_norm"] - ref["x_max_norm"]) <= 1e-7 * ref["x_max_norm"], (r, ref)
+    assert s2["solution_difference"] <= 1e-7
+    # The V-cycle stays a good preconditioner across the cut (one process: mg-gmres's count).
+    mg1 = {r["solver"]: r for r in s1["solvers"]}["mg-gmres"]["iterations"]
+    assert solvers["mg-gmres"]["iterations"] <= 2 * mg1 + 5
 
 
 @pytest.mark.parametrize("scene,levels", [("square", 4), ("hertz", 3)])
