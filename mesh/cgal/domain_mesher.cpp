@@ -133,6 +133,8 @@ public:
         nearest(x, 0, static_cast<int>(pts_.size()), 0, best2);
         return std::min(h_max_, h_min_ + grading_ * std::sqrt(best2));
     }
+    /// The largest spacing anywhere: length / max() bounds a segment's point count from below.
+    double max() const { return h_max_; }
 
 private:
     void build(int lo, int hi, int depth) {
@@ -415,6 +417,13 @@ std::vector<LoopPoints> discretize(const std::vector<SegmentGeometry>& segs, con
         const SegmentGeometry& g = segs[s];
         const double length = g.length();
         const double cap = g.arc ? g.r * max_arc_angle : std::numeric_limits<double>::infinity();
+        // Refuse before marching: even the coarsest spacing would need too many points.
+        MLC_CHECK(static_cast<double>(total) + length / std::min(h.max(), cap) <
+                      static_cast<double>(max_boundary_points),
+                  "mesh_domain: " << where(g.loop, g.index) << " is " << length
+                                  << " long; at the largest spacing " << std::min(h.max(), cap)
+                                  << " it alone needs more than " << max_boundary_points
+                                  << " boundary points; check its coordinates or max_size");
         auto density = [&](double t) { return 1.0 / std::min(h(g.at(t)), cap); };
         // March with a quarter of the local spacing, integrating the density by trapezoids.
         ts.assign(1, 0.0);
@@ -708,12 +717,25 @@ Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField
     // loop segment's end is put on it (the only boundary points they may share).
     std::vector<SegmentGeometry> lgs;
     const double tol = 1e-9 * diameter;
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const SegmentGeometry& g : segs) {
+        const Vec2 a = g.arc ? Vec2(g.c.array() - g.r) : Vec2(g.a.cwiseMin(g.b));
+        const Vec2 b = g.arc ? Vec2(g.c.array() + g.r) : Vec2(g.a.cwiseMax(g.b));
+        lo = lo.cwiseMin(a);
+        hi = hi.cwiseMax(b);
+    }
     for (std::size_t l = 0; l < lines.size(); ++l) {
         const Segment& s = lines[l];
         MLC_CHECK(s.kind == Segment::Kind::line,
                   "mesh_domain: line " << l << " is an arc; interior lines are straight");
         MLC_CHECK(s.from.allFinite() && s.to.allFinite(),
                   "mesh_domain: line " << l << " has a non-finite end point");
+        for (const Vec2* e : {&s.from, &s.to})
+            MLC_CHECK(((*e - lo).array() >= -tol).all() && ((hi - *e).array() >= -tol).all(),
+                      "mesh_domain: line " << l << " has its end (" << e->x() << ", " << e->y()
+                                           << ") outside the loops' bounding box [" << lo.x()
+                                           << ", " << hi.x() << "] x [" << lo.y() << ", "
+                                           << hi.y() << "]; interior lines must lie inside it");
         SegmentGeometry g;
         g.loop = static_cast<int>(l);
         g.index = 0;

@@ -360,6 +360,37 @@ TEST(DomainMesher, BadInputThrows) {
     EXPECT_THROW(mesh_domain({{Segment::line({0, 0}, {1, 0}, "l")}}, ok), InvalidInput);
 }
 
+// A fuzzer found a scene whose interior line ran to y = 8.9e100: marching it at max_size would
+// have pushed 80 million points before the size guard. Both are refused before any marching.
+TEST(DomainMesher, HugeSegmentsAndFarLinesAreRefusedAtOnce) {
+    const SizeField ok{.max_size = 0.25};
+    try {
+        mesh_domain({unit_square()}, ok, {Segment::line({0.5, 0.5}, {0.5, 8.9e100}, "rib")});
+        ADD_FAILURE() << "line leaving the domain accepted";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("line 0 has its end (0.5, 8.9e+100) outside the "
+                                             "loops' bounding box [0, 1] x [0, 1]"),
+                  std::string::npos)
+            << e.what();
+    }
+    // An end on the box (a loop corner) is accepted: the tolerance keeps it.
+    EXPECT_NO_THROW(mesh_domain({unit_square()}, ok, {Segment::line({0, 0}, {0.5, 0.5}, "d")}));
+    // A loop so long that even max_size needs more than 20 million points.
+    const double big = 1e7;
+    const std::vector<Segment> huge = {
+        Segment::line({0, 0}, {big, 0}, "a"), Segment::line({big, 0}, {big, big}, "b"),
+        Segment::line({big, big}, {0, big}, "c"), Segment::line({0, big}, {0, 0}, "d")};
+    try {
+        mesh_domain({huge}, ok);
+        ADD_FAILURE() << "huge loop accepted";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("loop 0, segment 0 is 1e+07 long; at the largest "
+                                             "spacing 0.25 it alone needs more than 20000000"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(DomainMesherSlow, LargeMeshIsValid) {
     const Mesh m = mesh_domain({quarter_disc()}, SizeField{.max_size = 0.004});
     EXPECT_GT(m.n_triangles(), 100000);
