@@ -566,7 +566,16 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
         const auto& lp = lines[l];
         const std::string w = "line " + std::to_string(l);
         for (std::size_t k = 0; k < lp.x.size(); ++k) {
-            const VertexHandle v = p.tr.insert(Point(lp.x[k].x(), lp.x[k].y()));
+            VertexHandle v;
+            try {
+                v = p.tr.insert(Point(lp.x[k].x(), lp.x[k].y()));
+            } catch (const CDT::Intersection_of_constraints_exception&) {
+                // The point lies inside a boundary constraint (not at one of its points).
+                MLC_CHECK(false, "mesh_domain: " << w << " meets the boundary or another line at "
+                                                 << lp.x[k]
+                                                 << " away from their points; interior lines may "
+                                                    "end on the boundary only at a segment's end");
+            }
             const bool end = k == 0 || k + 1 == lp.x.size();
             MLC_CHECK(v->info().input < 0 || end,
                       "mesh_domain: " << w << " passes through the boundary point "
@@ -734,8 +743,8 @@ Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField
             MLC_CHECK(((*e - lo).array() >= -tol).all() && ((hi - *e).array() >= -tol).all(),
                       "mesh_domain: line " << l << " has its end (" << e->x() << ", " << e->y()
                                            << ") outside the loops' bounding box [" << lo.x()
-                                           << ", " << hi.x() << "] x [" << lo.y() << ", "
-                                           << hi.y() << "]; interior lines must lie inside it");
+                                           << ", " << hi.x() << "] x [" << lo.y() << ", " << hi.y()
+                                           << "]; interior lines must lie inside it");
         SegmentGeometry g;
         g.loop = static_cast<int>(l);
         g.index = 0;

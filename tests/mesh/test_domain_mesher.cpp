@@ -373,6 +373,16 @@ TEST(DomainMesher, HugeSegmentsAndFarLinesAreRefusedAtOnce) {
                   std::string::npos)
             << e.what();
     }
+    // An end inside a boundary segment (not at one of its ends): CGAL refuses to split the
+    // constraint, and the mesher says so (a fuzzer found it ending in std::terminate).
+    try {
+        mesh_domain({unit_square()}, ok, {Segment::line({0, 0.4}, {0.6, 0.5}, "rib")});
+        ADD_FAILURE() << "line ending inside a boundary segment accepted";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("line 0 meets the boundary or another line at"),
+                  std::string::npos)
+            << e.what();
+    }
     // An end on the box (a loop corner) is accepted: the tolerance keeps it.
     EXPECT_NO_THROW(mesh_domain({unit_square()}, ok, {Segment::line({0, 0}, {0.5, 0.5}, "d")}));
     // A loop so long that even max_size needs more than 20 million points.
