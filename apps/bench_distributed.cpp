@@ -186,6 +186,43 @@ double global_relres(const solvers::ParMatrix& K, const Vector& b, const Vector&
 
 } // namespace
 
+std::unique_ptr<ElasticHierarchy> build_elastic_hierarchy(const std::string& scene, int L,
+                                                          int partition_level,
+                                                          const Communicator& comm) {
+    auto h = std::make_unique<ElasticHierarchy>();
+    h->problem = scene::load_scene(scene);
+    levels::Problem& problem = h->problem;
+    // Without contact pairs the levels have no multipliers: every level's K is the elastic block
+    // on the free displacements (the one-process bench's restriction).
+    problem.contacts.clear();
+    problem.levels = L;
+    problem.validate();
+    const int p = partition_level >= 0
+                      ? partition_level
+                      : levels::partition_level(problem.mesh0.n_triangles(), L, comm.size());
+    MLC_CHECK(p >= 0 && p < L, "the partition level must lie in 0.." << L - 1 << ", found " << p);
+    h->partition_level = p;
+
+    // The levels p..L as a distributed run builds them, and level p whole (the coarse solve).
+    comm.barrier();
+    const double th0 = wall_seconds();
+    mesh::Mesh mp = problem.mesh0;
+    for (int l = 0; l < p; ++l)
+        mp = mesh::refine(mp);
+    h->level_p = levels::build_level(problem, mp);
+    {
+        auto dh = mesh::distribute(mp, L - p, comm);
+        mp = mesh::Mesh{};
+        for (auto& lv : dh.levels)
+            h->levels.push_back(levels::build_distributed_level(problem, std::move(lv), comm));
+    }
+    for (size_t k = 1; k < h->levels.size(); ++k)
+        h->transfers.push_back(
+            levels::build_distributed_transfer(h->levels[k - 1], h->levels[k], comm));
+    h->seconds = comm.max(wall_seconds() - th0);
+    return h;
+}
+
 int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator& comm,
                               std::ostream& out) {
     std::ostream null_stream(nullptr);
@@ -196,36 +233,16 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
     MLC_CHECK(opt.repeat >= 1, "bench elastic: --repeat must be >= 1, found " << opt.repeat);
     MLC_CHECK(opt.rel_tol > 0 && opt.rel_tol < 1,
               "bench elastic: --tol must be in (0, 1), found " << opt.rel_tol);
-    levels::Problem problem = scene::load_scene(opt.scene);
-    // Without contact pairs the levels have no multipliers: every level's K is the elastic block
-    // on the free displacements (the one-process bench's restriction).
-    problem.contacts.clear();
-    problem.levels = opt.levels;
-    problem.validate();
     parallel::set_num_threads(1);
+    const auto h = build_elastic_hierarchy(opt.scene, opt.levels, -1, comm);
     const int np = comm.size();
     const int L = opt.levels;
-    const int p = levels::partition_level(problem.mesh0.n_triangles(), L, np);
-
-    // The levels p..L as a distributed run builds them, and level p whole (the coarse solve).
-    comm.barrier();
-    const double th0 = wall_seconds();
-    mesh::Mesh mp = problem.mesh0;
-    for (int l = 0; l < p; ++l)
-        mp = mesh::refine(mp);
-    const levels::Level level_p = levels::build_level(problem, mp);
-    std::vector<levels::DistributedLevel> dl;
-    {
-        auto dh = mesh::distribute(mp, L - p, comm);
-        mp = mesh::Mesh{};
-        for (auto& lv : dh.levels)
-            dl.push_back(levels::build_distributed_level(problem, std::move(lv), comm));
-    }
+    const int p = h->partition_level;
+    const double hierarchy_s = h->seconds;
+    const levels::Level& level_p = h->level_p;
+    const std::vector<levels::DistributedLevel>& dl = h->levels;
+    const std::vector<levels::DistributedTransfer>& transfers = h->transfers;
     const size_t m = dl.size() - 1;
-    std::vector<levels::DistributedTransfer> transfers;
-    for (size_t k = 1; k <= m; ++k)
-        transfers.push_back(levels::build_distributed_transfer(dl[k - 1], dl[k], comm));
-    const double hierarchy_s = comm.max(wall_seconds() - th0);
     const levels::DistributedLevel& fine = dl.back();
     const Index n = fine.n_owned;
     const Vector b = fine.local.elastic.f.head(n);

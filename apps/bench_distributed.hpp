@@ -18,8 +18,14 @@
 
 #include "apps/bench.hpp"
 #include "core/communicator.hpp"
+#include "levels/distributed.hpp"
+#include "levels/level.hpp"
+#include "levels/problem.hpp"
 
+#include <memory>
 #include <ostream>
+#include <string>
+#include <vector>
 
 namespace mlc::apps {
 
@@ -32,5 +38,23 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
 /// or a scene with no load on the free unknowns. Returns 0 when every solve converged, 2 otherwise.
 int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator& comm,
                               std::ostream& os);
+
+/// The elastic block's distributed levels p..L of a scene (its contact pairs dropped), as a run
+/// distributes them, and level p whole (the gathered coarse level). Built in place: the levels
+/// refer to the problem.
+struct ElasticHierarchy {
+    levels::Problem problem;
+    int partition_level = 0;
+    levels::Level level_p;
+    std::vector<levels::DistributedLevel> levels;       ///< levels[k]: level p + k, this part
+    std::vector<levels::DistributedTransfer> transfers; ///< transfers[k - 1]: k - 1 -> k
+    double seconds = 0;                                 ///< building time, slowest process
+};
+
+/// Collective. partition_level < 0: the run's rule (levels::partition_level). Throws
+/// InvalidInput for a partition level outside 0..L-1 and what the scene loader refuses.
+std::unique_ptr<ElasticHierarchy> build_elastic_hierarchy(const std::string& scene, int L,
+                                                          int partition_level,
+                                                          const Communicator& comm);
 
 } // namespace mlc::apps

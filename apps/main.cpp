@@ -8,6 +8,7 @@
 // breakdown; a run stopped by SIGINT / SIGTERM exits 130 / 143 after writing the files of its
 // completed load steps.
 #include "apps/bench.hpp"
+#include "apps/bench_comm.hpp"
 #include "apps/bench_distributed.hpp"
 #include "apps/interrupt.hpp"
 #include "apps/preconditioners.hpp"
@@ -182,6 +183,21 @@ int main(int argc, char** argv) {
     bel->add_option("--max-iter", beo.max_iter, "iterations of every solve (default 1000)");
     bel->add_option("--repeat", beo.repeat, "runs per solver, times are medians (default 1)");
     bel->add_option("--out,-o", beo_out, "JSON file (default out/bench/elastic_<scene>_L<L>.json)");
+    mlc::apps::BenchCommOptions bco;
+    std::string bco_out;
+    auto* bcm = bench->add_subcommand(
+        "comm", "messages, bytes, reductions and seconds per V-cycle, mat-vec and Krylov "
+                "iteration of the distributed mg (under mpirun with the PMPI library preloaded; "
+                "see README: Running on a cluster)");
+    bcm->add_option("scene", bco.scene, "scene file or built-in name (default square)");
+    bcm->add_option("--levels,-l", bco.levels, "finest level, 1..8 (default 5)");
+    bcm->add_option("--partition-level", bco.partition_level,
+                    "partition level p (default: the run's rule)")
+        ->check(CLI::NonNegativeNumber);
+    bcm->add_option("--ops", bco.ops, "repetitions of each operation per timing (default 10)");
+    bcm->add_option("--tol", bco.rel_tol, "relative tolerance of the CGS solve (default 1e-8)");
+    bcm->add_option("--out,-o", bco_out,
+                    "JSON file (default out/bench/comm_<scene>_L<L>_np<N>.json)");
     mlc::apps::BenchNewtonOptions bno;
     std::string bno_out;
     bool bno_no_amg = false;
@@ -225,13 +241,14 @@ int main(int argc, char** argv) {
     // run would write the same files). One process, with or without mpirun, runs as always.
     const bool distributed = mlc::comm::launched_by_mpirun() && mlc::comm::world().size() > 1;
     const int rank = distributed ? mlc::comm::world().rank() : 0;
-    if (distributed && !*run && !*bsq && !*bel) {
+    if (distributed && !*run && !*bsq && !*bel && !*bcm) {
         if (rank == 0)
             std::cerr
                 << "mlcontact: error: started as " << mlc::comm::world().size()
                 << " MPI processes, but this command runs as one process: on several "
                    "processes run `mlcontact run` (one-body scenes, Krylov + mg) or `mlcontact "
-                   "bench square|elastic`; run the others without mpirun or with mpirun -np 1\n";
+                   "bench square|elastic|comm`; run the others without mpirun or with mpirun -np "
+                   "1\n";
         return 1;
     }
     try {
@@ -253,6 +270,10 @@ int main(int argc, char** argv) {
             if (distributed)
                 return mlc::apps::bench_square_distributed(bso, mlc::comm::world(), std::cout);
             return mlc::apps::bench_square(bso, std::cout);
+        }
+        if (*bcm) {
+            bco.out = bco_out;
+            return mlc::apps::bench_comm(bco, mlc::comm::world(), std::cout);
         }
         if (*bnw) {
             bno.out = bno_out;
