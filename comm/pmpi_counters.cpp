@@ -48,6 +48,14 @@ void send(int count, MPI_Datatype type) {
     counts[p2p_bytes] += bytes(count, type);
 }
 
+/// A started persistent request: a message when it is a send (MPI_Send_init).
+void count_started(MPI_Request req) {
+    const auto it = persistent().find(req);
+    if (it == persistent().end()) return;
+    ++counts[p2p_messages];
+    counts[p2p_bytes] += it->second;
+}
+
 void reduce(int count, MPI_Datatype type) {
     ++counts[reductions];
     counts[reduction_bytes] += bytes(count, type);
@@ -123,21 +131,12 @@ int MPI_Send_init(const void* buf, int count, MPI_Datatype type, int dest, int t
     return rc;
 }
 int MPI_Start(MPI_Request* req) {
-    const auto it = persistent().find(*req);
-    if (it != persistent().end()) {
-        ++counts[p2p_messages];
-        counts[p2p_bytes] += it->second;
-    }
+    count_started(*req);
     return PMPI_Start(req);
 }
 int MPI_Startall(int n, MPI_Request reqs[]) {
-    for (int k = 0; k < n; ++k) {
-        const auto it = persistent().find(reqs[k]);
-        if (it != persistent().end()) {
-            ++counts[p2p_messages];
-            counts[p2p_bytes] += it->second;
-        }
-    }
+    for (int k = 0; k < n; ++k)
+        count_started(reqs[k]);
     return PMPI_Startall(n, reqs);
 }
 int MPI_Request_free(MPI_Request* req) {
