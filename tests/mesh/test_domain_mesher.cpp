@@ -360,6 +360,24 @@ TEST(DomainMesher, BadInputThrows) {
     EXPECT_THROW(mesh_domain({{Segment::line({0, 0}, {1, 0}, "l")}}, ok), InvalidInput);
 }
 
+// A line inside the loops' bounding box that leaves an L-shaped domain through its re-entrant
+// side is refused when its constraint meets the boundary.
+TEST(DomainMesher, ALineCrossingTheBoundaryOfAConcaveDomainIsRefused) {
+    const std::vector<Segment> ell = {
+        Segment::line({0, 0}, {1, 0}, "b"),       Segment::line({1, 0}, {1, 0.5}, "r"),
+        Segment::line({1, 0.5}, {0.5, 0.5}, "i"), Segment::line({0.5, 0.5}, {0.5, 1}, "j"),
+        Segment::line({0.5, 1}, {0, 1}, "t"),     Segment::line({0, 1}, {0, 0}, "l")};
+    try {
+        mesh_domain({ell}, SizeField{.max_size = 0.1},
+                    {Segment::line({0.25, 0.75}, {0.75, 0.75}, "rib")});
+        ADD_FAILURE() << "line leaving the domain accepted";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("line 0 crosses the boundary or another line"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 // A fuzzer found a scene whose interior line ran to y = 8.9e100: marching it at max_size would
 // have pushed 80 million points before the size guard. Both are refused before any marching.
 TEST(DomainMesher, HugeSegmentsAndFarLinesAreRefusedAtOnce) {
