@@ -5,6 +5,8 @@
 #include "core/check.hpp"
 #include "core/parallel.hpp"
 
+#include <cmath>
+
 namespace mlc {
 
 namespace {
@@ -21,17 +23,19 @@ bool equal_pattern(Index rows, Index cols, const int* outer, const int* inner, I
 
 } // namespace
 
-void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add, traffic::Kind kind) {
-    MLC_CHECK(x.size() == A.cols() && (!add || y.size() == A.rows()),
-              "csr_multiply: A is " << A.rows() << " x " << A.cols() << ", x has " << x.size()
+template <class Value>
+void csr_multiply(const CsrArrays<Value>& A, const Vector& x, Vector& y, bool add,
+                  traffic::Kind kind) {
+    MLC_CHECK(x.size() == A.cols && (!add || y.size() == A.rows),
+              "csr_multiply: A is " << A.rows << " x " << A.cols << ", x has " << x.size()
                                     << ", y has " << y.size());
-    MLC_CHECK(A.isCompressed(), "csr_multiply: A must be compressed");
-    const Index n = A.rows();
+    const Index n = A.rows;
     if (!add) y.resize(n);
-    const traffic::Pass pass(kind, traffic::csr_bytes(n, A.cols(), A.nonZeros(), add));
-    const int* outer = A.outerIndexPtr();
-    const int* inner = A.innerIndexPtr();
-    const double* val = A.valuePtr();
+    const traffic::Pass pass(
+        kind, traffic::csr_bytes(n, A.cols, A.nonzeros(), add, static_cast<int>(sizeof(Value))));
+    const int* outer = A.outer;
+    const int* inner = A.inner;
+    const Value* val = A.values;
     const double* xp = x.data();
     double* yp = y.data();
     // Chunks of at least kMinRowsPerThread rows claimed by the pool's threads (core/parallel):
@@ -45,6 +49,62 @@ void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add, t
                                for (size_t i = b; i < e; ++i)
                                    yp[i] = row_dot(inner, val, xp, outer[i], outer[i + 1]);
                        });
+}
+
+template void csr_multiply(const CsrArrays<double>&, const Vector&, Vector&, bool, traffic::Kind);
+template void csr_multiply(const CsrArrays<float>&, const Vector&, Vector&, bool, traffic::Kind);
+
+void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add, traffic::Kind kind) {
+    MLC_CHECK(A.isCompressed(), "csr_multiply: A must be compressed");
+    csr_multiply(csr_arrays(A, A.valuePtr()), x, y, add, kind);
+}
+
+template <class Value>
+void csr_residual(const CsrArrays<Value>& A, const Vector& b, const Vector& x, Vector& res,
+                  traffic::Kind kind) {
+    MLC_CHECK(x.size() == A.cols && b.size() == A.rows,
+              "csr_residual: A is " << A.rows << " x " << A.cols << ", x has " << x.size()
+                                    << ", b has " << b.size());
+    const Index n = A.rows;
+    res.resize(n);
+    const traffic::Pass pass(
+        kind, traffic::csr_bytes(n, A.cols, A.nonzeros(), true, static_cast<int>(sizeof(Value))));
+    const int* outer = A.outer;
+    const int* inner = A.inner;
+    const Value* val = A.values;
+    const double* xp = x.data();
+    const double* bp = b.data();
+    double* rp = res.data();
+    parallel::for_rows(static_cast<size_t>(n), static_cast<size_t>(kMinRowsPerThread),
+                       [&](size_t i0, size_t i1) {
+                           for (size_t i = i0; i < i1; ++i)
+                               rp[i] = bp[i] - row_dot(inner, val, xp, outer[i], outer[i + 1]);
+                       });
+}
+
+template void csr_residual(const CsrArrays<double>&, const Vector&, const Vector&, Vector&,
+                           traffic::Kind);
+template void csr_residual(const CsrArrays<float>&, const Vector&, const Vector&, Vector&,
+                           traffic::Kind);
+
+void round_values(const SparseMatrix& A, std::vector<float>& out, const char* who) {
+    MLC_CHECK(A.isCompressed(), who << ": the matrix must be compressed");
+    const Index nnz = A.nonZeros();
+    out.resize(static_cast<size_t>(nnz));
+    const double* v = A.valuePtr();
+    for (Index k = 0; k < nnz; ++k) {
+        const auto f = static_cast<float>(v[k]);
+        if (!std::isfinite(f)) {
+            Index row = 0;
+            while (A.outerIndexPtr()[row + 1] <= k)
+                ++row;
+            MLC_CHECK(false, who << ": entry (" << row << ", " << A.innerIndexPtr()[k]
+                                 << ") = " << v[k]
+                                 << " has no single-precision value (beyond +-3.4e38, or not "
+                                    "finite); use precision=double");
+        }
+        out[static_cast<size_t>(k)] = f;
+    }
 }
 
 bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {

@@ -25,7 +25,10 @@ inline constexpr Index kMinRowsPerThread = 4096;
 /// sweeps and mat-vecs (about 18 entries per row) were bound by that latency rather than by
 /// memory bandwidth. The summation order differs from a one-accumulator loop, so results differ
 /// from Eigen's product in the last bits.
-inline double row_dot(const int* inner, const double* val, const double* x, int k0, int k1) {
+/// Templated over the stored value type: with float values (the multigrid's single-precision
+/// data) every product is formed and summed in double, only the stored entry is rounded.
+template <class Value>
+inline double row_dot(const int* inner, const Value* val, const double* x, int k0, int k1) {
     double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
     int k = k0;
     for (; k + 3 < k1; k += 4) {
@@ -48,6 +51,58 @@ inline double row_dot(const int* inner, const double* val, const double* x, int 
 /// (core/traffic.hpp: traffic::csr_bytes(A.rows(), A.cols(), A.nonZeros(), add) bytes).
 void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = false,
                   traffic::Kind kind = traffic::Kind::matvec);
+
+/// Precision in which a preconditioner stores its matrix data (values, block inverses, transfers);
+/// its vectors and the Krylov method stay double either way.
+enum class Precision {
+    float64, ///< double: the values as assembled (the default)
+    float32  ///< float: every stored value rounded once, products and sums still in double
+};
+
+/// "double" or "single".
+inline const char* to_string(Precision p) {
+    return p == Precision::float32 ? "single" : "double";
+}
+
+/// Bytes of one stored value in `p`: 8 or 4.
+inline int value_bytes(Precision p) {
+    return p == Precision::float32 ? 4 : 8;
+}
+
+/// A compressed CSR matrix by its arrays: `outer` (rows + 1 offsets), `inner` (column indices)
+/// and `values` of type Value, all borrowed. The pattern is usually an Eigen matrix's and the
+/// values either its own (double) or a rounded copy (float, `round_values`).
+template <class Value> struct CsrArrays {
+    Index rows = 0, cols = 0;
+    const int* outer = nullptr;
+    const int* inner = nullptr;
+    const Value* values = nullptr;
+    Index nonzeros() const { return rows > 0 ? outer[rows] : 0; }
+};
+
+/// The arrays of a compressed A with `values` in place of its own (values.size() == nnz).
+template <class Value> CsrArrays<Value> csr_arrays(const SparseMatrix& A, const Value* values) {
+    return {A.rows(), A.cols(), A.outerIndexPtr(), A.innerIndexPtr(), values};
+}
+
+/// A's stored values rounded to float into `out` (resized to A.nonZeros(); no allocation when it
+/// has that size). A must be compressed. Throws mlc::InvalidInput, naming `who`, if a finite
+/// value overflows float (|a| > 3.4e38) or A holds NaN or Inf.
+void round_values(const SparseMatrix& A, std::vector<float>& out, const char* who);
+
+/// y = A x (or y += A x with `add`) on CSR arrays with values of type Value (double or float),
+/// each row by `row_dot`, rows split as in the SparseMatrix overload below (so with Value =
+/// double the result is the same, bit for bit). Counts one pass of `kind` with
+/// traffic::csr_bytes(rows, cols, nnz, add, sizeof(Value)).
+template <class Value>
+void csr_multiply(const CsrArrays<Value>& A, const Vector& x, Vector& y, bool add,
+                  traffic::Kind kind);
+
+/// res = b - A x on CSR arrays (res resized), each row by `row_dot`: one pass over A, counted as
+/// traffic::csr_bytes(rows, cols, nnz, true, sizeof(Value)) of `kind` (b read in place of y).
+template <class Value>
+void csr_residual(const CsrArrays<Value>& A, const Vector& b, const Vector& x, Vector& res,
+                  traffic::Kind kind);
 
 /// True when A and B have identical sizes and identical compressed patterns (outer and inner
 /// index arrays compared entry by entry); values are ignored. False if either is uncompressed.

@@ -108,23 +108,29 @@ bool timing() {
     return timing_on.load(std::memory_order_relaxed);
 }
 
-double csr_bytes(Index rows, Index cols, Index nonzeros, bool add) {
+double csr_bytes(Index rows, Index cols, Index nonzeros, bool add, int value_bytes) {
     const auto n = static_cast<double>(rows), m = static_cast<double>(cols),
                z = static_cast<double>(nonzeros);
-    return 12.0 * z + 4.0 * (n + 1) + 8.0 * m + 8.0 * n + (add ? 8.0 * n : 0.0);
+    const double v = value_bytes;
+    return (v + 4.0) * z + 4.0 * (n + 1) + 8.0 * m + 8.0 * n + (add ? 8.0 * n : 0.0);
 }
 
-double sweep_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_doubles) {
+double sweep_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_entries,
+                   int value_bytes) {
     const auto n = static_cast<double>(rows), z = static_cast<double>(nonzeros),
-               nb = static_cast<double>(blocks), d = static_cast<double>(inverse_doubles);
-    return 12.0 * z + 4.0 * (n + 1) + 8.0 * d + 8.0 * (2 * nb + 1) + 8.0 * n + 8.0 * n + 16.0 * n;
+               nb = static_cast<double>(blocks), d = static_cast<double>(inverse_entries);
+    const double v = value_bytes;
+    return (v + 4.0) * z + 4.0 * (n + 1) + v * d + 8.0 * (2 * nb + 1) + 8.0 * n + 8.0 * n +
+           16.0 * n;
 }
 
-double sweep_from_zero_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_doubles) {
+double sweep_from_zero_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_entries,
+                             int value_bytes) {
     const auto n = static_cast<double>(rows), z = static_cast<double>(nonzeros),
-               nb = static_cast<double>(blocks), d = static_cast<double>(inverse_doubles);
-    return 12.0 * z + 8.0 * (n + 1) + 8.0 * d + 8.0 * (2 * nb + 1) + 16.0 * n + 8.0 * n + 16.0 * n +
-           24.0 * n;
+               nb = static_cast<double>(blocks), d = static_cast<double>(inverse_entries);
+    const double v = value_bytes;
+    return (v + 4.0) * z + 8.0 * (n + 1) + v * d + 8.0 * (2 * nb + 1) + 16.0 * n + 8.0 * n +
+           16.0 * n + 24.0 * n;
 }
 
 Stream measure_stream(std::size_t n, int repeats) {

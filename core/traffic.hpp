@@ -26,6 +26,8 @@
 ///   touching k vectors of length n (an axpy y += a x: k = 3; a dot product: 2; a norm: 1).
 ///   Kind `vector`; not timed per statement (their time is what the solve spends outside the
 ///   timed kinds).
+/// - Single precision (`value_bytes` = 4 below: matrix values and block inverses stored as float,
+///   vectors still double): each 12 nnz becomes 8 nnz and each 8 d becomes 4 d.
 /// - The multigrid's coarse solve (level 0, sparse LU): timed, its bytes not counted (0), kind
 ///   `coarse`.
 ///
@@ -104,10 +106,14 @@ private:
     std::chrono::steady_clock::time_point t0_{};
 };
 
-/// Closed forms of the file comment.
-double csr_bytes(Index rows, Index cols, Index nonzeros, bool add);
-double sweep_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_doubles);
-double sweep_from_zero_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_doubles);
+/// Closed forms of the file comment. `value_bytes` is the size of one stored matrix value and
+/// one block-inverse entry: 8 (double, the default) or 4 (float: the multigrid's single-precision
+/// data, `mg:precision=single`); indices, offsets and vectors keep their sizes.
+double csr_bytes(Index rows, Index cols, Index nonzeros, bool add, int value_bytes = 8);
+double sweep_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_entries,
+                   int value_bytes = 8);
+double sweep_from_zero_bytes(Index rows, Index nonzeros, Index blocks, Index inverse_entries,
+                             int value_bytes = 8);
 inline double vector_bytes(Index n, int vectors) {
     return 8.0 * static_cast<double>(n) * vectors;
 }

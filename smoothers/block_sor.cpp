@@ -63,7 +63,8 @@ std::ostream& operator<<(std::ostream& os, const BlockSORParams& p) {
     else
         os << "[" << p.block_starts.size() << " starts, largest inner block " << largest << "]";
     return os << ", singular_tol=" << p.singular_tol << ", parts=" << p.parts
-              << ", kernel=" << to_string(p.kernel) << "}";
+              << ", kernel=" << to_string(p.kernel) << ", precision=" << to_string(p.precision)
+              << "}";
 }
 
 std::vector<Index> uniform_block_starts(Index n, Index block_size) {
@@ -104,11 +105,11 @@ void BlockSOR::setup(const SparseMatrix& A) {
         max_block_ = std::max(max_block_, s);
         offset_[b + 1] = offset_[b] + s * s;
     }
-    dinv_.assign(static_cast<size_t>(offset_[nb]), 0.0);
     post_ = params_.kernel == Kernel::unrolled ? 1.0 : params_.omega;
     A_ = &A;
     derive_structure();
     invert_blocks();
+    round_data();
     res_.resize(n);
 }
 
@@ -123,6 +124,20 @@ void BlockSOR::update_values(const SparseMatrix& A) {
     // positions; any other pattern has them derived anew.
     if (!pattern_.matches(A)) derive_structure();
     invert_blocks();
+    round_data();
+}
+
+void BlockSOR::round_data() {
+    if (params_.precision != Precision::float32) return;
+    round_values(*A_, values32_, "BlockSOR (single precision)");
+    dinv32_.resize(dinv_.size());
+    for (size_t k = 0; k < dinv_.size(); ++k) {
+        dinv32_[k] = static_cast<float>(dinv_[k]);
+        MLC_CHECK(std::isfinite(dinv32_[k]),
+                  "BlockSOR (single precision): a block inverse entry "
+                      << dinv_[k] << " has no single-precision value; use precision=double");
+    }
+    std::vector<double>().swap(dinv_); // the double inverses are not read by float32 sweeps
 }
 
 void BlockSOR::derive_structure() {
@@ -298,6 +313,7 @@ void BlockSOR::invert_blocks() {
     const double* av = A_->valuePtr();
     const double omega = params_.omega;
     const double tol = params_.singular_tol;
+    dinv_.resize(static_cast<size_t>(inverse_entries()));
     Eigen::MatrixXd block;
     for (Index b = 0; b < n_blocks(); ++b) {
         const Index s0 = starts_[b], s = starts_[b + 1] - s0;
@@ -350,11 +366,11 @@ void BlockSOR::invert_blocks() {
 // One part's half-sweep over blocks [b0, b1) with scratch t (one block). The other parts'
 // unknowns are read from snap_ (their values when the sweep began). With from_zero (in_order
 // kernel only) x is zero on entry and only the already-visited own entries of each row count.
-void BlockSOR::sweep_part(const double* bp, double* xp, Index b0, Index b1, bool forward,
-                          bool from_zero, double* t) const {
+template <class Value>
+void BlockSOR::sweep_part(const Value* av, const Value* dinv, const double* bp, double* xp,
+                          Index b0, Index b1, bool forward, bool from_zero, double* t) const {
     const int* ao = A_->outerIndexPtr();
     const int* ai = A_->innerIndexPtr();
-    const double* av = A_->valuePtr();
     const double* sp = snap_.data();
     const bool unrolled = params_.kernel == Kernel::unrolled;
     for (Index step = b0; step < b1; ++step) {
@@ -385,7 +401,7 @@ void BlockSOR::sweep_part(const double* bp, double* xp, Index b0, Index b1, bool
             }
             t[i - s0] = acc;
         }
-        const double* D = dinv_.data() + offset_[blk];
+        const Value* D = dinv + offset_[blk];
         for (Index a = 0; a < s; ++a) {
             double c = 0.0;
             for (Index q = 0; q < s; ++q)
@@ -399,7 +415,7 @@ void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_ze
                           bool count) const {
     const traffic::Pass pass(traffic::Kind::smoother,
                              count ? traffic::sweep_bytes(A_->rows(), A_->nonZeros(), n_blocks(),
-                                                          static_cast<Index>(dinv_.size()))
+                                                          inverse_entries(), value_size())
                                    : 0.0,
                              count ? 1 : 0);
     double* xp = x.data();
@@ -410,9 +426,15 @@ void BlockSOR::half_sweep(const Vector& b, Vector& x, bool forward, bool from_ze
     const bool zero = from_zero && params_.kernel == Kernel::in_order;
     // The parts are claimed by whichever threads of core/parallel are free: with a loaded core
     // the other thread sweeps both, and the map is the same.
+    const bool single = params_.precision == Precision::float32;
     parallel::for_chunks(static_cast<size_t>(P), [&](size_t p) {
-        sweep_part(b.data(), xp, part_block_[p], part_block_[p + 1], forward, zero,
-                   work_.data() + static_cast<Index>(p) * max_block_);
+        double* t = work_.data() + static_cast<Index>(p) * max_block_;
+        if (single)
+            sweep_part(values32_.data(), dinv32_.data(), b.data(), xp, part_block_[p],
+                       part_block_[p + 1], forward, zero, t);
+        else
+            sweep_part(A_->valuePtr(), dinv_.data(), b.data(), xp, part_block_[p],
+                       part_block_[p + 1], forward, zero, t);
     });
 }
 
@@ -428,31 +450,47 @@ void BlockSOR::forward_from_zero(const Vector& b, Vector& x, Vector& res) const 
     MLC_CHECK(A_ != nullptr, "BlockSOR::forward_from_zero called before setup");
     check_size(b, A_->rows(), "BlockSOR::forward_from_zero", "b");
     const Index n = A_->rows();
-    const int* outer = A_->outerIndexPtr();
-    const int* inner = A_->innerIndexPtr();
-    const double* val = A_->valuePtr();
     const traffic::Pass pass(traffic::Kind::smoother,
                              traffic::sweep_from_zero_bytes(n, A_->nonZeros(), n_blocks(),
-                                                            static_cast<Index>(dinv_.size())),
+                                                            inverse_entries(), value_size()),
                              2);
+    const bool single = params_.precision == Precision::float32;
     if (params_.kernel == Kernel::in_order) {
         x.setZero(n);
         half_sweep(b, x, true, true, false);
         res.resize(n);
-        for (Index i = 0; i < n; ++i) {
-            double acc = b[i];
-            for (int p = outer[i]; p < outer[i + 1]; ++p)
-                acc -= val[p] * x[inner[p]];
-            res[i] = acc;
-        }
+        const int* outer = A_->outerIndexPtr();
+        const int* inner = A_->innerIndexPtr();
+        auto residual = [&](const auto* val) {
+            for (Index i = 0; i < n; ++i) {
+                double acc = b[i];
+                for (int p = outer[i]; p < outer[i + 1]; ++p)
+                    acc -= val[p] * x[inner[p]];
+                res[i] = acc;
+            }
+        };
+        if (single)
+            residual(values32_.data());
+        else
+            residual(A_->valuePtr());
         return;
     }
     x.resize(n);
     res.resize(n);
+    if (single)
+        forward_from_zero_unrolled(values32_.data(), dinv32_.data(), b.data(), x.data(),
+                                   res.data());
+    else
+        forward_from_zero_unrolled(A_->valuePtr(), dinv_.data(), b.data(), x.data(), res.data());
+}
+
+template <class Value>
+void BlockSOR::forward_from_zero_unrolled(const Value* val, const Value* dinv, const double* bp,
+                                          double* xp, double* rp) const {
+    const Index n = A_->rows();
+    const int* outer = A_->outerIndexPtr();
+    const int* inner = A_->innerIndexPtr();
     const int* dbeg = diag_begin_.data();
-    double* xp = x.data();
-    double* rp = res.data();
-    const double* bp = b.data();
     // Each part from zero with its own lower entries (the other parts' x count as 0, as they
     // are at the start of the sweep); then the whole residual with the final x: the diagonal
     // and upper entries, and the lower ones of other parts. One part: plain Gauss–Seidel.
@@ -464,7 +502,7 @@ void BlockSOR::forward_from_zero(const Vector& b, Vector& x, Vector& res) const 
             for (Index i = s; i < s + bs; ++i)
                 rp[i] =
                     bp[i] - row_dot(inner, val, xp, own_begin_[static_cast<size_t>(i)], dbeg[i]);
-            const double* d = dinv_.data() + offset_[static_cast<size_t>(I)];
+            const Value* d = dinv + offset_[static_cast<size_t>(I)];
             for (Index i = 0; i < bs; ++i) {
                 double acc = 0.0;
                 for (Index j = 0; j < bs; ++j)
@@ -560,6 +598,9 @@ void BlockSOR::apply_transpose(const Vector& r, Vector& z) const {
     MLC_CHECK(A_ != nullptr, "BlockSOR::apply_transpose called before setup");
     MLC_CHECK(parts() == 1, "BlockSOR::apply_transpose: the hybrid sweep with "
                                 << parts() << " parts has no transpose here; use parts = 1");
+    MLC_CHECK(params_.precision == Precision::float64,
+              "BlockSOR::apply_transpose: not available with single-precision data; use "
+              "precision=double");
     check_size(r, A_->rows(), "BlockSOR::apply_transpose", "r");
     z.setZero(r.size());
     const bool sym = params_.sweep == Sweep::symmetric;
@@ -597,6 +638,7 @@ std::string BlockSOR::name() const {
         os << ",block=" << params_.block_size;
     if (params_.parts != 1) os << ",parts=" << params_.parts;
     if (params_.kernel == Kernel::unrolled) os << ",unrolled";
+    if (params_.precision == Precision::float32) os << ",single";
     os << ")";
     return os.str();
 }

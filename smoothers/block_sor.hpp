@@ -83,6 +83,13 @@ struct BlockSORParams {
     int parts = 1;
     /// Arithmetic of the sweeps. Default in_order (see `Kernel`).
     Kernel kernel = Kernel::in_order;
+    /// Precision of the stored smoother data. float64 (default): the sweeps read A's own values
+    /// and double block inverses. float32: a float copy of A's values (rounded at every `setup`
+    /// and `update_values`; A's pattern is shared, so it costs 4 bytes per nonzero beside A) and
+    /// the block inverses (computed in double, then rounded) are what the sweeps read, with x, b
+    /// and the residual still double and every product summed in double; the traffic account
+    /// counts 4-byte values. About a third fewer bytes per sweep; `apply_transpose` refuses it.
+    Precision precision = Precision::float64;
 
     /// Throws mlc::InvalidInput naming the first field out of range (block_starts is checked
     /// against the matrix size in `BlockSOR::setup`).
@@ -161,7 +168,7 @@ public:
     void forward_from_zero(const Vector& b, Vector& x, Vector& res) const;
     /// "sor(omega=W)", "ssor(omega=W)", "backward-sor(omega=W)", with ",sweeps=N" when N > 1,
     /// ",block=B" for uniform blocks B > 1, ",blocks=var" for given block starts, ",parts=P"
-    /// when P != 1 and ",unrolled" for that kernel.
+    /// when P != 1, ",unrolled" for that kernel and ",single" for float32 data.
     std::string name() const override;
 
     /// Number of diagonal blocks after the last `setup`.
@@ -174,20 +181,33 @@ public:
     std::vector<Index> part_rows() const;
     /// The parameters in effect.
     const BlockSORParams& params() const { return params_; }
+    /// float32: A's values rounded to float, in A's storage order (empty for float64); valid
+    /// until the next `setup` / `update_values`.
+    const float* values32() const { return values32_.data(); }
 
 private:
     void derive_structure(); // parts and diagonal positions, from *A_'s pattern
     using InverseMap =
         Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
     void invert_blocks();
+    // float32: values32_ from A's values and dinv32_ from dinv_ (then released).
+    void round_data();
     // D^{-1} of a block the kernel's fast path rejected (equilibrated full-pivot LU); throws.
     void robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, InverseMap inv) const;
     // One half-sweep; `count`: one smoother pass of traffic::sweep_bytes (core/traffic.hpp).
     void half_sweep(const Vector& b, Vector& x, bool forward, bool from_zero,
                     bool count = true) const;
-    // One part's sweep (blocks [b0, b1)), other parts' unknowns read from snap_.
-    void sweep_part(const double* bp, double* xp, Index b0, Index b1, bool forward, bool from_zero,
-                    double* t) const;
+    // One part's sweep (blocks [b0, b1)), other parts' unknowns read from snap_; `av` and
+    // `dinv` are A's values and the block inverses in the stored precision.
+    template <class Value>
+    void sweep_part(const Value* av, const Value* dinv, const double* bp, double* xp, Index b0,
+                    Index b1, bool forward, bool from_zero, double* t) const;
+    template <class Value>
+    void forward_from_zero_unrolled(const Value* val, const Value* dinv, const double* bp,
+                                    double* xp, double* rp) const;
+    // Entries of the stored block inverses and their bytes per value, for the traffic account.
+    Index inverse_entries() const { return offset_.empty() ? 0 : offset_.back(); }
+    int value_size() const { return value_bytes(params_.precision); }
     void solve_lower_transpose(Vector& w) const; // (D/omega + L)^T t = w, t -> w
     void solve_upper_transpose(Vector& w) const; // (D/omega + U)^T t = w, t -> w
 
@@ -196,8 +216,9 @@ private:
     SparsityPattern pattern_;   // of A at the last derive_structure
     std::vector<Index> starts_; // block starts followed by n
     std::vector<Index> offset_; // offset of block I's inverse in dinv_
-    std::vector<double> dinv_;  // row-major inverses (times omega for `unrolled`)
-    double post_ = 1.0;         // factor of the block correction: omega or 1 (unrolled)
+    std::vector<double> dinv_;  // row-major inverses (times omega for `unrolled`); float64 only
+    std::vector<float> values32_, dinv32_; // float32: A's values and the inverses, rounded
+    double post_ = 1.0;                    // factor of the block correction: omega or 1 (unrolled)
     Index max_block_ = 0;
     std::vector<int> diag_begin_;          // per row: first stored entry in or right of its block
     std::vector<int> own_begin_, own_end_; // per row: its entries with columns in its own part

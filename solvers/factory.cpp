@@ -165,6 +165,10 @@ std::unique_ptr<Preconditioner> build_mg(SpecOptions& o, const LevelData* level)
     AggregationParams ap;
     ap.coarse_size = o.get_int("csize", ap.coarse_size);
     ap.smoothing = o.get_double("smooth", ap.smoothing);
+    const std::string precision = o.get_string("precision", "double");
+    MLC_CHECK(precision == "double" || precision == "single",
+              "option precision=" << precision << " of mg: valid double, single");
+    p.precision = precision == "single" ? Precision::float32 : Precision::float64;
     o.finish();
     p.validate();
     if (coarse == "aggregation") {
@@ -287,12 +291,14 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          false,
          &build_ebe},
         {"mg",
-         "mg[:pre=N,post=N,omega=W,coarse=rediscretize|galerkin|aggregation,csize=N,smooth=S] "
+         "mg[:pre=N,post=N,omega=W,coarse=rediscretize|galerkin|aggregation,csize=N,smooth=S,"
+         "precision=double|single] "
          "(multilevel V-cycle over all levels, vertex-block Gauss-Seidel; on a single level, "
          "or with coarse=aggregation, over an algebraic hierarchy of vertex aggregates coarsened "
-         "to at most N = 3000 unknowns, prolongation smoothing S = 4/3)",
+         "to at most N = 3000 unknowns, prolongation smoothing S = 4/3; precision=single stores "
+         "the smoother's matrices, block inverses and transfers as float, vectors stay double)",
          "",
-         {"pre", "post", "omega", "coarse", "csize", "smooth"},
+         {"pre", "post", "omega", "coarse", "csize", "smooth", "precision"},
          true,
          true,
          &build_mg,

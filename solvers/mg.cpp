@@ -25,7 +25,7 @@ void MultigridParams::validate() const {
 
 std::ostream& operator<<(std::ostream& os, const MultigridParams& p) {
     return os << "MultigridParams{pre=" << p.pre_sweeps << ", post=" << p.post_sweeps
-              << ", omega=" << p.omega << "}";
+              << ", omega=" << p.omega << ", precision=" << to_string(p.precision) << "}";
 }
 
 namespace {
@@ -38,7 +38,8 @@ smoothers::BlockSORParams smoother_params(const MultigridParams& params,
             .block_size = 2,
             .block_starts = std::move(block_starts),
             .parts = 0,
-            .kernel = smoothers::Kernel::unrolled};
+            .kernel = smoothers::Kernel::unrolled,
+            .precision = params.precision};
 }
 } // namespace
 
@@ -47,10 +48,16 @@ smoothers::BlockSORParams smoother_params(const MultigridParams& params,
 struct Multigrid::Level {
     Level(const MultigridLevelData& d, const MultigridParams& p)
         : T(d.T), R(d.R), T_storage(d.T_storage), R_storage(d.R_storage), params(p),
-          smoother(smoother_params(p, d.block_starts)) {}
+          smoother(smoother_params(p, d.block_starts)) {
+        if (T && p.precision == Precision::float32) {
+            round_values(*T, T32, "mg:precision=single (prolongation)");
+            round_values(*R, R32, "mg:precision=single (restriction)");
+        }
+    }
     const SparseMatrix* T = nullptr;
     const SparseMatrix* R = nullptr;
     std::shared_ptr<const SparseMatrix> T_storage, R_storage; // owned transfers, or null
+    std::vector<float> T32, R32; // float32: T's and R's values, rounded (patterns are theirs)
     MultigridParams params;
     smoothers::BlockSOR smoother;           // levels >= 1
     std::unique_ptr<Preconditioner> coarse; // level 0
@@ -189,6 +196,7 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
     }
     MLC_CHECK(L.A != nullptr, "Multigrid: the operator of level " << k << " is not set");
     const MultigridParams& p = L.params;
+    const bool single = p.precision == Precision::float32;
     if (p.pre_sweeps == 0) {
         z.setZero(r.size());
         L.res = r;
@@ -196,7 +204,10 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
         L.smoother.forward_from_zero(r, z, L.res);
         for (int s = 1; s < p.pre_sweeps; ++s)
             L.smoother.sweep(r, z, smoothers::Sweep::forward);
-        if (p.pre_sweeps > 1) {
+        if (p.pre_sweeps > 1 && single) {
+            csr_residual(csr_arrays(*L.A, L.smoother.values32()), r, z, L.res,
+                         traffic::Kind::matvec);
+        } else if (p.pre_sweeps > 1) {
             const traffic::Pass pass(
                 traffic::Kind::matvec,
                 traffic::csr_bytes(L.A->rows(), L.A->cols(), L.A->nonZeros(), true));
@@ -204,9 +215,15 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
             L.res.noalias() -= *L.A * z;
         }
     }
-    csr_multiply(*L.R, L.res, L.rc, false, traffic::Kind::transfer);
-    cycle(k - 1, L.rc, L.ec);
-    csr_multiply(*L.T, L.ec, z, true, traffic::Kind::transfer);
+    if (single) {
+        csr_multiply(csr_arrays(*L.R, L.R32.data()), L.res, L.rc, false, traffic::Kind::transfer);
+        cycle(k - 1, L.rc, L.ec);
+        csr_multiply(csr_arrays(*L.T, L.T32.data()), L.ec, z, true, traffic::Kind::transfer);
+    } else {
+        csr_multiply(*L.R, L.res, L.rc, false, traffic::Kind::transfer);
+        cycle(k - 1, L.rc, L.ec);
+        csr_multiply(*L.T, L.ec, z, true, traffic::Kind::transfer);
+    }
     for (int s = 0; s < p.post_sweeps; ++s)
         L.smoother.sweep(r, z, smoothers::Sweep::backward);
 }
@@ -221,7 +238,9 @@ void Multigrid::apply(const Vector& r, Vector& z) const {
 std::string Multigrid::name() const {
     const MultigridParams& p = levels_.back()->params;
     std::ostringstream os;
-    os << "mg(pre=" << p.pre_sweeps << ",post=" << p.post_sweeps << ",omega=" << p.omega << ")";
+    os << "mg(pre=" << p.pre_sweeps << ",post=" << p.post_sweeps << ",omega=" << p.omega;
+    if (p.precision == Precision::float32) os << ",precision=single";
+    os << ")";
     return os.str();
 }
 
@@ -249,6 +268,8 @@ MultigridReport Multigrid::report() const {
     std::ostringstream sm;
     sm << "vertex-block Gauss-Seidel, forward before / backward after, " << smoothers::kHybridParts
        << " threaded parts";
+    if (p.precision == Precision::float32)
+        sm << ", single-precision matrices, block inverses and transfers";
     r.smoother = sm.str();
     const Level& L0 = *levels_.front();
     r.coarse_solver =

@@ -44,6 +44,12 @@ struct MultigridParams {
     int pre_sweeps = 1;  ///< forward smoothing sweeps before the coarse correction, >= 0
     int post_sweeps = 1; ///< backward sweeps after it, >= 0 (pre + post >= 1)
     double omega = 1.0;  ///< relaxation of the block Gauss–Seidel sweeps, in (0, 2)
+    /// Precision of the cycle's stored data on the levels above the coarsest: the smoother's
+    /// matrix values and block inverses (smoothers::BlockSORParams::precision) and the transfers
+    /// T and R (float copies of their values, made at construction). The vectors of the cycle,
+    /// the coarsest level's LU and the Krylov method stay double. Default float64; float32 is
+    /// `mg:precision=single`.
+    Precision precision = Precision::float64;
     /// Throws mlc::InvalidInput naming the first field out of range.
     void validate() const;
 };
@@ -135,7 +141,8 @@ public:
     void update_values(const SparseMatrix& A) override;
     /// One V-cycle from the finest level.
     void apply(const Vector& r, Vector& z) const override;
-    /// "mg(pre=1,post=1,omega=1)" (the finest level's parameters).
+    /// "mg(pre=1,post=1,omega=1)" (the finest level's parameters), with ",precision=single"
+    /// appended for float32 data.
     std::string name() const override;
 
     /// Levels, sizes, complexities, smoother and coarse solve (operators must be set).

@@ -3,6 +3,7 @@
 // header on a known matrix (values, indices, offsets, x once, y once, y twice with `add`),
 // under the kind it is given; MatrixOperator's Eigen path counts the same; timing is kept only
 // when switched on; STREAM returns positive finite bandwidths.
+#include "core/check.hpp"
 #include "core/csr.hpp"
 #include "core/linear_operator.hpp"
 #include "core/parallel.hpp"
@@ -47,6 +48,39 @@ TEST(Traffic, CsrMultiplyCountsTheClosedForm) {
     EXPECT_EQ(y, Vector((Vector(3) << 6.0, 6.0, 18.0).finished()));
 }
 
+TEST(Traffic, SinglePrecisionValuesCountFourBytes) {
+    // The same 3 x 4 matrix with float values: 8 * 5 (values and indices) + 4 * 4 + 8 * 4 + 8 * 3.
+    EXPECT_EQ(traffic::csr_bytes(3, 4, 5, false, 4), 112.0);
+    EXPECT_EQ(traffic::csr_bytes(3, 4, 5, true, 4), 136.0);
+    const SparseMatrix A = known_matrix();
+    std::vector<float> v32;
+    round_values(A, v32, "test");
+    const Vector x = (Vector(4) << 1.0, 0.1, 0.5, 1.0 / 3.0).finished();
+    Vector y, y64, res;
+    traffic::Account a0 = traffic::snapshot();
+    csr_multiply(csr_arrays(A, v32.data()), x, y, false, traffic::Kind::transfer);
+    traffic::Account d = traffic::snapshot() - a0;
+    EXPECT_EQ(d.b(traffic::Kind::transfer), 112.0);
+    EXPECT_EQ(d.p(traffic::Kind::transfer), 1.0);
+    // The values are small integers (exact in float) and products are summed in double: the
+    // float path gives the double one's result bit for bit.
+    csr_multiply(A, x, y64);
+    EXPECT_EQ(y, y64);
+    a0 = traffic::snapshot();
+    csr_residual(csr_arrays(A, v32.data()), Vector::Ones(3), x, res, traffic::Kind::matvec);
+    d = traffic::snapshot() - a0;
+    EXPECT_EQ(d.b(traffic::Kind::matvec), 136.0);
+    EXPECT_EQ(res, Vector(Vector::Ones(3) - y64));
+    // Rounding is real (0.1 is not a float) and a value beyond float's range is refused.
+    SparseMatrix B = A;
+    B.valuePtr()[0] = 0.1;
+    round_values(B, v32, "test");
+    EXPECT_NE(static_cast<double>(v32[0]), 0.1);
+    EXPECT_EQ(v32[0], 0.1f);
+    B.valuePtr()[4] = 1e39;
+    EXPECT_THROW(round_values(B, v32, "test"), InvalidInput);
+}
+
 TEST(Traffic, MatrixOperatorCountsOneMatVecWhicheverKernel) {
     const SparseMatrix A = known_matrix();
     const Vector x = Vector::Ones(4);
@@ -88,6 +122,11 @@ TEST(Traffic, SweepClosedForms) {
     EXPECT_EQ(traffic::sweep_from_zero_bytes(4, 10, 2, 8),
               12 * 10 + 8 * 5 + 8 * 8 + 8 * 5 + 16 * 4 + 8 * 4 + 16 * 4 + 24 * 4);
     EXPECT_EQ(traffic::vector_bytes(1000, 3), 24000.0);
+    // Single precision: 4-byte values and inverse entries, everything else unchanged.
+    EXPECT_EQ(traffic::sweep_bytes(4, 10, 2, 8, 4),
+              8 * 10 + 4 * 5 + 4 * 8 + 8 * (2 * 2 + 1) + 8 * 4 + 8 * 4 + 16 * 4);
+    EXPECT_EQ(traffic::sweep_from_zero_bytes(4, 10, 2, 8, 4),
+              8 * 10 + 8 * 5 + 4 * 8 + 8 * 5 + 16 * 4 + 8 * 4 + 16 * 4 + 24 * 4);
 }
 
 TEST(Traffic, StreamIsPositiveAndFinite) {

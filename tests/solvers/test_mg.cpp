@@ -30,13 +30,13 @@ struct ElasticHierarchy {
     std::unique_ptr<levels::ElasticMultigrid> mg;
     Vector b;
 
-    explicit ElasticHierarchy(int levels) {
+    explicit ElasticHierarchy(int levels, solvers::MultigridParams params = {}) {
         auto problem = scene::load_scene("square");
         problem.levels = levels;
         h = levels::build_hierarchy(problem);
         for (const auto& L : h.levels)
             blocks.push_back(levels::elastic_block(L));
-        mg = std::make_unique<levels::ElasticMultigrid>(h, blocks);
+        mg = std::make_unique<levels::ElasticMultigrid>(h, blocks, params);
         b = blocks.back().restrict(h.finest().elastic.f);
     }
     const SparseMatrix& K() const { return blocks.back().K; }
@@ -346,4 +346,49 @@ TEST(Multigrid, OneVCycleCountsItsPasses) {
     const double ops = 12.0 * static_cast<double>(rep.levels[1].nonzeros + rep.levels[2].nonzeros);
     EXPECT_GT(d.b(traffic::Kind::smoother), 2 * ops);
     EXPECT_LT(d.b(traffic::Kind::smoother), 4 * ops);
+}
+
+TEST(Multigrid, OneVCycleCountsItsBytesInBothPrecisions) {
+    // Every pass of a V-cycle on levels 0..2 in closed form (core/traffic.hpp): per level above
+    // 0 the sweep from zero with its residual and the backward sweep on K_l (vertex blocks), the
+    // restriction R_l r and the prolongation z += P_l e; with precision=single the same passes
+    // with 4-byte values and block-inverse entries. The single cycle is the double one up to
+    // float rounding of the data (about 1e-7 relative), not bit for bit.
+    solvers::MultigridParams single;
+    single.precision = Precision::float32;
+    ElasticHierarchy d(2), s(2, single);
+    EXPECT_EQ(s.mg->finest().name(), "mg(pre=1,post=1,omega=1,precision=single)");
+    EXPECT_EQ(d.mg->finest().name(), "mg(pre=1,post=1,omega=1)");
+    for (const auto& [e, vb] : {std::pair<ElasticHierarchy*, int>{&d, 8}, {&s, 4}}) {
+        double smoother = 0.0, transfer = 0.0;
+        for (size_t l = 1; l < 3; ++l) {
+            const SparseMatrix& K = e->blocks[l].K;
+            const std::vector<Index> starts = solvers::vertex_block_starts(e->blocks[l].vertex);
+            Index inverse = 0;
+            for (size_t b = 0; b < starts.size(); ++b) {
+                const Index size = (b + 1 < starts.size() ? starts[b + 1] : K.rows()) - starts[b];
+                inverse += size * size;
+            }
+            const auto nb = static_cast<Index>(starts.size());
+            smoother += traffic::sweep_from_zero_bytes(K.rows(), K.nonZeros(), nb, inverse, vb) +
+                        traffic::sweep_bytes(K.rows(), K.nonZeros(), nb, inverse, vb);
+            const SparseMatrix& R = e->mg->R[l];
+            const SparseMatrix& P = e->mg->P[l];
+            transfer += traffic::csr_bytes(R.rows(), R.cols(), R.nonZeros(), false, vb) +
+                        traffic::csr_bytes(P.rows(), P.cols(), P.nonZeros(), true, vb);
+        }
+        Vector z;
+        const traffic::Account a0 = traffic::snapshot();
+        e->mg->finest().apply(e->b, z);
+        const traffic::Account a = traffic::snapshot() - a0;
+        EXPECT_EQ(a.b(traffic::Kind::smoother), smoother) << vb;
+        EXPECT_EQ(a.b(traffic::Kind::transfer), transfer) << vb;
+        EXPECT_EQ(a.p(traffic::Kind::smoother), 6.0);
+        EXPECT_EQ(a.p(traffic::Kind::transfer), 4.0);
+    }
+    Vector zd, zs;
+    d.mg->finest().apply(d.b, zd);
+    s.mg->finest().apply(s.b, zs);
+    EXPECT_LT((zs - zd).norm(), 1e-5 * zd.norm());
+    EXPECT_GT((zs - zd).norm(), 0.0);
 }
