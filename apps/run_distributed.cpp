@@ -10,6 +10,7 @@
 #include "core/parallel.hpp"
 #include "levels/checks.hpp"
 #include "levels/distributed_solve.hpp"
+#include "levels/resources.hpp"
 #include "mesh/distributed.hpp"
 #include "scene/scene.hpp"
 #include "solvers/factory.hpp"
@@ -27,7 +28,7 @@
 
 namespace mlc::apps {
 
-levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt) {
+levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two_body) {
     MLC_CHECK(!opt.linear || *opt.linear == "krylov",
               "--linear " << *opt.linear
                           << " has no distributed form (it needs the whole level on one "
@@ -35,8 +36,8 @@ levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt) {
                              "a Krylov method with mg (--linear krylov, the default there)");
     levels::LinearSolverSpec s;
     s.method = "krylov";
-    s.krylov = opt.krylov.value_or("cgs");
-    s.pc = opt.pc.value_or("mg");
+    s.krylov = opt.krylov.value_or(two_body ? "bicgstab" : "cgs");
+    s.pc = opt.pc.value_or(two_body ? levels::kMgDefaultTwoBody : "mg");
     if (opt.linear_rel_tol) s.rel_tol = *opt.linear_rel_tol;
     s.validate();
     return s;
@@ -144,6 +145,20 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
     return cb;
 }
 
+/// This process's contact elements with a target vertex owned by another process.
+std::int64_t cut_elements(const levels::DistributedLevel& F) {
+    std::int64_t n = 0;
+    for (const auto& e : F.local.contacts) {
+        bool cut = false;
+        for (int j = 1; j < e.n_nodes; ++j)
+            cut =
+                cut || F.part.vertex_owner[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])] !=
+                           F.part.vertex_owner[static_cast<size_t>(e.vertex[0])];
+        n += cut;
+    }
+    return n;
+}
+
 } // namespace
 
 int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::ostream& out) {
@@ -161,7 +176,11 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
               "distributed run writes solution.pvtu of the final state)");
     MLC_CHECK(p.levels >= 1, "a run on several processes needs --levels >= 1 (level 0 is solved "
                              "on every process; the levels above it are distributed)");
-    const levels::LinearSolverSpec spec = distributed_solver_spec(opt);
+    const bool two_body =
+        std::any_of(p.contacts.begin(), p.contacts.end(), [](const levels::ContactPair& c) {
+            return c.element != levels::ContactElementKind::node_on_rigid;
+        });
+    const levels::LinearSolverSpec spec = distributed_solver_spec(opt, two_body);
     const int finest = p.levels;
     int plevel = opt.partition_level
                      ? *opt.partition_level
@@ -193,7 +212,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
        << (mg ? std::string("Krylov + distributed mg")
               : "Krylov + " + spec.pc +
                     " on each process's diagonal block, Jacobi across the cuts; levels 0-p on "
-                    "every process") << ")\n";
+                    "every process")
+       << ")\n";
     os << "partition level " << plevel
        << (opt.partition_level
                ? " (--partition-level)"
@@ -220,7 +240,9 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         static_cast<double>(F.local.mesh.n_vertices() - F.part.n_owned_vertices()),
         static_cast<double>(F.local.mesh.n_triangles()),
         r.distributed_seconds,
-        static_cast<double>(peak_rss_bytes())};
+        static_cast<double>(peak_rss_bytes()),
+        static_cast<double>(cut_elements(F)),
+        static_cast<double>(F.local.ghost_contacts.size())};
     const auto all = comm.allgather(std::span<const double>(mine));
     const size_t w = mine.size();
     os << "\nprocesses: " << comm.size() << "\n"
@@ -237,6 +259,23 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     }
     os << "finest level " << finest << ": " << F.n_global_dofs << " unknowns, "
        << F.n_global_contacts << " contact nodes\n";
+    if (two_body) {
+        // The contact interface across the cuts: elements whose contactor and targets are owned
+        // by different processes (their Jacobian rows couple the processes).
+        os << "contact interface on the finest level (two-body elements):\n"
+           << "  rank  contact nodes  with targets owned elsewhere  other processes' elements "
+              "reaching owned vertices\n";
+        std::int64_t cut = 0;
+        for (int q = 0; q < comm.size(); ++q) {
+            const double* a = all.data() + static_cast<size_t>(q) * w;
+            cut += static_cast<std::int64_t>(a[7]);
+            os << "  " << std::setw(4) << q << std::setw(15) << static_cast<std::int64_t>(a[1])
+               << std::setw(30) << static_cast<std::int64_t>(a[7]) << std::setw(43)
+               << static_cast<std::int64_t>(a[8]) << "\n";
+        }
+        os << "  the partition " << (cut > 0 ? "cuts" : "does not cut") << " the interface (" << cut
+           << " of " << F.n_global_contacts << " contact elements)\n";
+    }
     os << "\n level  step  Newton  Krylov  Krylov/Newton  agreement  statuses (gap/stick/slip)\n";
     for (size_t k = 1; k < r.level_steps.size(); ++k)
         for (const auto& ls : r.level_steps[k]) {
@@ -354,6 +393,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
             t.insert("local_triangles", static_cast<int64_t>(a[4]));
             t.insert("distributed_seconds", a[5]);
             t.insert("peak_rss_bytes", a[6]);
+            t.insert("cut_contact_elements", static_cast<int64_t>(a[7]));
+            t.insert("ghost_contact_elements", static_cast<int64_t>(a[8]));
             procs.push_back(std::move(t));
         }
         root_t.insert("per_process", std::move(procs));

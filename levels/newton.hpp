@@ -79,6 +79,11 @@ struct NewtonDistribution {
     const Communicator* comm = nullptr; ///< borrowed; null: one process (the default)
     Index n_owned = 0;
     const LinearOperator* K = nullptr; ///< the stiffness on the owned unknowns, borrowed
+    /// Collective: overwrites the ghost entries of a vector of the part's unknowns (owned ones
+    /// first) with their owners' values (GhostExchange::update), which two-body elements read
+    /// (Level::ghost_contacts). Empty: ghost entries are zero (node-on-rigid elements read
+    /// owned unknowns only).
+    std::function<void(Vector&)> fill_ghosts;
 };
 
 /// Generalized Newton on one level.
@@ -108,7 +113,9 @@ public:
     /// norm `norm` (NewtonParams::forcing); 0: the solver's own.
     double forcing_term(int k, double norm, double scale) const;
 
-    /// Residual R(x) at load factor s and its scaled norm (force units); also returns statuses.
+    /// Residual R(x) at load factor s and its scaled norm (force units); also returns statuses
+    /// (one per element of level().contacts) and the status matrices M (one per element of
+    /// level().contacts, then one per element of level().ghost_contacts).
     double residual(double s, const Vector& u_prev_full, const Vector& x, Vector& R,
                     std::vector<contact::Status>* st, std::vector<Eigen::Matrix2d>* M,
                     double* scale) const;
