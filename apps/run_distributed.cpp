@@ -46,7 +46,8 @@ levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two
 namespace {
 
 /// The contact boundary of a distributed run's finest level, gathered on rank 0 (empty
-/// elsewhere): a Level holding only the contact nodes (sorted by pair, then x, then y) and the
+/// elsewhere): a Level holding only the contact nodes (sorted by pair, then as on one process
+/// where the vertex is born on level p or below, then by x and y) and the
 /// boundary edges carrying a contactor tag, which is what contact_geometry reads, and the node
 /// states of every completed step in the same order.
 struct ContactBoundary {
@@ -54,8 +55,9 @@ struct ContactBoundary {
     std::vector<std::vector<levels::ContactNodeState>> step_nodes;
 };
 
-constexpr size_t kNodeWidth = 10; // pair, x, y, ux, uy, lambda_t, lambda_n, d_n, d_t, status
-constexpr size_t kEdgeWidth = 5;  // tag, x0, y0, x1, y1
+// pair, birth, index, x, y, ux, uy, lambda_t, lambda_n, d_n, d_t, status
+constexpr size_t kNodeWidth = 12;
+constexpr size_t kEdgeWidth = 5; // tag, x0, y0, x1, y1
 
 ContactBoundary gather_contact_boundary(const levels::Problem& p,
                                         const levels::DistributedRunResult& r,
@@ -72,14 +74,27 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
             const Vec2& b = mesh.vertices[static_cast<size_t>(be.v1)];
             edges.insert(edges.end(), {static_cast<double>(be.tag), a.x(), a.y(), b.x(), b.y()});
         }
+    // The one-process order of the contact nodes (what contact_geometry walks the pieces of the
+    // contact boundary in): by pair, then by vertex index, which refinement keeps, so a vertex
+    // born on a coarser level comes first. Born on level p or below: its level-p index is its
+    // one-process index; born above p: after those, by coordinates (the one-process index
+    // among the vertices born on one level needs the whole level).
+    auto birth = [&](int v) {
+        for (size_t k = 0; k < r.levels.size(); ++k)
+            if (v < r.levels[k].local.mesh.n_vertices()) return static_cast<double>(k);
+        return static_cast<double>(r.levels.size());
+    };
     std::vector<double> nodes;
     for (const auto& step : r.step_nodes)
         for (const auto& n : step) {
             const int e = F.local.contact_of_vertex[static_cast<size_t>(n.vertex)];
+            const double b = birth(n.vertex);
+            const double index =
+                b == 0 ? F.part.vertex_location[static_cast<size_t>(n.vertex)].id : 0.0;
             nodes.insert(nodes.end(),
-                         {static_cast<double>(F.local.contacts[static_cast<size_t>(e)].pair),
-                          n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n, n.d_n, n.d_t,
-                          static_cast<double>(static_cast<int>(n.status))});
+                         {static_cast<double>(F.local.contacts[static_cast<size_t>(e)].pair), b,
+                          index, n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n, n.d_n,
+                          n.d_t, static_cast<double>(static_cast<int>(n.status))});
         }
     const auto all_edges = comm.gather(std::span<const double>(edges), 0);
     // Every process holds the same number of steps; its nodes per step are contiguous.
@@ -113,14 +128,14 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
                 rows[k].push_back(all_nodes.data() + at);
     for (auto& step : rows)
         std::sort(step.begin(), step.end(), [](const double* a, const double* b) {
-            return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
+            return std::tie(a[0], a[1], a[2], a[3], a[4]) < std::tie(b[0], b[1], b[2], b[3], b[4]);
         });
     if (!rows.empty())
         for (const double* a : rows.front()) {
             contact::ContactElement e;
             e.n_nodes = 1;
             e.pair = static_cast<int>(a[0]);
-            e.vertex[0] = vertex(a[1], a[2]);
+            e.vertex[0] = vertex(a[3], a[4]);
             L.contacts.push_back(e);
         }
     L.contact_of_vertex.assign(static_cast<size_t>(L.mesh.n_vertices()), -1);
@@ -130,14 +145,14 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
         std::vector<levels::ContactNodeState> out;
         for (const double* a : step) {
             levels::ContactNodeState n;
-            n.vertex = vertex(a[1], a[2]);
-            n.x = Vec2(a[1], a[2]);
-            n.u = Vec2(a[3], a[4]);
-            n.lambda_t = a[5];
-            n.lambda_n = a[6];
-            n.d_n = a[7];
-            n.d_t = a[8];
-            n.status = static_cast<contact::Status>(static_cast<int>(a[9]));
+            n.vertex = vertex(a[3], a[4]);
+            n.x = Vec2(a[3], a[4]);
+            n.u = Vec2(a[5], a[6]);
+            n.lambda_t = a[7];
+            n.lambda_n = a[8];
+            n.d_n = a[9];
+            n.d_t = a[10];
+            n.status = static_cast<contact::Status>(static_cast<int>(a[11]));
             out.push_back(n);
         }
         cb.step_nodes.push_back(std::move(out));
