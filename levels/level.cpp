@@ -25,11 +25,19 @@ Vector path_at(const std::vector<Vector>& P, const Vector& full, double s) {
     return (1.0 - theta) * P[static_cast<size_t>(k - 1)] + theta * P[static_cast<size_t>(k)];
 }
 
-/// The two-body elements of `pair` for `nodes` (the search build_level runs).
+/// The two-body elements of `pair` for `nodes` (the search build_level runs). A process's part
+/// (`is_part`) may hold no target facet: its nodes are then further than the search reaches from
+/// the target (the ghost layer holds every facet within reach, mesh::GhostReach), not found.
 contact::SearchResult two_body_search(const Problem& problem, const mesh::Mesh& mesh, size_t p,
-                                      const std::vector<int>& nodes) {
+                                      const std::vector<int>& nodes, bool is_part = false) {
     const auto& pair = problem.contacts[p];
     const int ip = static_cast<int>(p);
+    if (is_part) {
+        const int target = mesh.tag(pair.target);
+        if (std::none_of(mesh.boundary.begin(), mesh.boundary.end(),
+                         [&](const mesh::BoundaryEdge& e) { return e.tag == target; }))
+            return {{}, nodes};
+    }
     if (pair.element == ContactElementKind::node_on_node)
         return contact::node_on_node_search(mesh, nodes, mesh.tag(pair.target),
                                             pair.match_tolerance, pair.mu, pair.r, ip);
@@ -57,7 +65,7 @@ void build_ghost_contacts(const Problem& problem, Level& L, const std::vector<in
         if (nodes.empty()) continue;
         // A node whose search finds nothing here has no target near this part's vertices (the
         // ghost layer holds every facet within reach of them: mesh::GhostReach).
-        for (auto& e : two_body_search(problem, L.mesh, p, nodes).elements) {
+        for (auto& e : two_body_search(problem, L.mesh, p, nodes, true).elements) {
             bool reaches = false;
             for (int j = 1; j < e.n_nodes; ++j)
                 reaches = reaches || owned(e.vertex[static_cast<size_t>(j)]);
@@ -159,7 +167,7 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
             break;
         case ContactElementKind::node_on_facet:
         case ContactElementKind::node_on_node: {
-            auto found = two_body_search(problem, mesh, p, nodes);
+            auto found = two_body_search(problem, mesh, p, nodes, part != nullptr);
             elems = std::move(found.elements);
             L.not_found[p] = std::move(found.not_found);
             break;
