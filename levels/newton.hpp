@@ -72,7 +72,8 @@ struct ContactNodeState {
 
 /// One process's share of the Newton of a distributed level (levels/distributed.hpp): the
 /// level is this process's part, whose first `n_owned` unknowns are the ones it owns (its contact
-/// elements are all at owned vertices); iterates, residuals and Newton systems hold the owned
+/// elements are at owned contact nodes; Level::ghost_contacts add the forces of other processes'
+/// elements on owned vertices); iterates, residuals and Newton systems hold the owned
 /// entries only, K x is the distributed stiffness's product, and every norm, count and decision is
 /// reduced over `comm`, so that all processes take the same steps.
 struct NewtonDistribution {
