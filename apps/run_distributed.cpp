@@ -10,6 +10,7 @@
 #include "core/parallel.hpp"
 #include "levels/checks.hpp"
 #include "levels/distributed_solve.hpp"
+#include "levels/resources.hpp"
 #include "mesh/distributed.hpp"
 #include "scene/scene.hpp"
 #include "solvers/factory.hpp"
@@ -27,7 +28,7 @@
 
 namespace mlc::apps {
 
-levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt) {
+levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two_body) {
     MLC_CHECK(!opt.linear || *opt.linear == "krylov",
               "--linear " << *opt.linear
                           << " has no distributed form (it needs the whole level on one "
@@ -35,8 +36,8 @@ levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt) {
                              "a Krylov method with mg (--linear krylov, the default there)");
     levels::LinearSolverSpec s;
     s.method = "krylov";
-    s.krylov = opt.krylov.value_or("cgs");
-    s.pc = opt.pc.value_or("mg");
+    s.krylov = opt.krylov.value_or(two_body ? "bicgstab" : "cgs");
+    s.pc = opt.pc.value_or(two_body ? levels::kMgDefaultTwoBody : "mg");
     if (opt.linear_rel_tol) s.rel_tol = *opt.linear_rel_tol;
     s.validate();
     return s;
@@ -45,7 +46,8 @@ levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt) {
 namespace {
 
 /// The contact boundary of a distributed run's finest level, gathered on rank 0 (empty
-/// elsewhere): a Level holding only the contact nodes (sorted by pair, then x, then y) and the
+/// elsewhere): a Level holding only the contact nodes (sorted by pair, then as on one process
+/// where the vertex is born on level p or below, then by x and y) and the
 /// boundary edges carrying a contactor tag, which is what contact_geometry reads, and the node
 /// states of every completed step in the same order.
 struct ContactBoundary {
@@ -53,8 +55,9 @@ struct ContactBoundary {
     std::vector<std::vector<levels::ContactNodeState>> step_nodes;
 };
 
-constexpr size_t kNodeWidth = 10; // pair, x, y, ux, uy, lambda_t, lambda_n, d_n, d_t, status
-constexpr size_t kEdgeWidth = 5;  // tag, x0, y0, x1, y1
+// pair, birth, index, x, y, ux, uy, lambda_t, lambda_n, d_n, d_t, status
+constexpr size_t kNodeWidth = 12;
+constexpr size_t kEdgeWidth = 5; // tag, x0, y0, x1, y1
 
 ContactBoundary gather_contact_boundary(const levels::Problem& p,
                                         const levels::DistributedRunResult& r,
@@ -71,14 +74,27 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
             const Vec2& b = mesh.vertices[static_cast<size_t>(be.v1)];
             edges.insert(edges.end(), {static_cast<double>(be.tag), a.x(), a.y(), b.x(), b.y()});
         }
+    // The one-process order of the contact nodes (what contact_geometry walks the pieces of the
+    // contact boundary in): by pair, then by vertex index, which refinement keeps, so a vertex
+    // born on a coarser level comes first. Born on level p or below: its level-p index is its
+    // one-process index; born above p: after those, by coordinates (the one-process index
+    // among the vertices born on one level needs the whole level).
+    auto birth = [&](int v) {
+        for (size_t k = 0; k < r.levels.size(); ++k)
+            if (v < r.levels[k].local.mesh.n_vertices()) return static_cast<double>(k);
+        return static_cast<double>(r.levels.size());
+    };
     std::vector<double> nodes;
     for (const auto& step : r.step_nodes)
         for (const auto& n : step) {
             const int e = F.local.contact_of_vertex[static_cast<size_t>(n.vertex)];
+            const double b = birth(n.vertex);
+            const double index =
+                b == 0 ? F.part.vertex_location[static_cast<size_t>(n.vertex)].id : 0.0;
             nodes.insert(nodes.end(),
-                         {static_cast<double>(F.local.contacts[static_cast<size_t>(e)].pair),
-                          n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n, n.d_n, n.d_t,
-                          static_cast<double>(static_cast<int>(n.status))});
+                         {static_cast<double>(F.local.contacts[static_cast<size_t>(e)].pair), b,
+                          index, n.x.x(), n.x.y(), n.u.x(), n.u.y(), n.lambda_t, n.lambda_n, n.d_n,
+                          n.d_t, static_cast<double>(static_cast<int>(n.status))});
         }
     const auto all_edges = comm.gather(std::span<const double>(edges), 0);
     // Every process holds the same number of steps; its nodes per step are contiguous.
@@ -112,14 +128,14 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
                 rows[k].push_back(all_nodes.data() + at);
     for (auto& step : rows)
         std::sort(step.begin(), step.end(), [](const double* a, const double* b) {
-            return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
+            return std::tie(a[0], a[1], a[2], a[3], a[4]) < std::tie(b[0], b[1], b[2], b[3], b[4]);
         });
     if (!rows.empty())
         for (const double* a : rows.front()) {
             contact::ContactElement e;
             e.n_nodes = 1;
             e.pair = static_cast<int>(a[0]);
-            e.vertex[0] = vertex(a[1], a[2]);
+            e.vertex[0] = vertex(a[3], a[4]);
             L.contacts.push_back(e);
         }
     L.contact_of_vertex.assign(static_cast<size_t>(L.mesh.n_vertices()), -1);
@@ -129,19 +145,33 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
         std::vector<levels::ContactNodeState> out;
         for (const double* a : step) {
             levels::ContactNodeState n;
-            n.vertex = vertex(a[1], a[2]);
-            n.x = Vec2(a[1], a[2]);
-            n.u = Vec2(a[3], a[4]);
-            n.lambda_t = a[5];
-            n.lambda_n = a[6];
-            n.d_n = a[7];
-            n.d_t = a[8];
-            n.status = static_cast<contact::Status>(static_cast<int>(a[9]));
+            n.vertex = vertex(a[3], a[4]);
+            n.x = Vec2(a[3], a[4]);
+            n.u = Vec2(a[5], a[6]);
+            n.lambda_t = a[7];
+            n.lambda_n = a[8];
+            n.d_n = a[9];
+            n.d_t = a[10];
+            n.status = static_cast<contact::Status>(static_cast<int>(a[11]));
             out.push_back(n);
         }
         cb.step_nodes.push_back(std::move(out));
     }
     return cb;
+}
+
+/// This process's contact elements with a target vertex owned by another process.
+std::int64_t cut_elements(const levels::DistributedLevel& F) {
+    std::int64_t n = 0;
+    for (const auto& e : F.local.contacts) {
+        bool cut = false;
+        for (int j = 1; j < e.n_nodes; ++j)
+            cut =
+                cut || F.part.vertex_owner[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])] !=
+                           F.part.vertex_owner[static_cast<size_t>(e.vertex[0])];
+        n += cut;
+    }
+    return n;
 }
 
 } // namespace
@@ -161,7 +191,11 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
               "distributed run writes solution.pvtu of the final state)");
     MLC_CHECK(p.levels >= 1, "a run on several processes needs --levels >= 1 (level 0 is solved "
                              "on every process; the levels above it are distributed)");
-    const levels::LinearSolverSpec spec = distributed_solver_spec(opt);
+    const bool two_body =
+        std::any_of(p.contacts.begin(), p.contacts.end(), [](const levels::ContactPair& c) {
+            return c.element != levels::ContactElementKind::node_on_rigid;
+        });
+    const levels::LinearSolverSpec spec = distributed_solver_spec(opt, two_body);
     const int finest = p.levels;
     int plevel = opt.partition_level
                      ? *opt.partition_level
@@ -193,7 +227,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
        << (mg ? std::string("Krylov + distributed mg")
               : "Krylov + " + spec.pc +
                     " on each process's diagonal block, Jacobi across the cuts; levels 0-p on "
-                    "every process") << ")\n";
+                    "every process")
+       << ")\n";
     os << "partition level " << plevel
        << (opt.partition_level
                ? " (--partition-level)"
@@ -220,7 +255,9 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         static_cast<double>(F.local.mesh.n_vertices() - F.part.n_owned_vertices()),
         static_cast<double>(F.local.mesh.n_triangles()),
         r.distributed_seconds,
-        static_cast<double>(peak_rss_bytes())};
+        static_cast<double>(peak_rss_bytes()),
+        static_cast<double>(cut_elements(F)),
+        static_cast<double>(F.local.ghost_contacts.size())};
     const auto all = comm.allgather(std::span<const double>(mine));
     const size_t w = mine.size();
     os << "\nprocesses: " << comm.size() << "\n"
@@ -237,6 +274,23 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     }
     os << "finest level " << finest << ": " << F.n_global_dofs << " unknowns, "
        << F.n_global_contacts << " contact nodes\n";
+    if (two_body) {
+        // The contact interface across the cuts: elements whose contactor and targets are owned
+        // by different processes (their Jacobian rows couple the processes).
+        os << "contact interface on the finest level (two-body elements):\n"
+           << "  rank  contact nodes  with targets owned elsewhere  other processes' elements "
+              "reaching owned vertices\n";
+        std::int64_t cut = 0;
+        for (int q = 0; q < comm.size(); ++q) {
+            const double* a = all.data() + static_cast<size_t>(q) * w;
+            cut += static_cast<std::int64_t>(a[7]);
+            os << "  " << std::setw(4) << q << std::setw(15) << static_cast<std::int64_t>(a[1])
+               << std::setw(30) << static_cast<std::int64_t>(a[7]) << std::setw(43)
+               << static_cast<std::int64_t>(a[8]) << "\n";
+        }
+        os << "  the partition " << (cut > 0 ? "cuts" : "does not cut") << " the interface (" << cut
+           << " of " << F.n_global_contacts << " contact elements)\n";
+    }
     os << "\n level  step  Newton  Krylov  Krylov/Newton  agreement  statuses (gap/stick/slip)\n";
     for (size_t k = 1; k < r.level_steps.size(); ++k)
         for (const auto& ls : r.level_steps[k]) {
@@ -354,6 +408,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
             t.insert("local_triangles", static_cast<int64_t>(a[4]));
             t.insert("distributed_seconds", a[5]);
             t.insert("peak_rss_bytes", a[6]);
+            t.insert("cut_contact_elements", static_cast<int64_t>(a[7]));
+            t.insert("ghost_contact_elements", static_cast<int64_t>(a[8]));
             procs.push_back(std::move(t));
         }
         root_t.insert("per_process", std::move(procs));

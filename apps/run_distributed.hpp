@@ -12,14 +12,15 @@
 
 namespace mlc::apps {
 
-/// The Newton-system solver of a run on several processes: Krylov (default cgs) with mg (the
-/// default; its pre/post/omega options apply). Throws InvalidInput for --linear schur|lu and
-/// names what works.
-levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt);
+/// The Newton-system solver of a run on several processes: Krylov with mg (the default; its
+/// pre/post/omega options apply). Defaults as on one process: CGS + mg, and with a two-body pair
+/// (`two_body`) BiCGStab + mg:omega=0.8 (levels::kMgDefaultTwoBody). Throws InvalidInput for
+/// --linear schur|lu and names what works.
+levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two_body = false);
 
 /// Collective: `mlcontact run` on the processes of `comm`; progress and report on rank 0's `out`.
 /// Returns the exit code (0, or 2 when a load step does not converge). Throws InvalidInput for
-/// what is not distributed (--cold, --every-step, --every-level, two-body scenes, --levels 0,
+/// what is not distributed (--cold, --every-step, --every-level, --levels 0,
 /// solvers other than Krylov + mg), on every process alike.
 int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::ostream& out);
 

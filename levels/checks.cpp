@@ -15,9 +15,12 @@ namespace {
 
 /// Per axis: the resultant of loads, contact forces and support reactions, and the sum of their
 /// magnitudes, over the vertices `count` accepts (all, or a process's own).
+/// `x` (a distributed part's unknowns with their ghost values; null on one process) gives the
+/// multipliers of Level::ghost_contacts, whose forces act on owned vertices too.
 template <class Count>
 std::array<double, 4> balance_sums(const Level& level, double s, const Vector& u_full,
-                                   const std::vector<ContactNodeState>& nodes, Count&& count) {
+                                   const std::vector<ContactNodeState>& nodes, Count&& count,
+                                   const Vector* x = nullptr) {
     // External forces on the body: loads F, contact forces -C (C = sum_j w_j (lambda_t t +
     // lambda_n n), the multiplier being the force the body exerts), and support reactions
     // Rs = K u - F + C on the fixed components (nodal equilibrium K u = F - C + Rs). The
@@ -28,6 +31,16 @@ std::array<double, 4> balance_sums(const Level& level, double s, const Vector& u
     for (size_t e = 0; e < level.contacts.size(); ++e) {
         const auto& el = level.contacts[e];
         const Vec2 f = nodes[e].lambda_t * el.t + nodes[e].lambda_n * el.n;
+        for (int j = 0; j < el.n_nodes; ++j)
+            C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
+                el.weight[static_cast<size_t>(j)] * f;
+    }
+    for (size_t e = 0; x && e < level.ghost_contacts.size(); ++e) {
+        const auto& el = level.ghost_contacts[e];
+        const int d = level.ghost_lambda_dof[e];
+        const double lt = el.frictional() ? (*x)[d] : 0.0;
+        const double ln = (*x)[el.frictional() ? d + 1 : d];
+        const Vec2 f = lt * el.t + ln * el.n;
         for (int j = 0; j < el.n_nodes; ++j)
             C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
                 el.weight[static_cast<size_t>(j)] * f;
@@ -110,9 +123,9 @@ StateChecks check_state(const Problem& p, const RunResult& r) {
 StateChecks check_state(const Problem& p, const DistributedRunResult& r, const Communicator& comm) {
     const DistributedLevel& F = r.finest();
     const int me = comm.rank();
-    auto sums = balance_sums(F.local, 1.0, r.u_full, r.nodes, [&](int v) {
-        return F.part.vertex_owner[static_cast<size_t>(v)] == me;
-    });
+    auto sums = balance_sums(
+        F.local, 1.0, r.u_full, r.nodes,
+        [&](int v) { return F.part.vertex_owner[static_cast<size_t>(v)] == me; }, &r.x);
     comm.allreduce(std::span<double>(sums), ReduceOp::sum);
     auto m = node_maxima(p, F.local, r.u_full, r.nodes);
     comm.allreduce(std::span<double>(m), ReduceOp::max);

@@ -150,11 +150,7 @@ transfer::ContactNodes DistributedLevel::contact_nodes() const {
 
 DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLevel part,
                                          const Communicator& comm) {
-    for (const auto& c : problem.contacts)
-        MLC_CHECK(c.element == ContactElementKind::node_on_rigid,
-                  "contact '" << c.name
-                              << "' is two-body; only rigid obstacles (node-on-rigid pairs) are "
-                                 "solved on several processes so far");
+    static constexpr const char* kAnother = "another process could not build its part of the level";
     DistributedLevel d;
     const int me = comm.rank();
     const int nv = part.mesh.n_vertices();
@@ -166,20 +162,26 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
     lp.order = mesh::hilbert_order(part.mesh.vertices);
     std::stable_partition(lp.order.begin(), lp.order.end(),
                           [&](int v) { return lp.owned[static_cast<size_t>(v)] != 0; });
-    lp.complete = [&](Level& L, std::vector<int>& n_extra) {
-        // Owners send: fixed x, fixed y, multipliers, then the prescribed values at every path
-        // point.
+    // An error on one process before `complete` (whose exchanges are collective) is agreed on
+    // at its start, so that the others do not wait in the exchange.
+    bool reached_complete = false;
+    lp.complete = [&](Level& L, std::vector<int>& n_extra, std::vector<int>& contact_pair) {
+        reached_complete = true;
+        MLC_CHECK(comm.max(0) == 0, kAnother);
+        // Owners send: fixed x, fixed y, multipliers, contact pair, then the prescribed values at
+        // every path point.
         const int K = static_cast<int>(L.path_u_fixed.size());
-        const int w = 3 + 2 * K;
+        const int w = 4 + 2 * K;
         std::vector<double> rec(static_cast<size_t>(nv) * static_cast<size_t>(w), 0.0);
         for (int v = 0; v < nv; ++v) {
             double* r = rec.data() + static_cast<size_t>(v) * static_cast<size_t>(w);
             r[0] = L.fixed[static_cast<size_t>(v)][0];
             r[1] = L.fixed[static_cast<size_t>(v)][1];
             r[2] = n_extra[static_cast<size_t>(v)];
+            r[3] = contact_pair[static_cast<size_t>(v)];
             for (int k = 0; k < K; ++k)
                 for (int c = 0; c < 2; ++c)
-                    r[3 + 2 * k + c] = L.path_u_fixed[static_cast<size_t>(k)][2 * v + c];
+                    r[4 + 2 * k + c] = L.path_u_fixed[static_cast<size_t>(k)][2 * v + c];
         }
         d.ghosts.vertex_records(rec, w);
         for (int v = 0; v < nv; ++v) {
@@ -187,9 +189,10 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
             const double* r = rec.data() + static_cast<size_t>(v) * static_cast<size_t>(w);
             L.fixed[static_cast<size_t>(v)] = {r[0] != 0.0, r[1] != 0.0};
             n_extra[static_cast<size_t>(v)] = static_cast<int>(r[2]);
+            contact_pair[static_cast<size_t>(v)] = static_cast<int>(r[3]);
             for (int k = 0; k < K; ++k)
                 for (int c = 0; c < 2; ++c)
-                    L.path_u_fixed[static_cast<size_t>(k)][2 * v + c] = r[3 + 2 * k + c];
+                    L.path_u_fixed[static_cast<size_t>(k)][2 * v + c] = r[4 + 2 * k + c];
         }
         L.u_fixed = L.path_u_fixed.back();
         d.n_extra = n_extra;
@@ -200,10 +203,21 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
         d.local = build_level(problem, std::move(part.mesh), &lp);
     } catch (const InvalidInput& e) {
         error = e.what();
+        if (!reached_complete) comm.max(1); // the agreement at the start of `complete`
     }
-    if (comm.max(error.empty() ? 0 : 1) > 0)
-        throw InvalidInput(error.empty() ? "another process could not build its part of the level"
-                                         : error);
+    if (comm.max(error.empty() ? 0 : 1) > 0) {
+        // Every process reports the error of the lowest process that had one of its own.
+        const int first =
+            comm.min(error.empty() || error.rfind(kAnother, 0) == 0 ? comm.size() : comm.rank());
+        if (first == comm.size()) throw InvalidInput(error.empty() ? kAnother : error);
+        std::int64_t n = comm.rank() == first ? static_cast<std::int64_t>(error.size()) : 0;
+        comm.broadcast(std::span<std::int64_t>(&n, 1), first);
+        std::vector<std::int64_t> chars(static_cast<size_t>(n));
+        if (comm.rank() == first) std::copy(error.begin(), error.end(), chars.begin());
+        comm.broadcast(std::span<std::int64_t>(chars), first);
+        throw InvalidInput(std::string(chars.begin(), chars.end()) + " (process " +
+                           std::to_string(first) + ")");
+    }
     part.mesh = mesh::Mesh{};
     d.part = std::move(part);
     // Pairs with no contact node anywhere; support points held by no process.
@@ -267,6 +281,35 @@ DistributedTransfer build_distributed_transfer(const DistributedLevel& coarse,
     // Kept: P_nodal and Q (the coarse-to-fine initial guess); T lives in the ParMatrix.
     t.local.T = t.local.R = t.local.P_vertex = SparseMatrix();
     return t;
+}
+
+std::vector<mesh::GhostReach> contact_ghost_reach(const Problem& problem,
+                                                  const mesh::Mesh& level_p) {
+    std::vector<mesh::GhostReach> out;
+    const auto& m0 = problem.mesh0;
+    for (const auto& pair : problem.contacts) {
+        if (pair.element == ContactElementKind::node_on_rigid) continue;
+        mesh::GhostReach r;
+        r.tags = {level_p.tag(pair.contactor), level_p.tag(pair.target)};
+        double h0 = 0.0, hp = 0.0;
+        const int t0 = m0.tag(pair.target);
+        for (const auto& e : m0.boundary)
+            if (e.tag == t0)
+                h0 = std::max(h0, (m0.vertices[static_cast<size_t>(e.v1)] -
+                                   m0.vertices[static_cast<size_t>(e.v0)])
+                                      .norm());
+        for (const auto& e : level_p.boundary)
+            if (e.tag == r.tags[0] || e.tag == r.tags[1])
+                hp = std::max(hp, (level_p.vertices[static_cast<size_t>(e.v1)] -
+                                   level_p.vertices[static_cast<size_t>(e.v0)])
+                                      .norm());
+        const double factor = pair.element == ContactElementKind::node_on_facet
+                                  ? pair.search_radius
+                                  : pair.match_tolerance;
+        r.distance = 2.0 * ((factor + 2.0) * h0 + 2.0 * hp);
+        out.push_back(std::move(r));
+    }
+    return out;
 }
 
 int partition_level(std::int64_t level0_triangles, int finest, int n_processes) {

@@ -10,8 +10,13 @@
 /// unknowns [first_dof, first_dof + n_owned) (contiguous per process, in rank order: hypre's row
 /// partition). The fixed components, prescribed values and multiplier counts of ghost vertices
 /// are their owners' (a part's mesh may lack a ghost vertex's boundary edges). Contact elements
-/// exist only at owned vertices: a node-on-rigid element couples its vertex's unknowns alone, so
-/// a process evaluates all its contact rows without communication.
+/// exist only at owned vertices. A node-on-rigid element couples its vertex's unknowns alone; a
+/// two-body element couples its contactor with target vertices that other processes may own, so
+/// each process also builds the elements of other processes' contact nodes that reach its owned
+/// vertices (Level::ghost_contacts, through a ghost layer widened along the contact interface:
+/// mesh::GhostReach). Every owned row of the residual and the Jacobian is then complete from local
+/// data and the current ghost values; the Jacobian's off-diagonal block gains the contact
+/// couplings to other processes' unknowns.
 ///
 /// What is exact. The rows of the owned unknowns of the part's stiffness, loads and transfers are
 /// those of the whole level: every triangle around an owned vertex is local (the ghost layer),
@@ -83,10 +88,25 @@ struct DistributedLevel {
 
 /// Collective: builds this process's part of a level from its local mesh (`part`, from
 /// mesh::distribute; its mesh is moved out). Throws InvalidInput on every process when a contact
-/// pair has no contactor node on any process or a support point is not a vertex of the level, or
-/// for a two-body pair (only node-on-rigid pairs are distributed so far).
+/// pair has no contactor node on any process or a support point is not a vertex of the level.
+/// For two-body pairs `part` must hold the ghost layer solve_distributed asks mesh::distribute
+/// for (contact_ghost_reach).
 DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLevel part,
                                          const Communicator& comm);
+
+/// The ghost layer a distributed run needs along the interfaces of `problem`'s two-body pairs on
+/// the partitioned level `level_p` (mesh::distribute's `reach`; empty without two-body pairs).
+/// Per pair, its contactor and target boundaries within twice the reach R of its search:
+///   node on facet: R = (search_radius + 2) h0 + 2 hp,  node on node: R = (match_tolerance + 2)
+///   h0 + 2 hp,
+/// h0 the longest level-0 target facet (search_radius h0 bounds the search distance of every
+/// level, a segment-integrated element reaches one more facet and one contactor edge) and hp
+/// the longest level-p edge of the pair's boundaries (the finer vertices of a curved boundary
+/// leave the level-p polygon by less). One R covers the facets an owned contact node needs; the
+/// second the facets of another process's contact node whose element reaches an owned vertex
+/// (Level::ghost_contacts).
+std::vector<mesh::GhostReach> contact_ghost_reach(const Problem& problem,
+                                                  const mesh::Mesh& level_p);
 
 /// The transfer between consecutive distributed levels (fine refined from coarse): the local
 /// LevelTransfer of the two parts (whose owned fine rows are exact) and its T as a ParMatrix

@@ -26,8 +26,7 @@ struct DistributedMultigrid::Impl {
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
          LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
-          use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"),
-          op_(levels.size()) {
+          use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"), op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k)
             build_jacobian(k);
     }
@@ -59,20 +58,45 @@ struct DistributedMultigrid::Impl {
         const bool same = o.prepared && M.size() == o.last_M.size() &&
                           std::equal(M.begin(), M.end(), o.last_M.begin());
         if (comm_.min(same ? 1 : 0) == 1) return;
-        // J = K + the contact tangents, in place in J's blocks (hypre's matrix reads them there):
-        // the contact entries are all in owned rows and columns, so the off-diagonal block is
-        // K's, copied once.
+        // J = K + the contact tangents, in place in J's blocks (hypre's matrix reads them there).
+        // The owned rows of J: the tangents of this process's elements and of the ghost elements
+        // (other processes' contact nodes reaching owned vertices), whose columns may be other
+        // processes' unknowns (the off-diagonal block).
         const DistributedLevel& L = levels_[k];
+        const size_t n_el = L.local.contacts.size() + L.local.ghost_contacts.size();
+        MLC_CHECK(M.size() == n_el, "internal error: " << M.size() << " status matrices for "
+                                                       << n_el << " contact elements");
         double* v = o.blocks->diag.valuePtr();
         std::fill(v, v + o.blocks->diag.nonZeros(), 0.0);
         const double* kv = L.K_blocks->diag.valuePtr();
         for (size_t q = 0; q < o.kpos.size(); ++q)
             v[o.kpos[q]] += kv[q];
+        double* vo = o.blocks->offd.valuePtr();
+        if (o.kopos.empty()) {
+            // The off-diagonal block is K's (no contact coupling across the cuts): copied once.
+            if (!o.prepared)
+                std::copy_n(L.K_blocks->offd.valuePtr(), L.K_blocks->offd.nonZeros(), vo);
+        } else {
+            std::fill(vo, vo + o.blocks->offd.nonZeros(), 0.0);
+            const double* kov = L.K_blocks->offd.valuePtr();
+            for (size_t q = 0; q < o.kopos.size(); ++q)
+                vo[o.kopos[q]] += kov[q];
+        }
         size_t c = 0;
+        auto add = [&](int, int, double value) {
+            const Entry& p = o.cpos[c++];
+            if (p.block == 0)
+                v[p.pos] += value;
+            else if (p.block == 1)
+                vo[p.pos] += value;
+        };
         for (size_t e = 0; e < L.local.contacts.size(); ++e)
-            contact::for_each_tangent_entry(
-                L.local.contacts[e], M[e], L.local.dofs, L.local.lambda_dof[e],
-                [&](int, int, double value) { v[o.cpos[c++]] += value; });
+            contact::for_each_tangent_entry(L.local.contacts[e], M[e], L.local.dofs,
+                                            L.local.lambda_dof[e], add);
+        for (size_t e = 0; e < L.local.ghost_contacts.size(); ++e)
+            contact::for_each_tangent_entry(L.local.ghost_contacts[e],
+                                            M[L.local.contacts.size() + e], L.local.dofs,
+                                            L.local.ghost_lambda_dof[e], add);
         if (!use_mg_) {
             if (!o.block_pc) {
                 o.block_pc = solvers::make_preconditioner(spec_.pc);
@@ -127,11 +151,21 @@ struct DistributedMultigrid::Impl {
         return os.str();
     }
 
+    struct Entry {
+        int pos = 0;
+        int block = -1;
+    };
+
     struct Op {
         /// J's owned rows (the one copy of J: hypre's J and the smoother read them in place).
         std::unique_ptr<solvers::RowBlocks> blocks;
         std::vector<int> kpos; ///< position in blocks->diag of every entry of K's diagonal block
-        std::vector<int> cpos; ///< position of every contact tangent entry, in visiting order
+        /// Position of every contact tangent entry, in visiting order (owned elements, then
+        /// ghost elements): block 0 diag, 1 offd, -1 a row owned elsewhere (not stored).
+        std::vector<Entry> cpos;
+        /// Position in blocks->offd of every entry of K's off-diagonal block; empty when J's
+        /// off-diagonal block is K's (no contact entry in it).
+        std::vector<int> kopos;
         std::unique_ptr<solvers::ParMatrix> J;
         std::unique_ptr<smoothers::BlockSOR> smoother;
         std::unique_ptr<Preconditioner> block_pc; ///< without mg: spec.pc on the diagonal block
@@ -145,9 +179,7 @@ struct DistributedMultigrid::Impl {
     public:
         BlockPc(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
         void setup(const SparseMatrix&) override {}
-        void apply(const Vector& r, Vector& z) const override {
-            s_.op_[k_].block_pc->apply(r, z);
-        }
+        void apply(const Vector& r, Vector& z) const override { s_.op_[k_].block_pc->apply(r, z); }
         std::string name() const override { return s_.name(); }
 
     private:
@@ -178,41 +210,85 @@ struct DistributedMultigrid::Impl {
         solvers::RowBlocks& B = *o.blocks;
         B.first_row = Kb.first_row;
         B.first_col = Kb.first_col;
-        B.offd = Kb.offd;
-        B.col_map = Kb.col_map;
+        // The contact entries of the owned rows: (row, local column) in visiting order, -1 rows
+        // for those owned elsewhere.
+        std::vector<std::pair<int, int>> centries;
+        const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+        auto visit = [&](int row, int col, double) {
+            centries.emplace_back(row < n ? row : -1, col);
+        };
+        for (size_t e = 0; e < L.contacts.size(); ++e)
+            contact::for_each_tangent_entry(L.contacts[e], I, L.dofs, L.lambda_dof[e], visit);
+        for (size_t e = 0; e < L.ghost_contacts.size(); ++e)
+            contact::for_each_tangent_entry(L.ghost_contacts[e], I, L.dofs, L.ghost_lambda_dof[e],
+                                            visit);
+        // Off-diagonal columns: K's and the contact couplings to other processes' unknowns.
+        std::vector<std::int64_t> col_map = Kb.col_map;
+        for (auto [r, c] : centries)
+            if (r >= 0 && c >= n) col_map.push_back(D.global_dof[static_cast<size_t>(c)]);
+        std::sort(col_map.begin(), col_map.end());
+        col_map.erase(std::unique(col_map.begin(), col_map.end()), col_map.end());
+        const bool offd_grows = col_map.size() != Kb.col_map.size() ||
+                                std::any_of(centries.begin(), centries.end(), [&](auto rc) {
+                                    return rc.first >= 0 && rc.second >= n;
+                                });
+        auto offd_col = [&](std::int64_t g) {
+            const auto it = std::lower_bound(col_map.begin(), col_map.end(), g);
+            MLC_ASSERT(it != col_map.end() && *it == g, "an off-diagonal column is not mapped");
+            return static_cast<int>(it - col_map.begin());
+        };
         std::vector<Eigen::Triplet<double>> trip;
-        trip.reserve(static_cast<size_t>(Kb.diag.nonZeros()) + 16 * L.contacts.size());
+        trip.reserve(static_cast<size_t>(Kb.diag.nonZeros()) + centries.size());
         for (int i = 0; i < n; ++i)
             for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
                 trip.emplace_back(i, it.col(), 0.0);
-        std::vector<std::pair<int, int>> centries;
-        const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-        for (size_t e = 0; e < L.contacts.size(); ++e)
-            contact::for_each_tangent_entry(
-                L.contacts[e], I, L.dofs, L.lambda_dof[e], [&](int row, int col, double) {
-                    MLC_ASSERT(row < n && col < n, "a contact entry outside the owned "
-                                                   "unknowns");
-                    trip.emplace_back(row, col, 0.0);
-                    centries.emplace_back(row, col);
-                });
+        for (auto [r, c] : centries)
+            if (r >= 0 && c < n) trip.emplace_back(r, c, 0.0);
         B.diag.resize(n, n);
         B.diag.setFromTriplets(trip.begin(), trip.end());
         B.diag.makeCompressed();
+        if (!offd_grows) {
+            B.offd = Kb.offd;
+            B.col_map = Kb.col_map;
+        } else {
+            trip.clear();
+            for (int i = 0; i < n; ++i)
+                for (SparseMatrix::InnerIterator it(Kb.offd, i); it; ++it)
+                    trip.emplace_back(i, offd_col(Kb.col_map[static_cast<size_t>(it.col())]), 0.0);
+            for (auto [r, c] : centries)
+                if (r >= 0 && c >= n)
+                    trip.emplace_back(r, offd_col(D.global_dof[static_cast<size_t>(c)]), 0.0);
+            B.offd.resize(n, static_cast<Index>(col_map.size()));
+            B.offd.setFromTriplets(trip.begin(), trip.end());
+            B.offd.makeCompressed();
+            B.col_map = col_map;
+        }
         trip = {};
-        auto position = [&](int row, int col) {
-            const int* begin = B.diag.innerIndexPtr() + B.diag.outerIndexPtr()[row];
-            const int* end = B.diag.innerIndexPtr() + B.diag.outerIndexPtr()[row + 1];
+        auto position = [](const SparseMatrix& A, int row, int col) {
+            const int* begin = A.innerIndexPtr() + A.outerIndexPtr()[row];
+            const int* end = A.innerIndexPtr() + A.outerIndexPtr()[row + 1];
             const int* it = std::lower_bound(begin, end, col);
             MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
-            return static_cast<int>(it - B.diag.innerIndexPtr());
+            return static_cast<int>(it - A.innerIndexPtr());
         };
         o.kpos.reserve(static_cast<size_t>(Kb.diag.nonZeros()));
         for (int i = 0; i < n; ++i)
             for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
-                o.kpos.push_back(position(i, static_cast<int>(it.col())));
+                o.kpos.push_back(position(B.diag, i, static_cast<int>(it.col())));
+        if (offd_grows)
+            for (int i = 0; i < n; ++i)
+                for (SparseMatrix::InnerIterator it(Kb.offd, i); it; ++it)
+                    o.kopos.push_back(
+                        position(B.offd, i, offd_col(Kb.col_map[static_cast<size_t>(it.col())])));
         o.cpos.reserve(centries.size());
         for (auto [r, c] : centries)
-            o.cpos.push_back(position(r, c));
+            if (r < 0)
+                o.cpos.push_back({0, -1});
+            else if (c < n)
+                o.cpos.push_back({position(B.diag, r, c), 0});
+            else
+                o.cpos.push_back(
+                    {position(B.offd, r, offd_col(D.global_dof[static_cast<size_t>(c)])), 1});
         o.J = std::make_unique<solvers::ParMatrix>(comm_, B);
     }
 
@@ -436,12 +512,6 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
                   "supports released or taken up along the loading path are solved on one "
                   "process only so far (load step "
                       << step << ")");
-    for (const auto& c : problem.contacts)
-        MLC_CHECK(c.element == ContactElementKind::node_on_rigid,
-                  "contact '" << c.name
-                              << "' is two-body; only rigid obstacles (node-on-rigid pairs) are "
-                                 "solved on several processes so far: run this scene on one "
-                                 "process");
     res.mg = distributed_mg_params(options.linear);
     {
         // Memory: a process holds about 1/N of what one process needs for the run (the square at
@@ -472,7 +542,7 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
         mp = mesh::refine(mp);
     {
         ScopedTimer t(&res.timings, "setup/distribute");
-        auto dh = mesh::distribute(mp, L - p, comm);
+        auto dh = mesh::distribute(mp, L - p, comm, {}, contact_ghost_reach(problem, mp));
         mp = mesh::Mesh{};
         for (auto& lv : dh.levels)
             res.levels.push_back(build_distributed_level(problem, std::move(lv), comm));
@@ -486,11 +556,19 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
     }
     DistributedMultigrid mg(res.levels, res.transfers, comm, options.linear, res.mg);
     std::vector<std::unique_ptr<ContactNewton>> newton(m + 1);
+    const bool two_body =
+        std::any_of(problem.contacts.begin(), problem.contacts.end(), [](const ContactPair& c) {
+            return c.element != ContactElementKind::node_on_rigid;
+        });
     for (size_t k = 1; k <= m; ++k) {
         newton[k] = std::make_unique<ContactNewton>(res.levels[k].local, problem.newton,
                                                     std::make_unique<DistributedSystem>(mg, k),
                                                     &res.timings);
-        newton[k]->set_distribution({&comm, res.levels[k].n_owned, res.levels[k].K.get()});
+        const DistributedLevel& D = res.levels[k];
+        NewtonDistribution nd{&comm, D.n_owned, D.K.get(), {}};
+        // Two-body elements read ghost values (every process alike: the call is collective).
+        if (two_body) nd.fill_ghosts = [&D](Vector& x) { D.ghosts.update(D.local.dofs, x); };
+        newton[k]->set_distribution(std::move(nd));
         newton[k]->set_interrupt(options.interrupt_requested);
     }
     res.level_steps.resize(m + 1);

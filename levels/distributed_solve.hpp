@@ -99,8 +99,8 @@ struct DistributedRunResult {
     const DistributedLevel& finest() const { return levels.back(); }
 };
 
-/// Collective: solves `problem` on the processes of `comm` (at least two levels above level p,
-/// node-on-rigid pairs, supports that stay the same along the path) with the partition level
+/// Collective: solves `problem` on the processes of `comm` (at least one level above level p,
+/// rigid or two-body pairs, supports that stay the same along the path) with the partition level
 /// `partition_level` (< problem.levels). options.linear must be "krylov" with pc "mg" (its
 /// pre/post/omega options apply); options.coarse_to_fine must be on. Progress lines (every
 /// level) go to options.progress on rank 0. Throws InvalidInput naming what is not distributed

@@ -25,6 +25,55 @@ Vector path_at(const std::vector<Vector>& P, const Vector& full, double s) {
     return (1.0 - theta) * P[static_cast<size_t>(k - 1)] + theta * P[static_cast<size_t>(k)];
 }
 
+/// The two-body elements of `pair` for `nodes` (the search build_level runs). A process's part
+/// (`is_part`) may hold no target facet: its nodes are then further than the search reaches from
+/// the target (the ghost layer holds every facet within reach, mesh::GhostReach), not found.
+contact::SearchResult two_body_search(const Problem& problem, const mesh::Mesh& mesh, size_t p,
+                                      const std::vector<int>& nodes, bool is_part = false) {
+    const auto& pair = problem.contacts[p];
+    const int ip = static_cast<int>(p);
+    if (is_part) {
+        const int target = mesh.tag(pair.target);
+        if (std::none_of(mesh.boundary.begin(), mesh.boundary.end(),
+                         [&](const mesh::BoundaryEdge& e) { return e.tag == target; }))
+            return {{}, nodes};
+    }
+    if (pair.element == ContactElementKind::node_on_node)
+        return contact::node_on_node_search(mesh, nodes, mesh.tag(pair.target),
+                                            pair.match_tolerance, pair.mu, pair.r, ip);
+    // Whether a vertex is a contact node is decided on the level-0 target facets: the same on
+    // every level, so that the contact nodes nest (transfer/ requires it).
+    const auto& m0 = problem.mesh0;
+    const contact::FacetIndex reference(m0.vertices,
+                                        contact::target_facets(m0, m0.tag(pair.target)));
+    return contact::node_on_facet_search(mesh, nodes, mesh.tag(pair.target), reference,
+                                         pair.search_radius, pair.mu, pair.r, ip, pair.integration,
+                                         mesh.tag(pair.contactor));
+}
+
+/// Level::ghost_contacts of a part: the two-body contact nodes of other processes
+/// (contact_pair >= 0 at a vertex not owned) whose elements reach an owned vertex.
+template <class Owned>
+void build_ghost_contacts(const Problem& problem, Level& L, const std::vector<int>& contact_pair,
+                          Owned&& owned) {
+    for (size_t p = 0; p < problem.contacts.size(); ++p) {
+        if (problem.contacts[p].element == ContactElementKind::node_on_rigid) continue;
+        std::vector<int> nodes;
+        for (int v = 0; v < L.mesh.n_vertices(); ++v)
+            if (!owned(v) && contact_pair[static_cast<size_t>(v)] == static_cast<int>(p))
+                nodes.push_back(v);
+        if (nodes.empty()) continue;
+        // A node whose search finds nothing here has no target near this part's vertices (the
+        // ghost layer holds every facet within reach of them: mesh::GhostReach).
+        for (auto& e : two_body_search(problem, L.mesh, p, nodes, true).elements) {
+            bool reaches = false;
+            for (int j = 1; j < e.n_nodes; ++j)
+                reaches = reaches || owned(e.vertex[static_cast<size_t>(j)]);
+            if (reaches) L.ghost_contacts.push_back(e);
+        }
+    }
+}
+
 } // namespace
 
 Vector Level::u_fixed_at(double s) const {
@@ -43,8 +92,10 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
 
 Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
     auto owned = [part](int v) { return !part || part->owned[static_cast<size_t>(v)] != 0; };
-    // A refined mesh (of a checked one, as the hierarchy builds them) only needs its areas checked.
-    if (m.n_coarse_vertices > 0)
+    // A refined mesh (of a checked one, as the hierarchy builds them) only needs its areas checked;
+    // so does a process's part of a level (cut from the whole level, which the levels up to p
+    // check; its interior lines may have a triangle on one side only, at the edge of the part).
+    if (m.n_coarse_vertices > 0 || part)
         mesh::check_refined_quality(m);
     else
         mesh::check_quality(m);
@@ -114,35 +165,23 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
         case ContactElementKind::node_on_rigid:
             elems = contact::node_on_rigid(mesh, nodes, *pair.obstacle, pair.mu, pair.r, ip);
             break;
-        case ContactElementKind::node_on_facet: {
-            // Whether a vertex is a contact node is decided on the level-0 target facets: the
-            // same on every level, so that the contact nodes nest (transfer/ requires it).
-            const auto& m0 = problem.mesh0;
-            const contact::FacetIndex reference(m0.vertices,
-                                                contact::target_facets(m0, m0.tag(pair.target)));
-            auto found = contact::node_on_facet_search(
-                mesh, nodes, mesh.tag(pair.target), reference, pair.search_radius, pair.mu, pair.r,
-                ip, pair.integration, mesh.tag(pair.contactor));
-            elems = std::move(found.elements);
-            L.not_found[p] = std::move(found.not_found);
-            break;
-        }
+        case ContactElementKind::node_on_facet:
         case ContactElementKind::node_on_node: {
-            auto found = contact::node_on_node_search(mesh, nodes, mesh.tag(pair.target),
-                                                      pair.match_tolerance, pair.mu, pair.r, ip);
+            auto found = two_body_search(problem, mesh, p, nodes, part != nullptr);
             elems = std::move(found.elements);
             L.not_found[p] = std::move(found.not_found);
             break;
         }
         }
-        MLC_CHECK(!elems.empty(), "contact '" << pair.name << "': none of the " << nodes.size()
-                                              << " contactor nodes on '" << pair.contactor
-                                              << "' found a "
-                                              << (pair.element == ContactElementKind::node_on_node
-                                                      ? "coincident target node"
-                                                      : "target facet within the search radius")
-                                              << " on '" << pair.target
-                                              << "' (check the tags, or raise search_radius)");
+        // (A part's nodes may all lie away from the target: the pair is checked over all parts.)
+        MLC_CHECK(part || !elems.empty(),
+                  "contact '" << pair.name << "': none of the " << nodes.size()
+                              << " contactor nodes on '" << pair.contactor << "' found a "
+                              << (pair.element == ContactElementKind::node_on_node
+                                      ? "coincident target node"
+                                      : "target facet within the search radius")
+                              << " on '" << pair.target
+                              << "' (check the tags, or raise search_radius)");
         for (const auto& e : elems) {
             L.contact_of_vertex[static_cast<size_t>(e.vertex[0])] =
                 static_cast<int>(L.contacts.size());
@@ -154,13 +193,21 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
     // Unknowns numbered along a Hilbert curve: refinement appends the new vertices after the
     // coarse ones, and in that order the mat-vecs and sweeps of the large levels gather x from
     // all over memory (at level 6 of the square one mat-vec took 1.4 times as long).
-    if (part && part->complete) part->complete(L, n_extra);
+    if (part && part->complete) {
+        std::vector<int> contact_pair(static_cast<size_t>(nv), -1);
+        for (const auto& e : L.contacts)
+            contact_pair[static_cast<size_t>(e.vertex[0])] = e.pair;
+        part->complete(L, n_extra, contact_pair);
+        build_ghost_contacts(problem, L, contact_pair, owned);
+    }
     L.dofs = fem::DofMap(L.fixed, n_extra,
                          part && !part->order.empty() ? part->order
                                                       : mesh::hilbert_order(L.mesh.vertices));
     L.lambda_dof.reserve(L.contacts.size());
     for (const auto& e : L.contacts)
         L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
+    for (const auto& e : L.ghost_contacts)
+        L.ghost_lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
 
     // Loads at every path point; the last one gives the assembled right-hand side.
     std::vector<Vec2> body_force;

@@ -28,6 +28,14 @@ struct Level {
     /// Per contact pair: contactor vertices left out because the search found no target facet
     /// (node_on_facet) or no coincident target vertex (node_on_node). Empty for rigid pairs.
     std::vector<std::vector<int>> not_found;
+    /// A distributed level's part only (build_level with a LevelPart; empty otherwise): the
+    /// elements of contact nodes owned by other processes that reach a vertex this process owns
+    /// (a two-body element couples its contactor with target vertices, which another process
+    /// may own), built here as their owners build them, so that the owned rows of the residual
+    /// and the Jacobian are complete without sending contributions. Their multiplier rows are
+    /// their owners'; they count in no status, norm or output.
+    std::vector<contact::ContactElement> ghost_contacts;
+    std::vector<int> ghost_lambda_dof; ///< first multiplier unknown of each ghost element
 
     /// Loading path (Problem::n_path_points K): prescribed displacements (2 per vertex), loads on
     /// the unknowns (f = F_free - K_(free,fixed) u_fixed) and nodal loads (2 per vertex) at path
@@ -68,16 +76,19 @@ struct LevelPart {
     std::vector<char> owned; ///< per vertex of the part's mesh: 1 where this process owns it
     /// Called once the supports and contact nodes of the owned vertices are known, before the
     /// unknowns are numbered: sets the fixed flags and path values (Level::fixed,
-    /// path_u_fixed, u_fixed) and the multiplier counts (n_extra) of the vertices owned by other
-    /// processes to their owners' (a part's mesh may lack the boundary edges that decide them).
-    std::function<void(Level&, std::vector<int>& n_extra)> complete;
+    /// path_u_fixed, u_fixed), the multiplier counts (n_extra) and the contact pair of the
+    /// contact nodes (contact_pair, -1 elsewhere) of the vertices owned by other processes to
+    /// their owners' (a part's mesh may lack the boundary edges that decide them).
+    std::function<void(Level&, std::vector<int>& n_extra, std::vector<int>& contact_pair)> complete;
     std::vector<int> order; ///< numbering order of the vertices (empty: Hilbert order)
 };
 
 /// build_level for one process's part (`part` non-null): contact nodes only at owned vertices (a
 /// pair may have none in the part; the caller checks the pairs over all parts), support points
-/// held only by the part that owns them, and `part->complete` before numbering. Null `part`:
-/// build_level(problem, m).
+/// held only by the part that owns them, and `part->complete` before numbering. Two-body pairs
+/// also get Level::ghost_contacts: the contact nodes of other processes (contact_pair from
+/// `complete`) are searched again here, and their elements kept where they reach an owned
+/// vertex. Null `part`: build_level(problem, m).
 Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part);
 
 } // namespace mlc::levels

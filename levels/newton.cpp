@@ -50,6 +50,7 @@ const Vector& ContactNewton::padded(const Vector& x, Vector& work) const {
     if (!dist_.comm) return x;
     work = Vector::Zero(level_.n_unknowns());
     work.head(x.size()) = x;
+    if (dist_.fill_ghosts) dist_.fill_ghosts(work);
     return work;
 }
 
@@ -69,10 +70,11 @@ double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector
     const Vector f = dist_.comm ? Vector(L.f_at(s).head(x.size())) : L.f_at(s);
     R -= f;
     double load2 = f.squaredNorm();
-    Vector contact_force = Vector::Zero(R.size());
+    // Distributed: the part's unknowns (ghost rows included; those are other processes').
+    Vector contact_force = Vector::Zero(xl.size());
     double lambda_res2 = 0.0;
     if (st) st->resize(L.contacts.size());
-    if (M) M->resize(L.contacts.size());
+    if (M) M->resize(L.contacts.size() + L.ghost_contacts.size());
     for (size_t e = 0; e < L.contacts.size(); ++e) {
         const auto& el = L.contacts[e];
         const auto es = contact::evaluate(el, u_full, u_prev_full, xl, L.lambda_dof[e]);
@@ -87,12 +89,21 @@ double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector
         if (st) (*st)[e] = es.proj.status;
         if (M) (*M)[e] = es.proj.M;
     }
-    R += contact_force;
+    // Other processes' elements reaching owned vertices: their forces on the owned rows.
+    for (size_t e = 0; e < L.ghost_contacts.size(); ++e) {
+        const auto& el = L.ghost_contacts[e];
+        const auto es = contact::evaluate(el, u_full, u_prev_full, xl, L.ghost_lambda_dof[e]);
+        contact::add_residual(el, es, L.dofs, L.ghost_lambda_dof[e], contact_force);
+        for (int q = 0; q < el.n_multipliers(); ++q)
+            contact_force[L.ghost_lambda_dof[e] + q] = 0.0;
+        if (M) (*M)[L.contacts.size() + e] = es.proj.M;
+    }
+    R += contact_force.head(R.size());
     // Norm in force units: displacement rows as they are, multiplier rows times r.
     double ru2 = 0.0;
     for (Index i = 0; i < R.size(); ++i)
         if (L.dofs.is_displacement(i)) ru2 += R[i] * R[i];
-    double contact2 = contact_force.squaredNorm();
+    double contact2 = contact_force.head(R.size()).squaredNorm();
     if (dist_.comm) {
         std::array<double, 5> sums{internal2, load2, contact2, ru2, lambda_res2};
         dist_.comm->allreduce(sums, ReduceOp::sum);

@@ -72,13 +72,19 @@ struct ContactNodeState {
 
 /// One process's share of the Newton of a distributed level (levels/distributed.hpp): the
 /// level is this process's part, whose first `n_owned` unknowns are the ones it owns (its contact
-/// elements are all at owned vertices); iterates, residuals and Newton systems hold the owned
+/// elements are at owned contact nodes; Level::ghost_contacts add the forces of other processes'
+/// elements on owned vertices); iterates, residuals and Newton systems hold the owned
 /// entries only, K x is the distributed stiffness's product, and every norm, count and decision is
 /// reduced over `comm`, so that all processes take the same steps.
 struct NewtonDistribution {
     const Communicator* comm = nullptr; ///< borrowed; null: one process (the default)
     Index n_owned = 0;
     const LinearOperator* K = nullptr; ///< the stiffness on the owned unknowns, borrowed
+    /// Collective: overwrites the ghost entries of a vector of the part's unknowns (owned ones
+    /// first) with their owners' values (GhostExchange::update), which two-body elements read
+    /// (Level::ghost_contacts). Empty: ghost entries are zero (node-on-rigid elements read
+    /// owned unknowns only).
+    std::function<void(Vector&)> fill_ghosts;
 };
 
 /// Generalized Newton on one level.
@@ -108,7 +114,9 @@ public:
     /// norm `norm` (NewtonParams::forcing); 0: the solver's own.
     double forcing_term(int k, double norm, double scale) const;
 
-    /// Residual R(x) at load factor s and its scaled norm (force units); also returns statuses.
+    /// Residual R(x) at load factor s and its scaled norm (force units); also returns statuses
+    /// (one per element of level().contacts) and the status matrices M (one per element of
+    /// level().contacts, then one per element of level().ghost_contacts).
     double residual(double s, const Vector& u_prev_full, const Vector& x, Vector& R,
                     std::vector<contact::Status>* st, std::vector<Eigen::Matrix2d>* M,
                     double* scale) const;

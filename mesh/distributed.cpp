@@ -52,21 +52,88 @@ LevelP level_p_edges(const Mesh& m, const Partition& part) {
     return e;
 }
 
-/// The local mesh of level p: owned triangles and those sharing a vertex with one.
-LocalLevel local_level_p(const Mesh& m, const Partition& part, int rank) {
+double point_segment_distance(const Vec2& x, const Vec2& a, const Vec2& b) {
+    const Vec2 d = b - a;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((x - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+    return (x - (a + t * d)).norm();
+}
+
+/// Distance between two segments that do not cross (boundary edges): the least distance of an
+/// end point of one to the other.
+double segment_distance(const Vec2& a0, const Vec2& a1, const Vec2& b0, const Vec2& b1) {
+    return std::min({point_segment_distance(a0, b0, b1), point_segment_distance(a1, b0, b1),
+                     point_segment_distance(b0, a0, a1), point_segment_distance(b1, a0, a1)});
+}
+
+/// The triangles (flagged in `local`) added by `reach` to a local set (GhostReach).
+void widen_along_contact(const Mesh& m, const std::vector<GhostReach>& reach,
+                         std::vector<char>& local) {
+    if (reach.empty()) return;
+    // The triangle of every boundary edge.
+    std::map<std::pair<int, int>, int> triangle_of;
+    for (int t = 0; t < m.n_triangles(); ++t) {
+        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        for (int k = 0; k < 3; ++k)
+            triangle_of.emplace(
+                std::minmax(tri[static_cast<size_t>(k)], tri[static_cast<size_t>((k + 1) % 3)]), t);
+    }
+    std::vector<char> add(local.size(), 0);
+    for (const GhostReach& r : reach) {
+        std::vector<std::pair<int, int>> seeds, candidates; // (boundary edge, its triangle)
+        for (size_t i = 0; i < m.boundary.size(); ++i) {
+            const auto& e = m.boundary[i];
+            if (std::find(r.tags.begin(), r.tags.end(), e.tag) == r.tags.end()) continue;
+            const auto it = triangle_of.find(std::minmax(e.v0, e.v1));
+            MLC_CHECK(it != triangle_of.end(), "distribute: boundary edge (" << e.v0 << ", " << e.v1
+                                                                             << ") is no edge of a "
+                                                                             << "triangle");
+            (local[static_cast<size_t>(it->second)] ? seeds : candidates)
+                .emplace_back(static_cast<int>(i), it->second);
+        }
+        for (const auto& [ci, ct] : candidates) {
+            if (add[static_cast<size_t>(ct)]) continue;
+            const auto& c = m.boundary[static_cast<size_t>(ci)];
+            const Vec2& c0 = m.vertices[static_cast<size_t>(c.v0)];
+            const Vec2& c1 = m.vertices[static_cast<size_t>(c.v1)];
+            for (const auto& [si, st] : seeds) {
+                const auto& e = m.boundary[static_cast<size_t>(si)];
+                if (segment_distance(c0, c1, m.vertices[static_cast<size_t>(e.v0)],
+                                     m.vertices[static_cast<size_t>(e.v1)]) <= r.distance) {
+                    add[static_cast<size_t>(ct)] = 1;
+                    break;
+                }
+            }
+        }
+    }
+    for (size_t t = 0; t < local.size(); ++t)
+        local[t] = local[t] || add[t];
+}
+
+/// The local mesh of level p: owned triangles and those sharing a vertex with one, and those
+/// `reach` adds along contact interfaces.
+LocalLevel local_level_p(const Mesh& m, const Partition& part, int rank,
+                         const std::vector<GhostReach>& reach) {
     const int nv = m.n_vertices(), nt = m.n_triangles();
     std::vector<char> touched(static_cast<size_t>(nv), 0);
     for (int t = 0; t < nt; ++t)
         if (part.triangle_part[static_cast<size_t>(t)] == rank)
             for (int v : m.triangles[static_cast<size_t>(t)])
                 touched[static_cast<size_t>(v)] = 1;
+    std::vector<char> local_triangle(static_cast<size_t>(nt), 0);
+    for (int t = 0; t < nt; ++t) {
+        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        local_triangle[static_cast<size_t>(t)] = touched[static_cast<size_t>(tri[0])] ||
+                                                 touched[static_cast<size_t>(tri[1])] ||
+                                                 touched[static_cast<size_t>(tri[2])];
+    }
+    widen_along_contact(m, reach, local_triangle);
     LocalLevel L;
     std::vector<int> local_of(static_cast<size_t>(nv), -1);
     std::vector<int> tris;
     for (int t = 0; t < nt; ++t) {
         const auto& tri = m.triangles[static_cast<size_t>(t)];
-        if (touched[static_cast<size_t>(tri[0])] || touched[static_cast<size_t>(tri[1])] ||
-            touched[static_cast<size_t>(tri[2])]) {
+        if (local_triangle[static_cast<size_t>(t)]) {
             tris.push_back(t);
             for (int v : tri)
                 local_of[static_cast<size_t>(v)] = 0;
@@ -217,7 +284,8 @@ void number_vertices(LocalLevel& L, const std::vector<Key>& keys, const Communic
 } // namespace
 
 DistributedHierarchy distribute(const Mesh& level_p, int n_refinements, const Communicator& comm,
-                                const std::vector<int>& weights) {
+                                const std::vector<int>& weights,
+                                const std::vector<GhostReach>& reach) {
     MLC_CHECK(n_refinements >= 0,
               "distribute: n_refinements must be >= 0, found " << n_refinements);
     DistributedHierarchy H;
@@ -227,7 +295,7 @@ DistributedHierarchy distribute(const Mesh& level_p, int n_refinements, const Co
     const LevelP lp = level_p_edges(level_p, H.partition);
     H.edges = lp.edges;
     H.levels.reserve(static_cast<size_t>(n_refinements) + 1);
-    H.levels.push_back(local_level_p(level_p, H.partition, H.rank));
+    H.levels.push_back(local_level_p(level_p, H.partition, H.rank, reach));
     {
         LocalLevel& L = H.levels.back();
         std::vector<Key> keys(L.vertex_location.size());

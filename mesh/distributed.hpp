@@ -70,6 +70,17 @@ struct LocalLevel {
     std::int64_t first_row() const { return 2 * first_vertex; }
 };
 
+/// A deeper ghost layer along a contact interface (two-body contact pairs, issue 13 item 1): the
+/// level-p triangles with a boundary edge tagged one of `tags` lying within `distance` of a
+/// boundary edge tagged one of `tags` of a triangle of the one-layer local mesh become ghosts too
+/// (with their refinements), so that the contact search of every local contact node, and of the
+/// contact nodes of other processes whose elements reach an owned vertex, sees every target facet
+/// it needs on every level.
+struct GhostReach {
+    std::vector<int> tags; ///< tags of the level-p mesh (contactor and target boundaries)
+    double distance = 0.0; ///< (edge to edge, in the reference configuration)
+};
+
 /// One process's part of a hierarchy refined from a partitioned level p.
 struct DistributedHierarchy {
     Partition partition; ///< of the level-p mesh, the same on every process
@@ -85,11 +96,13 @@ struct DistributedHierarchy {
 /// number of finest triangles each stands for: all equal under uniform refinement) and builds
 /// this process's part of it and of its `n_refinements` uniform refinements.
 ///
-/// Collective: every process calls it with the same mesh, refinements and weights. `level_p`
-/// must pass check_quality. Throws InvalidInput for n_refinements < 0 or more processes than
-/// triangles, on every process alike.
+/// Collective: every process calls it with the same mesh, refinements, weights and reach.
+/// `level_p` must pass check_quality. Throws InvalidInput for n_refinements < 0 or more processes
+/// than triangles, on every process alike. `reach` (GhostReach) widens the ghost layer along
+/// contact interfaces; empty: the one-triangle layer.
 DistributedHierarchy distribute(const Mesh& level_p, int n_refinements, const Communicator& comm,
-                                const std::vector<int>& weights = {});
+                                const std::vector<int>& weights = {},
+                                const std::vector<GhostReach>& reach = {});
 
 /// The name of process `rank`'s piece of the parallel file `file`: "<stem>_<rank>.vtu" in the
 /// folder of `file` (solution.pvtu -> solution_0.vtu, solution_1.vtu, ...).

@@ -19,6 +19,30 @@ double Partition::imbalance() const {
     return mean > 0 ? *std::max_element(part_work.begin(), part_work.end()) / mean : 1.0;
 }
 
+namespace {
+
+/// Whether every triangle is reachable from triangle 0 through shared edges.
+bool dual_graph_connected(const std::vector<std::vector<idx_t>>& adj) {
+    if (adj.empty()) return true;
+    std::vector<char> seen(adj.size(), 0);
+    std::vector<idx_t> stack{0};
+    seen[0] = 1;
+    size_t reached = 1;
+    while (!stack.empty()) {
+        const idx_t t = stack.back();
+        stack.pop_back();
+        for (idx_t u : adj[static_cast<size_t>(t)])
+            if (!seen[static_cast<size_t>(u)]) {
+                seen[static_cast<size_t>(u)] = 1;
+                ++reached;
+                stack.push_back(u);
+            }
+    }
+    return reached == adj.size();
+}
+
+} // namespace
+
 Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& weights) {
     const int nt = m.n_triangles();
     MLC_CHECK(parts >= 1, "a partition needs at least one part, found " << parts);
@@ -57,15 +81,16 @@ Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& 
         idx_t n = nt, ncon = 1, np = parts, objval = 0;
         idx_t options[METIS_NOPTIONS];
         METIS_SetDefaultOptions(options);
-        options[METIS_OPTION_CONTIG] = 1; // connected parts (each process one piece)
-        options[METIS_OPTION_SEED] = 1;   // reproducible
+        // Connected parts (each process one piece) where the mesh is connected; METIS cannot
+        // make them on a mesh of several bodies (it fails), so there the parts may be in pieces.
+        options[METIS_OPTION_CONTIG] = dual_graph_connected(adj) ? 1 : 0;
+        options[METIS_OPTION_SEED] = 1; // reproducible
         std::vector<idx_t> part(static_cast<size_t>(nt), 0);
         const int rc = METIS_PartGraphKway(&n, &ncon, xadj.data(), adjncy.data(),
                                            vwgt.empty() ? nullptr : vwgt.data(), nullptr, nullptr,
                                            &np, nullptr, nullptr, options, &objval, part.data());
         MLC_CHECK(rc == METIS_OK, "METIS could not partition the mesh into "
-                                      << parts << " parts (status " << rc
-                                      << "; is the mesh connected?)");
+                                      << parts << " parts (status " << rc << ")");
         p.triangle_part.assign(part.begin(), part.end());
     }
     p.part_work.assign(static_cast<size_t>(parts), 0.0);
@@ -74,8 +99,8 @@ Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& 
             weights.empty() ? 1.0 : weights[static_cast<size_t>(t)];
     for (int t = 0; t < nt; ++t)
         for (idx_t u : adj[static_cast<size_t>(t)])
-            if (u > t && p.triangle_part[static_cast<size_t>(t)] !=
-                             p.triangle_part[static_cast<size_t>(u)])
+            if (u > t &&
+                p.triangle_part[static_cast<size_t>(t)] != p.triangle_part[static_cast<size_t>(u)])
                 ++p.cut_edges;
     // Vertex owners: the part with most triangles around the vertex, ties to the lower part.
     const int nv = m.n_vertices();

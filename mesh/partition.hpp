@@ -23,11 +23,12 @@ struct Partition {
 };
 
 /// Splits the triangles of `m` into `parts` parts of balanced weight with few cut edges: METIS
-/// k-way on the dual graph (triangles adjacent through an edge), contiguous parts. `weights`
-/// (one positive integer per triangle, or empty for all 1) is the work a triangle stands for,
-/// e.g. on the finest level of a hierarchy refined from `m`. One part gives everything to part 0
-/// without calling METIS. The result depends only on the mesh, the weights and `parts`.
-/// Throws InvalidInput for parts < 1, more parts than triangles, or a weight that is not positive.
+/// k-way on the dual graph (triangles adjacent through an edge), contiguous parts when the
+/// mesh is connected (a mesh of several bodies has parts that may hold pieces of several bodies).
+/// `weights` (one positive integer per triangle, or empty for all 1) is the work a triangle stands
+/// for, e.g. on the finest level of a hierarchy refined from `m`. One part gives everything to part
+/// 0 without calling METIS. The result depends only on the mesh, the weights and `parts`. Throws
+/// InvalidInput for parts < 1, more parts than triangles, or a weight that is not positive.
 Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& weights = {});
 
 } // namespace mlc::mesh

@@ -195,6 +195,92 @@ TEST(Distributed, LevelsAreNestedPerProcess) {
     }
 }
 
+namespace {
+
+/// Two stacked blocks, apart by 0.01, with non-matching meshes: the lower one's top tagged
+/// "lower_top", the upper one's bottom "upper_bottom" (a contact interface).
+Mesh two_blocks() {
+    Mesh m = mesh::structured_rectangle({0, 0}, {1, 0.5}, 9, 5);
+    const Mesh up = mesh::structured_rectangle({0, 0.51}, {1, 0.5}, 7, 4);
+    const int lower_top = m.add_tag("lower_top");
+    const int upper_bottom = m.add_tag("upper_bottom");
+    for (auto& e : m.boundary)
+        if (e.tag == m.tag("top")) e.tag = lower_top;
+    const int off = m.n_vertices();
+    for (const auto& x : up.vertices)
+        m.vertices.push_back(x);
+    for (auto t : up.triangles) {
+        for (int& v : t)
+            v += off;
+        m.triangles.push_back(t);
+    }
+    for (auto e : up.boundary) {
+        const std::string name = up.tag_name(e.tag);
+        e.tag = name == "bottom" ? upper_bottom : m.add_tag("upper_" + name);
+        e.v0 += off;
+        e.v1 += off;
+        m.boundary.push_back(e);
+    }
+    m.attribute.assign(static_cast<size_t>(m.n_triangles()), 0);
+    for (size_t t = m.triangles.size() - up.triangles.size(); t < m.triangles.size(); ++t)
+        m.attribute[t] = 1;
+    return m;
+}
+
+double point_segment(const Vec2& x, const Vec2& a, const Vec2& b) {
+    const Vec2 d = b - a;
+    const double t = std::clamp((x - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    return (x - (a + t * d)).norm();
+}
+
+} // namespace
+
+// A ghost layer widened along a contact interface (mesh::GhostReach): on every level, every
+// interface edge of the serial mesh within the reach of an owned interface vertex is local, so
+// that the contact search of an owned node sees every facet it may need.
+TEST(Distributed, GhostReachHoldsEveryInterfaceFacetWithinReach) {
+    const Mesh m0 = two_blocks();
+    const int tags[2] = {m0.tag("lower_top"), m0.tag("upper_bottom")};
+    const double reach = 0.3;
+    const auto serial = serial_levels(m0, 2);
+    const DistributedHierarchy H = mesh::distribute(m0, 2, W(), {}, {{{tags[0], tags[1]}, reach}});
+    const DistributedHierarchy H1 = mesh::distribute(m0, 2, W());
+    // The widened layer holds more triangles (somewhere, on several processes).
+    const std::int64_t wide = W().sum(static_cast<std::int64_t>(H.levels[0].mesh.n_triangles()));
+    const std::int64_t narrow = W().sum(static_cast<std::int64_t>(H1.levels[0].mesh.n_triangles()));
+    if (W().size() > 1) EXPECT_GT(wide, narrow);
+    for (size_t l = 0; l < H.levels.size(); ++l) {
+        SCOPED_TRACE("level " + std::to_string(l));
+        const LocalLevel& L = H.levels[l];
+        const Mesh& S = serial[l];
+        std::set<std::pair<Point, Point>> local;
+        for (const auto& e : L.mesh.boundary)
+            local.insert(std::minmax(point(L.mesh, e.v0), point(L.mesh, e.v1)));
+        std::vector<char> on_interface(static_cast<size_t>(L.mesh.n_vertices()), 0);
+        for (const auto& e : L.mesh.boundary)
+            if (e.tag == tags[0] || e.tag == tags[1])
+                on_interface[static_cast<size_t>(e.v0)] = on_interface[static_cast<size_t>(e.v1)] =
+                    1;
+        int checked = 0;
+        for (int v : L.owned_vertices) {
+            if (!on_interface[static_cast<size_t>(v)]) continue;
+            const Vec2& x = L.mesh.vertices[static_cast<size_t>(v)];
+            for (const auto& e : S.boundary) {
+                if (e.tag != tags[0] && e.tag != tags[1]) continue;
+                if (point_segment(x, S.vertices[static_cast<size_t>(e.v0)],
+                                  S.vertices[static_cast<size_t>(e.v1)]) > reach)
+                    continue;
+                ++checked;
+                EXPECT_TRUE(local.count(std::minmax(point(S, e.v0), point(S, e.v1))))
+                    << "interface edge at (" << S.vertices[static_cast<size_t>(e.v0)].x() << ", "
+                    << S.vertices[static_cast<size_t>(e.v0)].y() << ") within " << reach
+                    << " of owned vertex (" << x.x() << ", " << x.y() << ") is not local";
+            }
+        }
+        EXPECT_GT(W().sum(checked), 0);
+    }
+}
+
 TEST(Distributed, OneProcessIsTheSerialHierarchy) {
     const mlc::SerialCommunicator one;
     const Mesh m0 = curved_rectangle();
