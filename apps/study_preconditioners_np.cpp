@@ -271,7 +271,7 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
         os << " -n N'";
     }
     os << "\n\n"
-       << std::left << std::setw(8) << "krylov" << std::setw(16) << "pc" << std::right
+       << std::left << std::setw(10) << "krylov" << std::setw(16) << "pc" << std::right
        << std::setw(6) << "mu" << std::setw(8) << "r/E" << std::setw(7) << "level" << std::setw(5)
        << "N" << std::setw(10) << "unknowns" << std::setw(8) << "newton" << std::setw(11)
        << "its/newton" << std::setw(8) << "max"
@@ -363,7 +363,7 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
                                 if (ext == ".vtu" || ext == ".pvtu")
                                     std::filesystem::remove(e.path());
                             }
-                            os << std::left << std::setw(8) << kr << std::setw(16) << pc
+                            os << std::left << std::setw(10) << kr << std::setw(16) << pc
                                << std::right << std::setw(6) << mu << std::setw(8) << rf
                                << std::setw(7) << l << std::setw(5) << np << std::setw(10)
                                << c.unknowns << std::setw(8) << c.newton << std::setw(11)
@@ -421,7 +421,7 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
 
     // The table by processes: Krylov iterations per Newton step, mean (max), on the finest level.
     os << "\nKrylov iterations per Newton step on level l, mean (max), by processes N:\n"
-       << std::left << std::setw(8) << "krylov" << std::setw(16) << "pc" << std::right
+       << std::left << std::setw(10) << "krylov" << std::setw(16) << "pc" << std::right
        << std::setw(6) << "mu" << std::setw(8) << "r/E" << std::setw(7) << "level" << std::setw(10)
        << "unknowns";
     for (int n : nps)
@@ -440,7 +440,7 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
         std::int64_t unknowns = 0;
         for (const auto& [n, c] : row)
             unknowns = std::max(unknowns, c->unknowns);
-        os << std::left << std::setw(8) << std::get<0>(k) << std::setw(16) << std::get<1>(k)
+        os << std::left << std::setw(10) << std::get<0>(k) << std::setw(16) << std::get<1>(k)
            << std::right << std::setw(6) << std::get<2>(k) << std::setw(8) << std::get<3>(k)
            << std::setw(7) << std::get<4>(k) << std::setw(10) << unknowns;
         for (int n : nps) {
