@@ -100,6 +100,11 @@ ChildEnd run_child(const std::vector<std::string>& argv, const std::filesystem::
     MLC_CHECK(pid >= 0, "fork failed: " << std::strerror(errno));
     if (pid == 0) {
         ::setpgid(0, 0);
+        // No terminal input: a launcher reading it in a background job would be stopped.
+        if (const int in = ::open("/dev/null", O_RDONLY); in >= 0) {
+            ::dup2(in, 0);
+            ::close(in);
+        }
         const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (fd >= 0) {
             ::dup2(fd, 1);
