@@ -143,6 +143,16 @@ int main(int argc, char** argv) {
     ps->add_option("--seconds", pso.seconds_per_run, "time bound per combination (default 600)");
     ps->add_option("--out,-o", pso_out, "output folder");
     ps->add_flag("!--no-plot", pso.plot, "do not draw the PNG");
+    auto* ps_np = ps->add_option("--np-list", pso.np_list,
+                                 "process counts (list, e.g. 1,2,4): run each cell as `mlcontact "
+                                 "run` on N processes (mpiexec -n N for N > 1) and tabulate the "
+                                 "Krylov iterations per Newton step by N (default --pc diag "
+                                 "ilu:0 ebe mg)")
+                      ->delimiter(',');
+    ps->add_option("--mpiexec", pso.mpiexec,
+                   "with --np-list: the MPI launcher (default mpiexec or mpirun on PATH, with "
+                   "--oversubscribe for Open MPI)")
+        ->needs(ps_np);
     mlc::apps::AccuracyOptions aco;
     std::string aco_scene = "hertz", aco_out;
     auto* ac = study->add_subcommand(
@@ -297,6 +307,12 @@ int main(int argc, char** argv) {
         }
         if (*ps) {
             pso.out = pso_out;
+            if (!pso.np_list.empty()) {
+                pso.scene_arg = pso_scene;
+                if (ps->count("--pc") == 0) pso.pcs = {"diag", "ilu:0", "ebe", "mg"};
+                return mlc::apps::study_preconditioners_np(mlc::scene::load_scene(pso_scene), pso,
+                                                           std::cout);
+            }
             return mlc::apps::study_preconditioners(mlc::scene::load_scene(pso_scene), pso,
                                                     std::cout);
         }

@@ -382,6 +382,19 @@ toml::table checks_json(const levels::StateChecks& c) {
     return ct;
 }
 
+void write_iterations_csv(const std::filesystem::path& file,
+                          const std::vector<LevelIterations>& levels) {
+    write_file_atomically(file, [&](std::ostream& f) {
+        f << "level,unknowns,distributed,step,newton,krylov\n";
+        for (const auto& lv : levels)
+            for (const auto& st : *lv.steps)
+                for (size_t i = 0; i < st.report.linear_iterations_per_newton.size(); ++i)
+                    f << lv.level << "," << lv.unknowns << "," << (lv.distributed ? 1 : 0) << ","
+                      << st.report.step << "," << i + 1 << ","
+                      << st.report.linear_iterations_per_newton[i] << "\n";
+    });
+}
+
 std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
                                        const levels::RunResult& r, const OutputOptions& options) {
     const auto& L = r.finest();
@@ -411,6 +424,14 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
     }
     write_contact_steps(dir / "contact_steps.csv", p, L, r.step_nodes, r.completed_steps);
     written.push_back("contact_steps.csv");
+    {
+        std::vector<LevelIterations> its;
+        for (size_t l = 0; l < r.level_steps.size(); ++l)
+            if (!r.level_steps[l].empty())
+                its.push_back({static_cast<int>(l), r.levels()[l].n_unknowns(), &r.level_steps[l]});
+        write_iterations_csv(dir / "iterations.csv", its);
+        written.push_back("iterations.csv");
+    }
     { // summary.json
         toml::table root;
         root.insert("scene", p.name);

@@ -9,6 +9,7 @@
 #include "levels/solve.hpp"
 #include "mesh/io/vtu.hpp"
 
+#include <cstdint>
 #include <filesystem>
 #include <ostream>
 #include <string>
@@ -78,10 +79,24 @@ void write_contact_steps(const std::filesystem::path& file, const levels::Proble
                          const std::vector<std::vector<levels::ContactNodeState>>& step_nodes,
                          int completed_steps);
 
+/// One level's load steps, for iterations.csv.
+struct LevelIterations {
+    int level = 0;
+    std::int64_t unknowns = 0;
+    const std::vector<levels::LevelStep>* steps = nullptr;
+    bool distributed = false; ///< solved by the processes each on its part (mpirun -np N, N > 1)
+};
+
+/// iterations.csv: one row per Newton system solved on every level listed, columns
+/// `level,unknowns,distributed,step,newton,krylov`: the load step, the Newton iteration (1, 2, ...
+/// within the step) and the Krylov iterations of its linear solve (0 for a direct solve).
+void write_iterations_csv(const std::filesystem::path& file,
+                          const std::vector<LevelIterations>& levels);
+
 /// Writes the files of a run into dir (created if needed), each under a temporary name renamed
-/// when complete: when converged, solution.vtu, contact.csv, contact_steps.csv and
-/// summary.json; when stopped on request, contact_steps.csv (the completed steps) and
-/// summary.json; nothing else. Returns the names of the files written.
+/// when complete: when converged, solution.vtu, contact.csv, contact_steps.csv, iterations.csv
+/// and summary.json; when stopped on request, contact_steps.csv (the completed steps),
+/// iterations.csv and summary.json; nothing else. Returns the names of the files written.
 std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
                                        const levels::RunResult& r,
                                        const OutputOptions& options = {});

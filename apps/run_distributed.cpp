@@ -380,6 +380,19 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         write_contact_steps(dir / "contact_steps.csv", p, cb.level, cb.step_nodes,
                             r.completed_steps);
         files.push_back("contact_steps.csv");
+        {
+            // Levels 0..p as one process solves them, then the distributed ones.
+            std::vector<LevelIterations> its;
+            for (size_t l = 0; l < r.serial.level_steps.size(); ++l)
+                if (!r.serial.level_steps[l].empty())
+                    its.push_back({static_cast<int>(l), r.serial.levels()[l].n_unknowns(),
+                                   &r.serial.level_steps[l]});
+            for (size_t k = 1; k < r.level_steps.size(); ++k)
+                its.push_back({plevel + static_cast<int>(k), r.levels[k].n_global_dofs,
+                               &r.level_steps[k], true});
+            write_iterations_csv(dir / "iterations.csv", its);
+            files.push_back("iterations.csv");
+        }
         toml::table root_t;
         root_t.insert("scene", p.name);
         root_t.insert("units", p.units);

@@ -5,6 +5,7 @@
 #include "comm/world.hpp"
 #include "contact/element.hpp"
 #include "core/check.hpp"
+#include "levels/krylov_system.hpp"
 #include "levels/newton.hpp"
 #include "levels/newton_system.hpp"
 #include "smoothers/block_sor.hpp"
@@ -26,7 +27,8 @@ struct DistributedMultigrid::Impl {
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
          LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
-          use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"), op_(levels.size()) {
+          use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"),
+          use_ebe_(solvers::parse_preconditioner_spec(spec_.pc).name == "ebe"), op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k)
             build_jacobian(k);
     }
@@ -98,8 +100,13 @@ struct DistributedMultigrid::Impl {
                                             M[L.local.contacts.size() + e], L.local.dofs,
                                             L.local.ghost_lambda_dof[e], add);
         if (!use_mg_) {
+            if (use_ebe_) refresh_block_elements(k, M);
             if (!o.block_pc) {
-                o.block_pc = solvers::make_preconditioner(spec_.pc);
+                // EBE: built from the process's elements restricted to its owned unknowns.
+                solvers::LevelData d;
+                d.has_multipliers = !L.local.contacts.empty();
+                d.elements = [&o]() { return &o.elements; };
+                o.block_pc = solvers::make_preconditioner(spec_.pc, use_ebe_ ? &d : nullptr);
                 o.block_pc->setup(o.blocks->diag);
             } else {
                 o.block_pc->update_values(o.blocks->diag);
@@ -143,6 +150,27 @@ struct DistributedMultigrid::Impl {
         return r;
     }
 
+    /// EBE on the diagonal block (issue 13): the elastic element matrices of every local triangle
+    /// restricted to the owned unknowns (so that they sum to the diagonal block of K; the
+    /// triangles cut by the partition contribute their owned rows and columns), then the contact
+    /// elements (all at owned vertices) at the statuses M. EBE colours them within the process.
+    void refresh_block_elements(size_t k, const std::vector<Eigen::Matrix2d>& M) {
+        Op& o = op_[k];
+        const DistributedLevel& D = levels_[k];
+        if (o.elements.empty()) {
+            o.elements = elastic_element_matrices(D.local);
+            restrict_elements(o.elements, D.n_owned);
+            o.n_elastic = o.elements.size();
+            o.elements.resize(o.n_elastic + D.local.contacts.size());
+        }
+        for (size_t e = 0; e < D.local.contacts.size(); ++e) {
+            smoothers::ElementMatrix& el = o.elements[o.n_elastic + e];
+            contact_element_matrix(D.local, e, M[e], el);
+            for (const int d : el.dofs)
+                MLC_ASSERT(d < D.n_owned, "a contact element outside the owned unknowns");
+        }
+    }
+
     std::string name() const {
         std::ostringstream os;
         if (!use_mg_) return spec_.krylov + " + " + spec_.pc + " on each process's diagonal block";
@@ -169,6 +197,10 @@ struct DistributedMultigrid::Impl {
         std::unique_ptr<solvers::ParMatrix> J;
         std::unique_ptr<smoothers::BlockSOR> smoother;
         std::unique_ptr<Preconditioner> block_pc; ///< without mg: spec.pc on the diagonal block
+        /// ebe: the elements of the diagonal block (elastic, restricted; then contact), which
+        /// block_pc borrows.
+        std::vector<smoothers::ElementMatrix> elements;
+        size_t n_elastic = 0;
         std::vector<Eigen::Matrix2d> last_M;
         bool prepared = false;
         mutable Vector res, t, rc, ec, d, ghost;
@@ -376,7 +408,8 @@ struct DistributedMultigrid::Impl {
     const Communicator& comm_;
     LinearSolverSpec spec_;
     solvers::MultigridParams mg_;
-    bool use_mg_ = true; ///< else spec_.pc on each process's diagonal block
+    bool use_mg_ = true;   ///< else spec_.pc on each process's diagonal block
+    bool use_ebe_ = false; ///< spec_.pc is ebe (on each process's diagonal block)
     std::vector<Op> op_;
     const Level* coarse_level_ = nullptr;
     std::unique_ptr<JacobianAssembler> coarse_asm_;
@@ -449,13 +482,17 @@ solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
     if (ps.name != "mg") {
         // A preconditioner of the matrix alone runs on each process's diagonal block.
         const solvers::PreconditionerEntry* e = solvers::find_preconditioner(spec.pc);
-        MLC_CHECK(e && !e->level_aware,
-                  "on several processes the preconditioner is mg, or one that needs the matrix "
-                  "alone (diag, ilu, sor, ...) on each process's diagonal block; '"
+        MLC_CHECK(e && (!e->level_aware || e->name == "ebe"),
+                  "on several processes the preconditioner is mg, ebe, or one that needs the "
+                  "matrix alone (diag, ilu, sor, ...) on each process's diagonal block; '"
                       << spec.pc
-                      << "' has no distributed form (cf, sorcf, ebe and mgr need the whole level: "
+                      << "' has no distributed form (cf, sorcf and mgr need the whole level: "
                          "run it on one process)");
-        solvers::make_preconditioner(spec.pc); // its options checked here, on every process
+        // Its options checked here, on every process (ebe: on no elements, not set up).
+        static const std::vector<smoothers::ElementMatrix> none;
+        solvers::LevelData d;
+        d.elements = [] { return &none; };
+        solvers::make_preconditioner(spec.pc, e->level_aware ? &d : nullptr);
         return p;
     }
     solvers::SpecOptions o(ps);
@@ -467,6 +504,11 @@ solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
               "mg:coarse=" << coarse
                            << " has no distributed form; on several processes mg rediscretizes "
                               "(coarse=rediscretize)");
+    const std::string precision = o.get_string("precision", "double");
+    MLC_CHECK(precision == "double",
+              "mg:precision=" << precision
+                              << " has no distributed form; on several processes mg's data is "
+                                 "double (precision=double)");
     o.finish();
     p.validate();
     return p;

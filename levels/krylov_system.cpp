@@ -373,6 +373,31 @@ std::vector<smoothers::ElementMatrix> elastic_element_matrices(const Level& leve
     return out;
 }
 
+void restrict_elements(std::vector<smoothers::ElementMatrix>& elements, Index n) {
+    size_t kept = 0;
+    for (auto& el : elements) {
+        std::vector<Index> keep;
+        for (size_t a = 0; a < el.dofs.size(); ++a)
+            if (el.dofs[a] < n) keep.push_back(static_cast<Index>(a));
+        if (keep.empty()) continue;
+        if (keep.size() < el.dofs.size()) {
+            const auto ne = static_cast<Index>(keep.size());
+            smoothers::ElementMatrix r;
+            r.is_contact = el.is_contact;
+            r.A.resize(ne, ne);
+            for (Index a = 0; a < ne; ++a) {
+                r.dofs.push_back(el.dofs[static_cast<size_t>(keep[static_cast<size_t>(a)])]);
+                for (Index b = 0; b < ne; ++b)
+                    r.A(a, b) = el.A(keep[static_cast<size_t>(a)], keep[static_cast<size_t>(b)]);
+            }
+            el = std::move(r);
+        }
+        if (&elements[kept] != &el) elements[kept] = std::move(el);
+        ++kept;
+    }
+    elements.resize(kept);
+}
+
 void contact_element_matrix(const Level& level, size_t e, const Eigen::Matrix2d& M,
                             smoothers::ElementMatrix& out) {
     MLC_CHECK(e < level.contacts.size(), "contact_element_matrix: element "

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 
 using namespace mlc;
@@ -146,6 +147,42 @@ TEST(KrylovSystem, ElementMatricesSumToTheJacobian) {
     S.setFromTriplets(trip.begin(), trip.end());
     const SparseMatrix D = S - t.J->matrix();
     EXPECT_LT(D.norm(), 1e-12 * t.J->matrix().norm());
+}
+
+TEST(KrylovSystem, ElementsRestrictedToTheFirstUnknownsSumToTheLeadingBlock) {
+    // EBE on one process's diagonal block (issue 13): the elements restricted to the unknowns
+    // [0, n) sum to J's leading n x n block, for any n; elements with none of them are dropped.
+    TwoLevels& t = two_levels();
+    std::vector<smoothers::ElementMatrix> all = elastic_element_matrices(t.fine);
+    for (size_t e = 0; e < t.fine.contacts.size(); ++e) {
+        smoothers::ElementMatrix c;
+        contact_element_matrix(t.fine, e, t.fine_M[e], c);
+        all.push_back(c);
+    }
+    const Index N = t.fine.n_unknowns();
+    for (const Index n : {N, N / 2 + 1, N / 3, Index{5}}) {
+        std::vector<smoothers::ElementMatrix> els = all;
+        restrict_elements(els, n);
+        size_t touching = 0;
+        for (const auto& e : all)
+            touching += std::any_of(e.dofs.begin(), e.dofs.end(), [n](int d) { return d < n; });
+        EXPECT_EQ(els.size(), touching) << n;
+        std::vector<Triplet> trip;
+        for (const auto& e : els) {
+            ASSERT_EQ(e.A.rows(), static_cast<Index>(e.dofs.size()));
+            for (size_t a = 0; a < e.dofs.size(); ++a) {
+                ASSERT_LT(e.dofs[a], n);
+                for (size_t b = 0; b < e.dofs.size(); ++b)
+                    trip.emplace_back(e.dofs[a], e.dofs[b],
+                                      e.A(static_cast<Index>(a), static_cast<Index>(b)));
+            }
+        }
+        SparseMatrix S(n, n);
+        S.setFromTriplets(trip.begin(), trip.end());
+        const SparseMatrix B = t.J->matrix().topLeftCorner(n, n);
+        EXPECT_LT(SparseMatrix(S - B).norm(), 1e-12 * t.J->matrix().norm()) << n;
+        EXPECT_GT(B.norm(), 0) << n;
+    }
 }
 
 TEST(KrylovSystem, EveryPreconditionerSolvesTheFineSystem) {

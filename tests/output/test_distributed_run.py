@@ -176,10 +176,36 @@ def test_a_preconditioner_of_the_matrix_alone_runs_on_each_process_block(tmp_pat
     compare(out1, dist)
 
 
+def ebe_on_processes(tmp_path, np_):
+    # EBE (C1) from each process's elements restricted to its owned unknowns, coloured within the
+    # process, Jacobi across the cuts (issue 13): the one-process answer on np_ processes.
+    f = scene_file(tmp_path, "square")
+    out1 = tmp_path / "one"
+    # BiCGStab: CGS with EBE on 2 processes stalls at 5000 iterations here (README).
+    p1 = subprocess.run([MLCONTACT, "run", str(f), "--levels", "2", "--pc", "ebe",
+                         "--krylov", "bicgstab", "--linear-tol", "1e-12", "--quiet",
+                         "--out", str(out1)],
+                        capture_output=True, text=True, timeout=600,
+                        env=dict(ENV, OMPI_MCA_ess_singleton_isolated="1"))
+    assert p1.returncode == 0, p1.stdout + p1.stderr
+    dist, p = run(tmp_path, f, 2, np_, "--pc", "ebe", "--krylov", "bicgstab")
+    assert "ebe on each process's diagonal block" in p.stdout
+    compare(out1, dist)
+    # The finest level was distributed (iterations.csv says so) and EBE converged there.
+    with open(dist / "iterations.csv") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["level"] == "2"]
+    assert rows and all(r["distributed"] == "1" and int(r["krylov"]) > 0 for r in rows)
+
+
+def test_ebe_runs_on_each_process_block(tmp_path):
+    ebe_on_processes(tmp_path, 2)
+
+
 @pytest.mark.parametrize("args,message", [
     (["--linear", "schur"], "--linear schur has no distributed form"),
     (["--pc", "sorcf"], "'sorcf' has no distributed form"),
     (["--cold"], "--cold is one process only"),
+    (["--pc", "mg:precision=single"], "mg:precision=single has no distributed form"),
     (["--partition-level", "3"], "--partition-level must lie in [0, 2] for --levels 3"),
 ])
 def test_what_has_no_distributed_form_is_refused_once(tmp_path, args, message):
