@@ -178,6 +178,47 @@ std::string at(const char* what, int it, double value) {
 
 } // namespace
 
+SolveResult cg(const LinearOperator& A, const Preconditioner& M, const Vector& b, Vector& x,
+               const KrylovParams& params) {
+    Run run("cg", A, b, x, params);
+    if (run.trivial()) return run.result();
+    const Index n = b.size();
+    Vector r(n), z(n), p(n), q(n), t(n);
+    double rn = run.true_residual(t);
+    r = t;
+    run.initial(rn);
+    if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
+    int it = 0;
+    double rz = 0.0;
+    while (true) {
+        if (const auto stop = run.should_stop(it))
+            return run.finish(StopReason::max_iter, it, run.true_residual(t), *stop);
+        M.apply(r, z);
+        const double rz_new = run.dot(r, z);
+        if (it == 0)
+            p = z;
+        else
+            p = z + (rz_new / rz) * p;
+        rz = rz_new;
+        A.apply(p, q);
+        const double pq = run.dot(p, q);
+        if (!(pq > 0.0) || !std::isfinite(pq))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("(p, A p)", it, pq));
+        const double a = rz / pq;
+        x += a * p;
+        r -= a * q;
+        ++it;
+        rn = run.norm(r);
+        traffic::vectors(n, 10); // (r, z), p, (p, q), x, r, ||r||
+        run.record(rn);
+        if (!std::isfinite(rn))
+            return run.finish(StopReason::breakdown, it, run.true_residual(t),
+                              at("residual norm", it, rn));
+        if (run.ok(rn)) return run.finish(StopReason::converged, it, run.true_residual(t));
+    }
+}
+
 SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& b, Vector& x,
                 const KrylovParams& params) {
     Run run("cgs", A, b, x, params);

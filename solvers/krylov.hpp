@@ -73,6 +73,13 @@ std::ostream& operator<<(std::ostream& os, const KrylovParams& p);
 /// - solve_seconds is the wall time of the call; setup_seconds is left at 0 (the caller times
 ///   the preconditioner setup).
 
+/// Preconditioned conjugate gradients for a symmetric positive definite A and preconditioner
+/// (the elastic block with a symmetric V-cycle: `bench elastic`); not a `Krylov` method of the
+/// Newton systems, which are not symmetric. Per iteration: 1 mat-vec, 1 C^{-1}, 2 reductions.
+/// Monitors the recursive residual; a breakdown when (p, A p) is not positive.
+SolveResult cg(const LinearOperator& A, const Preconditioner& M, const Vector& b, Vector& x,
+               const KrylovParams& params = {});
+
 /// Preconditioned CGS (Sonneveld), left preconditioned exactly as formulation.md sect. 4:
 ///   r0 = b - A x0, z0 = C^{-1} r0, p0 = q0 = z0; per iteration
 ///   y = C^{-1} A q, a = (z0, z) / (z0, y), h = p - a y, x += a (p + h), r -= a A (p + h),

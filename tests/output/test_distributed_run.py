@@ -284,7 +284,7 @@ def bench_elastic(tmp_path, np_):
 
 def test_bench_elastic_on_two_processes_solves_the_one_process_block(tmp_path):
     """`mpirun -np 2 mlcontact bench elastic`: hypre's ParCSR BoomerAMG-PCG and the distributed
-    V-cycle in GMRES and CGS solve the same elastic block as the one-process bench, to 1e-10."""
+    V-cycle in CG, GMRES and CGS solve the same elastic block as the one-process bench, to 1e-10."""
     s1, _ = bench_elastic(tmp_path, 1)
     s2, p = bench_elastic(tmp_path, 2)
     assert p.stdout.count("wrote ") == 1, p.stdout  # rank 0 reports alone
@@ -293,7 +293,7 @@ def test_bench_elastic_on_two_processes_solves_the_one_process_block(tmp_path):
     assert sum(q["owned_unknowns"] for q in s2["per_process"]) == s1["unknowns"]
     assert all(q["owned_unknowns"] > 0 and q["peak_rss_bytes"] > 0 for q in s2["per_process"])
     solvers = {r["solver"]: r for r in s2["solvers"]}
-    assert sorted(solvers) == ["boomeramg-pcg", "mg-cgs", "mg-gmres"]
+    assert sorted(solvers) == ["boomeramg-pcg", "mg-cg", "mg-cgs", "mg-gmres"]
     for r in s2["solvers"] + s1["solvers"]:
         assert r["converged"] and r["relative_residual"] <= 1e-10, r
         assert r["iterations"] >= 1 and r["x_norm"] > 0 and r["x_max_norm"] > 0, r
@@ -306,6 +306,10 @@ def test_bench_elastic_on_two_processes_solves_the_one_process_block(tmp_path):
     # The V-cycle stays a good preconditioner across the cut (one process: mg-gmres's count).
     mg1 = {r["solver"]: r for r in s1["solvers"]}["mg-gmres"]["iterations"]
     assert solvers["mg-gmres"]["iterations"] <= 2 * mg1 + 5
+    # CG with the distributed V-cycle (symmetric: forward sweeps before, backward after), like the
+    # one-process mg-cg.
+    cg1 = {r["solver"]: r for r in s1["solvers"]}["mg-cg"]["iterations"]
+    assert solvers["mg-cg"]["iterations"] <= 2 * cg1 + 5
 
 
 @pytest.mark.parametrize("scene,levels", [("square", 4), ("hertz", 3)])
