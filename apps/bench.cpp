@@ -541,7 +541,10 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
             x_mg = Vector::Zero(n);
             SolveResult s;
             if (method == std::string("mg-cg")) {
-                s = solvers::pcg(fine.K, mg.finest(), b, x_mg, opt.rel_tol, opt.max_iter);
+                solvers::KrylovParams kp;
+                kp.rel_tol = opt.rel_tol;
+                kp.max_iter = opt.max_iter;
+                s = solvers::cg(MatrixOperator(fine.K, MatVec::unrolled), mg.finest(), b, x_mg, kp);
             } else {
                 solvers::KrylovParams kp;
                 kp.rel_tol = opt.rel_tol;

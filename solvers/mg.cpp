@@ -296,58 +296,6 @@ std::ostream& operator<<(std::ostream& os, const MultigridReport& r) {
 
 // ---------------------------------------------------------------------------------------------
 // ---------------------------------------------------------------------------------------------
-SolveResult pcg(const SparseMatrix& A, const Preconditioner& M, const Vector& b, Vector& x,
-                double rel_tol, int max_iter) {
-    MLC_CHECK(rel_tol > 0.0 && rel_tol < 1.0, "pcg: rel_tol must be in (0, 1), found " << rel_tol);
-    MLC_CHECK(max_iter >= 1, "pcg: max_iter must be >= 1, found " << max_iter);
-    MLC_CHECK(A.rows() == A.cols() && b.size() == A.rows(),
-              "pcg: A is " << A.rows() << " x " << A.cols() << ", b has " << b.size());
-    const double t0 = wall_seconds();
-    if (x.size() != b.size()) x = Vector::Zero(b.size());
-    SolveResult res;
-    Vector r = b;
-    r.noalias() -= A * x;
-    Vector z(b.size()), p(b.size()), q(b.size());
-    const MatrixOperator Aop(A, MatVec::unrolled);
-    const double bnorm = b.norm();
-    const double target = rel_tol * (bnorm > 0 ? bnorm : r.norm());
-    res.initial_residual = r.norm();
-    double rnorm = res.initial_residual;
-    double rz = 0.0;
-    int it = 0;
-    while (rnorm > target && it < max_iter) {
-        M.apply(r, z);
-        const double rz_new = r.dot(z);
-        if (it == 0)
-            p = z;
-        else
-            p = z + (rz_new / rz) * p;
-        rz = rz_new;
-        Aop.apply(p, q);
-        const double pq = p.dot(q);
-        if (!(pq > 0.0) || !std::isfinite(pq)) {
-            res.reason = StopReason::breakdown;
-            res.message = "p^T A p is not positive";
-            break;
-        }
-        const double alpha = rz / pq;
-        x += alpha * p;
-        r -= alpha * q;
-        rnorm = r.norm();
-        ++it;
-    }
-    r = b;
-    r.noalias() -= A * x;
-    res.iterations = it;
-    res.final_residual = r.norm();
-    res.relative_residual = res.final_residual / (bnorm > 0 ? bnorm : res.initial_residual);
-    res.converged = res.reason != StopReason::breakdown && rnorm <= target;
-    if (res.converged) res.reason = StopReason::converged;
-    if (it > 0 && res.initial_residual > 0)
-        res.average_rate = std::pow(res.final_residual / res.initial_residual, 1.0 / it);
-    res.solve_seconds = wall_seconds() - t0;
-    return res;
-}
 
 std::vector<Index> vertex_block_starts(const std::vector<int>& vertex_of_dof) {
     std::vector<Index> starts;

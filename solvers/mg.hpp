@@ -17,7 +17,7 @@
 /// and R_k = T_k^T. Every step is linear in r and nothing depends on the iteration, so the cycle
 /// is a fixed linear operator: CGS, BiCGStab and (non-flexible) GMRES all apply. With forward
 /// pre- and backward post-sweeps (nu1 = nu2) and symmetric operators, the cycle is symmetric
-/// too, so it also preconditions CG (`pcg` below) on the elastic block.
+/// too, so it also preconditions CG (`solvers::cg`) on the elastic block.
 ///
 /// Two ways of filling the coarse operators:
 /// - rediscretized: each level's operator is given by `set_operator` (the contact solve: each
@@ -157,13 +157,6 @@ private:
     std::vector<std::shared_ptr<Level>> levels_; ///< coarsest first
     CoarseOperators coarse_operators_ = CoarseOperators::rediscretized;
 };
-
-/// Preconditioned conjugate gradients for a symmetric positive definite A with a symmetric
-/// positive definite preconditioner M: stops when ||b - A x|| <= rel_tol ||b|| (the recursive
-/// residual; the true one is recomputed at exit) or after max_iter iterations. x holds the
-/// initial guess on entry (resized to zero if empty).
-SolveResult pcg(const SparseMatrix& A, const Preconditioner& M, const Vector& b, Vector& x,
-                double rel_tol, int max_iter);
 
 /// The vertex blocks of a dof numbering in which each vertex's unknowns are contiguous:
 /// `vertex_of_dof[i]` is the owner of unknown i; returns the first unknown of each run.

@@ -11,6 +11,7 @@
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/hypre/boomeramg.hpp"
+#include "solvers/krylov.hpp"
 #include "solvers/mg.hpp"
 
 #include <gtest/gtest.h>
@@ -85,7 +86,8 @@ TEST(Multigrid, VCycleIsLevelIndependentAsCGPreconditioner) {
     for (int levels : {1, 2, 3}) {
         ElasticHierarchy e(levels);
         Vector x;
-        const SolveResult r = solvers::pcg(e.K(), e.mg->finest(), e.b, x, 1e-8, 100);
+        const SolveResult r = solvers::cg(MatrixOperator(e.K()), e.mg->finest(), e.b, x,
+                                          solvers::KrylovParams{.rel_tol = 1e-8, .max_iter = 100});
         ASSERT_TRUE(r.converged) << "levels " << levels << ": " << r;
         EXPECT_LE(r.iterations, 16) << "levels " << levels;
         EXPECT_LE(r.relative_residual, 1e-8);
@@ -131,7 +133,8 @@ TEST(BoomerAMG, AsPreconditionerFromTheFactory) {
     amg.set_dof_func(e.blocks.back().component);
     amg.setup(e.K());
     Vector x;
-    const SolveResult r = solvers::pcg(e.K(), amg, e.b, x, 1e-8, 200);
+    const SolveResult r = solvers::cg(MatrixOperator(e.K()), amg, e.b, x,
+                                      solvers::KrylovParams{.rel_tol = 1e-8, .max_iter = 200});
     ASSERT_TRUE(r.converged) << r;
     EXPECT_LE(r.iterations, 30);
     EXPECT_THROW(solvers::make_preconditioner("amg:theta=1.5"), InvalidInput);
