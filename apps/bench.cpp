@@ -207,7 +207,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
        << ",\n  \"krylov\": " << json_string(opt.krylov) << ",\n  \"rel_tol\": " << opt.rel_tol
-       << ",\n  \"repeat\": " << opt.repeat << ",\n  \"runs\": [";
+       << ",\n  \"repeat\": " << opt.repeat
+       << ",\n  \"extrapolate\": " << (opt.extrapolate ? "true" : "false") << ",\n  \"runs\": [";
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
        << base.load_steps << " load steps, Krylov " << opt.krylov << " rel_tol " << opt.rel_tol
        << ", times are medians of " << opt.repeat << " run(s)\n";
@@ -231,6 +232,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         const std::string& pc = opt.pcs[ip];
         levels::SolveOptions so;
         so.coarse_to_fine = true;
+        so.extrapolate = opt.extrapolate;
         if (pc == "schur" || pc == "lu")
             so.linear.method = pc;
         else

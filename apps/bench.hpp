@@ -43,6 +43,9 @@ struct BenchSquareOptions {
     double rel_tol = 1e-8;                 ///< Krylov relative tolerance
     int max_iter = 5000;                   ///< Krylov iterations per Newton step
     int repeat = 1;                        ///< runs per solver; times are medians over them
+    /// Linear load steps taken at the extrapolated state (levels::SolveOptions::extrapolate, the
+    /// run's default); off by default here, so that every load step's Newton is measured.
+    bool extrapolate = false;
     std::filesystem::path out;             ///< JSON file (default out/bench/square_L<L>.json)
     /// STREAM (core/traffic.hpp) array length in doubles, and its repetitions (best taken).
     std::size_t stream_doubles = std::size_t(1) << 25;

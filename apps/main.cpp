@@ -57,6 +57,10 @@ int main(int argc, char** argv) {
     run->add_flag("--no-fallback", ro.no_fallback,
                   "a Newton system the Krylov solve fails on ends the run, instead of being "
                   "solved again by the exact schur solver (the default; reported)");
+    run->add_flag("--no-extrapolation", ro.no_extrapolation,
+                  "every load step starts from the usual guess (coarse-to-fine or the previous "
+                  "step), instead of first trying each level's last two states extrapolated, taken "
+                  "when no status changes over the step (then it is exact: 0 Newton iterations)");
     run->add_flag("--no-continuation", ro.no_continuation,
                   "a load step whose Newton fails at the scene's r ends the run, instead of being "
                   "solved again at r/100 (then r/1e4) with the exact schur solver and finished "
@@ -180,6 +184,9 @@ int main(int argc, char** argv) {
     bsq->add_option("--tol", bso.rel_tol, "Krylov relative tolerance (default 1e-8)");
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
     bsq->add_option("--repeat", bso.repeat, "runs per solver, times are medians (default 1)");
+    bsq->add_flag("--extrapolate", bso.extrapolate,
+                  "take linear load steps at the extrapolated state, as `run` does by default "
+                  "(default here: every step's Newton measured)");
     bsq->add_option("--out,-o", bso_out, "JSON file (default out/bench/<scene>_L<L>.json)");
     bsq->add_option("--stream-doubles", bso.stream_doubles,
                     "STREAM array length in doubles (default 2^25 = 33554432: 256 MiB each)")

@@ -352,7 +352,9 @@ toml::table level_json(int level, std::int64_t unknowns, std::int64_t contact_no
         u.insert("newton_iterations", static_cast<int64_t>(st.report.iterations));
         u.insert("linear_iterations", static_cast<int64_t>(st.report.linear_iterations));
         u.insert("predicted_status_agreement", st.agreement());
-        u.insert("initial_guess", st.predicted ? "interpolated" : "previous step");
+        u.insert("initial_guess", st.predicted      ? "interpolated"
+                                  : st.extrapolated ? "extrapolated"
+                                                    : "previous step");
         u.insert("seconds", st.report.seconds);
         ls.push_back(u);
     }

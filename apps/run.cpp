@@ -47,6 +47,7 @@ levels::SolveOptions run_solve_options(const levels::Problem& p, const RunOption
     choice = levels::choose_solver(p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol},
                                    &so.predicted_sizes);
     so.coarse_to_fine = !opt.cold;
+    so.extrapolate = !opt.no_extrapolation;
     so.linear = choice.spec;
     MLC_CHECK(!opt.no_fallback || choice.spec.method == "krylov",
               "--no-fallback applies to Krylov solves only; the solver of this run is "

@@ -35,6 +35,8 @@ struct RunOptions {
     /// No r continuation (levels::SolveOptions::r_continuation): a load step whose Newton fails
     /// at the scene's r ends the run (exit 2) instead of being solved again through a reduced r.
     bool no_continuation = false;
+    /// No extrapolation of linear load steps (levels::SolveOptions::extrapolate, on by default).
+    bool no_extrapolation = false;
     std::string vtu = "binary"; ///< VTU encoding: binary (zlib, appended) or ascii
     bool every_step = false;    ///< a VTU per load step of the finest level + solution.pvd
     bool every_level = false;   ///< also a VTU series + collection per coarser level

@@ -219,6 +219,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     so.linear = spec;
     so.exact_fallback = !opt.no_fallback;
     so.r_continuation = !opt.no_continuation;
+    so.extrapolate = !opt.no_extrapolation;
     so.progress = opt.quiet ? nullptr : &out;
     MLC_CHECK(!opt.stop, "internal error: a distributed run has no stop flag");
     os << "mlcontact: solving '" << p.name << "' on " << comm.size() << " processes\n";

@@ -623,6 +623,11 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
         u_prev[k] = Vector::Zero(2 * res.levels[k].local.mesh.n_vertices());
     }
     Vector u_prev_p; // level p's (serial) nodal displacements at the previous step
+    // SolveOptions::extrapolate: each distributed level's owned state at the last two steps
+    // (x^0 = 0: the supports never change on several processes, checked above).
+    std::vector<Vector> xo_last(m + 1), xo_older(m + 1);
+    for (size_t k = 1; k <= m; ++k)
+        xo_last[k] = xo_older[k] = Vector::Zero(res.levels[k].n_owned);
     std::atomic<bool> stop{false};
     bool failed = false;
     std::ostream* progress = comm.rank() == 0 ? options.progress : nullptr;
@@ -684,7 +689,21 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
             LevelStep ls;
             ls.level = p + static_cast<int>(k);
             Vector xo(D.n_owned);
-            {
+            // As levels::solve does (SolveOptions::extrapolate): the extrapolated state when
+            // Newton would stop there at once, otherwise the interpolated coarse state.
+            bool extrapolated = false;
+            if (options.extrapolate) {
+                Vector xe = 2.0 * xo_last[k] - xo_older[k];
+                Vector R(xe.size());
+                double scale = 0.0;
+                const double norm = nw.residual(s, u_prev[k], xe, R, nullptr, nullptr, &scale);
+                if (norm <= problem.newton.rel_tol * scale) {
+                    xo = std::move(xe);
+                    extrapolated = true;
+                    ls.extrapolated = true;
+                }
+            }
+            if (!extrapolated) {
                 ScopedTimer t(&res.timings, "newton/interpolate");
                 const auto& T = res.transfers[k - 1].local;
                 Vector uf;
@@ -700,15 +719,20 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
                         xo[d] = q[d];
                     }
             }
-            ls.predicted = true;
-            ls.predicted_statuses = nw.statuses(s, u_prev[k], xo);
+            ls.predicted = !extrapolated;
+            if (ls.predicted) ls.predicted_statuses = nw.statuses(s, u_prev[k], xo);
             ls.report = nw.solve(s, u_prev[k], xo);
             ls.report.step = st.step;
             ls.report.counts = reduce_counts(comm, ls.report.counts);
             ls.final_statuses = nw.statuses(s, u_prev[k], xo);
-            for (size_t e = 0; e < ls.final_statuses.size(); ++e)
-                ++ls.confusion[static_cast<size_t>(ls.predicted_statuses[e])]
-                              [static_cast<size_t>(ls.final_statuses[e])];
+            if (ls.predicted)
+                for (size_t e = 0; e < ls.final_statuses.size(); ++e)
+                    ++ls.confusion[static_cast<size_t>(ls.predicted_statuses[e])]
+                                  [static_cast<size_t>(ls.final_statuses[e])];
+            if (options.extrapolate) {
+                xo_older[k] = std::move(xo_last[k]);
+                xo_last[k] = xo;
+            }
             reduce_confusion(comm, ls.confusion);
             if (progress) {
                 const auto& r = ls.report;

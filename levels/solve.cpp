@@ -291,6 +291,12 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     }
     std::vector<Vector> x_before(
         static_cast<size_t>(n_levels)); // each level's state before its solve
+    // SolveOptions::extrapolate: each level's state two steps back (x^0 = 0; emptied when the
+    // supports change, the states before then being of another set of unknowns).
+    std::vector<Vector> x_older(static_cast<size_t>(n_levels));
+    if (options.extrapolate)
+        for (int l = 0; l < n_levels; ++l)
+            x_older[static_cast<size_t>(l)] = Vector::Zero(x[static_cast<size_t>(l)].size());
     res.level_steps.resize(static_cast<size_t>(n_levels));
     res.converged = true;
     const double t_start = wall_seconds();
@@ -367,6 +373,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             }
             setup_solvers();
             phase_step = step;
+            for (auto& xo : x_older)
+                xo.resize(0);
             for (int l = 0; l < n_levels; ++l) {
                 const size_t li = static_cast<size_t>(l);
                 const Level& L = levels[li];
@@ -390,7 +398,28 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             LevelStep ls;
             ls.level = l;
             if (options.transfer_increment) x_before[li] = x[li]; // step - 1, for the level above
-            if (options.coarse_to_fine && l > first) {
+            // SolveOptions::extrapolate: the level's own state extrapolated from its last two
+            // steps, taken when Newton would stop there at once (the step is then linear: no
+            // status changed); otherwise the usual guess below, as without the option.
+            bool extrapolated = false;
+            if (options.extrapolate) {
+                if (x_older[li].size() == x[li].size()) {
+                    Vector xe = 2.0 * x[li] - x_older[li];
+                    Vector R(xe.size());
+                    double scale = 0.0;
+                    const double norm =
+                        nw.residual(s, u_prev[li], xe, R, nullptr, nullptr, &scale);
+                    x_older[li] = x[li];
+                    if (norm <= problem.newton.rel_tol * scale) {
+                        x[li] = std::move(xe);
+                        extrapolated = true;
+                        ls.extrapolated = true;
+                    }
+                } else {
+                    x_older[li] = x[li];
+                }
+            }
+            if (options.coarse_to_fine && l > first && !extrapolated) {
                 // Initial guess (P u_H, Q lambda_H): displacements through the full nodal vectors
                 // (prescribed values included), multipliers through Q.
                 ScopedTimer t(&res.timings, "newton/interpolate");

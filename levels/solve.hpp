@@ -58,6 +58,14 @@ struct SolveOptions {
     /// two agree in step 1; later, the increment keeps the fine level's own resolution of the
     /// zone ends and interpolates only what changed.
     bool transfer_increment = false;
+    /// Load steps that are linear: in load step k >= 3 (k >= 2 from the unloaded state x^0 = 0
+    /// when the supports never changed), each level first tries its own last two states
+    /// extrapolated, 2 x^(k-1) - x^(k-2) (the load steps are uniform), and takes it when Newton
+    /// would stop there at once (residual within NewtonParams::rel_tol: no status changed over
+    /// the step, so the step is linear and the extrapolation exact to round-off); otherwise the
+    /// guess is the usual one (coarse-to-fine or the previous step), so that no step takes more
+    /// Newton iterations than without it. Costs one residual per level and step.
+    bool extrapolate = false;
     /// How Newton systems are solved on levels >= 1 (level 0 always uses the exact "schur").
     LinearSolverSpec linear;
     /// Solve every level even in cold mode (the status-transfer study compares per level).
@@ -105,6 +113,7 @@ struct LevelStep {
     int level = 0;
     StepReport report;
     bool predicted = false;                          ///< an interpolated initial guess was used
+    bool extrapolated = false; ///< the extrapolated state was taken (SolveOptions::extrapolate)
     std::vector<contact::Status> predicted_statuses; ///< statuses of the initial guess
     std::vector<contact::Status> final_statuses;     ///< Newton (projection) statuses at the end
     Confusion confusion{};                           ///< predicted x final counts

@@ -110,6 +110,7 @@ py::list level_reports(const Result& r) {
         for (const auto& st : r.run.level_steps[l]) {
             py::dict s = step_dict(st.report);
             s["predicted"] = st.predicted;
+            s["extrapolated"] = st.extrapolated;
             s["agreement"] = st.agreement();
             py::array_t<int> conf({4, 4});
             for (int a = 0; a < 4; ++a)
@@ -193,7 +194,7 @@ std::shared_ptr<Result> solve(const Scene& scene, std::optional<int> levels,
                               std::optional<int> load_steps, std::optional<std::string> linear,
                               std::optional<std::string> krylov, std::optional<std::string> pc,
                               std::optional<double> linear_tol, bool cold, bool keep_steps,
-                              bool progress) {
+                              bool progress, bool extrapolate) {
     apps::RunOptions opt;
     opt.levels = levels;
     opt.mu = mu;
@@ -204,6 +205,7 @@ std::shared_ptr<Result> solve(const Scene& scene, std::optional<int> levels,
     opt.pc = pc;
     opt.linear_rel_tol = linear_tol;
     opt.cold = cold;
+    opt.no_extrapolation = !extrapolate;
     if (linear && *linear != "schur" && *linear != "lu" && *linear != "krylov")
         throw InvalidInput("solver must be schur, lu or krylov, found '" + *linear + "'");
     auto res = std::make_shared<Result>();
@@ -793,7 +795,8 @@ PYBIND11_MODULE(_core, m) {
           py::arg("mu") = py::none(), py::arg("r") = py::none(), py::arg("load_steps") = py::none(),
           py::arg("solver") = py::none(), py::arg("krylov") = py::none(),
           py::arg("pc") = py::none(), py::arg("linear_tol") = py::none(), py::arg("cold") = false,
-          py::arg("keep_steps") = false, py::arg("progress") = false);
+          py::arg("keep_steps") = false, py::arg("progress") = false,
+          py::arg("extrapolate") = true);
 
     m.def(
         "study_status_transfer",

@@ -73,14 +73,15 @@ Scene.__setattr__ = _scene_setattr
 
 def solve(scene, *, levels=None, mu=None, r=None, load_steps=None, solver=None, krylov=None,
           pc=None, linear_tol=None, cold=False, keep_steps=False, progress=False,
-          raise_on_failure=True):
+          extrapolate=True, raise_on_failure=True):
     """Solves a Scene as `mlcontact run` does, with the same options and the same numbers.
 
     levels, mu, r, load_steps override the scene's (as --levels, --mu, --r, --steps);
     solver ("schur", "lu", "krylov"), krylov, pc, linear_tol choose the Newton-system solver
     (as --linear, --krylov, --pc, --linear-tol; none: chosen by size); cold=True solves the
     finest level alone (--cold); keep_steps=True keeps every step's state (Result.step_state);
-    progress=True prints the per-step progress lines on stdout.
+    progress=True prints the per-step progress lines on stdout; extrapolate=False starts every
+    load step from the usual guess (--no-extrapolation).
 
     The GIL is released while solving; Ctrl-C raises KeyboardInterrupt within one Newton
     iteration. A step that does not converge raises NotConverged (raise_on_failure=False returns
@@ -98,7 +99,8 @@ def solve(scene, *, levels=None, mu=None, r=None, load_steps=None, solver=None, 
                 raise BadType(f"{name}: {value!r} is not {'an' if kind is int else 'a'} {kind.__name__}")
             value = kind(value)
         options[name] = value
-    result = _core.solve(scene, cold=cold, keep_steps=keep_steps, progress=progress, **options)
+    result = _core.solve(scene, cold=cold, keep_steps=keep_steps, progress=progress,
+                         extrapolate=bool(extrapolate), **options)
     if not result.converged and raise_on_failure:
         raise NotConverged(result.failure, result)
     return result

@@ -184,16 +184,22 @@ def test_reports_and_checks(result):
     assert r.converged and r.failure == "" and r.level == 1
     steps = r.steps
     assert len(steps) == SQUARE_TOML.load_steps
-    for s in steps:
-        assert s["converged"] and s["newton_iterations"] >= 1
+    for k, s in enumerate(steps):
+        # The square's statuses do not change after step 1: steps 2.. are linear, and the
+        # extrapolated state is already converged (SolveOptions::extrapolate).
+        assert s["converged"] and (s["newton_iterations"] >= 1) == (k == 0)
         assert s["residuals"][-1] <= 1e-10 and len(s["residuals"]) == s["newton_iterations"] + 1
         assert sum(s["statuses"].values()) == r.lambda_n.shape[0]
         assert s["seconds"] > 0
     assert [lv["level"] for lv in r.levels] == [0, 1]
     fine = r.levels[1]
     assert fine["contact_nodes"] == r.lambda_n.shape[0]
-    for st in fine["steps"]:
-        assert st["predicted"] and st["confusion"].shape == (4, 4)
+    for k, st in enumerate(fine["steps"]):
+        # Steps 2.. start from the extrapolated state, not from the coarse prediction.
+        assert st["predicted"] == (k == 0) and st["confusion"].shape == (4, 4)
+        if not st["predicted"]:
+            assert st["confusion"].sum() == 0
+            continue
         assert st["confusion"].sum() == fine["contact_nodes"]
         assert 0 <= st["agreement"] <= 1
         assert st["agreement"] == pytest.approx(np.trace(st["confusion"]) / fine["contact_nodes"])
@@ -281,3 +287,13 @@ def test_status_transfer_study_tables(tmp):
     assert os.path.exists(tmp / "st" / "statuses.csv")
     with pytest.raises(ValueError, match="q_rule must be"):
         mlcontact.study_status_transfer(square(), levels=1, q_rule="nope")
+
+
+def test_extrapolation_off_solves_every_step_by_newton_to_the_same_state(result):
+    plain = mlcontact.solve(square(), levels=1, extrapolate=False)
+    assert all(s["newton_iterations"] >= 1 for s in plain.steps)
+    assert result.steps[0]["newton_iterations"] == plain.steps[0]["newton_iterations"]
+    assert sum(s["newton_iterations"] for s in result.steps[1:]) == 0
+    scale = np.abs(plain.displacement).max()
+    assert np.abs(result.displacement - plain.displacement).max() <= 1e-12 * scale
+    assert np.abs(result.lambda_n - plain.lambda_n).max() <= 1e-9 * np.abs(plain.lambda_n).max()

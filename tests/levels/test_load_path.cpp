@@ -70,3 +70,56 @@ TEST(LoadPath, LoadFactorsScaleTractionsPerStep) {
     ASSERT_TRUE(r.converged) << r.failure;
     EXPECT_LT(levels::force_balance_error(r.finest(), 1.0, r.u_full, r.nodes), 1e-12);
 }
+
+namespace {
+levels::RunResult solve_with(levels::Problem p, int levels_, int steps, bool extrapolate) {
+    p.levels = levels_;
+    p.load_steps = steps;
+    levels::SolveOptions so;
+    so.extrapolate = extrapolate;
+    return levels::solve(p, so);
+}
+double relative_difference(const Vector& a, const Vector& b) {
+    return (a - b).norm() / b.norm();
+}
+} // namespace
+
+TEST(Extrapolation, LinearLoadStepsAreTakenWithoutANewtonIteration) {
+    // The square's statuses are those of step 1 in every later step (proportional loading):
+    // each later step is linear, so 2 x^(k-1) - x^(k-2) is its solution to round-off.
+    const auto p = scene::load_scene("square");
+    const auto plain = solve_with(p, 2, 5, false);
+    const auto extra = solve_with(p, 2, 5, true);
+    ASSERT_TRUE(plain.converged && extra.converged);
+    for (int l = 0; l <= 2; ++l)
+        for (int k = 0; k < 5; ++k) {
+            const auto& a = plain.level_steps[l][k].report;
+            const auto& b = extra.level_steps[l][k].report;
+            EXPECT_GE(a.iterations, 1) << "level " << l << " step " << k + 1;
+            // Step 1 as without; steps 2.. converged at the extrapolated state.
+            EXPECT_EQ(b.iterations, k == 0 ? a.iterations : 0) << "level " << l << " step " << k + 1;
+            EXPECT_TRUE(b.converged);
+            EXPECT_LE(b.residuals.back(), 1e-10);
+        }
+    EXPECT_LT(relative_difference(extra.x, plain.x), 1e-9);
+    EXPECT_LT(relative_difference(extra.u_full, plain.u_full), 1e-12);
+}
+
+TEST(Extrapolation, StepsWhoseStatusesChangeStartFromTheUsualGuess) {
+    // hertz in 4 steps: the contact zone grows with the load, so statuses change in every step
+    // and the extrapolated state is not converged: each step takes the iterations it takes
+    // without the option, from the same guess, and ends at the same state.
+    const auto p = scene::load_scene("hertz");
+    const auto plain = solve_with(p, 1, 4, false);
+    const auto extra = solve_with(p, 1, 4, true);
+    ASSERT_TRUE(plain.converged && extra.converged);
+    for (int l = 0; l <= 1; ++l)
+        for (int k = 0; k < 4; ++k) {
+            // Level 0 starts from the previous step: its statuses change over every step.
+            if (l == 0) EXPECT_GE(plain.level_steps[l][k].report.iterations, 2);
+            EXPECT_EQ(extra.level_steps[l][k].report.iterations,
+                      plain.level_steps[l][k].report.iterations)
+                << "level " << l << " step " << k + 1;
+        }
+    EXPECT_EQ(extra.x, plain.x);
+}
