@@ -188,7 +188,7 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
        << std::left << std::setw(26) << "configuration" << std::right << std::setw(6) << "level"
        << std::setw(10) << "unknowns" << std::setw(10) << "seconds" << std::setw(13) << "energy err"
        << std::setw(14) << "traction err";
-    if (problem.name == "hertz") os << std::setw(14) << "vs closed form";
+    if (problem.name == "hertz") os << std::setw(14) << "closed form";
     os << std::setw(8) << "newton" << std::setw(9) << "krylov"
        << "\n";
     for (const auto& c : configurations()) {
