@@ -162,6 +162,16 @@ void Multigrid::set_coarse_solver(std::unique_ptr<Preconditioner> coarse) {
 
 void Multigrid::set_galerkin_operators(const SparseMatrix& A) {
     // A_{k-1} = R_k A_k T_k from the finest down; then the levels set up from level 0 up.
+    if (galerkin_values_.empty()) {
+        // Once: is R = T^T on every level (then update_values may refresh incrementally)?
+        galerkin_symmetric_ = true;
+        for (size_t k = levels_.size() - 1; k >= 1 && galerkin_symmetric_; --k) {
+            const Level& L = *levels_[k];
+            const SparseMatrix Tt = L.T->transpose();
+            galerkin_symmetric_ = Tt.nonZeros() == L.R->nonZeros() && (Tt - *L.R).norm() == 0.0;
+        }
+    }
+    galerkin_values_.assign(A.valuePtr(), A.valuePtr() + A.nonZeros());
     const SparseMatrix* Ak = &A;
     for (size_t k = levels_.size() - 1; k >= 1; --k) {
         const Level& L = *levels_[k];
@@ -180,8 +190,76 @@ void Multigrid::setup(const SparseMatrix& A) {
     levels_.back()->set(A, true);
 }
 
+namespace {
+/// One changed entry of an operator: row, column, change.
+struct Change {
+    Index i, j;
+    double d;
+};
+} // namespace
+
+// Adds R_k (A_k - A_k,last) T_k into each coarse operator, finest down; false (the caller forms
+// the products) when R is not T^T, A's pattern is not the one of the last products, more than a
+// tenth of its entries changed, or a coarse entry is missing from the stored pattern.
+bool Multigrid::refresh_galerkin_operators(const SparseMatrix& A) {
+    if (!galerkin_symmetric_ || A.nonZeros() != static_cast<Index>(galerkin_values_.size()) ||
+        !A.isCompressed())
+        return false;
+    for (size_t k = 0; k + 1 < levels_.size(); ++k)
+        if (!levels_[k]->A) return false;
+    std::vector<Change> d;
+    const double* v = A.valuePtr();
+    for (Index i = 0; i < A.outerSize(); ++i)
+        for (Index p = A.outerIndexPtr()[i]; p < A.outerIndexPtr()[i + 1]; ++p)
+            if (v[p] != galerkin_values_[static_cast<size_t>(p)]) {
+                d.push_back(
+                    {i, A.innerIndexPtr()[p], v[p] - galerkin_values_[static_cast<size_t>(p)]});
+                if (d.size() * 10 > galerkin_values_.size()) return false;
+            }
+    // Level by level: D_{k-1} = T_k^T D_k T_k, added into the stored coarse operator (whose
+    // pattern holds it: the pattern of R A T contains that of R D T when D's is within A's).
+    std::vector<std::vector<Change>> per_level(levels_.size());
+    per_level.back() = std::move(d);
+    for (size_t k = levels_.size() - 1; k >= 1; --k) {
+        const SparseMatrix& T = *levels_[k]->T;
+        std::vector<Change> c;
+        for (const Change& e : per_level[k])
+            for (SparseMatrix::InnerIterator a(T, e.i); a; ++a)
+                for (SparseMatrix::InnerIterator b(T, e.j); b; ++b)
+                    c.push_back({a.col(), b.col(), a.value() * e.d * b.value()});
+        std::sort(c.begin(), c.end(), [](const Change& x, const Change& y) {
+            return x.i != y.i ? x.i < y.i : x.j < y.j;
+        });
+        std::vector<Change> merged;
+        for (const Change& e : c)
+            if (!merged.empty() && merged.back().i == e.i && merged.back().j == e.j)
+                merged.back().d += e.d;
+            else
+                merged.push_back(e);
+        // Check first that every entry exists (no insertion into a compressed matrix).
+        SparseMatrix& B = levels_[k - 1]->owned;
+        std::vector<Index> where(merged.size());
+        for (size_t q = 0; q < merged.size(); ++q) {
+            const int* b = B.innerIndexPtr() + B.outerIndexPtr()[merged[q].i];
+            const int* e = B.innerIndexPtr() + B.outerIndexPtr()[merged[q].i + 1];
+            const int* f = std::lower_bound(b, e, static_cast<int>(merged[q].j));
+            if (f == e || *f != merged[q].j) return false;
+            where[q] = f - B.innerIndexPtr();
+        }
+        for (size_t q = 0; q < merged.size(); ++q)
+            B.valuePtr()[where[q]] += merged[q].d;
+        per_level[k - 1] = std::move(merged);
+    }
+    galerkin_values_.assign(A.valuePtr(), A.valuePtr() + A.nonZeros());
+    for (size_t k = 0; k + 1 < levels_.size(); ++k)
+        levels_[k]->set(levels_[k]->owned, false);
+    ++galerkin_refreshes_;
+    return true;
+}
+
 void Multigrid::update_values(const SparseMatrix& A) {
-    if (coarse_operators_ == CoarseOperators::galerkin) set_galerkin_operators(A);
+    if (coarse_operators_ == CoarseOperators::galerkin && !refresh_galerkin_operators(A))
+        set_galerkin_operators(A);
     levels_.back()->set(A, false);
 }
 

@@ -137,7 +137,11 @@ public:
     /// The finest level's operator (borrowed until the next setup). With Galerkin coarse
     /// operators, also computes and sets up every coarser level.
     void setup(const SparseMatrix& A) override;
-    /// Same as setup, reusing the finest smoother's structure.
+    /// Same as setup, reusing the structure of every level. With Galerkin coarse operators and
+    /// R = T^T on every level, when at most a tenth of A's stored entries changed since the last
+    /// products (a Newton Jacobian whose contact rows changed), each coarse operator is
+    /// refreshed by adding R_k (A_k - A_k,last) T_k instead of forming R A T again (equal up to
+    /// round-off).
     void update_values(const SparseMatrix& A) override;
     /// One V-cycle from the finest level.
     void apply(const Vector& r, Vector& z) const override;
@@ -148,14 +152,24 @@ public:
     /// Levels, sizes, complexities, smoother and coarse solve (operators must be set).
     MultigridReport report() const;
 
+    /// How many update_values calls refreshed the Galerkin operators incrementally.
+    int galerkin_refreshes() const { return galerkin_refreshes_; }
+
 private:
     struct Level;
     Multigrid() = default;
     void cycle(int k, const Vector& r, Vector& z) const;
     void set_galerkin_operators(const SparseMatrix& A);
+    bool refresh_galerkin_operators(const SparseMatrix& A);
 
     std::vector<std::shared_ptr<Level>> levels_; ///< coarsest first
     CoarseOperators coarse_operators_ = CoarseOperators::rediscretized;
+    /// Galerkin: the finest operator's values at the last products (update_values then adds
+    /// R (A - A_last) T level by level when few entries changed), and whether every level's R
+    /// is T^T (the refresh reads T alone).
+    std::vector<double> galerkin_values_;
+    bool galerkin_symmetric_ = false;
+    int galerkin_refreshes_ = 0;
 };
 
 /// The vertex blocks of a dof numbering in which each vertex's unknowns are contiguous:

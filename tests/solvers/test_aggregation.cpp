@@ -188,3 +188,50 @@ TEST(Aggregation, BadInputIsRejected) {
     EXPECT_THROW(solvers::aggregate_once(s.in, {.smoothing = 2.0}), InvalidInput);
     EXPECT_THROW(solvers::aggregate_once(s.in, {.max_levels = 1}), InvalidInput);
 }
+
+TEST(Aggregation, GalerkinRefreshOfChangedRowsIsTheFullProduct) {
+    // A Newton Jacobian changes in its contact rows only: update_values adds T^T (A2 - A) T
+    // level by level instead of forming T^T A2 T again. The cycle equals a multigrid set up on
+    // A2 from scratch to round-off; a change of most entries takes the full products instead.
+    const SquareLevel s(3);
+    const auto levels = solvers::aggregation_levels(s.in, {.coarse_size = 300});
+    ASSERT_GE(levels.size(), 3u);
+    SparseMatrix A = *s.in.K;
+    for (Index i = 0; i < A.rows(); ++i)
+        if (solvers::is_multiplier(s.in.kind[static_cast<size_t>(i)])) A.coeffRef(i, i) = -1.0;
+    A.makeCompressed();
+    // A2: the multiplier rows and the first 60 displacement rows changed (within A's pattern).
+    SparseMatrix A2 = A;
+    int changed = 0;
+    for (Index i = 0; i < A2.rows(); ++i) {
+        const bool mult = solvers::is_multiplier(s.in.kind[static_cast<size_t>(i)]);
+        if (!mult && i >= 60) continue;
+        for (SparseMatrix::InnerIterator it(A2, i); it; ++it) {
+            it.valueRef() *= mult ? 0.5 : 1.1;
+            ++changed;
+        }
+    }
+    ASSERT_GT(changed, 60);
+    ASSERT_LT(10 * changed, A.nonZeros());
+    solvers::Multigrid refreshed(levels, {}, solvers::CoarseOperators::galerkin);
+    refreshed.setup(A);
+    refreshed.update_values(A2);
+    EXPECT_EQ(refreshed.galerkin_refreshes(), 1);
+    solvers::Multigrid fresh(levels, {}, solvers::CoarseOperators::galerkin);
+    fresh.setup(A2);
+    const Vector r = Vector::LinSpaced(A.rows(), -1.0, 2.0).array().sin();
+    Vector z1, z2;
+    refreshed.apply(r, z1);
+    fresh.apply(r, z2);
+    EXPECT_LT((z1 - z2).norm(), 1e-11 * z2.norm());
+    // Back to A (a second refresh), then every entry scaled: the full products, bit for bit.
+    refreshed.update_values(A);
+    EXPECT_EQ(refreshed.galerkin_refreshes(), 2);
+    const SparseMatrix A3 = 2.0 * A2;
+    refreshed.update_values(A3);
+    EXPECT_EQ(refreshed.galerkin_refreshes(), 2);
+    fresh.update_values(A3);
+    refreshed.apply(r, z1);
+    fresh.apply(r, z2);
+    EXPECT_EQ(z1, z2);
+}
