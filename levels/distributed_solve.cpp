@@ -694,11 +694,10 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
             bool extrapolated = false;
             if (options.extrapolate) {
                 Vector xe = 2.0 * xo_last[k] - xo_older[k];
-                Vector R(xe.size());
-                double scale = 0.0;
-                const double norm = nw.residual(s, u_prev[k], xe, R, nullptr, nullptr, &scale);
-                if (norm <= problem.newton.rel_tol * scale) {
+                StepReport r = nw.check(s, u_prev[k], xe);
+                if (r.converged) {
                     xo = std::move(xe);
+                    ls.report = std::move(r);
                     extrapolated = true;
                     ls.extrapolated = true;
                 }
@@ -721,7 +720,7 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
             }
             ls.predicted = !extrapolated;
             if (ls.predicted) ls.predicted_statuses = nw.statuses(s, u_prev[k], xo);
-            ls.report = nw.solve(s, u_prev[k], xo);
+            if (!extrapolated) ls.report = nw.solve(s, u_prev[k], xo);
             ls.report.step = st.step;
             ls.report.counts = reduce_counts(comm, ls.report.counts);
             ls.final_statuses = nw.statuses(s, u_prev[k], xo);

@@ -132,6 +132,14 @@ double ContactNewton::forcing_term(int k, double norm, double scale) const {
 }
 
 StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) {
+    return solve(s, u_prev_full, x, params_.max_iter);
+}
+
+StepReport ContactNewton::check(double s, const Vector& u_prev_full, Vector& x) {
+    return solve(s, u_prev_full, x, 0);
+}
+
+StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x, int max_iter) {
     const double t_start = wall_seconds();
     StepReport rep;
     rep.load_factor = s;
@@ -199,9 +207,9 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) 
             rep.message = os.str();
             break;
         }
-        if (k == params_.max_iter) {
+        if (k == max_iter) {
             std::ostringstream os;
-            os << "no convergence in " << params_.max_iter << " Newton iterations; relative "
+            os << "no convergence in " << max_iter << " Newton iterations; relative "
                << "residual went " << rep.residuals.front() << " -> " << rel << " (tolerance "
                << params_.rel_tol << "), " << changes << " status changes in the last iteration";
             if (rep.cycling_detected_at >= 0)

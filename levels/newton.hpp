@@ -99,6 +99,11 @@ public:
     /// converged step). Never throws for non-convergence: see StepReport::converged/message.
     StepReport solve(double s, const Vector& u_prev_full, Vector& x);
 
+    /// solve() allowed no iteration: converged when x already passes the convergence test (the
+    /// report is then the one solve would return, 0 iterations); otherwise not converged, x
+    /// unchanged and no Newton system solved.
+    StepReport check(double s, const Vector& u_prev_full, Vector& x);
+
     /// Statuses the projection gives at (x, u_prev) for load factor s (the Newton statuses).
     std::vector<contact::Status> statuses(double s, const Vector& u_prev_full,
                                           const Vector& x) const;
@@ -145,6 +150,7 @@ public:
     void set_interrupt(std::function<bool()> requested) { interrupt_ = std::move(requested); }
 
 private:
+    StepReport solve(double s, const Vector& u_prev_full, Vector& x, int max_iter);
     const Level& level_;
     NewtonParams params_;
     std::unique_ptr<NewtonSystemSolver> solver_;

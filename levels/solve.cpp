@@ -405,13 +405,11 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             if (options.extrapolate) {
                 if (x_older[li].size() == x[li].size()) {
                     Vector xe = 2.0 * x[li] - x_older[li];
-                    Vector R(xe.size());
-                    double scale = 0.0;
-                    const double norm =
-                        nw.residual(s, u_prev[li], xe, R, nullptr, nullptr, &scale);
                     x_older[li] = x[li];
-                    if (norm <= problem.newton.rel_tol * scale) {
+                    StepReport r = nw.check(s, u_prev[li], xe);
+                    if (r.converged) {
                         x[li] = std::move(xe);
+                        ls.report = std::move(r);
                         extrapolated = true;
                         ls.extrapolated = true;
                     }
@@ -446,7 +444,9 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             }
             try {
                 const Vector x0 = options.r_continuation ? x[li] : Vector();
-                if (continued[li] > 0) {
+                if (extrapolated) {
+                    // ls.report is check()'s: converged at the extrapolated state.
+                } else if (continued[li] > 0) {
                     // Newton at r failed on this level in an earlier step: straight to the
                     // continuation (a failed attempt at r would only cost).
                     ls.report = StepReport{};
