@@ -497,12 +497,12 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
                 const solvers::MultigridReport& m = *r.multigrid;
                 toml::table mg;
                 toml::array rows;
-                for (const auto& lv : m.levels) {
+                for (const auto& ml : m.levels) {
                     toml::table row;
-                    row.insert("level", lv.level);
-                    row.insert("rows", static_cast<int64_t>(lv.rows));
-                    row.insert("nonzeros", static_cast<int64_t>(lv.nonzeros));
-                    row.insert("solve", lv.solve);
+                    row.insert("level", ml.level);
+                    row.insert("rows", static_cast<int64_t>(ml.rows));
+                    row.insert("nonzeros", static_cast<int64_t>(ml.nonzeros));
+                    row.insert("solve", ml.solve);
                     rows.push_back(std::move(row));
                 }
                 mg.insert("levels", std::move(rows));

@@ -52,6 +52,12 @@ inline double row_dot(const int* inner, const Value* val, const double* x, int k
 void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = false,
                   traffic::Kind kind = traffic::Kind::matvec);
 
+/// y = A x for a compressed CSR matrix, each row summed in storage order with one accumulator:
+/// bit for bit Eigen's serial `y = A * x`, but with the rows split as in csr_multiply over
+/// core/parallel's threads. Counts no traffic (MatrixOperator's `in_order` kernel counts its own
+/// pass; the Newton residual is outside the linear solves the bandwidth account covers).
+void csr_multiply_in_order(const SparseMatrix& A, const Vector& x, Vector& y);
+
 /// Precision in which a preconditioner stores its matrix data (values, block inverses, transfers);
 /// its vectors and the Krylov method stay double either way.
 enum class Precision {

@@ -27,7 +27,8 @@ public:
 
 /// How `MatrixOperator` sums each row of y = A x.
 enum class MatVec {
-    /// Eigen's product `A * x`: every row summed in storage order with one accumulator. The
+    /// Eigen's product `A * x`: every row summed in storage order with one accumulator (rows
+    /// over core/parallel's threads, `csr_multiply_in_order`, for a compressed A). The
     /// default, so that the iteration counts published for the papers' preconditioners (DIAG,
     /// ILU, CF, SORCF, EBE, SOR) stay bit-for-bit reproducible.
     in_order,

@@ -166,7 +166,7 @@ struct DistributedMultigrid::Impl {
         for (size_t e = 0; e < D.local.contacts.size(); ++e) {
             smoothers::ElementMatrix& el = o.elements[o.n_elastic + e];
             contact_element_matrix(D.local, e, M[e], el);
-            for (const int d : el.dofs)
+            for ([[maybe_unused]] const int d : el.dofs)
                 MLC_ASSERT(d < D.n_owned, "a contact element outside the owned unknowns");
         }
     }

@@ -3,6 +3,7 @@
 #include "levels/newton.hpp"
 
 #include "core/check.hpp"
+#include "core/csr.hpp"
 
 #include <algorithm>
 #include <array>
@@ -65,7 +66,7 @@ double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector
     if (dist_.comm)
         dist_.K->apply(x, R);
     else
-        R.noalias() = L.elastic.K * x;
+        csr_multiply_in_order(L.elastic.K, x, R); // Eigen's K * x, bit for bit, row-parallel
     double internal2 = R.squaredNorm();
     const Vector f = dist_.comm ? Vector(L.f_at(s).head(x.size())) : L.f_at(s);
     R -= f;

@@ -3,6 +3,7 @@
 #include "levels/newton_system.hpp"
 
 #include "core/check.hpp"
+#include "core/parallel.hpp"
 #include "core/timer.hpp"
 #include "levels/krylov_system.hpp"
 #include "solvers/cholesky.hpp"
@@ -15,46 +16,131 @@ namespace mlc::levels {
 
 // ---------------------------------------------------------------------------------------------
 JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
+    // J's pattern is K's plus the contact tangent entries: each row of J is K's row merged with
+    // that row's contact columns, written straight into CSR (triplets and setFromTriplets took
+    // 16 bytes per entry, a column-major copy and a sort: about 1 s and 0.8 GB at level 6).
     const SparseMatrix& K = level.elastic.K;
     const Index n = level.n_unknowns();
-    std::vector<Triplet> trip;
-    trip.reserve(static_cast<size_t>(K.nonZeros()) + 16 * level.contacts.size());
-    for (int i = 0; i < K.outerSize(); ++i)
-        for (SparseMatrix::InnerIterator it(K, i); it; ++it)
-            trip.emplace_back(i, it.col(), 0.0);
+    MLC_ASSERT(K.isCompressed() && K.rows() <= n, "K must be compressed, at most n rows");
     std::vector<std::pair<int, int>> centries;
     const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
     for (size_t e = 0; e < level.contacts.size(); ++e)
         contact::for_each_tangent_entry(level.contacts[e], I, level.dofs, level.lambda_dof[e],
                                         [&](int row, int col, double) {
-                                            trip.emplace_back(row, col, 0.0);
                                             centries.emplace_back(row, col);
                                         });
+    std::vector<std::pair<int, int>> extra = centries;
+    std::sort(extra.begin(), extra.end());
+    extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
+    const int* ko = K.outerIndexPtr();
+    const int* ki = K.innerIndexPtr();
+    const Index kr = K.rows();
+    auto in_k = [&](int row, int col) {
+        if (row >= kr) return false;
+        return std::binary_search(ki + ko[row], ki + ko[row + 1], col);
+    };
+    extra.erase(std::remove_if(extra.begin(), extra.end(),
+                               [&](const auto& rc) { return in_k(rc.first, rc.second); }),
+                extra.end());
+    // Rows with new columns; every other row is K's row at a shifted offset.
     J_.resize(n, n);
-    J_.setFromTriplets(trip.begin(), trip.end());
-    J_.makeCompressed();
+    int* jo = J_.outerIndexPtr();
+    jo[0] = 0;
+    size_t x = 0;
+    for (Index i = 0; i < n; ++i) {
+        int cnt = i < kr ? ko[i + 1] - ko[i] : 0;
+        const size_t x0 = x;
+        while (x < extra.size() && extra[x].first == i)
+            ++x;
+        cnt += static_cast<int>(x - x0);
+        if (x > x0) merged_rows_.push_back(static_cast<int>(i));
+        jo[i + 1] = jo[i] + cnt;
+    }
+    J_.resizeNonZeros(jo[n]);
+    int* ji = J_.innerIndexPtr();
+    double* jv = J_.valuePtr();
+    parallel::for_rows(static_cast<size_t>(n), 4096, [&](size_t b, size_t e) {
+        std::fill(jv + jo[b], jv + jo[e], 0.0);
+        for (size_t i = b; i < std::min(e, static_cast<size_t>(kr)); ++i)
+            std::copy(ki + ko[i], ki + ko[i + 1], ji + jo[i]);
+    });
+    x = 0;
+    for (int i : merged_rows_) {
+        kpos_start_.push_back(kpos_.size());
+        while (extra[x].first < i)
+            ++x;
+        const int* kb = i < kr ? ki + ko[i] : nullptr;
+        const int* ke = i < kr ? ki + ko[i + 1] : nullptr;
+        int* out = ji + jo[i];
+        size_t xe = x;
+        while (xe < extra.size() && extra[xe].first == i)
+            ++xe;
+        for (size_t y = x; kb != ke || y < xe;) {
+            if (y == xe || (kb != ke && *kb < extra[y].second)) {
+                kpos_.push_back(static_cast<int>(out - ji));
+                *out++ = *kb++;
+            } else {
+                *out++ = extra[y++].second;
+            }
+        }
+        x = xe;
+    }
     auto position = [&](int row, int col) {
-        const int* begin = J_.innerIndexPtr() + J_.outerIndexPtr()[row];
-        const int* end = J_.innerIndexPtr() + J_.outerIndexPtr()[row + 1];
+        const int* begin = ji + jo[row];
+        const int* end = ji + jo[row + 1];
         const int* it = std::lower_bound(begin, end, col);
         MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
-        return static_cast<int>(it - J_.innerIndexPtr());
+        return static_cast<int>(it - ji);
     };
-    kpos_.reserve(static_cast<size_t>(K.nonZeros()));
-    for (int i = 0; i < K.outerSize(); ++i)
-        for (SparseMatrix::InnerIterator it(K, i); it; ++it)
-            kpos_.push_back(position(i, it.col()));
     cpos_.reserve(centries.size());
-    for (auto [r, c] : centries)
+    for (auto [r, c] : centries) {
         cpos_.push_back(position(r, c));
+        contact_rows_.push_back(r);
+    }
+    std::sort(contact_rows_.begin(), contact_rows_.end());
+    contact_rows_.erase(std::unique(contact_rows_.begin(), contact_rows_.end()),
+                        contact_rows_.end());
+}
+
+void JacobianAssembler::reset_row(int i) {
+    // Row i of J back to K's row i (zero in the columns only contact has).
+    const SparseMatrix& K = level_.elastic.K;
+    const int* ko = K.outerIndexPtr();
+    const double* kv = K.valuePtr();
+    double* v = J_.valuePtr();
+    const int* jo = J_.outerIndexPtr();
+    const bool has_k = i < K.rows();
+    const auto m = std::lower_bound(merged_rows_.begin(), merged_rows_.end(), i);
+    if (m == merged_rows_.end() || *m != i) {
+        if (has_k) std::copy(kv + ko[i], kv + ko[i + 1], v + jo[i]);
+        return;
+    }
+    std::fill(v + jo[i], v + jo[i + 1], 0.0);
+    if (!has_k) return;
+    const int* kp = kpos_.data() + kpos_start_[static_cast<size_t>(m - merged_rows_.begin())];
+    for (int p = ko[i]; p < ko[i + 1]; ++p)
+        v[*kp++] = kv[p];
 }
 
 void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
+    // K's values are copied once; afterwards only the rows holding contact entries are reset.
     double* v = J_.valuePtr();
-    std::fill(v, v + J_.nonZeros(), 0.0);
-    const double* kv = level_.elastic.K.valuePtr();
-    for (size_t k = 0; k < kpos_.size(); ++k)
-        v[kpos_[k]] += kv[k];
+    if (!k_copied_) {
+        const SparseMatrix& K = level_.elastic.K;
+        const int* ko = K.outerIndexPtr();
+        const int* jo = J_.outerIndexPtr();
+        const double* kv = K.valuePtr();
+        parallel::for_rows(static_cast<size_t>(K.rows()), 4096, [&](size_t b, size_t e) {
+            for (size_t i = b; i < e; ++i)
+                std::copy(kv + ko[i], kv + ko[i + 1], v + jo[i]);
+        });
+        for (int i : merged_rows_)
+            reset_row(i);
+        k_copied_ = true;
+    } else {
+        for (int i : contact_rows_)
+            reset_row(i);
+    }
     size_t c = 0;
     for (size_t e = 0; e < level_.contacts.size(); ++e)
         contact::for_each_tangent_entry(level_.contacts[e], M[e], level_.dofs, level_.lambda_dof[e],

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 namespace mlc {
@@ -63,6 +64,27 @@ TEST(RowDot, UsesFourAccumulatorsInAFixedOrder) {
         in_order += val[k] * x[inner[k]];
     EXPECT_EQ(in_order, 3.0);
     EXPECT_EQ(row_dot(inner, val, x, 2, 2), 0.0);
+}
+
+TEST(CsrMultiplyInOrder, IsEigensSerialProductBitForBitOnEveryChunk) {
+    // Rows over several chunks (and threads): each row still summed as Eigen sums it. Values
+    // spread over 12 orders of magnitude, so that another summation order shows in the last bits.
+    const Index n = 3 * kMinRowsPerThread + 11;
+    SparseMatrix A = random_matrix(n, 17, 9);
+    std::mt19937 gen(4);
+    std::uniform_int_distribution<int> e(-6, 6);
+    for (Index k = 0; k < A.nonZeros(); ++k)
+        A.valuePtr()[k] *= std::pow(10.0, e(gen));
+    const Vector x = Vector::Random(n);
+    Vector y;
+    csr_multiply_in_order(A, x, y);
+    const Vector ref = A * x;
+    ASSERT_EQ(y.size(), n);
+    EXPECT_EQ((y - ref).cwiseAbs().maxCoeff(), 0.0);
+    Vector u;
+    csr_multiply(A, x, u); // four accumulators: not the same sums
+    EXPECT_GT((u - ref).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_THROW(csr_multiply_in_order(A, Vector::Ones(n - 1), y), InvalidInput);
 }
 
 TEST(MatrixOperator, InOrderIsEigensProductBitForBitAndUnrolledIsCsrMultiply) {

@@ -2,6 +2,7 @@
 // Krylov Newton-system solvers with the papers' preconditioners on two levels of the square:
 // one fine Newton system of the multilevel Newton, solved by CGS with ILU(0), CF, SORCF and EBE,
 // against the exact condensed ("schur") solve.
+#include "contact/element.hpp"
 #include "core/check.hpp"
 #include "levels/hierarchy.hpp"
 #include "levels/krylov_system.hpp"
@@ -147,6 +148,46 @@ TEST(KrylovSystem, ElementMatricesSumToTheJacobian) {
     S.setFromTriplets(trip.begin(), trip.end());
     const SparseMatrix D = S - t.J->matrix();
     EXPECT_LT(D.norm(), 1e-12 * t.J->matrix().norm());
+}
+
+TEST(JacobianAssembler, IsKPlusTheContactTangentsAndReassemblesInPlace) {
+    // The pattern is merged row by row from K's and the contact entries' (multiplier rows and
+    // the contact nodes' displacement rows gain columns K lacks); the values are K's plus the
+    // tangents at the given statuses. Reassembling at other statuses resets exactly the rows
+    // contact touches: the result equals a fresh assembler's, bit for bit.
+    TwoLevels& t = two_levels();
+    const Level& L = t.fine;
+    std::vector<Triplet> trip;
+    const SparseMatrix& K = L.elastic.K;
+    for (int i = 0; i < K.outerSize(); ++i)
+        for (SparseMatrix::InnerIterator it(K, i); it; ++it)
+            trip.emplace_back(i, static_cast<int>(it.col()), it.value());
+    for (size_t e = 0; e < L.contacts.size(); ++e)
+        contact::for_each_tangent_entry(L.contacts[e], t.fine_M[e], L.dofs, L.lambda_dof[e],
+                                        [&](int r, int c, double v) { trip.emplace_back(r, c, v); });
+    SparseMatrix ref(L.n_unknowns(), L.n_unknowns());
+    ref.setFromTriplets(trip.begin(), trip.end());
+    ASSERT_GT(ref.nonZeros(), K.nonZeros()); // contact adds entries outside K's pattern
+
+    JacobianAssembler a(L);
+    a.assemble(std::vector<Eigen::Matrix2d>(L.contacts.size(), Eigen::Matrix2d::Identity()));
+    a.assemble(std::vector<Eigen::Matrix2d>(L.contacts.size(), Eigen::Matrix2d::Zero()));
+    a.assemble(t.fine_M);
+    const SparseMatrix& J = a.matrix();
+    ASSERT_EQ(J.nonZeros(), ref.nonZeros());
+    for (Index i = 0; i <= J.rows(); ++i)
+        ASSERT_EQ(J.outerIndexPtr()[i], ref.outerIndexPtr()[i]) << i;
+    for (Index k = 0; k < J.nonZeros(); ++k)
+        ASSERT_EQ(J.innerIndexPtr()[k], ref.innerIndexPtr()[k]) << k;
+    const SparseMatrix D = J - ref;
+    const double kmax = Eigen::Map<const Vector>(K.valuePtr(), K.nonZeros()).cwiseAbs().maxCoeff();
+    EXPECT_LE(Eigen::Map<const Vector>(D.valuePtr(), D.nonZeros()).cwiseAbs().maxCoeff(),
+              1e-14 * kmax);
+
+    JacobianAssembler fresh(L);
+    fresh.assemble(t.fine_M);
+    for (Index k = 0; k < J.nonZeros(); ++k)
+        ASSERT_EQ(J.valuePtr()[k], fresh.matrix().valuePtr()[k]) << k;
 }
 
 TEST(KrylovSystem, ElementsRestrictedToTheFirstUnknownsSumToTheLeadingBlock) {
