@@ -3,6 +3,7 @@
 #include "fem/assembly.hpp"
 
 #include "core/check.hpp"
+#include "core/parallel.hpp"
 
 #include <algorithm>
 
@@ -64,38 +65,53 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
 
     // The pattern, straight into CSR: vertex w's free components are in the row of each free
     // component of v when v and w share a triangle. (Triplets and setFromTriplets took 36 x 16
-    // bytes per triangle, 2.4 GB at level 6 of the square, and a sort.)
-    std::vector<int> adj_start(static_cast<size_t>(nv) + 1, 0);
+    // bytes per triangle, 2.4 GB at level 6 of the square, and a sort.) Each vertex's rows are
+    // written by one thread: the loops over vertices below run over core/parallel's threads.
+    const int nt = m.n_triangles();
+    std::vector<int> vt_start(static_cast<size_t>(nv) + 1, 0); // triangles of each vertex
     for (const auto& tri : m.triangles)
         for (int v : tri)
-            adj_start[static_cast<size_t>(v) + 1] += 3; // itself and the two others
+            ++vt_start[static_cast<size_t>(v) + 1];
     for (int v = 0; v < nv; ++v)
-        adj_start[static_cast<size_t>(v) + 1] += adj_start[static_cast<size_t>(v)];
-    std::vector<int> adj(static_cast<size_t>(adj_start.back()));
+        vt_start[static_cast<size_t>(v) + 1] += vt_start[static_cast<size_t>(v)];
+    std::vector<int> vt(static_cast<size_t>(vt_start.back()));
     {
-        std::vector<int> fill(adj_start.begin(), adj_start.end() - 1);
-        for (const auto& tri : m.triangles)
-            for (int v : tri)
-                for (int w : tri)
-                    adj[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = w;
+        std::vector<int> fill(vt_start.begin(), vt_start.end() - 1);
+        for (int t = 0; t < nt; ++t) // ascending per vertex: the serial summation order
+            for (int v : m.triangles[static_cast<size_t>(t)])
+                vt[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
     }
+    constexpr size_t kVerticesPerChunk = 2048;
+    auto for_vertices = [&](auto&& fn) {
+        parallel::for_rows(static_cast<size_t>(nv), kVerticesPerChunk, [&](size_t b, size_t e) {
+            for (size_t v = b; v < e; ++v)
+                fn(static_cast<int>(v));
+        });
+    };
+    // Neighbours of v (v included), sorted, in adj[3 vt_start[v], adj_end[v]).
+    std::vector<int> adj(3 * vt.size());
     std::vector<int> adj_end(static_cast<size_t>(nv));
-    for (int v = 0; v < nv; ++v) {
-        const auto b = adj.begin() + adj_start[static_cast<size_t>(v)];
-        const auto e = adj.begin() + adj_start[static_cast<size_t>(v) + 1];
-        std::sort(b, e);
-        adj_end[static_cast<size_t>(v)] = static_cast<int>(std::unique(b, e) - adj.begin());
-    }
+    for_vertices([&](int v) {
+        const int b = 3 * vt_start[static_cast<size_t>(v)];
+        int* out = adj.data() + b;
+        for (int k = vt_start[static_cast<size_t>(v)]; k < vt_start[static_cast<size_t>(v) + 1];
+             ++k)
+            for (int w : m.triangles[static_cast<size_t>(vt[static_cast<size_t>(k)])])
+                *out++ = w;
+        std::sort(adj.data() + b, out);
+        adj_end[static_cast<size_t>(v)] =
+            static_cast<int>(std::unique(adj.data() + b, out) - adj.data());
+    });
     sys.K.resize(n, n);
     std::vector<int> row_nnz(static_cast<size_t>(n), 0);
-    for (int v = 0; v < nv; ++v) {
+    for_vertices([&](int v) {
         int cols = 0;
-        for (int k = adj_start[static_cast<size_t>(v)]; k < adj_end[static_cast<size_t>(v)]; ++k)
+        for (int k = 3 * vt_start[static_cast<size_t>(v)]; k < adj_end[static_cast<size_t>(v)]; ++k)
             for (int c = 0; c < 2; ++c)
                 cols += dofs.u_dof(adj[static_cast<size_t>(k)], c) >= 0;
         for (int c = 0; c < 2; ++c)
             if (const int d = dofs.u_dof(v, c); d >= 0) row_nnz[static_cast<size_t>(d)] = cols;
-    }
+    });
     int* outer = sys.K.outerIndexPtr();
     outer[0] = 0;
     for (Index i = 0; i < n; ++i)
@@ -103,45 +119,55 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
     sys.K.resizeNonZeros(outer[n]);
     int* inner = sys.K.innerIndexPtr();
     double* val = sys.K.valuePtr();
-    std::fill(val, val + outer[n], 0.0);
-    for (int v = 0; v < nv; ++v)
+    for_vertices([&](int v) {
         for (int c = 0; c < 2; ++c) {
             const int d = dofs.u_dof(v, c);
             if (d < 0) continue;
             int* out = inner + outer[d];
-            for (int k = adj_start[static_cast<size_t>(v)]; k < adj_end[static_cast<size_t>(v)];
+            for (int k = 3 * vt_start[static_cast<size_t>(v)]; k < adj_end[static_cast<size_t>(v)];
                  ++k)
                 for (int cw = 0; cw < 2; ++cw)
                     if (const int dw = dofs.u_dof(adj[static_cast<size_t>(k)], cw); dw >= 0)
                         *out++ = dw;
             std::sort(inner + outer[d], out);
+            std::fill(val + outer[d], out - inner + val, 0.0);
         }
+    });
 
-    // Values: each element entry added at its place in the row (binary search in ~14 columns).
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
-        const auto ke = element_stiffness(
-            m.vertices[static_cast<size_t>(tri[0])], m.vertices[static_cast<size_t>(tri[1])],
-            m.vertices[static_cast<size_t>(tri[2])], material_of(m, materials, t));
-        int idx[6];
-        for (int i = 0; i < 3; ++i)
-            for (int c = 0; c < 2; ++c)
-                idx[2 * i + c] = dofs.u_dof(tri[static_cast<size_t>(i)], c);
-        for (int i = 0; i < 6; ++i) {
-            if (idx[i] < 0) continue;
-            const int* rb = inner + outer[idx[i]];
-            const int* re = inner + outer[idx[i] + 1];
-            for (int j = 0; j < 6; ++j) {
-                if (idx[j] >= 0) {
-                    const int* at = std::lower_bound(rb, re, idx[j]);
-                    val[at - inner] += ke(i, j);
-                } else {
-                    const int v = tri[static_cast<size_t>(j / 2)];
-                    sys.f[idx[i]] -= ke(i, j) * u_fixed[2 * v + j % 2];
+    // Values: the rows of v gather the element entries of v's triangles, in ascending triangle
+    // order (the order of the serial loop over triangles, so the sums are the same bit for bit),
+    // each at its place in the row (binary search in ~14 columns). Each element matrix is thus
+    // formed once per vertex, three times in all, in exchange for no two threads writing a row.
+    for_vertices([&](int v) {
+        const int d0 = dofs.u_dof(v, 0), d1 = dofs.u_dof(v, 1);
+        if (d0 < 0 && d1 < 0) return;
+        for (int k = vt_start[static_cast<size_t>(v)]; k < vt_start[static_cast<size_t>(v) + 1];
+             ++k) {
+            const int t = vt[static_cast<size_t>(k)];
+            const auto& tri = m.triangles[static_cast<size_t>(t)];
+            const auto ke = element_stiffness(
+                m.vertices[static_cast<size_t>(tri[0])], m.vertices[static_cast<size_t>(tri[1])],
+                m.vertices[static_cast<size_t>(tri[2])], material_of(m, materials, t));
+            int idx[6];
+            for (int i = 0; i < 3; ++i)
+                for (int c = 0; c < 2; ++c)
+                    idx[2 * i + c] = dofs.u_dof(tri[static_cast<size_t>(i)], c);
+            for (int i = 0; i < 6; ++i) {
+                if (tri[static_cast<size_t>(i / 2)] != v || idx[i] < 0) continue;
+                const int* rb = inner + outer[idx[i]];
+                const int* re = inner + outer[idx[i] + 1];
+                for (int j = 0; j < 6; ++j) {
+                    if (idx[j] >= 0) {
+                        const int* at = std::lower_bound(rb, re, idx[j]);
+                        val[at - inner] += ke(i, j);
+                    } else {
+                        const int w = tri[static_cast<size_t>(j / 2)];
+                        sys.f[idx[i]] -= ke(i, j) * u_fixed[2 * w + j % 2];
+                    }
                 }
             }
         }
-    }
+    });
     return sys;
 }
 

@@ -25,10 +25,9 @@ JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
     std::vector<std::pair<int, int>> centries;
     const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
     for (size_t e = 0; e < level.contacts.size(); ++e)
-        contact::for_each_tangent_entry(level.contacts[e], I, level.dofs, level.lambda_dof[e],
-                                        [&](int row, int col, double) {
-                                            centries.emplace_back(row, col);
-                                        });
+        contact::for_each_tangent_entry(
+            level.contacts[e], I, level.dofs, level.lambda_dof[e],
+            [&](int row, int col, double) { centries.emplace_back(row, col); });
     std::vector<std::pair<int, int>> extra = centries;
     std::sort(extra.begin(), extra.end());
     extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
@@ -305,7 +304,8 @@ public:
                         const int pc = newpos_[static_cast<size_t>(j)];
                         if (pr >= pc) pt.emplace_back(pr, pc, it.value());
                     }
-                SparseMatrixCol().swap(K0); // frees it (assigning an empty matrix keeps the storage)
+                SparseMatrixCol().swap(
+                    K0); // frees it (assigning an empty matrix keeps the storage)
                 K0p.setFromTriplets(pt.begin(), pt.end());
             }
             try {

@@ -30,11 +30,11 @@ private:
 
     const Level& level_;
     SparseMatrix J_;
-    std::vector<int> merged_rows_;      ///< rows where contact adds columns K lacks (sorted)
-    std::vector<size_t> kpos_start_;    ///< per merged row, its first entry in kpos_
-    std::vector<int> kpos_;             ///< positions in J of K's values, merged rows only
-    std::vector<int> contact_rows_;     ///< rows holding a contact tangent entry (sorted)
-    std::vector<int> cpos_; ///< position of each contact tangent entry, in visiting order
+    std::vector<int> merged_rows_;   ///< rows where contact adds columns K lacks (sorted)
+    std::vector<size_t> kpos_start_; ///< per merged row, its first entry in kpos_
+    std::vector<int> kpos_;          ///< positions in J of K's values, merged rows only
+    std::vector<int> contact_rows_;  ///< rows holding a contact tangent entry (sorted)
+    std::vector<int> cpos_;          ///< position of each contact tangent entry, in visiting order
     bool k_copied_ = false; ///< K's values are in J (every later assemble resets contact rows)
 };
 

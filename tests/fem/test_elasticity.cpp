@@ -7,6 +7,7 @@
 #include "mesh/mesh.hpp"
 #include <Eigen/SparseLU>
 #include <functional>
+#include <map>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -130,6 +131,69 @@ TEST(Assembly, UniaxialTractionGivesTheClosedFormExtension) {
         EXPECT_NEAR(s[static_cast<size_t>(3 * t)], p, 1e-11);
         EXPECT_NEAR(s[static_cast<size_t>(3 * t + 1)], 0.0, 1e-11);
     }
+}
+
+TEST(Assembly, RowsOverThreadsAreTheSerialElementLoopBitForBit) {
+    // Each vertex's rows gather its triangles' element entries in ascending triangle order, over
+    // several chunks of vertices (and threads): K and f must be, bit for bit, those of the serial
+    // loop over triangles (element matrix by element matrix, summed per entry), with a prescribed,
+    // non-zero displacement on the left side and two materials.
+    mesh::Mesh m =
+        mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 90, 60, mesh::Diagonal::alternate);
+    ASSERT_GT(m.n_vertices(), 2 * 2048);
+    m.attribute.assign(static_cast<size_t>(m.n_triangles()), 0);
+    for (int t = 0; t < m.n_triangles(); t += 3)
+        m.attribute[static_cast<size_t>(t)] = 1;
+    const std::vector<fem::Material> mats{{.E = 7.0, .nu = 0.35}, {.E = 3e3, .nu = 0.1}};
+    std::vector<std::array<bool, 2>> fixed(static_cast<size_t>(m.n_vertices()), {false, false});
+    Vector u_fixed = Vector::Zero(2 * m.n_vertices());
+    for (int v : m.vertices_with_tag(m.tag("left"))) {
+        fixed[static_cast<size_t>(v)] = {true, true};
+        u_fixed.segment<2>(2 * v) = Vec2(1e-3 * m.vertices[static_cast<size_t>(v)].y(), -2e-3);
+    }
+    // Vertices numbered backwards: rows and triangles in different orders.
+    std::vector<int> order(static_cast<size_t>(m.n_vertices()));
+    for (int v = 0; v < m.n_vertices(); ++v)
+        order[static_cast<size_t>(v)] = m.n_vertices() - 1 - v;
+    fem::DofMap dofs(fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0), order);
+    const Vector F = Vector::LinSpaced(2 * m.n_vertices(), -1.0, 1.0);
+    const auto sys = fem::assemble_elastic(m, mats, dofs, F, u_fixed);
+
+    const Index n = dofs.n_dofs();
+    std::map<std::pair<int, int>, double> K; // summed in triangle order
+    Vector f = Vector::Zero(n);
+    for (int v = 0; v < m.n_vertices(); ++v)
+        for (int c = 0; c < 2; ++c)
+            if (const int d = dofs.u_dof(v, c); d >= 0) f[d] = F[2 * v + c];
+    const Vector loads = f;
+    for (int t = 0; t < m.n_triangles(); ++t) {
+        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        const auto ke = fem::element_stiffness(
+            m.vertices[static_cast<size_t>(tri[0])], m.vertices[static_cast<size_t>(tri[1])],
+            m.vertices[static_cast<size_t>(tri[2])], fem::material_of(m, mats, t));
+        for (int i = 0; i < 6; ++i) {
+            const int di = dofs.u_dof(tri[static_cast<size_t>(i / 2)], i % 2);
+            if (di < 0) continue;
+            for (int j = 0; j < 6; ++j) {
+                const int w = tri[static_cast<size_t>(j / 2)];
+                if (const int dj = dofs.u_dof(w, j % 2); dj >= 0)
+                    K[{di, dj}] += ke(i, j);
+                else
+                    f[di] -= ke(i, j) * u_fixed[2 * w + j % 2];
+            }
+        }
+    }
+    // The same entries (the pattern is that of shared triangles), the same values.
+    ASSERT_EQ(sys.K.nonZeros(), static_cast<Index>(K.size()));
+    size_t mismatches = 0;
+    for (int i = 0; i < sys.K.outerSize(); ++i)
+        for (SparseMatrix::InnerIterator it(sys.K, i); it; ++it) {
+            const auto at = K.find({i, static_cast<int>(it.col())});
+            mismatches += at == K.end() || at->second != it.value();
+        }
+    EXPECT_EQ(mismatches, 0u);
+    EXPECT_EQ((sys.f - f).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_GT((sys.f - loads).cwiseAbs().maxCoeff(), 1e-6); // the lifting of u_fixed is in f
 }
 
 TEST(Assembly, PressureIsANormalTractionIntoTheBody) {

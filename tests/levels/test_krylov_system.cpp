@@ -163,8 +163,9 @@ TEST(JacobianAssembler, IsKPlusTheContactTangentsAndReassemblesInPlace) {
         for (SparseMatrix::InnerIterator it(K, i); it; ++it)
             trip.emplace_back(i, static_cast<int>(it.col()), it.value());
     for (size_t e = 0; e < L.contacts.size(); ++e)
-        contact::for_each_tangent_entry(L.contacts[e], t.fine_M[e], L.dofs, L.lambda_dof[e],
-                                        [&](int r, int c, double v) { trip.emplace_back(r, c, v); });
+        contact::for_each_tangent_entry(
+            L.contacts[e], t.fine_M[e], L.dofs, L.lambda_dof[e],
+            [&](int r, int c, double v) { trip.emplace_back(r, c, v); });
     SparseMatrix ref(L.n_unknowns(), L.n_unknowns());
     ref.setFromTriplets(trip.begin(), trip.end());
     ASSERT_GT(ref.nonZeros(), K.nonZeros()); // contact adds entries outside K's pattern
