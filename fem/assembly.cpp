@@ -136,33 +136,38 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
 
     // Values: the rows of v gather the element entries of v's triangles, in ascending triangle
     // order (the order of the serial loop over triangles, so the sums are the same bit for bit),
-    // each at its place in the row (binary search in ~14 columns). Each element matrix is thus
-    // formed once per vertex, three times in all, in exchange for no two threads writing a row.
+    // each at its place in the row (binary search in ~14 columns). Each vertex forms only its own
+    // two rows of the element matrix (element_stiffness_rows, the same sums bit for bit).
+    std::vector<Eigen::Matrix3d> D;
+    for (const auto& mat : materials)
+        D.push_back(mat.D());
     for_vertices([&](int v) {
-        const int d0 = dofs.u_dof(v, 0), d1 = dofs.u_dof(v, 1);
-        if (d0 < 0 && d1 < 0) return;
+        if (dofs.u_dof(v, 0) < 0 && dofs.u_dof(v, 1) < 0) return;
         for (int k = vt_start[static_cast<size_t>(v)]; k < vt_start[static_cast<size_t>(v) + 1];
              ++k) {
             const int t = vt[static_cast<size_t>(k)];
             const auto& tri = m.triangles[static_cast<size_t>(t)];
-            const auto ke = element_stiffness(
+            const int a = m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
+            const int iv = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
+            const auto ke = element_stiffness_rows(
                 m.vertices[static_cast<size_t>(tri[0])], m.vertices[static_cast<size_t>(tri[1])],
-                m.vertices[static_cast<size_t>(tri[2])], material_of(m, materials, t));
+                m.vertices[static_cast<size_t>(tri[2])], D[static_cast<size_t>(a)], iv);
             int idx[6];
             for (int i = 0; i < 3; ++i)
                 for (int c = 0; c < 2; ++c)
                     idx[2 * i + c] = dofs.u_dof(tri[static_cast<size_t>(i)], c);
-            for (int i = 0; i < 6; ++i) {
-                if (tri[static_cast<size_t>(i / 2)] != v || idx[i] < 0) continue;
-                const int* rb = inner + outer[idx[i]];
-                const int* re = inner + outer[idx[i] + 1];
+            for (int c = 0; c < 2; ++c) {
+                const int row = idx[2 * iv + c];
+                if (row < 0) continue;
+                const int* rb = inner + outer[row];
+                const int* re = inner + outer[row + 1];
                 for (int j = 0; j < 6; ++j) {
                     if (idx[j] >= 0) {
                         const int* at = std::lower_bound(rb, re, idx[j]);
-                        val[at - inner] += ke(i, j);
+                        val[at - inner] += ke(c, j);
                     } else {
                         const int w = tri[static_cast<size_t>(j / 2)];
-                        sys.f[idx[i]] -= ke(i, j) * u_fixed[2 * w + j % 2];
+                        sys.f[row] -= ke(c, j) * u_fixed[2 * w + j % 2];
                     }
                 }
             }

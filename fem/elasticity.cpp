@@ -57,4 +57,14 @@ Eigen::Matrix<double, 6, 6> element_stiffness(const Vec2& a, const Vec2& b, cons
     return area * B.transpose() * m.D() * B;
 }
 
+Eigen::Matrix<double, 2, 6> element_stiffness_rows(const Vec2& a, const Vec2& b, const Vec2& c,
+                                                   const Eigen::Matrix3d& D, int i) {
+    double area = 0;
+    const auto B = strain_matrix(a, b, c, area);
+    // The products of element_stiffness, restricted to rows 2i, 2i + 1: each entry is formed
+    // by the same operations in the same order.
+    const Eigen::Matrix<double, 2, 3> BtD = (area * B.transpose()).middleRows<2>(2 * i) * D;
+    return BtD * B;
+}
+
 } // namespace mlc::fem

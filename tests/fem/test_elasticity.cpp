@@ -8,6 +8,7 @@
 #include <Eigen/SparseLU>
 #include <functional>
 #include <map>
+#include <random>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
@@ -48,6 +49,28 @@ TEST(ElementStiffness, ConstantStrainEnergyIsExact) {
     const double energy = 0.5 * u.dot(K * u);
     const double lam = m.E * m.nu / ((1 + m.nu) * (1 - 2 * m.nu)), mu = m.E / (2 * (1 + m.nu));
     EXPECT_NEAR(energy, 0.5 * 1.0 * (lam + 2 * mu) * e * e, 1e-15);
+}
+
+TEST(ElementStiffness, RowsOfOneVertexAreTheFullMatrixRowsBitForBit) {
+    std::mt19937 gen(7);
+    std::uniform_real_distribution<double> u(-3.0, 3.0);
+    const fem::Material mats[2] = {{.E = 210e3, .nu = 0.3},
+                                   {.E = 0.7, .nu = 0.45, .plane = fem::Plane::stress}};
+    int compared = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        const Vec2 a(u(gen), u(gen)), b(u(gen), u(gen)), c(u(gen), u(gen));
+        if (std::abs((b - a).x() * (c - a).y() - (c - a).x() * (b - a).y()) < 1e-3) continue;
+        const auto& mat = mats[trial % 2];
+        const auto ke = fem::element_stiffness(a, b, c, mat);
+        for (int i = 0; i < 3; ++i) {
+            const auto rows = fem::element_stiffness_rows(a, b, c, mat.D(), i);
+            for (int r = 0; r < 2; ++r)
+                for (int j = 0; j < 6; ++j)
+                    ASSERT_EQ(rows(r, j), ke(2 * i + r, j)) << trial << " " << i;
+            ++compared;
+        }
+    }
+    EXPECT_GT(compared, 500);
 }
 
 TEST(Material, RejectsOutOfRangeParameters) {
