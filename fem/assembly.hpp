@@ -29,9 +29,9 @@ Vector nodal_loads(const mesh::Mesh& m, const std::vector<Traction>& tractions,
 
 /// Elastic operator on the unknowns of `dofs`.
 struct ElasticSystem {
-    SparseMatrix K;      ///< n_dofs x n_dofs stiffness (rows/cols of multipliers are empty)
-    Vector f;            ///< loads on the unknowns: nodal loads minus K_(free,fixed) u_fixed
-    Vector f_nodal_full; ///< nodal loads on every vertex component (for reactions)
+    MovableSparseMatrix K; ///< n_dofs x n_dofs stiffness (rows/cols of multipliers are empty)
+    Vector f;              ///< loads on the unknowns: nodal loads minus K_(free,fixed) u_fixed
+    Vector f_nodal_full;   ///< nodal loads on every vertex component (for reactions)
 };
 
 /// Assembles K on the free unknowns and the right-hand side for the full load:

@@ -36,18 +36,18 @@ enum class QRule {
 struct LevelTransfer {
     /// Nodal interpolation, one scalar per vertex (n_fine_vertices x n_coarse_vertices):
     /// identity at coarse vertices, 1/2, 1/2 at edge midpoints.
-    SparseMatrix P_vertex;
+    MovableSparseMatrix P_vertex;
     /// The same for interleaved nodal displacement vectors (2 n_fine x 2 n_coarse).
-    SparseMatrix P_nodal;
+    MovableSparseMatrix P_nodal;
     /// On the unknowns (fine n_dofs x coarse n_dofs): P on displacement unknowns (rows and columns
     /// of prescribed components dropped, so it maps homogeneous corrections), Q on multiplier
     /// unknowns, component by component (t to t, n to n).
-    SparseMatrix T;
+    MovableSparseMatrix T;
     /// Q alone on the multiplier unknowns, as rows/cols of T (fine n_dofs x coarse n_dofs, zero
     /// on displacement rows). T = P_u + Q.
-    SparseMatrix Q;
+    MovableSparseMatrix Q;
     /// Restriction of residuals, R = T^T (stored explicitly; style.md §3).
-    SparseMatrix R;
+    MovableSparseMatrix R;
     /// Coarse/fine splitting of the fine unknowns: `coarse_set` lists the fine unknowns that
     /// live on coarse vertices (their displacements, and the multipliers of coarse contact
     /// nodes), in increasing order; `fine_set` the others (new vertices), increasing.
