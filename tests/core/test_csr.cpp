@@ -105,6 +105,33 @@ TEST(MatrixOperator, InOrderIsEigensProductBitForBitAndUnrolledIsCsrMultiply) {
     EXPECT_EQ((t - tref).norm(), 0.0);
 }
 
+TEST(MovableSparseMatrix, MovesTheArraysAndCopiesOnlyOnCopy) {
+    SparseMatrix A = random_matrix(50, 3, 2);
+    MovableSparseMatrix a(A); // a copy
+    EXPECT_NE(a.valuePtr(), A.valuePtr());
+    const double* values = a.valuePtr();
+    const int* inner = a.innerIndexPtr();
+    MovableSparseMatrix b(std::move(a)); // the same arrays, not a copy
+    EXPECT_EQ(b.valuePtr(), values);
+    EXPECT_EQ(b.innerIndexPtr(), inner);
+    MovableSparseMatrix c;
+    c = std::move(b);
+    EXPECT_EQ(c.valuePtr(), values);
+    EXPECT_EQ(SparseMatrix(c - A).norm(), 0.0);
+    // A plain SparseMatrix moved in is taken over too; expressions and copies assign as usual.
+    SparseMatrix tmp = A;
+    const double* tv = tmp.valuePtr();
+    MovableSparseMatrix d(std::move(tmp));
+    EXPECT_EQ(d.valuePtr(), tv);
+    MovableSparseMatrix e;
+    e = A.transpose();
+    EXPECT_EQ(SparseMatrix(e - SparseMatrix(A.transpose())).norm(), 0.0);
+    MovableSparseMatrix f;
+    f = c;
+    EXPECT_NE(f.valuePtr(), c.valuePtr());
+    EXPECT_EQ(SparseMatrix(f - A).norm(), 0.0);
+}
+
 TEST(SparsityPattern, MatchesTheSamePatternWhateverTheValues) {
     const SparseMatrix A = random_matrix(50, 4, 7);
     SparseMatrix B = 3.0 * A;
