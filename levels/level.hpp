@@ -40,7 +40,8 @@ struct Level {
     /// Loading path (Problem::n_path_points K): prescribed displacements (2 per vertex), loads on
     /// the unknowns (f = F_free - K_(free,fixed) u_fixed) and nodal loads (2 per vertex) at path
     /// points k = 1..K, entry k-1. The last entries equal u_fixed, elastic.f, elastic.f_nodal_full.
-    /// Empty in a level assembled by hand: the loading is then proportional to those.
+    /// Empty with one path point (proportional loading; build_level leaves them empty then) and
+    /// in a level assembled by hand: the loading is then proportional to those.
     std::vector<Vector> path_u_fixed, path_f, path_f_nodal;
 
     /// Prescribed displacements at path parameter s in [0, 1] (s = step / load_steps): linear
