@@ -133,43 +133,50 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
     LevelTransfer tr;
     tr.rule = rule;
 
-    // Nodal P: identity at coarse vertices, 1/2, 1/2 at edge midpoints.
+    // Nodal P: identity at coarse vertices, 1/2, 1/2 at edge midpoints, straight into CSR (each
+    // row's entries in column order; no triplets: 16 bytes per entry and a sort, 0.6 GB at
+    // level 7 of the square).
     {
-        std::vector<Triplet> tv, tn;
-        tv.reserve(static_cast<size_t>(nc + 2 * (nf - nc)));
-        tn.reserve(2 * tv.capacity());
-        auto add = [&](int row, int col, double w) {
-            tv.emplace_back(row, col, w);
-            tn.emplace_back(2 * row, 2 * col, w);
-            tn.emplace_back(2 * row + 1, 2 * col + 1, w);
-        };
-        for (int v = 0; v < nc; ++v)
-            add(v, v, 1.0);
-        for (int m = nc; m < nf; ++m)
-            for (int p : fine.parents[static_cast<size_t>(m - nc)])
-                add(m, p, 0.5);
         tr.P_vertex.resize(nf, nc);
-        tr.P_vertex.setFromTriplets(tv.begin(), tv.end());
         tr.P_nodal.resize(2 * nf, 2 * nc);
-        tr.P_nodal.setFromTriplets(tn.begin(), tn.end());
-    }
-
-    // Displacement rows of T.
-    std::vector<Triplet> tu;
-    tu.reserve(static_cast<size_t>(2 * fine_dofs.n_displacement_dofs()));
-    for (int v = 0; v < nf; ++v)
-        for (int c = 0; c < 2; ++c) {
-            const int row = fine_dofs.u_dof(v, c);
-            if (row < 0) continue;
+        tr.P_vertex.resizeNonZeros(nc + 2 * (nf - nc));
+        tr.P_nodal.resizeNonZeros(2 * (nc + 2 * (nf - nc)));
+        int* ov = tr.P_vertex.outerIndexPtr();
+        int* iv = tr.P_vertex.innerIndexPtr();
+        double* vv = tr.P_vertex.valuePtr();
+        int* on = tr.P_nodal.outerIndexPtr();
+        int* in = tr.P_nodal.innerIndexPtr();
+        double* vn = tr.P_nodal.valuePtr();
+        int kv = 0, kn = 0;
+        ov[0] = 0;
+        on[0] = 0;
+        for (int v = 0; v < nf; ++v) {
             if (v < nc) {
-                tu.emplace_back(row, coarse_dofs.u_dof(v, c), 1.0);
-                continue;
+                iv[kv] = v;
+                vv[kv++] = 1.0;
+                for (int c = 0; c < 2; ++c) {
+                    in[kn] = 2 * v + c;
+                    vn[kn++] = 1.0;
+                    on[2 * v + c + 1] = kn;
+                }
+            } else {
+                std::array<int, 2> pr = fine.parents[static_cast<size_t>(v - nc)];
+                if (pr[1] < pr[0]) std::swap(pr[0], pr[1]);
+                for (int p : pr) {
+                    iv[kv] = p;
+                    vv[kv++] = 0.5;
+                }
+                for (int c = 0; c < 2; ++c) {
+                    for (int p : pr) {
+                        in[kn] = 2 * p + c;
+                        vn[kn++] = 0.5;
+                    }
+                    on[2 * v + c + 1] = kn;
+                }
             }
-            for (int p : fine.parents[static_cast<size_t>(v - nc)]) {
-                const int col = coarse_dofs.u_dof(p, c);
-                if (col >= 0) tu.emplace_back(row, col, 0.5);
-            }
+            ov[v + 1] = kv;
         }
+    }
 
     // Multiplier rows (Q). k[i][c]: fine contact midpoints next to coarse node i that receive
     // component c from it; the conservative rule keeps 1 - k/4 at i so that the weights of
@@ -224,9 +231,49 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
     const Index n_f = fine_dofs.n_dofs(), n_c = coarse_dofs.n_dofs();
     tr.Q.resize(n_f, n_c);
     tr.Q.setFromTriplets(tq.begin(), tq.end());
-    tu.insert(tu.end(), tq.begin(), tq.end());
-    tr.T.resize(n_f, n_c);
-    tr.T.setFromTriplets(tu.begin(), tu.end());
+    // T = P on the displacement rows (prescribed components dropped) and Q on the multiplier
+    // rows, row by row into CSR.
+    {
+        const SparseMatrix& Q = tr.Q;
+        const int* qo = Q.outerIndexPtr();
+        // The columns of displacement row d (at most two), in increasing order.
+        auto u_cols = [&](Index d, int cols[2]) {
+            const int v = fine_dofs.vertex_of(d);
+            const int c = fine_dofs.u_dof(v, 0) == d ? 0 : 1;
+            if (v < nc) {
+                cols[0] = coarse_dofs.u_dof(v, c);
+                return 1;
+            }
+            int m = 0;
+            for (int p : fine.parents[static_cast<size_t>(v - nc)])
+                if (const int col = coarse_dofs.u_dof(p, c); col >= 0) cols[m++] = col;
+            if (m == 2 && cols[1] < cols[0]) std::swap(cols[0], cols[1]);
+            return m;
+        };
+        tr.T.resize(n_f, n_c);
+        int* to = tr.T.outerIndexPtr();
+        to[0] = 0;
+        int cols[2];
+        for (Index d = 0; d < n_f; ++d)
+            to[d + 1] =
+                to[d] + (fine_dofs.is_displacement(d) ? u_cols(d, cols) : qo[d + 1] - qo[d]);
+        tr.T.resizeNonZeros(to[n_f]);
+        int* ti = tr.T.innerIndexPtr();
+        double* tv = tr.T.valuePtr();
+        for (Index d = 0; d < n_f; ++d) {
+            const int k = to[d];
+            if (fine_dofs.is_displacement(d)) {
+                const int m = u_cols(d, cols);
+                for (int j = 0; j < m; ++j) {
+                    ti[k + j] = cols[j];
+                    tv[k + j] = m == 1 && fine_dofs.vertex_of(d) < nc ? 1.0 : 0.5;
+                }
+            } else {
+                std::copy(Q.innerIndexPtr() + qo[d], Q.innerIndexPtr() + qo[d + 1], ti + k);
+                std::copy(Q.valuePtr() + qo[d], Q.valuePtr() + qo[d + 1], tv + k);
+            }
+        }
+    }
     tr.R = tr.T.transpose();
 
     // Coarse/fine splitting: unknowns on coarse vertices and their coarse counterparts.

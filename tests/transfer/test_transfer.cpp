@@ -324,6 +324,31 @@ TEST(Transfer, CoarseRowsAreIdentityOnDisplacementsAndHalfOnMultipliers) {
     }
 }
 
+TEST(Transfer, MatricesAreCompressedWithIncreasingColumnsAndPNodalIsPVertexPerComponent) {
+    // The operators are written straight into CSR: every row's columns strictly increase (what
+    // Eigen's products and coeff() assume), and P_nodal(2v + c, 2p + c) = P_vertex(v, p).
+    for (const auto* levs : {&square_levels(), &hertz_levels()}) {
+        for (int l = 0; l + 1 < 3; ++l) {
+            const auto tr =
+                make_transfer((*levs)[static_cast<size_t>(l)], (*levs)[static_cast<size_t>(l) + 1]);
+            for (const SparseMatrix* M : {static_cast<const SparseMatrix*>(&tr.P_vertex),
+                                          static_cast<const SparseMatrix*>(&tr.P_nodal),
+                                          static_cast<const SparseMatrix*>(&tr.T),
+                                          static_cast<const SparseMatrix*>(&tr.R)}) {
+                ASSERT_TRUE(M->isCompressed());
+                for (Index i = 0; i < M->rows(); ++i)
+                    for (int k = M->outerIndexPtr()[i] + 1; k < M->outerIndexPtr()[i + 1]; ++k)
+                        ASSERT_LT(M->innerIndexPtr()[k - 1], M->innerIndexPtr()[k]) << "row " << i;
+            }
+            ASSERT_EQ(tr.P_nodal.nonZeros(), 2 * tr.P_vertex.nonZeros());
+            for (Index v = 0; v < tr.P_vertex.rows(); ++v)
+                for (SparseMatrix::InnerIterator it(tr.P_vertex, v); it; ++it)
+                    for (int c = 0; c < 2; ++c)
+                        EXPECT_EQ(tr.P_nodal.coeff(2 * v + c, 2 * it.index() + c), it.value());
+        }
+    }
+}
+
 TEST(Transfer, CoarseAndFineSetsPartitionTheUnknowns) {
     for (const auto* levs : {&square_levels(), &hertz_levels()}) {
         for (int l = 0; l + 1 < 3; ++l) {
