@@ -58,10 +58,13 @@ JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
     J_.resizeNonZeros(jo[n]);
     int* ji = J_.innerIndexPtr();
     double* jv = J_.valuePtr();
+    const double* kv = K.valuePtr();
     parallel::for_rows(static_cast<size_t>(n), 4096, [&](size_t b, size_t e) {
         std::fill(jv + jo[b], jv + jo[e], 0.0);
-        for (size_t i = b; i < std::min(e, static_cast<size_t>(kr)); ++i)
+        for (size_t i = b; i < std::min(e, static_cast<size_t>(kr)); ++i) {
             std::copy(ki + ko[i], ki + ko[i + 1], ji + jo[i]);
+            std::copy(kv + ko[i], kv + ko[i + 1], jv + jo[i]);
+        }
     });
     x = 0;
     for (int i : merged_rows_) {
@@ -84,6 +87,9 @@ JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
         }
         x = xe;
     }
+    // J starts as K: the merged rows get K's values at their merged positions.
+    for (int i : merged_rows_)
+        reset_row(i);
     auto position = [&](int row, int col) {
         const int* begin = ji + jo[row];
         const int* end = ji + jo[row + 1];
@@ -122,24 +128,10 @@ void JacobianAssembler::reset_row(int i) {
 }
 
 void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
-    // K's values are copied once; afterwards only the rows holding contact entries are reset.
+    // J holds K plus the last tangents: the rows holding contact entries go back to K's.
     double* v = J_.valuePtr();
-    if (!k_copied_) {
-        const SparseMatrix& K = level_.elastic.K;
-        const int* ko = K.outerIndexPtr();
-        const int* jo = J_.outerIndexPtr();
-        const double* kv = K.valuePtr();
-        parallel::for_rows(static_cast<size_t>(K.rows()), 4096, [&](size_t b, size_t e) {
-            for (size_t i = b; i < e; ++i)
-                std::copy(kv + ko[i], kv + ko[i + 1], v + jo[i]);
-        });
-        for (int i : merged_rows_)
-            reset_row(i);
-        k_copied_ = true;
-    } else {
-        for (int i : contact_rows_)
-            reset_row(i);
-    }
+    for (int i : contact_rows_)
+        reset_row(i);
     size_t c = 0;
     for (size_t e = 0; e < level_.contacts.size(); ++e)
         contact::for_each_tangent_entry(level_.contacts[e], M[e], level_.dofs, level_.lambda_dof[e],
@@ -304,8 +296,8 @@ public:
                         const int pc = newpos_[static_cast<size_t>(j)];
                         if (pr >= pc) pt.emplace_back(pr, pc, it.value());
                     }
-                SparseMatrixCol().swap(
-                    K0); // frees it (assigning an empty matrix keeps the storage)
+                // Frees it (assigning an empty matrix keeps the storage).
+                SparseMatrixCol().swap(K0);
                 K0p.setFromTriplets(pt.begin(), pt.end());
             }
             try {

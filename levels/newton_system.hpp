@@ -35,7 +35,6 @@ private:
     std::vector<int> kpos_;          ///< positions in J of K's values, merged rows only
     std::vector<int> contact_rows_;  ///< rows holding a contact tangent entry (sorted)
     std::vector<int> cpos_;          ///< position of each contact tangent entry, in visiting order
-    bool k_copied_ = false; ///< K's values are in J (every later assemble resets contact rows)
 };
 
 /// Solves J x = b for an assembled matrix.
