@@ -8,6 +8,7 @@
 #include "core/types.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <vector>
 
 namespace mlc {
@@ -124,14 +125,20 @@ public:
     SparsityPattern() = default;
     /// The pattern of A (A must be compressed; throws mlc::InvalidInput otherwise).
     explicit SparsityPattern(const SparseMatrix& A);
+    SparsityPattern(const SparsityPattern& o);
+    SparsityPattern& operator=(const SparsityPattern& o);
+    SparsityPattern(SparsityPattern&&) noexcept = default;
+    SparsityPattern& operator=(SparsityPattern&&) noexcept = default;
+    ~SparsityPattern() = default;
     /// True when A is compressed and has exactly this pattern (the same test as `same_pattern`).
     bool matches(const SparseMatrix& A) const;
     /// False for a default-constructed pattern.
-    bool empty() const { return outer_.empty(); }
+    bool empty() const { return !outer_; }
 
 private:
     Index rows_ = 0, cols_ = 0;
-    std::vector<int> outer_, inner_;
+    size_t n_outer_ = 0, n_inner_ = 0;
+    std::unique_ptr<int[]> outer_, inner_; // filled over the threads (core/first_touch)
 };
 
 } // namespace mlc

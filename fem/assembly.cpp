@@ -3,6 +3,7 @@
 #include "fem/assembly.hpp"
 
 #include "core/check.hpp"
+#include "core/first_touch.hpp"
 #include "core/parallel.hpp"
 
 #include <algorithm>
@@ -55,9 +56,11 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
     check_materials(m, materials);
     MLC_CHECK(dofs.n_vertices() == m.n_vertices(), "DofMap and mesh disagree on vertex count");
     ElasticSystem sys;
-    sys.f_nodal_full = nodal_load_full;
+    sys.f_nodal_full.resize(nodal_load_full.size());
+    parallel::copy(nodal_load_full.data(), static_cast<size_t>(nodal_load_full.size()),
+                   sys.f_nodal_full.data());
     const Index n = dofs.n_dofs();
-    sys.f = Vector::Zero(n);
+    sys.f = parallel::zeros(n);
     const int nv = m.n_vertices();
     for (int v = 0; v < nv; ++v)
         for (int c = 0; c < 2; ++c)
@@ -89,18 +92,19 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
         });
     };
     // Neighbours of v (v included), sorted, in adj[3 vt_start[v], adj_end[v]).
-    std::vector<int> adj(3 * vt.size());
+    // adj is first written here, by the threads (core/first_touch): 300 MB at level 7.
+    const auto adj = parallel::uninitialized_array<int>(3 * vt.size());
     std::vector<int> adj_end(static_cast<size_t>(nv));
     for_vertices([&](int v) {
         const int b = 3 * vt_start[static_cast<size_t>(v)];
-        int* out = adj.data() + b;
+        int* out = adj.get() + b;
         for (int k = vt_start[static_cast<size_t>(v)]; k < vt_start[static_cast<size_t>(v) + 1];
              ++k)
             for (int w : m.triangles[static_cast<size_t>(vt[static_cast<size_t>(k)])])
                 *out++ = w;
-        std::sort(adj.data() + b, out);
+        std::sort(adj.get() + b, out);
         adj_end[static_cast<size_t>(v)] =
-            static_cast<int>(std::unique(adj.data() + b, out) - adj.data());
+            static_cast<int>(std::unique(adj.get() + b, out) - adj.get());
     });
     sys.K.resize(n, n);
     std::vector<int> row_nnz(static_cast<size_t>(n), 0);

@@ -3,6 +3,7 @@
 #include "fem/dof_map.hpp"
 
 #include "core/check.hpp"
+#include "core/first_touch.hpp"
 
 namespace mlc::fem {
 
@@ -53,11 +54,15 @@ DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<
 void DofMap::expand(const Vector& x, const Vector& u_fixed, Vector& u_full) const {
     const int nv = n_vertices();
     u_full.resize(2 * nv);
-    for (int v = 0; v < nv; ++v)
-        for (int c = 0; c < 2; ++c) {
-            const int d = u_dof_[static_cast<size_t>(v)][static_cast<size_t>(c)];
-            u_full[2 * v + c] = d >= 0 ? x[d] : u_fixed[2 * v + c];
-        }
+    // The vertices over the threads (the Newton residual expands every iterate).
+    parallel::for_rows(
+        static_cast<size_t>(nv), parallel::kTouchRowsPerChunk / 2, [&](size_t b, size_t e) {
+            for (auto v = static_cast<int>(b); v < static_cast<int>(e); ++v)
+                for (int c = 0; c < 2; ++c) {
+                    const int d = u_dof_[static_cast<size_t>(v)][static_cast<size_t>(c)];
+                    u_full[2 * v + c] = d >= 0 ? x[d] : u_fixed[2 * v + c];
+                }
+        });
 }
 
 } // namespace mlc::fem

@@ -4,6 +4,7 @@
 
 #include "contact/search.hpp"
 #include "core/check.hpp"
+#include "core/first_touch.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,14 +16,36 @@ namespace {
 /// Piecewise-linear interpolation of path values P[k-1] at s = k / K, with P = 0 at s = 0.
 /// For K = 1 this is s * P[0], bit for bit the proportional loading.
 /// A level made by hand (tests) has no path: then proportional to `full`.
-Vector path_at(const std::vector<Vector>& P, const Vector& full, double s) {
+/// Written into `out` with the rows over the threads (an elementwise expression: the same values
+/// as evaluated whole; chunks start at multiples of parallel::kTouchRowsPerChunk).
+void path_at(const std::vector<Vector>& P, const Vector& full, double s, Vector& out) {
     const int K = static_cast<int>(P.size());
-    if (K == 0) return s * full;
+    const Index n = K == 0 ? full.size() : P[0].size();
+    out.resize(n);
+    auto each = [&](auto&& expr_of) {
+        parallel::for_rows(static_cast<size_t>(n), parallel::kTouchRowsPerChunk,
+                           [&](size_t b, size_t e) {
+                               const auto i = static_cast<Index>(b);
+                               const auto m = static_cast<Index>(e - b);
+                               out.segment(i, m) = expr_of(i, m);
+                           });
+    };
+    if (K == 0) return each([&](Index i, Index m) { return s * full.segment(i, m); });
     const double t = s * K;
     const int k = std::clamp(static_cast<int>(std::floor(t)), 0, K - 1);
     const double theta = t - k;
-    if (k == 0) return theta * P[0];
-    return (1.0 - theta) * P[static_cast<size_t>(k - 1)] + theta * P[static_cast<size_t>(k)];
+    if (k == 0) return each([&](Index i, Index m) { return theta * P[0].segment(i, m); });
+    const Vector& a = P[static_cast<size_t>(k - 1)];
+    const Vector& b = P[static_cast<size_t>(k)];
+    each([&](Index i, Index m) {
+        return (1.0 - theta) * a.segment(i, m) + theta * b.segment(i, m);
+    });
+}
+
+Vector path_at(const std::vector<Vector>& P, const Vector& full, double s) {
+    Vector out;
+    path_at(P, full, s, out);
+    return out;
 }
 
 /// The two-body elements of `pair` for `nodes` (the search build_level runs). A process's part
@@ -84,6 +107,12 @@ Vector Level::f_at(double s) const {
 }
 Vector Level::f_nodal_at(double s) const {
     return path_at(path_f_nodal, elastic.f_nodal_full, s);
+}
+void Level::u_fixed_at(double s, Vector& out) const {
+    path_at(path_u_fixed, u_fixed, s, out);
+}
+void Level::f_at(double s, Vector& out) const {
+    path_at(path_f, elastic.f, s, out);
 }
 
 Level build_level(const Problem& problem, mesh::Mesh m) {

@@ -51,6 +51,9 @@ struct Level {
     Vector f_at(double s) const;
     /// Nodal loads (2 per vertex) at path parameter s (s * elastic.f_nodal_full if proportional).
     Vector f_nodal_at(double s) const;
+    /// u_fixed_at(s) and f_at(s) written into `out` (resized; no allocation when it has the size).
+    void u_fixed_at(double s, Vector& out) const;
+    void f_at(double s, Vector& out) const;
 
     Index n_unknowns() const { return dofs.n_dofs(); }
     int n_contact_nodes() const { return static_cast<int>(contacts.size()); }

@@ -4,6 +4,7 @@
 
 #include "core/check.hpp"
 #include "core/csr.hpp"
+#include "core/first_touch.hpp"
 
 #include <algorithm>
 #include <array>
@@ -59,20 +60,32 @@ double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector
                                std::vector<contact::Status>* st, std::vector<Eigen::Matrix2d>* M,
                                double* scale) const {
     const Level& L = level_;
-    const Vector u_fixed = L.u_fixed_at(s);
-    Vector u_full, work;
-    const Vector& xl = padded(x, work);
-    L.dofs.expand(xl, u_fixed, u_full);
+    // Level-size work vectors, written over the threads (core/first_touch).
+    struct {
+        Vector u_fixed, u_full, padded, f, contact_force;
+    } w;
+    L.u_fixed_at(s, w.u_fixed);
+    const Vector& xl = padded(x, w.padded);
+    L.dofs.expand(xl, w.u_fixed, w.u_full);
+    const Vector& u_full = w.u_full;
     if (dist_.comm)
         dist_.K->apply(x, R);
     else
         csr_multiply_in_order(L.elastic.K, x, R); // Eigen's K * x, bit for bit, row-parallel
     double internal2 = R.squaredNorm();
-    const Vector f = dist_.comm ? Vector(L.f_at(s).head(x.size())) : L.f_at(s);
-    R -= f;
+    L.f_at(s, w.f);
+    if (dist_.comm) w.f = Vector(w.f.head(x.size()));
+    const Vector& f = w.f;
+    parallel::for_rows(static_cast<size_t>(R.size()), parallel::kTouchRowsPerChunk,
+                       [&](size_t b, size_t e) {
+                           const auto i = static_cast<Index>(b);
+                           const auto m = static_cast<Index>(e - b);
+                           R.segment(i, m) -= f.segment(i, m); // R -= f, elementwise
+                       });
     double load2 = f.squaredNorm();
     // Distributed: the part's unknowns (ghost rows included; those are other processes').
-    Vector contact_force = Vector::Zero(xl.size());
+    parallel::set_zero(w.contact_force, xl.size());
+    Vector& contact_force = w.contact_force;
     double lambda_res2 = 0.0;
     if (st) st->resize(L.contacts.size());
     if (M) M->resize(L.contacts.size() + L.ghost_contacts.size());
@@ -99,7 +112,12 @@ double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector
             contact_force[L.ghost_lambda_dof[e] + q] = 0.0;
         if (M) (*M)[L.contacts.size() + e] = es.proj.M;
     }
-    R += contact_force.head(R.size());
+    parallel::for_rows(static_cast<size_t>(R.size()), parallel::kTouchRowsPerChunk,
+                       [&](size_t b, size_t e) {
+                           const auto i = static_cast<Index>(b);
+                           const auto m = static_cast<Index>(e - b);
+                           R.segment(i, m) += contact_force.segment(i, m); // elementwise
+                       });
     // Norm in force units: displacement rows as they are, multiplier rows times r.
     double ru2 = 0.0;
     for (Index i = 0; i < R.size(); ++i)

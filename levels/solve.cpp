@@ -3,6 +3,7 @@
 #include "levels/solve.hpp"
 
 #include "core/check.hpp"
+#include "core/first_touch.hpp"
 #include "core/memory.hpp"
 #include "solvers/factory.hpp"
 
@@ -164,8 +165,7 @@ StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonPar
             return low;
         }
         if (!low.converged) {
-            tried << "; at " << factor << " r (schur) from the same initial guess: "
-                  << low.message;
+            tried << "; at " << factor << " r (schur) from the same initial guess: " << low.message;
             continue;
         }
         const int low_iterations = low.iterations;
@@ -186,9 +186,8 @@ StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonPar
             note << "Newton at r failed (" << failed.message << "); ";
         else
             note << "r continuation " << failed.message << ": ";
-        note << "solved at " << factor
-             << " r by schur in " << low_iterations << " Newton iterations, then at r in "
-             << fin.iterations;
+        note << "solved at " << factor << " r by schur in " << low_iterations
+             << " Newton iterations, then at r in " << fin.iterations;
         fin.continuation_factor = factor;
         fin.continuation_iterations = spent - fin.iterations;
         fin.continuation_note = note.str();
@@ -196,8 +195,7 @@ StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonPar
         fin.linear_iterations += failed.linear_iterations;
         fin.linear_seconds += failed.linear_seconds + low.linear_seconds;
         fin.linear_setup_seconds += failed.linear_setup_seconds + low.linear_setup_seconds;
-        fin.linear_assembly_seconds +=
-            failed.linear_assembly_seconds + low.linear_assembly_seconds;
+        fin.linear_assembly_seconds += failed.linear_assembly_seconds + low.linear_assembly_seconds;
         fin.fallback_solves += failed.fallback_solves;
         if (fin.fallback_reason.empty()) fin.fallback_reason = failed.fallback_reason;
         fin.seconds += failed.seconds + low.seconds;
@@ -263,8 +261,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 if (l - 1 > first) lb.below = &below[static_cast<size_t>(l - 1)];
             }
             auto sys = make_newton_system_solver(L, spec, &lb);
-            if (options.wrap_system_solver)
-                sys = options.wrap_system_solver(l, L, std::move(sys));
+            if (options.wrap_system_solver) sys = options.wrap_system_solver(l, L, std::move(sys));
             system[static_cast<size_t>(l)] = sys.get();
             newton[static_cast<size_t>(l)] =
                 std::make_unique<ContactNewton>(L, problem.newton, std::move(sys), &res.timings);
@@ -428,16 +425,27 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 Vector uf;
                 T.interpolate_nodal(inc ? Vector(u_now[li - 1] - u_prev[li - 1]) : u_now[li - 1],
                                     uf);
-                const Vector q = T.Q * (inc ? Vector(x[li - 1] - x_before[li - 1]) : x[li - 1]);
+                const Vector inc_coarse = inc ? Vector(x[li - 1] - x_before[li - 1]) : Vector();
+                const Vector& xc = inc ? inc_coarse : x[li - 1];
                 Vector& xl = x[li];
-                for (int v = 0; v < L.mesh.n_vertices(); ++v)
-                    for (int c = 0; c < 2; ++c)
-                        if (const int d = L.dofs.u_dof(v, c); d >= 0)
-                            xl[d] = (inc ? xl[d] : 0.0) + uf[2 * v + c];
+                parallel::for_rows(static_cast<size_t>(L.mesh.n_vertices()),
+                                   parallel::kTouchRowsPerChunk / 2, [&](size_t b, size_t e) {
+                                       for (auto v = static_cast<int>(b); v < static_cast<int>(e);
+                                            ++v)
+                                           for (int c = 0; c < 2; ++c)
+                                               if (const int d = L.dofs.u_dof(v, c); d >= 0)
+                                                   xl[d] = (inc ? xl[d] : 0.0) + uf[2 * v + c];
+                                   });
+                // Q's rows of the multipliers only (Q is zero on the displacement rows); the sums
+                // of Eigen's row-major `T.Q * xc`, whose result starts at zero.
+                const SparseMatrix& Q = T.Q;
                 for (size_t e = 0; e < L.contacts.size(); ++e)
                     for (int k = 0; k < L.contacts[e].n_multipliers(); ++k) {
                         const Index d = L.lambda_dof[e] + k;
-                        xl[d] = (inc ? xl[d] : 0.0) + q[d];
+                        double row = 0.0;
+                        for (SparseMatrix::InnerIterator it(Q, d); it; ++it)
+                            row += it.value() * xc[it.index()];
+                        xl[d] = (inc ? xl[d] : 0.0) + (0.0 + 1.0 * row);
                     }
                 ls.predicted = true;
                 ls.predicted_statuses = nw.statuses(s, u_prev[li], xl);
@@ -458,11 +466,10 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 if (options.r_continuation && !ls.report.converged && !ls.report.stopped &&
                     !L.contacts.empty()) {
                     x[li] = x0;
-                    ls.report = continue_in_r(res.hierarchy.levels[li], l,
-                                              res.predicted_sizes[li], problem.newton, nw, s,
-                                              u_prev[li], x0, x[li], std::move(ls.report),
-                                              continued[li], continuation_solver[li], options,
-                                              &res.timings);
+                    ls.report = continue_in_r(res.hierarchy.levels[li], l, res.predicted_sizes[li],
+                                              problem.newton, nw, s, u_prev[li], x0, x[li],
+                                              std::move(ls.report), continued[li],
+                                              continuation_solver[li], options, &res.timings);
                     continued[li] = ls.report.continuation_factor;
                 }
             } catch (const Interrupted& e) {

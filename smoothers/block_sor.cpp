@@ -4,6 +4,7 @@
 #include "smoothers/block_sor.hpp"
 
 #include "core/check.hpp"
+#include "core/first_touch.hpp"
 #include "core/parallel.hpp"
 #include "smoothers/matrix_checks.hpp"
 
@@ -180,7 +181,7 @@ void BlockSOR::derive_structure() {
     interface_.clear();
     for (Index j = 0; j < n; ++j)
         if (across[static_cast<size_t>(j)]) interface_.push_back(static_cast<int>(j));
-    snap_.setZero(n);
+    parallel::set_zero(snap_, n);
     // First entry of every row in or right of its own diagonal block.
     diag_begin_.resize(static_cast<size_t>(n));
     for (Index I = 0; I < nb; ++I)
@@ -314,8 +315,19 @@ void BlockSOR::invert_blocks() {
     const double omega = params_.omega;
     const double tol = params_.singular_tol;
     dinv_.resize(static_cast<size_t>(inverse_entries()));
+    // The blocks over the threads: each block's inverse is its own (the same arithmetic whichever
+    // thread forms it). At level 7 of the square that is 4.2 million blocks per Newton step.
+    parallel::for_rows(static_cast<size_t>(n_blocks()), kInvertBlocksPerChunk,
+                       [&](size_t b_begin, size_t b_end) {
+                           invert_block_range(static_cast<Index>(b_begin),
+                                              static_cast<Index>(b_end), ao, ai, av, omega, tol);
+                       });
+}
+
+void BlockSOR::invert_block_range(Index b_begin, Index b_end, const int* ao, const int* ai,
+                                  const double* av, double omega, double tol) {
     Eigen::MatrixXd block;
-    for (Index b = 0; b < n_blocks(); ++b) {
+    for (Index b = b_begin; b < b_end; ++b) {
         const Index s0 = starts_[b], s = starts_[b + 1] - s0;
         block.setZero(s, s);
         for (Index i = s0; i < s0 + s; ++i)

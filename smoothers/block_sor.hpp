@@ -190,6 +190,10 @@ private:
     using InverseMap =
         Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
     void invert_blocks();
+    // Blocks [b_begin, b_end) of invert_blocks (one chunk of the threads' loop).
+    void invert_block_range(Index b_begin, Index b_end, const int* ao, const int* ai,
+                            const double* av, double omega, double tol);
+    static constexpr size_t kInvertBlocksPerChunk = 4096;
     // float32: values32_ from A's values and dinv32_ from dinv_ (then released).
     void round_data();
     // D^{-1} of a block the kernel's fast path rejected (equilibrated full-pivot LU); throws.

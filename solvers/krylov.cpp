@@ -4,6 +4,7 @@
 #include "solvers/krylov.hpp"
 
 #include "core/check.hpp"
+#include "core/first_touch.hpp"
 #include "core/timer.hpp"
 #include "core/traffic.hpp"
 
@@ -183,7 +184,10 @@ SolveResult cg(const LinearOperator& A, const Preconditioner& M, const Vector& b
     Run run("cg", A, b, x, params);
     if (run.trivial()) return run.result();
     const Index n = b.size();
-    Vector r(n), z(n), p(n), q(n), t(n);
+    // Workspace from parallel::zeros: its pages are first touched by all threads
+    // (core/first_touch).
+    Vector r = parallel::zeros(n), z = parallel::zeros(n), p = parallel::zeros(n),
+           q = parallel::zeros(n), t = parallel::zeros(n);
     double rn = run.true_residual(t);
     r = t;
     run.initial(rn);
@@ -224,7 +228,9 @@ SolveResult cgs(const LinearOperator& A, const Preconditioner& M, const Vector& 
     Run run("cgs", A, b, x, params);
     if (run.trivial()) return run.result();
     const Index n = b.size();
-    Vector r(n), z0(n), z(n), p(n), q(n), y(n), h(n), w(n), t(n);
+    Vector r = parallel::zeros(n), z0 = parallel::zeros(n), z = parallel::zeros(n),
+           p = parallel::zeros(n), q = parallel::zeros(n), y = parallel::zeros(n),
+           h = parallel::zeros(n), w = parallel::zeros(n), t = parallel::zeros(n);
 
     double rn = run.true_residual(t);
     r = t;
@@ -297,7 +303,9 @@ SolveResult bicg(const LinearOperator& A, const Preconditioner& M, const Vector&
     Run run("bicg", A, b, x, params);
     if (run.trivial()) return run.result();
     const Index n = b.size();
-    Vector r(n), rt(n), z(n), zt(n), p(n), pt(n), q(n), qt(n), t(n);
+    Vector r = parallel::zeros(n), rt = parallel::zeros(n), z = parallel::zeros(n),
+           zt = parallel::zeros(n), p = parallel::zeros(n), pt = parallel::zeros(n),
+           q = parallel::zeros(n), qt = parallel::zeros(n), t = parallel::zeros(n);
 
     double rn = run.true_residual(t);
     r = t;
@@ -363,7 +371,9 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
     Run run("bicgstab", A, b, x, params);
     if (run.trivial()) return run.result();
     const Index n = b.size();
-    Vector r(n), rh(n), p(n), ph(n), v(n), sh(n), t(n);
+    Vector r = parallel::zeros(n), rh = parallel::zeros(n), p = parallel::zeros(n),
+           ph = parallel::zeros(n), v = parallel::zeros(n), sh = parallel::zeros(n),
+           t = parallel::zeros(n);
 
     double rn = run.true_residual(t);
     r = t;

@@ -4,6 +4,7 @@
 #include "transfer/transfer.hpp"
 
 #include "core/check.hpp"
+#include "core/first_touch.hpp"
 
 #include <array>
 
@@ -28,12 +29,16 @@ void csr_apply(const SparseMatrix& A, const Vector& x, Vector& y, const char* wh
               what << ": input has " << x.size() << " entries, expected " << A.cols());
     MLC_CHECK(&x != &y, what << ": input and output must be different vectors");
     y.resize(A.rows());
-    for (Index i = 0; i < A.outerSize(); ++i) {
-        double s = 0.0;
-        for (SparseMatrix::InnerIterator it(A, i); it; ++it)
-            s += it.value() * x[it.index()];
-        y[i] = s;
-    }
+    // The rows over the threads, each row's sum in its own order (the same values serially).
+    parallel::for_rows(static_cast<size_t>(A.outerSize()), parallel::kTouchRowsPerChunk,
+                       [&](size_t b, size_t e) {
+                           for (auto i = static_cast<Index>(b); i < static_cast<Index>(e); ++i) {
+                               double s = 0.0;
+                               for (SparseMatrix::InnerIterator it(A, i); it; ++it)
+                                   s += it.value() * x[it.index()];
+                               y[i] = s;
+                           }
+                       });
 }
 
 /// Checks one level's contact nodes against its numbering; returns node index per vertex.

@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: MIT
 // Loading paths: proportional loading unchanged, per-step prescribed values and load factors
 // interpolated between path points.
+#include "core/first_touch.hpp"
 #include "levels/checks.hpp"
 #include "levels/level.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
 
 using namespace mlc;
 
@@ -41,6 +45,31 @@ TEST(LoadPath, PerStepValuesAreReachedAtTheirPathPoints) {
     const Vector f_mid = L.f_at(0.5);
     EXPECT_GT(f_mid.norm(), 0.0);
     EXPECT_LT((L.f_at(0.75) - 0.5 * (f_mid + L.f_at(1.0))).norm(), 1e-14 * L.f_at(1.0).norm());
+}
+
+TEST(LoadPath, ValuesOverTheThreadsAreTheWholeVectorExpressionsBitForBit) {
+    // Level::u_fixed_at writes chunks of the vector over the threads (core/first_touch); each
+    // chunk evaluates the same elementwise expression, so the values are those of the whole
+    // vector's, here on vectors of several chunks with random entries.
+    const auto p = scene::load_scene("mindlin");
+    auto L = levels::build_level(p, p.mesh0);
+    const Index n = 5 * static_cast<Index>(parallel::kTouchRowsPerChunk) + 11;
+    const Vector a = Vector::Random(n), b = Vector::Random(n);
+    L.path_u_fixed = {a, b};
+    L.u_fixed = b;
+    Vector out = Vector::Constant(7, 3.0); // resized
+    for (double s : {0.0, 0.3, 0.5, 0.75, 0.9, 1.0}) {
+        const double t = 2.0 * s;
+        const int k = std::clamp(static_cast<int>(std::floor(t)), 0, 1);
+        const double theta = t - k;
+        const Vector want = k == 0 ? Vector(theta * a) : Vector((1.0 - theta) * a + theta * b);
+        L.u_fixed_at(s, out);
+        EXPECT_EQ(out, want) << "s = " << s;
+        EXPECT_EQ(L.u_fixed_at(s), want) << "s = " << s;
+    }
+    L.path_u_fixed.clear(); // proportional: s * u_fixed
+    L.u_fixed_at(0.6, out);
+    EXPECT_EQ(out, (0.6 * b).eval());
 }
 
 TEST(LoadPath, LoadFactorsScaleTractionsPerStep) {
@@ -97,7 +126,8 @@ TEST(Extrapolation, LinearLoadStepsAreTakenWithoutANewtonIteration) {
             const auto& b = extra.level_steps[l][k].report;
             EXPECT_GE(a.iterations, 1) << "level " << l << " step " << k + 1;
             // Step 1 as without; steps 2.. converged at the extrapolated state.
-            EXPECT_EQ(b.iterations, k == 0 ? a.iterations : 0) << "level " << l << " step " << k + 1;
+            EXPECT_EQ(b.iterations, k == 0 ? a.iterations : 0)
+                << "level " << l << " step " << k + 1;
             EXPECT_TRUE(b.converged);
             EXPECT_LE(b.residuals.back(), 1e-10);
         }
