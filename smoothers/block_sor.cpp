@@ -188,6 +188,17 @@ void BlockSOR::derive_structure() {
         for (Index i = starts_[I]; i < starts_[I + 1]; ++i)
             diag_begin_[static_cast<size_t>(i)] = static_cast<int>(
                 std::lower_bound(inner + outer[i], inner + outer[i + 1], starts_[I]) - inner);
+    // Twin rows: a 2x2 block whose two rows have the same columns (a vertex of K: both
+    // displacement rows couple to the same vertices). The sweep reads their columns and x once.
+    twin_.assign(static_cast<size_t>(std::max<Index>(nb, 0)), 0);
+    for (Index I = 0; I < nb; ++I) {
+        const Index i = starts_[I];
+        if (starts_[I + 1] - i != 2) continue;
+        const int len = outer[i + 1] - outer[i];
+        twin_[static_cast<size_t>(I)] =
+            outer[i + 2] - outer[i + 1] == len &&
+            std::equal(inner + outer[i], inner + outer[i + 1], inner + outer[i + 1]);
+    }
     pattern_ = SparsityPattern(A);
     work_.resize(max_block_ * P);
 }
@@ -375,6 +386,41 @@ void BlockSOR::invert_block_range(Index b_begin, Index b_end, const int* ao, con
     }
 }
 
+namespace {
+
+// row_dot (core/csr.hpp) of two rows with the same columns at once: r0 over entries [k0, k1) of
+// the first row, r1 over the same positions of the second, whose values are `len` entries on.
+// Each row has row_dot's four accumulators and order, so r0 and r1 are its values bit for bit.
+template <class Value>
+inline void twin_row_dot(const int* inner, const Value* val, int len, const double* x, int k0,
+                         int k1, double& r0, double& r1) {
+    const Value* w = val + len;
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    double b0 = 0.0, b1 = 0.0, b2 = 0.0, b3 = 0.0;
+    int k = k0;
+    for (; k + 3 < k1; k += 4) {
+        const double x0 = x[inner[k]], x1 = x[inner[k + 1]];
+        const double x2 = x[inner[k + 2]], x3 = x[inner[k + 3]];
+        a0 += val[k] * x0;
+        a1 += val[k + 1] * x1;
+        a2 += val[k + 2] * x2;
+        a3 += val[k + 3] * x3;
+        b0 += w[k] * x0;
+        b1 += w[k + 1] * x1;
+        b2 += w[k + 2] * x2;
+        b3 += w[k + 3] * x3;
+    }
+    for (; k < k1; ++k) {
+        const double xk = x[inner[k]];
+        a0 += val[k] * xk;
+        b0 += w[k] * xk;
+    }
+    r0 = (a0 + a1) + (a2 + a3);
+    r1 = (b0 + b1) + (b2 + b3);
+}
+
+} // namespace
+
 // One part's half-sweep over blocks [b0, b1) with scratch t (one block). The other parts'
 // unknowns are read from snap_ (their values when the sweep began). With from_zero (in_order
 // kernel only) x is zero on entry and only the already-visited own entries of each row count.
@@ -385,15 +431,61 @@ void BlockSOR::sweep_part(const Value* av, const Value* dinv, const double* bp, 
     const int* ai = A_->innerIndexPtr();
     const double* sp = snap_.data();
     const bool unrolled = params_.kernel == Kernel::unrolled;
+    // The unrolled kernel's row: b_i - (own part) - (other parts before) - (other parts after).
+    // An empty range's row_dot is +0.0 and x - (+0.0) == x, so skipping it changes no bit.
+    auto unrolled_row = [&](Index i) {
+        const auto r = static_cast<size_t>(i);
+        const int ob = own_begin_[r], oe = own_end_[r];
+        double v = bp[i] - row_dot(ai, av, xp, ob, oe);
+        if (ao[i] != ob) v -= row_dot(ai, av, sp, ao[i], ob);
+        if (oe != ao[i + 1]) v -= row_dot(ai, av, sp, oe, ao[i + 1]);
+        return v;
+    };
     for (Index step = b0; step < b1; ++step) {
         const Index blk = forward ? step : b1 - 1 - (step - b0);
         const Index s0 = starts_[blk], s1 = starts_[blk + 1], s = s1 - s0;
+        if (unrolled && s == 2) {
+            // A vertex's 2x2 block (most blocks), with the general path's operations in its order.
+            double t0, t1;
+            if (twin_[static_cast<size_t>(blk)]) {
+                // Both rows in one pass over the first row's columns: the second row's values
+                // are `len` entries on, and each row keeps row_dot's accumulators and order.
+                const int len = ao[s0 + 1] - ao[s0];
+                const int ob = own_begin_[static_cast<size_t>(s0)];
+                const int oe = own_end_[static_cast<size_t>(s0)];
+                double d0, d1;
+                twin_row_dot(ai, av, len, xp, ob, oe, d0, d1);
+                t0 = bp[s0] - d0;
+                t1 = bp[s0 + 1] - d1;
+                if (ao[s0] != ob) {
+                    twin_row_dot(ai, av, len, sp, ao[s0], ob, d0, d1);
+                    t0 -= d0;
+                    t1 -= d1;
+                }
+                if (oe != ao[s0 + 1]) {
+                    twin_row_dot(ai, av, len, sp, oe, ao[s0 + 1], d0, d1);
+                    t0 -= d0;
+                    t1 -= d1;
+                }
+            } else {
+                t0 = unrolled_row(s0);
+                t1 = unrolled_row(s0 + 1);
+            }
+            const Value* D = dinv + offset_[blk];
+            double c0 = 0.0, c1 = 0.0;
+            c0 += D[0] * t0;
+            c0 += D[1] * t1;
+            c1 += D[2] * t0;
+            c1 += D[3] * t1;
+            xp[s0] += post_ * c0;
+            xp[s0 + 1] += post_ * c1;
+            continue;
+        }
         for (Index i = s0; i < s1; ++i) {
             const auto r = static_cast<size_t>(i);
             const int ob = own_begin_[r], oe = own_end_[r];
             if (unrolled) {
-                t[i - s0] = bp[i] - row_dot(ai, av, xp, ob, oe) - row_dot(ai, av, sp, ao[i], ob) -
-                            row_dot(ai, av, sp, oe, ao[i + 1]);
+                t[i - s0] = unrolled_row(i);
                 continue;
             }
             double acc = bp[i];

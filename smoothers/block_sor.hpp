@@ -226,11 +226,12 @@ private:
     Index max_block_ = 0;
     std::vector<int> diag_begin_;          // per row: first stored entry in or right of its block
     std::vector<int> own_begin_, own_end_; // per row: its entries with columns in its own part
-    std::vector<Index> part_block_;        // first block of each part, then the block count
-    std::vector<int> interface_;           // columns read across a cut (copied into snap_)
-    mutable Vector snap_;                  // other parts' unknowns at the start of a sweep
-    mutable Vector work_;                  // one block's residual per part
-    mutable Vector res_;                   // n-vector for apply_transpose
+    std::vector<char> twin_;        // per block: a 2x2 block whose rows have the same columns
+    std::vector<Index> part_block_; // first block of each part, then the block count
+    std::vector<int> interface_;    // columns read across a cut (copied into snap_)
+    mutable Vector snap_;           // other parts' unknowns at the start of a sweep
+    mutable Vector work_;           // one block's residual per part
+    mutable Vector res_;            // n-vector for apply_transpose
 };
 
 } // namespace mlc::smoothers
