@@ -591,7 +591,6 @@ void BlockSOR::forward_from_zero(const Vector& b, Vector& x, Vector& res) const 
 template <class Value>
 void BlockSOR::forward_from_zero_unrolled(const Value* val, const Value* dinv, const double* bp,
                                           double* xp, double* rp) const {
-    const Index n = A_->rows();
     const int* outer = A_->outerIndexPtr();
     const int* inner = A_->innerIndexPtr();
     const int* dbeg = diag_begin_.data();
@@ -603,9 +602,17 @@ void BlockSOR::forward_from_zero_unrolled(const Value* val, const Value* dinv, c
         for (Index I = part_block_[p]; I < part_block_[p + 1]; ++I) {
             const Index s = starts_[static_cast<size_t>(I)],
                         bs = starts_[static_cast<size_t>(I) + 1] - s;
-            for (Index i = s; i < s + bs; ++i)
-                rp[i] =
-                    bp[i] - row_dot(inner, val, xp, own_begin_[static_cast<size_t>(i)], dbeg[i]);
+            if (twin_[static_cast<size_t>(I)]) { // both rows in one pass (see sweep_part)
+                double d0, d1;
+                twin_row_dot(inner, val, outer[s + 1] - outer[s], xp,
+                             own_begin_[static_cast<size_t>(s)], dbeg[s], d0, d1);
+                rp[s] = bp[s] - d0;
+                rp[s + 1] = bp[s + 1] - d1;
+            } else {
+                for (Index i = s; i < s + bs; ++i)
+                    rp[i] = bp[i] -
+                            row_dot(inner, val, xp, own_begin_[static_cast<size_t>(i)], dbeg[i]);
+            }
             const Value* d = dinv + offset_[static_cast<size_t>(I)];
             for (Index i = 0; i < bs; ++i) {
                 double acc = 0.0;
@@ -615,12 +622,27 @@ void BlockSOR::forward_from_zero_unrolled(const Value* val, const Value* dinv, c
             }
         }
     });
-    parallel::for_rows(static_cast<size_t>(n), static_cast<size_t>(kMinRowsPerThread),
-                       [&](size_t i0, size_t i1) {
-                           for (size_t i = i0; i < i1; ++i)
-                               rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
-                                        row_dot(inner, val, xp, outer[i], own_begin_[i]);
-                       });
+    // The blocks over the threads (each row's sums as row by row; twin rows in one pass).
+    const auto nb = static_cast<size_t>(n_blocks());
+    const size_t blocks_per_chunk = static_cast<size_t>(kMinRowsPerThread) / 2;
+    parallel::for_rows(nb, blocks_per_chunk, [&](size_t I0, size_t I1) {
+        for (size_t I = I0; I < I1; ++I) {
+            const Index s = starts_[I], e = starts_[I + 1];
+            if (twin_[I]) {
+                const int len = outer[s + 1] - outer[s];
+                double u0, u1, l0, l1;
+                twin_row_dot(inner, val, len, xp, dbeg[s], outer[s + 1], u0, u1);
+                twin_row_dot(inner, val, len, xp, outer[s], own_begin_[static_cast<size_t>(s)], l0,
+                             l1);
+                rp[s] -= u0 + l0;
+                rp[s + 1] -= u1 + l1;
+                continue;
+            }
+            for (auto i = static_cast<size_t>(s); i < static_cast<size_t>(e); ++i)
+                rp[i] -= row_dot(inner, val, xp, dbeg[i], outer[i + 1]) +
+                         row_dot(inner, val, xp, outer[i], own_begin_[i]);
+        }
+    });
 }
 
 void BlockSOR::apply(const Vector& r, Vector& z) const {

@@ -426,4 +426,52 @@ TEST(BlockSOR, TwinRowsOfAVertexBlockSweepAsTheirRowsOneByOneBitForBit) {
         differing += x[i] != want[i];
     EXPECT_EQ(differing, 0) << "of " << n << " entries";
     EXPECT_GT((x - x0).norm(), 0.1 * x0.norm()); // the sweep did something
+
+    // forward_from_zero: each part's lower entries from x = 0, then the residual b - A x as
+    // (b - own lower part) - (diagonal and upper part + other parts' lower part), row by row.
+    Vector xz(n), rz(n);
+    for (size_t p = 0; p + 1 < rows.size(); ++p) {
+        const Index r0 = rows[p], r1 = rows[p + 1];
+        for (Index i0 = r0; i0 < r1; i0 += 2) {
+            for (int a = 0; a < 2; ++a) {
+                const Index i = i0 + a;
+                const int ob =
+                    static_cast<int>(std::lower_bound(ai + ao[i], ai + ao[i + 1], r0) - ai);
+                const int db =
+                    static_cast<int>(std::lower_bound(ai + ao[i], ai + ao[i + 1], i0) - ai);
+                rz[i] = b[i] - row_dot(ai, av, xz.data(), ob, db);
+            }
+            const double d00 = A.coeff(i0, i0), d01 = A.coeff(i0, i0 + 1);
+            const double d10 = A.coeff(i0 + 1, i0), d11 = A.coeff(i0 + 1, i0 + 1);
+            const double f = w / (d00 * d11 - d01 * d10);
+            const double inv[4] = {f * d11, -f * d01, -f * d10, f * d00};
+            for (int a = 0; a < 2; ++a) {
+                double c = 0.0;
+                c += inv[2 * a] * rz[i0];
+                c += inv[2 * a + 1] * rz[i0 + 1];
+                xz[i0 + a] = c;
+            }
+        }
+    }
+    for (size_t p = 0; p + 1 < rows.size(); ++p)
+        for (Index i = rows[p]; i < rows[p + 1]; ++i) {
+            const Index i0 = i - (i - rows[p]) % 2;
+            const int ob =
+                static_cast<int>(std::lower_bound(ai + ao[i], ai + ao[i + 1], rows[p]) - ai);
+            const int db = static_cast<int>(std::lower_bound(ai + ao[i], ai + ao[i + 1], i0) - ai);
+            rz[i] -=
+                row_dot(ai, av, xz.data(), db, ao[i + 1]) + row_dot(ai, av, xz.data(), ao[i], ob);
+        }
+    Vector xf, rf;
+    S.forward_from_zero(b, xf, rf);
+    int differing_x = 0, differing_r = 0;
+    for (Index i = 0; i < n; ++i) {
+        differing_x += xf[i] != xz[i];
+        differing_r += rf[i] != rz[i];
+    }
+    EXPECT_EQ(differing_x, 0) << "of " << n << " entries of x";
+    EXPECT_EQ(differing_r, 0) << "of " << n << " entries of the residual";
+    Vector check = b;
+    check.noalias() -= A * xf;
+    EXPECT_LT((rf - check).norm(), 1e-12 * b.norm()); // and it is b - A x
 }
