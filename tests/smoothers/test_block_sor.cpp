@@ -10,6 +10,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <sstream>
 
 using namespace mlc;
@@ -386,6 +387,20 @@ TEST(BlockSOR, TwinRowsOfAVertexBlockSweepAsTheirRowsOneByOneBitForBit) {
     const int* ai = A.innerIndexPtr();
     const double* av = A.valuePtr();
     const std::vector<Index> rows = S.part_rows();
+    // The unrolled kernel's closed-form inverse of block [i0, i0 + 2) (omega w) times (t0, t1),
+    // each entry summed from 0.0 as the kernel does.
+    auto block_solve = [&](Index i0, double t0, double t1) {
+        const double d00 = A.coeff(i0, i0), d01 = A.coeff(i0, i0 + 1);
+        const double d10 = A.coeff(i0 + 1, i0), d11 = A.coeff(i0 + 1, i0 + 1);
+        const double f = w / (d00 * d11 - d01 * d10);
+        const double inv[4] = {f * d11, -f * d01, -f * d10, f * d00};
+        std::array<double, 2> c{0.0, 0.0};
+        for (int a = 0; a < 2; ++a) {
+            c[a] += inv[2 * a] * t0;
+            c[a] += inv[2 * a + 1] * t1;
+        }
+        return c;
+    };
     auto reference_half_sweep = [&](Vector& x, bool forward) {
         const Vector snap = x;
         for (size_t p = 0; p + 1 < rows.size(); ++p) {
@@ -403,16 +418,9 @@ TEST(BlockSOR, TwinRowsOfAVertexBlockSweepAsTheirRowsOneByOneBitForBit) {
                            row_dot(ai, av, snap.data(), ao[i], ob) -
                            row_dot(ai, av, snap.data(), oe, ao[i + 1]);
                 }
-                const double d00 = A.coeff(i0, i0), d01 = A.coeff(i0, i0 + 1);
-                const double d10 = A.coeff(i0 + 1, i0), d11 = A.coeff(i0 + 1, i0 + 1);
-                const double f = w / (d00 * d11 - d01 * d10);
-                const double inv[4] = {f * d11, -f * d01, -f * d10, f * d00};
-                for (int a = 0; a < 2; ++a) {
-                    double c = 0.0;
-                    c += inv[2 * a] * t[0];
-                    c += inv[2 * a + 1] * t[1];
-                    x[i0 + a] += c;
-                }
+                const auto c = block_solve(i0, t[0], t[1]);
+                x[i0] += c[0];
+                x[i0 + 1] += c[1];
             }
         }
     };
@@ -441,16 +449,9 @@ TEST(BlockSOR, TwinRowsOfAVertexBlockSweepAsTheirRowsOneByOneBitForBit) {
                     static_cast<int>(std::lower_bound(ai + ao[i], ai + ao[i + 1], i0) - ai);
                 rz[i] = b[i] - row_dot(ai, av, xz.data(), ob, db);
             }
-            const double d00 = A.coeff(i0, i0), d01 = A.coeff(i0, i0 + 1);
-            const double d10 = A.coeff(i0 + 1, i0), d11 = A.coeff(i0 + 1, i0 + 1);
-            const double f = w / (d00 * d11 - d01 * d10);
-            const double inv[4] = {f * d11, -f * d01, -f * d10, f * d00};
-            for (int a = 0; a < 2; ++a) {
-                double c = 0.0;
-                c += inv[2 * a] * rz[i0];
-                c += inv[2 * a + 1] * rz[i0 + 1];
-                xz[i0 + a] = c;
-            }
+            const auto c = block_solve(i0, rz[i0], rz[i0 + 1]);
+            xz[i0] = c[0];
+            xz[i0 + 1] = c[1];
         }
     }
     for (size_t p = 0; p + 1 < rows.size(); ++p)
