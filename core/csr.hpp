@@ -43,6 +43,39 @@ inline double row_dot(const int* inner, const Value* val, const double* x, int k
     return (a0 + a1) + (a2 + a3);
 }
 
+/// row_dot of two rows with the same columns at once (a vertex's twin rows: BlockSOR's sweeps): r0
+/// over entries [k0, k1) of the first row, r1 over the same positions of the second, whose values
+/// are `len` entries on. Each row has row_dot's four accumulators and order, so r0 and r1 are its
+/// values bit for bit; a change of row_dot's order must be made here too (tests/smoothers: the twin
+/// test compares them).
+template <class Value>
+inline void twin_row_dot(const int* inner, const Value* val, int len, const double* x, int k0,
+                         int k1, double& r0, double& r1) {
+    const Value* w = val + len;
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    double b0 = 0.0, b1 = 0.0, b2 = 0.0, b3 = 0.0;
+    int k = k0;
+    for (; k + 3 < k1; k += 4) {
+        const double x0 = x[inner[k]], x1 = x[inner[k + 1]];
+        const double x2 = x[inner[k + 2]], x3 = x[inner[k + 3]];
+        a0 += val[k] * x0;
+        a1 += val[k + 1] * x1;
+        a2 += val[k + 2] * x2;
+        a3 += val[k + 3] * x3;
+        b0 += w[k] * x0;
+        b1 += w[k + 1] * x1;
+        b2 += w[k + 2] * x2;
+        b3 += w[k + 3] * x3;
+    }
+    for (; k < k1; ++k) {
+        const double xk = x[inner[k]];
+        a0 += val[k] * xk;
+        b0 += w[k] * xk;
+    }
+    r0 = (a0 + a1) + (a2 + a3);
+    r1 = (b0 + b1) + (b2 + b3);
+}
+
 /// y = A x (or y += A x with `add`) for a compressed CSR matrix, each row by `row_dot`, rows
 /// split into chunks of at least kMinRowsPerThread rows run by core/parallel's threads (every
 /// row is summed the same way

@@ -386,41 +386,6 @@ void BlockSOR::invert_block_range(Index b_begin, Index b_end, const int* ao, con
     }
 }
 
-namespace {
-
-// row_dot (core/csr.hpp) of two rows with the same columns at once: r0 over entries [k0, k1) of
-// the first row, r1 over the same positions of the second, whose values are `len` entries on.
-// Each row has row_dot's four accumulators and order, so r0 and r1 are its values bit for bit.
-template <class Value>
-inline void twin_row_dot(const int* inner, const Value* val, int len, const double* x, int k0,
-                         int k1, double& r0, double& r1) {
-    const Value* w = val + len;
-    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
-    double b0 = 0.0, b1 = 0.0, b2 = 0.0, b3 = 0.0;
-    int k = k0;
-    for (; k + 3 < k1; k += 4) {
-        const double x0 = x[inner[k]], x1 = x[inner[k + 1]];
-        const double x2 = x[inner[k + 2]], x3 = x[inner[k + 3]];
-        a0 += val[k] * x0;
-        a1 += val[k + 1] * x1;
-        a2 += val[k + 2] * x2;
-        a3 += val[k + 3] * x3;
-        b0 += w[k] * x0;
-        b1 += w[k + 1] * x1;
-        b2 += w[k + 2] * x2;
-        b3 += w[k + 3] * x3;
-    }
-    for (; k < k1; ++k) {
-        const double xk = x[inner[k]];
-        a0 += val[k] * xk;
-        b0 += w[k] * xk;
-    }
-    r0 = (a0 + a1) + (a2 + a3);
-    r1 = (b0 + b1) + (b2 + b3);
-}
-
-} // namespace
-
 // One part's half-sweep over blocks [b0, b1) with scratch t (one block). The other parts'
 // unknowns are read from snap_ (their values when the sweep began). With from_zero (in_order
 // kernel only) x is zero on entry and only the already-visited own entries of each row count.

@@ -66,6 +66,36 @@ TEST(RowDot, UsesFourAccumulatorsInAFixedOrder) {
     EXPECT_EQ(row_dot(inner, val, x, 2, 2), 0.0);
 }
 
+TEST(TwinRowDot, IsRowDotOfEachRowBitForBit) {
+    // Two rows with the same columns, their values stored one after the other (len apart):
+    // every sub-range [k0, k1) of the first row's entries (the remainder loop included) gives
+    // row_dot of each row. Values of mixed magnitudes make any other grouping show; the first
+    // row's case is RowDot's, whose grouped sum 0 differs from the in-order 3.
+    const int len = 9;
+    const int inner[2 * len] = {0, 2, 3, 5, 6, 7, 9, 10, 12, 0, 2, 3, 5, 6, 7, 9, 10, 12};
+    const double val[2 * len] = {1e16,  1.0, -1e16, 1.0, 1.0, 1.0, 3.5,   -2.25, 7.0,
+                                 -1e16, 2.0, 1e16,  1.0, 0.5, 1.0, -1e16, 1.0,   1e16};
+    double x[13];
+    for (int j = 0; j < 13; ++j)
+        x[j] = 1.0 + 0.125 * j;
+    x[0] = x[2] = x[3] = x[5] = x[6] = x[7] = 1.0; // the first six entries: RowDot's case
+    for (int k0 = 0; k0 <= len; ++k0)
+        for (int k1 = k0; k1 <= len; ++k1) {
+            double r0 = -1.0, r1 = -1.0;
+            twin_row_dot(inner, val, len, x, k0, k1, r0, r1);
+            EXPECT_EQ(r0, row_dot(inner, val, x, k0, k1)) << k0 << " " << k1;
+            EXPECT_EQ(r1, row_dot(inner, val, x, k0 + len, k1 + len)) << k0 << " " << k1;
+        }
+    double r0 = 0.0, r1 = 0.0;
+    twin_row_dot(inner, val, len, x, 0, 6, r0, r1);
+    EXPECT_EQ(r0, 0.0); // RowDot's grouping: (1e16 + 1 + 1) + 1 + (-1e16 + 1)
+    const float val32[2 * len] = {1.5f,  2.0f, -3.0f, 0.25f, 1.0f, 1.0f, 3.5f,  -2.25f, 7.0f,
+                                  -1.0f, 2.0f, 1.0f,  1.0f,  0.5f, 1.0f, -1.0f, 1.0f,   1e3f};
+    twin_row_dot(inner, val32, len, x, 1, 8, r0, r1);
+    EXPECT_EQ(r0, row_dot(inner, val32, x, 1, 8));
+    EXPECT_EQ(r1, row_dot(inner, val32, x, 1 + len, 8 + len));
+}
+
 TEST(CsrMultiplyInOrder, IsEigensSerialProductBitForBitOnEveryChunk) {
     // Rows over several chunks (and threads): each row still summed as Eigen sums it. Values
     // spread over 12 orders of magnitude, so that another summation order shows in the last bits.
