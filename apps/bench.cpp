@@ -195,23 +195,41 @@ double matrix_seconds(const traffic::Account& a) {
 
 } // namespace
 
+BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body) {
+    if (pc != "default") return {opt.krylov.value_or("cgs"), pc};
+    return {opt.krylov.value_or(levels::kMgDefaultKrylov),
+            two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody};
+}
+
 int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 8,
               "bench square: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench square: --repeat must be >= 1, found " << opt.repeat);
     MLC_CHECK(!opt.pcs.empty(), "bench square: no --pc given");
-    check_preconditioner_names(opt.pcs, true);
+    std::vector<std::string> named;
+    for (const std::string& pc : opt.pcs)
+        if (pc != "default") named.push_back(pc);
+    check_preconditioner_names(named, true);
     levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
+    const bool two_body = levels::mg_crossover_unknowns(base) == levels::kMgCrossoverTwoBody;
+    const BenchSolver def = bench_solver(opt, "default", two_body);
+    const std::string named_krylov = opt.krylov.value_or("cgs");
+    std::string krylov_label = named_krylov;
+    if (named.size() != opt.pcs.size())
+        krylov_label = named.empty() ? def.krylov : named_krylov + " (default: " + def.krylov + ")";
     const std::filesystem::path out = bench_json_path(opt.out, "", opt.scene, opt.levels);
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
-       << ",\n  \"krylov\": " << json_string(opt.krylov) << ",\n  \"rel_tol\": " << opt.rel_tol
+       << ",\n  \"krylov\": " << json_string(krylov_label) << ",\n  \"rel_tol\": " << opt.rel_tol
        << ",\n  \"repeat\": " << opt.repeat
        << ",\n  \"extrapolate\": " << (opt.extrapolate ? "true" : "false") << ",\n  \"runs\": [";
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
-       << base.load_steps << " load steps, Krylov " << opt.krylov << " rel_tol " << opt.rel_tol
+       << base.load_steps << " load steps, Krylov " << krylov_label << " rel_tol " << opt.rel_tol
        << ", times are medians of " << opt.repeat << " run(s)\n";
+    if (named.size() != opt.pcs.size())
+        os << "default = " << def.krylov << " + " << def.pc
+           << " (the run's default above the crossover)\n";
     os << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
        << std::setw(11) << "nonzeros" << std::setw(7) << "newton" << std::setw(10) << "its/newt"
        << std::setw(6) << "max" << std::setw(10) << "asm s" << std::setw(10) << "setup s"
@@ -233,12 +251,13 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         levels::SolveOptions so;
         so.coarse_to_fine = true;
         so.extrapolate = opt.extrapolate;
+        const BenchSolver solver = bench_solver(opt, pc, two_body);
         if (pc == "schur" || pc == "lu")
             so.linear.method = pc;
         else
             so.linear = {.method = "krylov",
-                         .krylov = opt.krylov,
-                         .pc = pc,
+                         .krylov = solver.krylov,
+                         .pc = solver.pc,
                          .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
         std::vector<SquareRow> rows;

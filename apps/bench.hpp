@@ -28,6 +28,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -37,20 +38,32 @@ namespace mlc::apps {
 /// Options of `bench square`.
 struct BenchSquareOptions {
     std::string scene = "square";
-    int levels = 3;                        ///< finest level L (levels 0..L are all solved)
-    std::vector<std::string> pcs = {"mg"}; ///< "schur", "lu", or Krylov preconditioner specs
-    std::string krylov = "cgs";            ///< Krylov method for the preconditioner specs
-    double rel_tol = 1e-8;                 ///< Krylov relative tolerance
-    int max_iter = 5000;                   ///< Krylov iterations per Newton step
-    int repeat = 1;                        ///< runs per solver; times are medians over them
+    int levels = 3; ///< finest level L (levels 0..L are all solved)
+    /// "schur", "lu", "default" (the run's default mg and Krylov method above the crossover:
+    /// levels::kMgDefaultOneBody or kMgDefaultTwoBody with levels::kMgDefaultKrylov), or Krylov
+    /// preconditioner specs.
+    std::vector<std::string> pcs = {"default"};
+    /// Krylov method for the preconditioner specs; unset: CGS, and for "default" the run's.
+    std::optional<std::string> krylov;
+    double rel_tol = 1e-8; ///< Krylov relative tolerance
+    int max_iter = 5000;   ///< Krylov iterations per Newton step
+    int repeat = 1;        ///< runs per solver; times are medians over them
     /// Linear load steps taken at the extrapolated state (levels::SolveOptions::extrapolate, the
     /// run's default); off by default here, so that every load step's Newton is measured.
     bool extrapolate = false;
-    std::filesystem::path out;             ///< JSON file (default out/bench/square_L<L>.json)
+    std::filesystem::path out; ///< JSON file (default out/bench/square_L<L>.json)
     /// STREAM (core/traffic.hpp) array length in doubles, and its repetitions (best taken).
     std::size_t stream_doubles = std::size_t(1) << 25;
     int stream_repeats = 5;
 };
+
+/// The Krylov method and preconditioner spec `bench square` runs for the entry `pc` of
+/// opt.pcs on a problem with (`two_body`) or without a two-body pair: "default" is the run's
+/// default above the crossover, anything else `pc` itself with opt.krylov (CGS if unset).
+struct BenchSolver {
+    std::string krylov, pc;
+};
+BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body);
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every run converged).
 int bench_square(const BenchSquareOptions& opt, std::ostream& os);
@@ -58,10 +71,10 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os);
 /// Options of `bench elastic`.
 struct BenchElasticOptions {
     std::string scene = "square";
-    int levels = 3;            ///< the elastic block of level L
-    double rel_tol = 1e-8;     ///< relative tolerance of every solve
-    int max_iter = 1000;       ///< iterations of every solve
-    int repeat = 1;            ///< runs per solver; times are medians over them
+    int levels = 3;        ///< the elastic block of level L
+    double rel_tol = 1e-8; ///< relative tolerance of every solve
+    int max_iter = 1000;   ///< iterations of every solve
+    int repeat = 1;        ///< runs per solver; times are medians over them
     /// JSON file (default out/bench/elastic_<scene>_L<L>.json; on N > 1 processes
     /// out/bench/elastic_<scene>_L<L>_np<N>.json)
     std::filesystem::path out;

@@ -37,25 +37,28 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 8,
               "bench square: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench square: --repeat must be >= 1, found " << opt.repeat);
-    MLC_CHECK(opt.pcs.size() == 1 && opt.pcs.front().rfind("mg", 0) == 0,
-              "bench square on several processes runs mg alone (--pc mg[:options]); the other "
-              "preconditioners have no distributed form");
+    MLC_CHECK(opt.pcs.size() == 1 &&
+                  (opt.pcs.front() == "default" || opt.pcs.front().rfind("mg", 0) == 0),
+              "bench square on several processes runs mg alone (--pc default or "
+              "mg[:options]); the other preconditioners have no distributed form");
     levels::Problem p = scene::load_scene(opt.scene);
     p.levels = opt.levels;
     p.validate();
+    const BenchSolver solver = bench_solver(
+        opt, opt.pcs.front(), levels::mg_crossover_unknowns(p) == levels::kMgCrossoverTwoBody);
     parallel::set_num_threads(1);
     const int np = comm.size();
     const int plevel = levels::partition_level(p.mesh0.n_triangles(), p.levels, np);
     levels::SolveOptions so;
     so.coarse_to_fine = true;
     so.linear = {.method = "krylov",
-                 .krylov = opt.krylov,
-                 .pc = opt.pcs.front(),
+                 .krylov = solver.krylov,
+                 .pc = solver.pc,
                  .rel_tol = opt.rel_tol,
                  .max_iter = opt.max_iter};
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
        << p.load_steps << " load steps, " << np << " processes (one thread each), partition level "
-       << plevel << ", Krylov " << opt.krylov << " + distributed " << opt.pcs.front() << " rel_tol "
+       << plevel << ", Krylov " << solver.krylov << " + distributed " << solver.pc << " rel_tol "
        << opt.rel_tol << ", times are medians of " << opt.repeat << " run(s)\n";
     std::vector<double> walls;
     levels::DistributedRunResult last;
@@ -136,7 +139,7 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
             js << std::setprecision(9) << "{\n  \"scene\": \"" << opt.scene
                << "\",\n  \"levels\": " << opt.levels << ",\n  \"processes\": " << np
                << ",\n  \"threads_per_process\": 1,\n  \"partition_level\": " << plevel
-               << ",\n  \"krylov\": \"" << opt.krylov << "\",\n  \"pc\": \"" << opt.pcs.front()
+               << ",\n  \"krylov\": \"" << solver.krylov << "\",\n  \"pc\": \"" << solver.pc
                << "\",\n  \"rel_tol\": " << opt.rel_tol << ",\n  \"repeat\": " << opt.repeat
                << ",\n  \"wall_seconds\": " << wall << ",\n  \"wall_seconds_runs\": [";
             for (size_t i = 0; i < walls.size(); ++i)

@@ -179,8 +179,12 @@ int main(int argc, char** argv) {
     bsq->add_option(
         "--pc", bso.pcs,
         mlc::apps::pc_option_help(
-            "solvers (space-separated list): schur, lu, or preconditioner specs (default mg)"));
-    bsq->add_option("--krylov", bso.krylov, "Krylov method for the preconditioners (default cgs)");
+            "solvers (space-separated list): schur, lu, default (the run's default above the "
+            "crossover: BiCGStab + mg:pre=0,post=2, damped with a two-body pair), or "
+            "preconditioner specs (default: default)"));
+    bsq->add_option("--krylov", bso.krylov,
+                    "Krylov method for the preconditioners (default cgs; for `default` the run's, "
+                    "bicgstab)");
     bsq->add_option("--tol", bso.rel_tol, "Krylov relative tolerance (default 1e-8)");
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
     bsq->add_option("--repeat", bso.repeat, "runs per solver, times are medians (default 1)");

@@ -36,8 +36,11 @@ levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two
                              "a Krylov method with mg (--linear krylov, the default there)");
     levels::LinearSolverSpec s;
     s.method = "krylov";
-    s.krylov = opt.krylov.value_or(two_body ? "bicgstab" : "cgs");
-    s.pc = opt.pc.value_or(two_body ? levels::kMgDefaultTwoBody : "mg");
+    // The driver's own default (BiCGStab + V(0,2) mg) when no preconditioner is named; a named
+    // one keeps the Krylov method it always had (CGS, BiCGStab with a two-body pair).
+    s.krylov =
+        opt.krylov.value_or(opt.pc ? (two_body ? "bicgstab" : "cgs") : levels::kMgDefaultKrylov);
+    s.pc = opt.pc.value_or(two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody);
     if (opt.linear_rel_tol) s.rel_tol = *opt.linear_rel_tol;
     s.validate();
     return s;

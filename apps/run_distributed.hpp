@@ -13,8 +13,10 @@
 namespace mlc::apps {
 
 /// The Newton-system solver of a run on several processes: Krylov with mg (the default; its
-/// pre/post/omega options apply). Defaults as on one process: CGS + mg, and with a two-body pair
-/// (`two_body`) BiCGStab + mg:omega=0.8 (levels::kMgDefaultTwoBody). Throws InvalidInput for
+/// pre/post/omega options apply). Defaults as on one process: BiCGStab + mg's V(0,2) cycle
+/// (levels::kMgDefaultOneBody), damped with a two-body pair (`two_body`,
+/// levels::kMgDefaultTwoBody); a named `pc` without `krylov` takes CGS (BiCGStab with a
+/// two-body pair), as before the V(0,2) default. Throws InvalidInput for
 /// --linear schur|lu and names what works.
 levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two_body = false);
 

@@ -53,8 +53,7 @@ Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec&
     so.r_continuation = true;
     const auto r = levels::solve(p, so);
     f["seconds"] = num(wall_seconds() - t0);
-    int newton = 0, krylov = 0, cycling = -1, krylov_systems = 0, fallbacks = 0,
-        continuations = 0;
+    int newton = 0, krylov = 0, cycling = -1, krylov_systems = 0, fallbacks = 0, continuations = 0;
     for (const auto& ls : r.level_steps)
         for (const auto& st : ls) {
             fallbacks += st.report.fallback_solves;
@@ -380,12 +379,13 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     } else {
         solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}}));
         if (opt.levels >= 1) {
-            // CGS + mg (one body) and BiCGStab + damped mg (what the default takes with a
-            // two-body pair, as in the contrast cases, above its crossover).
+            // What the default takes above its crossover: BiCGStab + mg's V(0,2) cycle (one
+            // body) and the same damped (with a two-body pair, as in the contrast cases).
+            const std::string krylov = levels::kMgDefaultKrylov;
             solvers.push_back(levels::choose_solver(
-                sq, {{}, {}, std::string(levels::kMgDefaultOneBody), {}}));
+                sq, {{}, krylov, std::string(levels::kMgDefaultOneBody), {}}));
             solvers.push_back(levels::choose_solver(
-                sq, {{}, std::string("bicgstab"), std::string(levels::kMgDefaultTwoBody), {}}));
+                sq, {{}, krylov, std::string(levels::kMgDefaultTwoBody), {}}));
         }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "

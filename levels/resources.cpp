@@ -109,11 +109,13 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
         } else {
             const bool two_body = mg_crossover_unknowns(problem) == kMgCrossoverTwoBody;
             s.pc = !has_levels ? "ilu:0" : two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
+            if (has_levels && !req.krylov) s.krylov = kMgDefaultKrylov;
             c.reason = !has_levels ? "--linear krylov on a single level (no level below for mg): "
                                      "ilu:0"
-                       : two_body ? "--linear krylov: multilevel mg over the levels, damped "
-                                    "(omega = 0.8) with a two-body pair"
-                                  : "--linear krylov: multilevel mg over the levels";
+                       : two_body  ? "--linear krylov: multilevel mg over the levels (V(0,2) "
+                                     "cycle), damped (omega = 0.8) with a two-body pair"
+                                   : "--linear krylov: multilevel mg over the levels (V(0,2) "
+                                     "cycle)";
         }
     } else {
         c.automatic = true;
@@ -124,17 +126,14 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
         os << std::setprecision(3);
         if (has_levels && n > crossover) {
             s.method = "krylov";
-            // Two-body pairs: BiCGStab and damped sweeps need fewer V-cycles than CGS and
-            // undamped ones (README "Choosing the Newton-system solver").
+            // BiCGStab with a V(0,2) cycle; two-body pairs also damp the sweeps (README
+            // "Choosing the Newton-system solver", "The default cycle: V(0,2) with BiCGStab").
             const bool two_body = crossover == kMgCrossoverTwoBody;
             s.pc = two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
-            if (two_body) s.krylov = "bicgstab";
+            if (!req.krylov) s.krylov = kMgDefaultKrylov;
             os << "default: " << n << " unknowns on the finest level exceed the crossover "
-               << crossover << ": " << (two_body ? "BiCGStab + mg:omega=0.8" : "CGS + mg")
-               << " (faster and smaller than schur there"
-               << (two_body ? "; with a two-body pair BiCGStab and damped sweeps need fewer "
-                              "V-cycles)"
-                            : ")");
+               << crossover << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
+               << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles)" : ")");
         } else {
             s.method = "schur";
             if (!has_levels && n > crossover)

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """The default Newton-system solver against both candidates (issue 11, "a fast default at every
 size"): for each scene and level, `mlcontact run SCENE --levels L --quiet` with no solver flag,
-with `--linear schur` and with the Krylov + mg candidate (`--pc mg`, that is CGS + mg; --mg sets
-other flags; none on level 0, where mg has no level below), REPEAT times each in turn. Wall time (perf_counter, ms resolution) and the peak
+with `--linear schur` and with the Krylov + mg candidate (`--linear krylov`, the driver's own
+pair: BiCGStab + mg:pre=0,post=2, damped with a two-body pair; until 2026-11-26 this was
+`--pc mg`, CGS + mg; --mg sets other flags; none on level 0, where mg has no level below), REPEAT times each in turn. Wall time (perf_counter, ms resolution) and the peak
 RSS of each process (wait4). Prints the medians, the solver the default chose and its ratios to
 the faster and to the smaller candidate (the bar: both at most 1.15), and writes
 out/bench/solver_choice.csv and .json. Run it on an idle machine: it measures wall time.
@@ -43,7 +44,7 @@ def run_once(scene, level, flags):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--mg", default="--pc mg")
+    ap.add_argument("--mg", default="--linear krylov")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "solver_choice"))
     ap.add_argument("cases", nargs="*",
                     default=["square:1,2,3", "hertz:1,2,3", "dovetail:1,2,3,4"])

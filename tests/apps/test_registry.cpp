@@ -131,8 +131,21 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
     // accept every registered name and refuse others.
     for (const auto& spec : apps::PreconditionerStudyOptions{}.pcs)
         EXPECT_NE(solvers::find_preconditioner(spec), nullptr) << spec;
-    for (const auto& spec : apps::BenchSquareOptions{}.pcs)
-        EXPECT_NE(solvers::find_preconditioner(spec), nullptr) << spec;
+    // The bench's default is the run's default pair, whose mg spec is registered too.
+    const apps::BenchSquareOptions bench_defaults;
+    EXPECT_EQ(bench_defaults.pcs, std::vector<std::string>{"default"});
+    for (const bool two_body : {false, true}) {
+        const apps::BenchSolver d = apps::bench_solver(bench_defaults, "default", two_body);
+        EXPECT_EQ(d.krylov, levels::kMgDefaultKrylov);
+        EXPECT_EQ(d.pc, two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody);
+        EXPECT_NE(solvers::find_preconditioner(d.pc), nullptr) << d.pc;
+    }
+    // A named preconditioner without --krylov keeps CGS; --krylov applies to both.
+    EXPECT_EQ(apps::bench_solver(bench_defaults, "mg", false).krylov, "cgs");
+    apps::BenchSquareOptions gmres;
+    gmres.krylov = "gmres";
+    EXPECT_EQ(apps::bench_solver(gmres, "mg", false).krylov, "gmres");
+    EXPECT_EQ(apps::bench_solver(gmres, "default", true).krylov, "gmres");
     std::vector<std::string> all;
     for (const auto& e : reg)
         all.push_back(e.name);

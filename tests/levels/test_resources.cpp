@@ -54,18 +54,29 @@ TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
     const auto k = levels::choose_solver(p, {{}, std::string("gmres"), {}, {}});
     EXPECT_EQ(k.spec.method, "krylov");
     EXPECT_EQ(k.spec.krylov, "gmres");
-    EXPECT_EQ(k.spec.pc, "mg");
+    EXPECT_EQ(k.spec.pc, "mg:pre=0,post=2");
+    // The tolerance alone: the driver's own mg pair, BiCGStab + V(0,2).
     const auto t = levels::choose_solver(p, {{}, {}, {}, 1e-6});
     EXPECT_EQ(t.spec.method, "krylov");
     EXPECT_EQ(t.spec.rel_tol, 1e-6);
+    EXPECT_EQ(t.spec.krylov, "bicgstab");
+    EXPECT_EQ(t.spec.pc, "mg:pre=0,post=2");
 }
 
 TEST(ChooseSolver, LinearKrylovUsesMgWhereLevelsExistAndIluOnOneLevel) {
     auto p = scene::load_scene("square");
     p.levels = 1;
-    EXPECT_EQ(levels::choose_solver(p, {std::string("krylov"), {}, {}, {}}).spec.pc, "mg");
+    const auto mg = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
+    EXPECT_EQ(mg.spec.pc, "mg:pre=0,post=2");
+    EXPECT_EQ(mg.spec.krylov, "bicgstab");
+    // A Krylov method named beside it is kept.
+    EXPECT_EQ(
+        levels::choose_solver(p, {std::string("krylov"), std::string("cgs"), {}, {}}).spec.krylov,
+        "cgs");
     p.levels = 0;
-    EXPECT_EQ(levels::choose_solver(p, {std::string("krylov"), {}, {}, {}}).spec.pc, "ilu:0");
+    const auto ilu = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
+    EXPECT_EQ(ilu.spec.pc, "ilu:0");
+    EXPECT_EQ(ilu.spec.krylov, "cgs");
 }
 
 TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
@@ -101,8 +112,10 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
             EXPECT_FALSE(c.reason.empty());
             if (L >= 1 && n > crossover) {
                 EXPECT_EQ(c.spec.method, "krylov");
-                EXPECT_EQ(c.spec.pc, crossover == levels::kMgCrossoverTwoBody ? "mg:omega=0.8"
-                                                                              : "mg");
+                EXPECT_EQ(c.spec.pc, crossover == levels::kMgCrossoverTwoBody
+                                         ? "mg:omega=0.8,pre=0,post=2"
+                                         : "mg:pre=0,post=2");
+                EXPECT_EQ(c.spec.krylov, "bicgstab");
             } else {
                 EXPECT_EQ(c.spec.method, "schur");
             }
@@ -116,30 +129,34 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
     sq.levels = 2;
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.method, "schur");
     sq.levels = 3;
-    EXPECT_EQ(levels::choose_solver(sq, {}).spec.pc, "mg");
+    EXPECT_EQ(levels::choose_solver(sq, {}).spec.pc, "mg:pre=0,post=2");
     auto hz = scene::load_scene("hertz");
     hz.levels = 1;
     EXPECT_EQ(levels::choose_solver(hz, {}).spec.method, "schur");
     hz.levels = 2;
-    EXPECT_EQ(levels::choose_solver(hz, {}).spec.pc, "mg");
+    EXPECT_EQ(levels::choose_solver(hz, {}).spec.pc, "mg:pre=0,post=2");
     auto dt = scene::load_scene("dovetail");
     EXPECT_EQ(levels::mg_crossover_unknowns(dt), levels::kMgCrossoverTwoBody);
     dt.levels = 2;
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
     dt.levels = 3;
-    // With a two-body pair the Krylov method is BiCGStab and the sweeps are damped (fewer
-    // V-cycles there), else CGS and undamped sweeps; --linear krylov alone damps them too.
-    EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg:omega=0.8");
+    // BiCGStab with a V(0,2) cycle, and with a two-body pair damped sweeps (fewer V-cycles
+    // there); --linear krylov alone takes the same pair.
+    EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg:omega=0.8,pre=0,post=2");
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.krylov, "bicgstab");
-    EXPECT_NE(levels::choose_solver(dt, {}).reason.find("BiCGStab + mg:omega=0.8"),
+    EXPECT_NE(levels::choose_solver(dt, {}).reason.find("BiCGStab + mg:omega=0.8,pre=0,post=2"),
               std::string::npos);
     EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.pc,
-              "mg:omega=0.8");
-    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.krylov, "cgs");
-    // A named preconditioner is taken as given.
+              "mg:omega=0.8,pre=0,post=2");
+    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.krylov,
+              "bicgstab");
+    // A named preconditioner is taken as given, with CGS unless a method is named.
     EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}}).spec.pc, "mg");
+    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}}).spec.krylov, "cgs");
     sq.levels = 3;
-    EXPECT_EQ(levels::choose_solver(sq, {}).spec.krylov, "cgs");
+    EXPECT_EQ(levels::choose_solver(sq, {}).spec.krylov, "bicgstab");
+    EXPECT_NE(levels::choose_solver(sq, {}).reason.find("BiCGStab + mg:pre=0,post=2"),
+              std::string::npos);
 }
 
 TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
