@@ -29,11 +29,19 @@ struct Config {
     enum class Family { exact, ilu, mg } family = Family::exact;
 };
 
-std::vector<Config> configurations() {
+std::vector<Config> configurations(const levels::Problem& problem) {
     std::vector<Config> c;
     using F = Config::Family;
-    // The multilevel solvers (the run's default above the crossover, `--pc mg`, and hypre's MGR
-    // with `--pc mgr`), CGS to the run's default linear tolerance.
+    // The multilevel solvers: the run's default above the crossover (BiCGStab + mg's V(0,2)
+    // cycle, damped with a two-body pair), `--pc mg` (CGS + V(1,1), the default before
+    // 2026-11-26) and hypre's MGR with `--pc mgr`, to the run's default linear tolerance.
+    const bool two_body = levels::mg_crossover_unknowns(problem) == levels::kMgCrossoverTwoBody;
+    const levels::LinearSolverSpec def{.method = "krylov",
+                                       .krylov = levels::kMgDefaultKrylov,
+                                       .pc = two_body ? levels::kMgDefaultTwoBody
+                                                      : levels::kMgDefaultOneBody,
+                                       .rel_tol = 1e-10};
+    c.push_back({"c2f default bicgstab+mg", true, def, 1e-10, F::mg});
     const levels::LinearSolverSpec mg{
         .method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-10};
     c.push_back({"c2f cgs+mg", true, mg, 1e-10, F::mg});
@@ -191,7 +199,7 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
     if (problem.name == "hertz") os << std::setw(14) << "closed form";
     os << std::setw(8) << "newton" << std::setw(9) << "krylov"
        << "\n";
-    for (const auto& c : configurations()) {
+    for (const auto& c : configurations(problem)) {
         if (!opt.only.empty() && c.name.find(opt.only) == std::string::npos) continue;
         const int lo = c.family == Config::Family::mg ? 1 : 0;
         const int hi = c.family == Config::Family::ilu ? std::min(opt.max_level, opt.ilu_max_level)

@@ -46,13 +46,13 @@ TEST(ErrorVsTime, MultilevelRowsConvergeAndTheirErrorFallsWithTheLevel) {
     std::filesystem::remove_all(dir);
     apps::ErrorVsTimeOptions opt;
     opt.max_level = 2;
-    opt.only = "mg"; // c2f cgs+mg, cold cgs+mg, c2f cgs+mgr
+    opt.only = "mg"; // c2f default bicgstab+mg, c2f cgs+mg, cold cgs+mg, c2f cgs+mgr
     opt.plot = false;
     opt.out = dir;
     std::ostringstream log;
     ASSERT_EQ(apps::study_error_vs_time(scene::load_scene("square"), opt, log), 0) << log.str();
     const auto rows = read_rows(dir / "error_vs_time.csv");
-    std::vector<std::string> expected{"c2f cgs+mg", "cold cgs+mg"};
+    std::vector<std::string> expected{"c2f default bicgstab+mg", "c2f cgs+mg", "cold cgs+mg"};
     if (solvers::have_hypre()) expected.push_back("c2f cgs+mgr");
     EXPECT_EQ(rows.size(), expected.size()) << log.str();
     for (const auto& name : expected) {
