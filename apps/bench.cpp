@@ -197,8 +197,7 @@ double matrix_seconds(const traffic::Account& a) {
 
 BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body) {
     if (pc != "default") return {opt.krylov.value_or("cgs"), pc};
-    return {opt.krylov.value_or(levels::kMgDefaultKrylov),
-            two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody};
+    return {opt.krylov.value_or(levels::kMgDefaultKrylov), levels::default_mg_spec(two_body)};
 }
 
 int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
@@ -212,7 +211,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     check_preconditioner_names(named, true);
     levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
-    const bool two_body = levels::mg_crossover_unknowns(base) == levels::kMgCrossoverTwoBody;
+    const bool two_body = levels::has_two_body_pair(base);
     const BenchSolver def = bench_solver(opt, "default", two_body);
     const std::string named_krylov = opt.krylov.value_or("cgs");
     std::string krylov_label = named_krylov;

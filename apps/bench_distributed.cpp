@@ -44,8 +44,7 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     levels::Problem p = scene::load_scene(opt.scene);
     p.levels = opt.levels;
     p.validate();
-    const BenchSolver solver = bench_solver(
-        opt, opt.pcs.front(), levels::mg_crossover_unknowns(p) == levels::kMgCrossoverTwoBody);
+    const BenchSolver solver = bench_solver(opt, opt.pcs.front(), levels::has_two_body_pair(p));
     parallel::set_num_threads(1);
     const int np = comm.size();
     const int plevel = levels::partition_level(p.mesh0.n_triangles(), p.levels, np);

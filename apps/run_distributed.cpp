@@ -40,7 +40,7 @@ levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two
     // one keeps the Krylov method it always had (CGS, BiCGStab with a two-body pair).
     s.krylov =
         opt.krylov.value_or(opt.pc ? (two_body ? "bicgstab" : "cgs") : levels::kMgDefaultKrylov);
-    s.pc = opt.pc.value_or(two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody);
+    s.pc = opt.pc.value_or(levels::default_mg_spec(two_body));
     if (opt.linear_rel_tol) s.rel_tol = *opt.linear_rel_tol;
     s.validate();
     return s;
@@ -194,10 +194,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
               "distributed run writes solution.pvtu of the final state)");
     MLC_CHECK(p.levels >= 1, "a run on several processes needs --levels >= 1 (level 0 is solved "
                              "on every process; the levels above it are distributed)");
-    const bool two_body =
-        std::any_of(p.contacts.begin(), p.contacts.end(), [](const levels::ContactPair& c) {
-            return c.element != levels::ContactElementKind::node_on_rigid;
-        });
+    const bool two_body = levels::has_two_body_pair(p);
     const levels::LinearSolverSpec spec = distributed_solver_spec(opt, two_body);
     const int finest = p.levels;
     int plevel = opt.partition_level

@@ -35,12 +35,11 @@ std::vector<Config> configurations(const levels::Problem& problem) {
     // The multilevel solvers: the run's default above the crossover (BiCGStab + mg's V(0,2)
     // cycle, damped with a two-body pair), `--pc mg` (CGS + V(1,1), the default before
     // 2026-11-26) and hypre's MGR with `--pc mgr`, to the run's default linear tolerance.
-    const bool two_body = levels::mg_crossover_unknowns(problem) == levels::kMgCrossoverTwoBody;
-    const levels::LinearSolverSpec def{.method = "krylov",
-                                       .krylov = levels::kMgDefaultKrylov,
-                                       .pc = two_body ? levels::kMgDefaultTwoBody
-                                                      : levels::kMgDefaultOneBody,
-                                       .rel_tol = 1e-10};
+    const levels::LinearSolverSpec def{
+        .method = "krylov",
+        .krylov = levels::kMgDefaultKrylov,
+        .pc = levels::default_mg_spec(levels::has_two_body_pair(problem)),
+        .rel_tol = 1e-10};
     c.push_back({"c2f default bicgstab+mg", true, def, 1e-10, F::mg});
     const levels::LinearSolverSpec mg{
         .method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-10};

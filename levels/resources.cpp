@@ -63,10 +63,14 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem) {
 }
 
 // ------------------------------------------------------------------------------------------
-double mg_crossover_unknowns(const Problem& problem) {
+bool has_two_body_pair(const Problem& problem) {
     for (const auto& c : problem.contacts)
-        if (c.two_body()) return kMgCrossoverTwoBody;
-    return kMgCrossoverOneBody;
+        if (c.two_body()) return true;
+    return false;
+}
+
+double mg_crossover_unknowns(const Problem& problem) {
+    return has_two_body_pair(problem) ? kMgCrossoverTwoBody : kMgCrossoverOneBody;
 }
 
 SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
@@ -107,8 +111,8 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             MLC_CHECK(has_levels || !entry->needs_level_below || entry->single_level_too,
                       "--pc " << s.pc << " needs the level below: use --levels >= 1");
         } else {
-            const bool two_body = mg_crossover_unknowns(problem) == kMgCrossoverTwoBody;
-            s.pc = !has_levels ? "ilu:0" : two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
+            const bool two_body = has_two_body_pair(problem);
+            s.pc = !has_levels ? "ilu:0" : default_mg_spec(two_body);
             if (has_levels && !req.krylov) s.krylov = kMgDefaultKrylov;
             c.reason = !has_levels ? "--linear krylov on a single level (no level below for mg): "
                                      "ilu:0"
@@ -128,8 +132,8 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             s.method = "krylov";
             // BiCGStab with a V(0,2) cycle; two-body pairs also damp the sweeps (README
             // "Choosing the Newton-system solver", "The default cycle: V(0,2) with BiCGStab").
-            const bool two_body = crossover == kMgCrossoverTwoBody;
-            s.pc = two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
+            const bool two_body = has_two_body_pair(problem);
+            s.pc = default_mg_spec(two_body);
             if (!req.krylov) s.krylov = kMgDefaultKrylov;
             os << "default: " << n << " unknowns on the finest level exceed the crossover "
                << crossover << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"

@@ -60,6 +60,15 @@ inline constexpr const char* kMgDefaultKrylov = "bicgstab";
 /// The crossover that applies to `problem` (two-body pairs or not).
 double mg_crossover_unknowns(const Problem& problem);
 
+/// Whether `problem` has a two-body pair (node on facet or node on node): what selects the
+/// two-body crossover and the damped default mg.
+bool has_two_body_pair(const Problem& problem);
+
+/// The default mg spec: kMgDefaultTwoBody with a two-body pair, else kMgDefaultOneBody.
+inline const char* default_mg_spec(bool two_body) {
+    return two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
+}
+
 /// What the user asked for; unset fields take the driver's defaults.
 struct SolverRequest {
     std::optional<std::string> linear; ///< schur | lu | krylov

@@ -137,6 +137,10 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
     EXPECT_EQ(levels::choose_solver(hz, {}).spec.pc, "mg:pre=0,post=2");
     auto dt = scene::load_scene("dovetail");
     EXPECT_EQ(levels::mg_crossover_unknowns(dt), levels::kMgCrossoverTwoBody);
+    EXPECT_TRUE(levels::has_two_body_pair(dt));
+    EXPECT_FALSE(levels::has_two_body_pair(sq));
+    EXPECT_STREQ(levels::default_mg_spec(true), "mg:omega=0.8,pre=0,post=2");
+    EXPECT_STREQ(levels::default_mg_spec(false), "mg:pre=0,post=2");
     dt.levels = 2;
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
     dt.levels = 3;
