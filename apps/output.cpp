@@ -6,6 +6,7 @@
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
+#include "core/parallel.hpp"
 #include "levels/checks.hpp"
 #include "mesh/io/vtu.hpp"
 
@@ -528,6 +529,9 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         for (const auto& [name, e] : r.timings.table())
             tt.insert(name, e.seconds);
         root.insert("timings_seconds", tt);
+        // What the timings ran on: our threads and the BLAS that schur's factorization calls.
+        root.insert("threads", static_cast<int64_t>(parallel::num_threads()));
+        root.insert("blas", parallel::blas_library());
         write_file_atomically(dir / "summary.json",
                               [&](std::ostream& f) { f << toml::json_formatter{root} << "\n"; });
         written.push_back("summary.json");

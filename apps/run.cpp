@@ -7,6 +7,7 @@
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
+#include "core/parallel.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 
@@ -77,6 +78,12 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     }
     os << "mlcontact: solving '" << p.name << "'\n";
     os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
+    if (choice.spec.method == "schur") {
+        const std::string blas = parallel::blas_library();
+        if (blas.find("OpenBLAS") == std::string::npos)
+            os << "note: the BLAS is " << blas << ", not OpenBLAS: schur's set-up runs 2-2.5x "
+               << "slower with it (scripts/deps.sh installs libopenblas0-serial)\n";
+    }
     levels::RunResult r = levels::solve(p, so);
     r.solver = choice;
     os << "memory: estimated peak " << levels::format_bytes(r.memory.bytes) << " of "

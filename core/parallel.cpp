@@ -15,8 +15,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <cstdint>
 #include <cstdlib>
+#include <dlfcn.h>
 #include <exception>
 #include <mutex>
 #include <sched.h>
@@ -263,12 +265,48 @@ int num_threads() {
     return pool().threads();
 }
 
+namespace {
+
+// A symbol of the process's BLAS, looked up at run time: the executable links CHOLMOD, which
+// links libblas.so.3, so the symbol is in the global scope; a module loaded with RTLD_LOCAL (the
+// Python extension) finds it through the already loaded library.
+void* blas_symbol(const char* name) {
+    if (void* f = dlsym(RTLD_DEFAULT, name)) return f;
+    if (void* h = dlopen("libblas.so.3", RTLD_NOW | RTLD_NOLOAD)) {
+        void* f = dlsym(h, name);
+        dlclose(h);
+        return f;
+    }
+    return nullptr;
+}
+
+} // namespace
+
 void set_num_threads(int n) {
     MLC_CHECK(n >= 0, "set_num_threads: the number of threads must be >= 0, found " << n);
     if (in_loop) throw std::logic_error("mlc::parallel::set_num_threads called inside a loop");
     Pool& p = pool();
     std::lock_guard lock(p.busy);
-    p.resize(n == 0 ? default_num_threads() : n);
+    const int threads = n == 0 ? default_num_threads() : n;
+    p.resize(threads);
+    // OpenBLAS's threads (its own pool): the same count as ours. The reference BLAS has none.
+    using SetThreads = void (*)(int);
+    if (auto f = reinterpret_cast<SetThreads>(blas_symbol("openblas_set_num_threads"))) f(threads);
+}
+
+std::string blas_library() {
+    void* dgemm = blas_symbol("dgemm_");
+    if (!dgemm) return "none";
+    std::string out = "unknown";
+    Dl_info info{};
+    if (dladdr(dgemm, &info) != 0 && info.dli_fname) {
+        char resolved[PATH_MAX];
+        out = realpath(info.dli_fname, resolved) ? resolved : info.dli_fname;
+    }
+    using Config = char* (*)();
+    if (auto f = reinterpret_cast<Config>(blas_symbol("openblas_get_config")))
+        if (const char* c = f()) out += std::string(" (") + c + ")";
+    return out;
 }
 
 RowChunks row_chunks(std::size_t n, std::size_t min_rows_per_chunk) {

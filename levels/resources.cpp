@@ -111,15 +111,16 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             MLC_CHECK(has_levels || !entry->needs_level_below || entry->single_level_too,
                       "--pc " << s.pc << " needs the level below: use --levels >= 1");
         } else {
+            // mg over the levels, or over an aggregation hierarchy on a single level (there it
+            // is faster than ILU(0), which falls back to schur from the square's level-3 export
+            // on: README "`mg` on a mesh without levels").
             const bool two_body = has_two_body_pair(problem);
-            s.pc = !has_levels ? "ilu:0" : default_mg_spec(two_body);
-            if (has_levels && !req.krylov) s.krylov = kMgDefaultKrylov;
-            c.reason = !has_levels ? "--linear krylov on a single level (no level below for mg): "
-                                     "ilu:0"
-                       : two_body  ? "--linear krylov: multilevel mg over the levels (V(0,2) "
-                                     "cycle), damped (omega = 0.8) with a two-body pair"
-                                   : "--linear krylov: multilevel mg over the levels (V(0,2) "
-                                     "cycle)";
+            s.pc = default_mg_spec(two_body);
+            if (!req.krylov) s.krylov = kMgDefaultKrylov;
+            c.reason =
+                std::string("--linear krylov: multilevel mg ") +
+                (has_levels ? "over the levels" : "over an aggregation hierarchy (one level)") +
+                " (V(0,2) cycle)" + (two_body ? ", damped (omega = 0.8) with a two-body pair" : "");
         }
     } else {
         c.automatic = true;

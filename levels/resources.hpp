@@ -33,15 +33,17 @@ struct LevelSize {
 /// fixed components and contact nodes with the boundary, which doubles per level.
 std::vector<LevelSize> predict_level_sizes(const Problem& problem);
 
-/// Finest-level unknowns above which the default Newton-system solver is Krylov + mg rather
-/// than the exact `schur` (measured, see the README: "Choosing the Newton-system solver"): with
-/// rigid obstacles only, schur is faster up to square level 2 (8 512 unknowns) and mg from
-/// hertz level 2 (21 420) and square level 3 (33 408) on, both within a few per cent in memory
-/// there; with a two-body pair (node on facet or node on node) mg needs about twice as many
-/// Krylov iterations and overtakes schur between dovetail levels 2 and 3 (56 181 and 222 373
-/// unknowns), where schur also stays within 1.15x of mg's memory below.
-inline constexpr double kMgCrossoverOneBody = 15000;
-inline constexpr double kMgCrossoverTwoBody = 100000;
+/// Finest-level unknowns above which the default Newton-system solver is Krylov + mg (BiCGStab +
+/// the V(0,2) cycle) rather than the exact `schur` (measured with OpenBLAS behind CHOLMOD,
+/// 2026-11-26, README "Choosing the Newton-system solver"): with rigid obstacles only, mg is
+/// 1.3-1.5x faster from calumet level 2 and square level 1 on (2 844 and 2 208 unknowns), the
+/// two equal below (incline level 1, 1 187; calumet level 1, 796); with a two-body pair mg is
+/// 1.3x faster from dovetail level 1 (14 341) and axis_release level 1 (23 724) on, and schur up
+/// to 1.2x faster on the patch tests (at most 1 405 unknowns, 20 ms). mg's memory is the
+/// smaller one wherever it is chosen. (Before 2026-11-26: 15 000 and 100 000, measured with the
+/// reference BLAS and the previous mg pairs.)
+inline constexpr double kMgCrossoverOneBody = 2000;
+inline constexpr double kMgCrossoverTwoBody = 10000;
 
 /// The preconditioner the driver takes for `mg` when nobody named one: a V(0,2) cycle (no
 /// pre-smoothing, two backward sweeps after the coarse correction), which needs fewer bytes per
@@ -85,12 +87,12 @@ struct SolverChoice {
 };
 
 /// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
-/// without `pc` uses `mg` where a level below exists (problem.levels >= 1; damped,
-/// kMgDefaultTwoBody, with a two-body pair) and `ilu:0` on a single level; nothing at all chooses
+/// without `pc` uses the default mg (damped, kMgDefaultTwoBody, with a two-body pair; over an
+/// aggregation hierarchy on a single level) with BiCGStab; nothing at all chooses
 /// by size: `schur` up to mg_crossover_unknowns(problem) unknowns on the finest level, Krylov +
 /// `mg` above it when levels exist (BiCGStab + mg's V(0,2) cycle, damped with a two-body pair).
-/// `linear krylov` or `pc` alone without `krylov` take CGS, except when the driver picks mg itself
-/// (then BiCGStab, kMgDefaultKrylov). A Krylov option next to `linear schur` or `linear lu`
+/// `pc` alone without `krylov` takes CGS; when the driver picks mg itself (no `pc`), BiCGStab
+/// (kMgDefaultKrylov). A Krylov option next to `linear schur` or `linear lu`
 /// contradicts it and throws InvalidInput saying so. `sizes`: predict_level_sizes(problem) when the
 /// caller has it already (it builds level 0).
 SolverChoice choose_solver(const Problem& problem, const SolverRequest& request,

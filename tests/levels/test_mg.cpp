@@ -338,8 +338,10 @@ TEST(AlgebraicMultigrid, IsAskedForOnASingleLevelAndEstimated) {
     LinearSolverSpec ilu = c.spec;
     ilu.pc = "ilu:0";
     EXPECT_GT(with_mg, 2.0 * estimate_memory(sizes, ilu, false).solver_bytes);
-    // --linear krylov alone keeps ILU(0) on a single level.
+    // --linear krylov alone takes the default pair over the aggregation hierarchy (since
+    // 2026-11-26; it was ILU(0), which falls back to schur from the level-3 export on).
     SolverRequest krylov;
     krylov.linear = "krylov";
-    EXPECT_EQ(choose_solver(p, krylov).spec.pc, "ilu:0");
+    EXPECT_EQ(choose_solver(p, krylov).spec.pc, "mg:pre=0,post=2");
+    EXPECT_EQ(choose_solver(p, krylov).spec.krylov, "bicgstab");
 }

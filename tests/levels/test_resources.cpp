@@ -63,7 +63,7 @@ TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
     EXPECT_EQ(t.spec.pc, "mg:pre=0,post=2");
 }
 
-TEST(ChooseSolver, LinearKrylovUsesMgWhereLevelsExistAndIluOnOneLevel) {
+TEST(ChooseSolver, LinearKrylovUsesTheDefaultMgOnEveryMesh) {
     auto p = scene::load_scene("square");
     p.levels = 1;
     const auto mg = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
@@ -73,10 +73,17 @@ TEST(ChooseSolver, LinearKrylovUsesMgWhereLevelsExistAndIluOnOneLevel) {
     EXPECT_EQ(
         levels::choose_solver(p, {std::string("krylov"), std::string("cgs"), {}, {}}).spec.krylov,
         "cgs");
+    // On a single level the same pair over an aggregation hierarchy (not ILU(0)), damped with a
+    // two-body pair.
     p.levels = 0;
-    const auto ilu = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
-    EXPECT_EQ(ilu.spec.pc, "ilu:0");
-    EXPECT_EQ(ilu.spec.krylov, "cgs");
+    const auto one = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
+    EXPECT_EQ(one.spec.pc, "mg:pre=0,post=2");
+    EXPECT_EQ(one.spec.krylov, "bicgstab");
+    EXPECT_NE(one.reason.find("aggregation hierarchy"), std::string::npos) << one.reason;
+    auto dt = scene::load_scene("dovetail");
+    dt.levels = 0;
+    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.pc,
+              "mg:omega=0.8,pre=0,post=2");
 }
 
 TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
@@ -121,29 +128,35 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
             }
         }
     }
-    // Rigid obstacles: mg from square level 3 (33 408 unknowns; 8 512 on level 2) and hertz
-    // level 2 (21 420; 5 459 on level 1); two bodies (dovetail: 56 181 and 222 373 unknowns on
-    // levels 2 and 3): from level 3.
+    // Rigid obstacles: mg from square level 1 (2 208 unknowns; 592 on level 0) and hertz level 1
+    // (5 459); two bodies: dovetail from level 1 (14 341).
     auto sq = scene::load_scene("square");
     EXPECT_EQ(levels::mg_crossover_unknowns(sq), levels::kMgCrossoverOneBody);
-    sq.levels = 2;
+    sq.levels = 0;
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.method, "schur");
-    sq.levels = 3;
+    sq.levels = 1;
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.pc, "mg:pre=0,post=2");
     auto hz = scene::load_scene("hertz");
     hz.levels = 1;
-    EXPECT_EQ(levels::choose_solver(hz, {}).spec.method, "schur");
-    hz.levels = 2;
     EXPECT_EQ(levels::choose_solver(hz, {}).spec.pc, "mg:pre=0,post=2");
+    auto cl = scene::load_scene("calumet"); // 796 unknowns on level 1, 2 844 on level 2
+    cl.levels = 1;
+    EXPECT_EQ(levels::choose_solver(cl, {}).spec.method, "schur");
+    cl.levels = 2;
+    EXPECT_EQ(levels::choose_solver(cl, {}).spec.pc, "mg:pre=0,post=2");
     auto dt = scene::load_scene("dovetail");
     EXPECT_EQ(levels::mg_crossover_unknowns(dt), levels::kMgCrossoverTwoBody);
     EXPECT_TRUE(levels::has_two_body_pair(dt));
     EXPECT_FALSE(levels::has_two_body_pair(sq));
     EXPECT_STREQ(levels::default_mg_spec(true), "mg:omega=0.8,pre=0,post=2");
     EXPECT_STREQ(levels::default_mg_spec(false), "mg:pre=0,post=2");
-    dt.levels = 2;
+    dt.levels = 0;
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
-    dt.levels = 3;
+    auto pt = scene::load_scene("patch"); // two bodies, 1 405 unknowns on level 2
+    pt.levels = 2;
+    EXPECT_TRUE(levels::has_two_body_pair(pt));
+    EXPECT_EQ(levels::choose_solver(pt, {}).spec.method, "schur");
+    dt.levels = 1;
     // BiCGStab with a V(0,2) cycle, and with a two-body pair damped sweeps (fewer V-cycles
     // there); --linear krylov alone takes the same pair.
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg:omega=0.8,pre=0,post=2");
