@@ -9,7 +9,8 @@ the faster and to the smaller candidate (the bar: both at most 1.15), and writes
 out/bench/solver_choice.csv and .json. Run it on an idle machine: it measures wall time.
 
 usage: scripts/bench_solver_choice.py [--repeat N] [--mg "FLAGS"] [SCENE:L1,L2 ...]
-  default cases: square:1,2,3 hertz:1,2,3 dovetail:1,2,3,4
+  default cases (the README's table): square:1,2,3,4 hertz:1,2,3 calumet:1,2 incline:1,2 patch:1,2
+  patch_matching:2 dovetail:1,2,3,4 axis_release:1,2 mindlin:1,2
 """
 import argparse
 import csv
@@ -47,7 +48,9 @@ def main():
     ap.add_argument("--mg", default="--linear krylov")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench", "solver_choice"))
     ap.add_argument("cases", nargs="*",
-                    default=["square:1,2,3", "hertz:1,2,3", "dovetail:1,2,3,4"])
+                    default=["square:1,2,3,4", "hertz:1,2,3", "calumet:1,2", "incline:1,2",
+                             "patch:1,2", "patch_matching:2", "dovetail:1,2,3,4",
+                             "axis_release:1,2", "mindlin:1,2"])
     a = ap.parse_args()
     if not os.access(EXE, os.X_OK):
         sys.exit(f"{EXE} not found: build first (bash scripts/build.sh)")
