@@ -50,7 +50,8 @@ int main(int argc, char** argv) {
                     "chosen by size, see the report)")
         ->check(CLI::IsMember({"schur", "lu", "krylov"}));
     run->add_option("--krylov", ro.krylov,
-                    "Krylov method (implies a Krylov solve): cgs (default), bicg, bicgstab, gmres");
+                    "Krylov method (implies a Krylov solve): cgs, bicg, bicgstab, gmres (default: "
+                    "bicgstab with the driver's mg, cgs with --pc)");
     run->add_option("--pc", ro.pc,
                     mlc::apps::pc_option_help("preconditioner (implies a Krylov solve; default mg "
                                               "above the crossover, see the report)"));

@@ -12,6 +12,7 @@
 #include "scene/scene.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 
@@ -78,11 +79,18 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     }
     os << "mlcontact: solving '" << p.name << "'\n";
     os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
-    if (choice.spec.method == "schur") {
+    {
+        // The BLAS behind CHOLMOD (README "The BLAS behind schur").
         const std::string blas = parallel::blas_library();
-        if (blas.find("OpenBLAS") == std::string::npos)
-            os << "note: the BLAS is " << blas << ", not OpenBLAS: schur's set-up runs 2-2.5x "
+        const bool openblas = blas.find("OpenBLAS") != std::string::npos;
+        if (choice.spec.method == "schur" && !openblas && blas != "none")
+            os << "note: the BLAS is " << blas << ", not OpenBLAS: schur's set-up runs 1.9-2.5x "
                << "slower with it (scripts/deps.sh installs libopenblas0-serial)\n";
+        if (openblas && blas.find("SINGLE_THREADED") == std::string::npos &&
+            !std::getenv("OPENBLAS_NUM_THREADS"))
+            os << "note: the BLAS is a threaded OpenBLAS (" << blas << "): its threads spin "
+               << "against ours (short runs take up to 2x); set OPENBLAS_NUM_THREADS=1 or choose "
+               << "libopenblas0-serial with update-alternatives\n";
     }
     levels::RunResult r = levels::solve(p, so);
     r.solver = choice;
@@ -108,8 +116,8 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
         for (const auto& ls : r.level_steps)
             for (const auto& st : ls)
                 if (st.report.continuation_factor > 0)
-                    os << "r continuation: level " << st.level << ", load step "
-                       << st.report.step << ": " << st.report.continuation_note << "\n";
+                    os << "r continuation: level " << st.level << ", load step " << st.report.step
+                       << ": " << st.report.continuation_note << "\n";
     }
     os << "\n";
     print_header(os, p, r);

@@ -454,6 +454,10 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         for (const auto& [name, e] : r.timings.table())
             tt.insert(name, e.seconds);
         root_t.insert("timings_seconds", tt);
+        // What the timings ran on (rank 0): threads per process and the BLAS behind level 0's
+        // schur.
+        root_t.insert("threads", static_cast<int64_t>(parallel::num_threads()));
+        root_t.insert("blas", parallel::blas_library());
         write_file_atomically(dir / "summary.json",
                               [&](std::ostream& f) { f << toml::json_formatter{root_t} << "\n"; });
         files.push_back("summary.json");

@@ -287,26 +287,26 @@ void set_num_threads(int n) {
     if (in_loop) throw std::logic_error("mlc::parallel::set_num_threads called inside a loop");
     Pool& p = pool();
     std::lock_guard lock(p.busy);
-    const int threads = n == 0 ? default_num_threads() : n;
-    p.resize(threads);
-    // OpenBLAS's threads (its own pool): the same count as ours. The reference BLAS has none.
-    using SetThreads = void (*)(int);
-    if (auto f = reinterpret_cast<SetThreads>(blas_symbol("openblas_set_num_threads"))) f(threads);
+    p.resize(n == 0 ? default_num_threads() : n);
 }
 
 std::string blas_library() {
-    void* dgemm = blas_symbol("dgemm_");
-    if (!dgemm) return "none";
-    std::string out = "unknown";
-    Dl_info info{};
-    if (dladdr(dgemm, &info) != 0 && info.dli_fname) {
-        char resolved[PATH_MAX];
-        out = realpath(info.dli_fname, resolved) ? resolved : info.dli_fname;
-    }
-    using Config = char* (*)();
-    if (auto f = reinterpret_cast<Config>(blas_symbol("openblas_get_config")))
-        if (const char* c = f()) out += std::string(" (") + c + ")";
-    return out;
+    // Once per process (the library does not change; openblas_get_config writes a static buffer).
+    static const std::string name = [] {
+        void* dgemm = blas_symbol("dgemm_");
+        if (!dgemm) return std::string("none");
+        std::string out = "unknown";
+        Dl_info info{};
+        if (dladdr(dgemm, &info) != 0 && info.dli_fname) {
+            char resolved[PATH_MAX];
+            out = realpath(info.dli_fname, resolved) ? resolved : info.dli_fname;
+        }
+        using Config = char* (*)();
+        if (auto f = reinterpret_cast<Config>(blas_symbol("openblas_get_config")))
+            if (const char* c = f()) out += std::string(" (") + c + ")";
+        return out;
+    }();
+    return name;
 }
 
 RowChunks row_chunks(std::size_t n, std::size_t min_rows_per_chunk) {

@@ -32,19 +32,16 @@ namespace mlc::parallel {
 int num_threads();
 
 /// Sets the number of threads (caller included); 0 restores the default. Stops and restarts the
-/// workers; must not be called from inside a chunk. With a threaded OpenBLAS as the process's
-/// BLAS (what CHOLMOD's supernodal factorization and solves call, see blas_library()), sets
-/// OpenBLAS's own thread count to the same number, so that one thread means one thread in
-/// `schur` too. (scripts/deps.sh installs the single-threaded OpenBLAS: the threaded one starts
-/// its threads when the library loads, and they spin against this pool: a level-3 square run
-/// took 0.17-0.20 s with it against 0.09-0.12 s with the serial one.)
+/// workers; must not be called from inside a chunk.
 void set_num_threads(int n);
 
 /// The BLAS library the process calls (the file behind `libblas.so.3`, which Debian's alternatives
-/// choose), and OpenBLAS's configuration when it is OpenBLAS; "none" when no BLAS is loaded.
-/// The reference BLAS (Debian's libblas3) makes `schur`'s set-up 2-2.5x slower than OpenBLAS
-/// (libopenblas0-serial, which scripts/deps.sh installs): the report names the library so that
-/// timings can be compared.
+/// choose), and OpenBLAS's configuration when it is OpenBLAS ("SINGLE_THREADED" for the serial
+/// one); "none" when no BLAS is loaded. Computed once per process. The reference BLAS (Debian's
+/// libblas3) makes `schur`'s set-up 1.9-2.5x slower than OpenBLAS (libopenblas0-serial, which
+/// scripts/deps.sh installs); a threaded OpenBLAS starts its threads when the library loads,
+/// and they spin against this pool (a level-3 square run took 0.17-0.20 s with it against
+/// 0.10-0.15 s with the serial one). The report notes both; summary.json names the library.
 std::string blas_library();
 
 /// The default: OMP_NUM_THREADS if set to a positive number (its first entry), else the number of

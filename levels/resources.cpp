@@ -113,12 +113,15 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
         } else {
             // mg over the levels, or over an aggregation hierarchy on a single level (there it
             // is faster than ILU(0), which falls back to schur from the square's level-3 export
-            // on: README "`mg` on a mesh without levels").
+            // on: README, the `--linear krylov` option).
             const bool two_body = has_two_body_pair(problem);
             s.pc = default_mg_spec(two_body);
             if (!req.krylov) s.krylov = kMgDefaultKrylov;
+            const std::string asked = req.linear   ? std::string("--linear krylov")
+                                      : req.krylov ? "--krylov " + *req.krylov
+                                                   : std::string("--linear-tol");
             c.reason =
-                std::string("--linear krylov: multilevel mg ") +
+                asked + " without --pc: multilevel mg " +
                 (has_levels ? "over the levels" : "over an aggregation hierarchy (one level)") +
                 " (V(0,2) cycle)" + (two_body ? ", damped (omega = 0.8) with a two-body pair" : "");
         }
@@ -143,7 +146,7 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             s.method = "schur";
             if (!has_levels && n > crossover)
                 os << "default: " << n << " unknowns on a single level: exact schur (faster "
-                   << "there than mg over an aggregation hierarchy, which --pc mg builds)";
+                   << "there than mg over an aggregation hierarchy, which --linear krylov builds)";
             else
                 os << "default: " << n << " unknowns on the finest level, at most the crossover "
                    << crossover << ": exact schur (faster there)";

@@ -38,10 +38,11 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem);
 /// 2026-11-26, README "Choosing the Newton-system solver"): with rigid obstacles only, mg is
 /// 1.3-1.5x faster from calumet level 2 and square level 1 on (2 844 and 2 208 unknowns), the
 /// two equal below (incline level 1, 1 187; calumet level 1, 796); with a two-body pair mg is
-/// 1.3x faster from dovetail level 1 (14 341) and axis_release level 1 (23 724) on, and schur up
-/// to 1.2x faster on the patch tests (at most 1 405 unknowns, 20 ms). mg's memory is the
-/// smaller one wherever it is chosen. (Before 2026-11-26: 15 000 and 100 000, measured with the
-/// reference BLAS and the previous mg pairs.)
+/// 1.3x faster on dovetail level 1 (14 341) and axis_release level 1 (23 724), equal on mindlin
+/// level 1 (28 594), faster on every level above, and schur up to 1.27x faster on the patch tests
+/// (at most 1 405 unknowns, 20-30 ms). mg's memory is within 2 MiB of schur's or smaller
+/// wherever it is chosen. (Before 2026-11-26: 15 000 and 100 000, measured with the reference
+/// BLAS and the previous mg pairs.)
 inline constexpr double kMgCrossoverOneBody = 2000;
 inline constexpr double kMgCrossoverTwoBody = 10000;
 
@@ -49,8 +50,8 @@ inline constexpr double kMgCrossoverTwoBody = 10000;
 /// pre-smoothing, two backward sweeps after the coarse correction), which needs fewer bytes per
 /// Newton step than V(1,1) for the same or fewer Krylov iterations (square level 6: a Newton
 /// step 1.09 -> 0.81 s, README "The default cycle: V(0,2) with BiCGStab"); with a two-body pair
-/// the sweeps are also damped (omega = 0.8), which halves BiCGStab's iterations on dovetail
-/// level 4 and keeps them on levels 2 and 3; with rigid obstacles only they are not (the
+/// the sweeps are also damped (omega = 0.8), which halved BiCGStab's iterations on dovetail
+/// level 4 with V(1,1) and keeps them on levels 2 and 3 (with V(0,2): 20 against 85); with rigid obstacles only they are not (the
 /// square's iterations grow with omega = 0.8).
 inline constexpr const char* kMgDefaultOneBody = "mg:pre=0,post=2";
 inline constexpr const char* kMgDefaultTwoBody = "mg:omega=0.8,pre=0,post=2";

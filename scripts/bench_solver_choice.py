@@ -3,7 +3,8 @@
 size"): for each scene and level, `mlcontact run SCENE --levels L --quiet` with no solver flag,
 with `--linear schur` and with the Krylov + mg candidate (`--linear krylov`, the driver's own
 pair: BiCGStab + mg:pre=0,post=2, damped with a two-body pair; until 2026-11-26 this was
-`--pc mg`, CGS + mg; --mg sets other flags; none on level 0, where mg has no level below), REPEAT times each in turn. Wall time (perf_counter, ms resolution) and the peak
+`--pc mg`, CGS + mg; --mg sets other flags; none on level 0, where the default is schur
+whatever the size), REPEAT times each in turn. Wall time (perf_counter, ms resolution) and the peak
 RSS of each process (wait4). Prints the medians, the solver the default chose and its ratios to
 the faster and to the smaller candidate (the bar: both at most 1.15), and writes
 out/bench/solver_choice.csv and .json. Run it on an idle machine: it measures wall time.
@@ -61,7 +62,7 @@ def main():
     for case in a.cases:
         scene, levels = case.split(":")
         for level in (int(x) for x in levels.split(",")):
-            # On level 0 there is no level below for mg: schur is the only candidate.
+            # On level 0 the default is schur whatever the size: the only candidate compared.
             names = [k for k in candidates if level > 0 or k != "mg"]
             runs = {k: [] for k in names}
             chosen = ""

@@ -6,7 +6,7 @@ packages=(
   build-essential cmake pkg-config
   libeigen3-dev libhypre-dev libopenmpi-dev openmpi-bin
   libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev libsuitesparse-dev
-  libopenblas0-serial           # the BLAS behind CHOLMOD (schur): 1.5-2.5x faster factorizations than libblas3
+  libopenblas0-serial           # the BLAS behind CHOLMOD (schur): 1.9-2.5x faster set-up than libblas3
   zlib1g-dev                    # binary (zlib-compressed) VTU output
   libmetis-dev                  # mesh partitioning for the distributed solve (mesh/partition)
   python3 python3-matplotlib

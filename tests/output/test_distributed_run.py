@@ -126,8 +126,10 @@ def test_several_processes_give_the_one_process_answer(tmp_path, scene, levels):
         assert pieces == [f"solution_{r}.vtu" for r in range(np_)]
         s = json.loads((dist / "summary.json").read_text())
         assert s["processes"] == np_ and len(s["per_process"]) == np_
-        for key in ("unknowns", "contact_nodes", "vertices", "triangles", "displacement_unknowns"):
+        for key in ("unknowns", "contact_nodes", "vertices", "triangles", "displacement_unknowns",
+                    "blas"):
             assert s[key] == s1[key], key
+        assert "OpenBLAS" in s["blas"] and s["threads"] >= 1  # what the timings ran on
         assert sum(q["owned_unknowns"] for q in s["per_process"]) == s1["unknowns"]
         assert sum(q["contact_nodes"] for q in s["per_process"]) == s1["contact_nodes"]
         assert s["converged"] and s["completed_steps"] == s1["load_steps"]

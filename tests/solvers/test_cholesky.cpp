@@ -8,7 +8,6 @@
 
 #include <Eigen/Dense>
 
-#include <dlfcn.h>
 #include <string>
 
 using namespace mlc;
@@ -69,22 +68,14 @@ TEST(SparseCholesky, TrailingBlockEqualsTheDenseFactor) {
 
 // The BLAS behind CHOLMOD's supernodes is OpenBLAS (scripts/deps.sh installs libopenblas0-serial,
 // which Debian's alternatives make libblas.so.3): with the reference BLAS the set-up of `schur`
-// is 2-2.5x slower. parallel::set_num_threads sets a threaded OpenBLAS's thread count with ours;
-// the single-threaded one stays at one.
-TEST(SparseCholesky, RunsOnOpenBlasWithOurThreadCount) {
+// is 1.9-2.5x slower. An environment check: it fails on a machine whose libblas.so.3 is another
+// library, naming it.
+TEST(SparseCholesky, RunsOnOpenBlas) {
     solvers::SparseCholesky chol;
     chol.factor(test_matrix(24)); // CHOLMOD (and its BLAS) loaded and used
     const std::string blas = parallel::blas_library();
-    ASSERT_NE(blas.find("OpenBLAS"), std::string::npos)
+    EXPECT_NE(blas.find("OpenBLAS"), std::string::npos)
         << "libblas.so.3 is " << blas << ": install libopenblas0-serial (scripts/deps.sh)";
-    const bool serial = blas.find("SINGLE_THREADED") != std::string::npos;
-    using GetThreads = int (*)();
-    auto get = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
-    ASSERT_NE(get, nullptr);
-    for (const int n : {1, 2, 3}) {
-        parallel::set_num_threads(n);
-        EXPECT_EQ(get(), serial ? 1 : n) << blas;
-    }
-    parallel::set_num_threads(0);
-    EXPECT_EQ(get(), serial ? 1 : parallel::default_num_threads()) << blas;
+    EXPECT_EQ(blas.find("libblas.so.3.11"), std::string::npos) << blas; // the reference BLAS
+    EXPECT_EQ(parallel::blas_library(), blas);                          // computed once
 }
