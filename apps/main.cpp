@@ -250,8 +250,9 @@ int main(int argc, char** argv) {
         ->required();
     int show_msh_level = -1;
     show->add_option("--msh-level", show_msh_level,
-                     "print the scene's mesh refined L times as a Gmsh 2.2 file instead (a fine "
-                     "mesh with no levels: `show square --msh-level 4 > square_L4.msh`)")
+                     "print the scene's mesh refined L times as a Gmsh 2.2 file instead "
+                     "(`show square --msh-level 4 > square_L4.msh`; a scene reading it recovers "
+                     "its levels unless [scene].recover_levels = false)")
         ->check(CLI::NonNegativeNumber);
     try {
         app.parse(argc, argv);

@@ -63,6 +63,12 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
         os << "body       " << b.name << ": " << b.material << "\n";
     os << "mesh       level " << r.levels().size() - 1 << ": " << L.mesh.n_vertices()
        << " vertices, " << L.mesh.n_triangles() << " triangles (" << plane_name(p) << ")\n";
+    if (p.recovered_levels > 0)
+        os << "           the Gmsh file's mesh is level " << p.recovered_levels
+           << ", a uniform refinement of a " << p.mesh0.n_triangles()
+           << "-triangle mesh: levels 0.." << p.recovered_levels
+           << " recovered ([scene].recover_levels)"
+           << (p.levels < p.recovered_levels ? "; this run stops at a coarser level" : "") << "\n";
     os << "unknowns   " << L.n_unknowns() << " (" << L.dofs.n_displacement_dofs()
        << " displacement, " << L.n_unknowns() - L.dofs.n_displacement_dofs() << " multipliers), "
        << L.n_contact_nodes() << " contact nodes\n";
@@ -449,6 +455,7 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         root.insert("stopped", r.stopped);
         if (r.stopped) root.insert("stopped_at", r.failure);
         root.insert("load_steps", static_cast<int64_t>(p.load_steps));
+        root.insert("recovered_levels", static_cast<int64_t>(p.recovered_levels));
         root.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
         root.insert("vtu_format", mesh::to_string(options.vtu));
         int total_newton = 0;

@@ -435,6 +435,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
             lv.push_back(level_json(plevel + static_cast<int>(k), r.levels[k].n_global_dofs,
                                     r.levels[k].n_global_contacts, r.level_steps[k]));
         root_t.insert("levels", lv);
+        root_t.insert("recovered_levels", static_cast<int64_t>(p.recovered_levels));
         root_t.insert("contacts", contacts_json(p, resultants));
         root_t.insert("checks", checks_json(checks));
         toml::table sv;

@@ -139,6 +139,10 @@ struct Problem {
     /// Load steps: step j solves at the path parameter s = j / load_steps (equal increments).
     int load_steps = 1;
     int levels = 0; ///< number of 1->4 refinements of mesh0
+    /// Levels recovered from a Gmsh mesh that is a uniform refinement (scene/scene.cpp,
+    /// mesh::unrefine): mesh0 is then its coarsest ancestor and the file's mesh is level
+    /// `recovered_levels`; 0 otherwise.
+    int recovered_levels = 0;
     NewtonParams newton;
 
     /// Checks materials, pairs (mu >= 0, r > 0, one target of the right kind, an integration

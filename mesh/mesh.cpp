@@ -390,3 +390,267 @@ Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diago
 }
 
 } // namespace mlc::mesh
+
+namespace mlc::mesh {
+
+std::optional<Mesh> unrefine(const Mesh& f, double tol) {
+    const int nt = f.n_triangles(), nv = f.n_vertices();
+    if (nt < 4 || nt % 4 != 0) return std::nullopt;
+    // The triangles of every vertex (CSR), then the neighbour across local edge e (opposite local
+    // vertex e) of every triangle, -1 on the boundary; an edge of more than two triangles is no
+    // refinement of ours.
+    std::vector<int> vt_off(static_cast<size_t>(nv) + 1, 0), vt(3 * static_cast<size_t>(nt));
+    for (const auto& tri : f.triangles)
+        for (int v : tri)
+            ++vt_off[static_cast<size_t>(v) + 1];
+    for (int v = 0; v < nv; ++v)
+        vt_off[static_cast<size_t>(v) + 1] += vt_off[static_cast<size_t>(v)];
+    {
+        std::vector<int> fill(vt_off.begin(), vt_off.end() - 1);
+        for (int t = 0; t < nt; ++t)
+            for (int v : f.triangles[static_cast<size_t>(t)])
+                vt[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
+    }
+    auto has = [&](int t, int v) {
+        const auto& tri = f.triangles[static_cast<size_t>(t)];
+        return tri[0] == v || tri[1] == v || tri[2] == v;
+    };
+    std::vector<std::array<int, 3>> nb(static_cast<size_t>(nt), {-1, -1, -1});
+    for (int t = 0; t < nt; ++t)
+        for (int e = 0; e < 3; ++e) {
+            const auto& tri = f.triangles[static_cast<size_t>(t)];
+            const int a = tri[(e + 1) % 3], b = tri[(e + 2) % 3];
+            int found = 0;
+            for (int k = vt_off[static_cast<size_t>(a)]; k < vt_off[static_cast<size_t>(a) + 1];
+                 ++k) {
+                const int u = vt[static_cast<size_t>(k)];
+                if (u == t || !has(u, b)) continue;
+                nb[static_cast<size_t>(t)][static_cast<size_t>(e)] = u;
+                ++found;
+            }
+            if (found > 1) return std::nullopt; // a third triangle on an edge
+        }
+    auto local = [&](int t, int v) {
+        const auto& tri = f.triangles[static_cast<size_t>(t)];
+        for (int i = 0; i < 3; ++i)
+            if (tri[i] == v) return i;
+        return -1;
+    };
+    // Label per triangle: -2 unknown, -1 the middle child of its coarse triangle (its three
+    // vertices are midpoints), 0..2 a corner child whose local vertex i is a coarse vertex.
+    // Rules of the 1->4 split: across each edge of a middle child lies a corner child whose
+    // vertex off that edge is coarse; across a corner child's edge opposite its coarse vertex
+    // lies the middle child, across its two other edges corner children of the same vertex.
+    std::vector<int> label(static_cast<size_t>(nt), -2);
+    std::vector<int> stack, touched;
+    auto propagate = [&](int seed, int seed_label) {
+        touched.clear();
+        stack.assign(1, seed);
+        label[static_cast<size_t>(seed)] = seed_label;
+        touched.push_back(seed);
+        auto put = [&](int t, int l) {
+            int& cur = label[static_cast<size_t>(t)];
+            if (cur == -2) {
+                cur = l;
+                touched.push_back(t);
+                stack.push_back(t);
+                return true;
+            }
+            return cur == l;
+        };
+        while (!stack.empty()) {
+            const int t = stack.back();
+            stack.pop_back();
+            const int l = label[static_cast<size_t>(t)];
+            const auto& tri = f.triangles[static_cast<size_t>(t)];
+            for (int e = 0; e < 3; ++e) {
+                const int n = nb[static_cast<size_t>(t)][static_cast<size_t>(e)];
+                if (l == -1 || e == l) { // a middle child's edge, or a corner's edge off its vertex
+                    if (n < 0) return false;
+                    if (l == -1) {
+                        // n's vertex off the shared edge (tri[e+1], tri[e+2]) is coarse
+                        const auto& tn = f.triangles[static_cast<size_t>(n)];
+                        int off = -1;
+                        for (int i = 0; i < 3; ++i)
+                            if (tn[i] != tri[(e + 1) % 3] && tn[i] != tri[(e + 2) % 3]) off = i;
+                        if (off < 0 || !put(n, off)) return false;
+                    } else if (!put(n, -1)) {
+                        return false;
+                    }
+                } else if (n >= 0) { // a corner's edge through its coarse vertex
+                    const int i = local(n, tri[l]);
+                    if (i < 0 || !put(n, i)) return false;
+                }
+            }
+        }
+        return true;
+    };
+    for (int t0 = 0; t0 < nt; ++t0) {
+        if (label[static_cast<size_t>(t0)] != -2) continue;
+        bool ok = false;
+        for (int guess : {-1, 0, 1, 2}) { // each component: the four roles of its first triangle
+            if (propagate(t0, guess)) {
+                ok = true;
+                break;
+            }
+            for (int t : touched)
+                label[static_cast<size_t>(t)] = -2;
+        }
+        if (!ok) return std::nullopt;
+    }
+    // Coarse vertices: the corners' vertices; no triangle may hold two of them.
+    std::vector<int> coarse_of(static_cast<size_t>(nv), -1);
+    for (int t = 0; t < nt; ++t)
+        if (const int l = label[static_cast<size_t>(t)]; l >= 0)
+            coarse_of[static_cast<size_t>(f.triangles[static_cast<size_t>(t)][l])] = 0;
+    for (int t = 0; t < nt; ++t) {
+        int n_coarse = 0;
+        for (int v : f.triangles[static_cast<size_t>(t)])
+            n_coarse += coarse_of[static_cast<size_t>(v)] == 0;
+        if (n_coarse != (label[static_cast<size_t>(t)] >= 0 ? 1 : 0)) return std::nullopt;
+    }
+    Mesh c;
+    c.circles = f.circles;
+    c.tag_names = f.tag_names;
+    for (int v = 0; v < nv; ++v)
+        if (coarse_of[static_cast<size_t>(v)] == 0) {
+            coarse_of[static_cast<size_t>(v)] = c.n_vertices();
+            c.vertices.push_back(f.vertices[static_cast<size_t>(v)]);
+        }
+    const int nc = c.n_vertices();
+    // Each middle child (ab, bc, ca) with the corners across its edges: coarse triangle (a, b, c),
+    // a = the coarse vertex across the edge opposite bc, and so on. Every corner in one group.
+    std::vector<char> grouped(static_cast<size_t>(nt), 0);
+    std::vector<std::array<int, 2>> edge_of(static_cast<size_t>(nv), {-1, -1}); // midpoint's pair
+    auto set_mid = [&](int m, int a, int b) {
+        std::array<int, 2> pair{std::min(a, b), std::max(a, b)};
+        auto& cur = edge_of[static_cast<size_t>(m)];
+        if (cur[0] < 0) cur = pair;
+        return cur == pair;
+    };
+    for (int t = 0; t < nt; ++t) {
+        if (label[static_cast<size_t>(t)] != -1) continue;
+        const auto& mid = f.triangles[static_cast<size_t>(t)];
+        std::array<int, 3> p{};
+        for (int e = 0; e < 3; ++e) {
+            const int n = nb[static_cast<size_t>(t)][static_cast<size_t>(e)];
+            if (grouped[static_cast<size_t>(n)]) return std::nullopt;
+            grouped[static_cast<size_t>(n)] = 1;
+            p[static_cast<size_t>(e)] =
+                f.triangles[static_cast<size_t>(n)][label[static_cast<size_t>(n)]];
+        }
+        grouped[static_cast<size_t>(t)] = 1;
+        // mid = (ab, bc, ca): across (bc, ca) lies c = p[0], across (ca, ab) a = p[1], b = p[2].
+        const int a = p[1], b = p[2], cc = p[0];
+        if (!set_mid(mid[0], a, b) || !set_mid(mid[1], b, cc) || !set_mid(mid[2], cc, a))
+            return std::nullopt;
+        c.triangles.push_back({coarse_of[static_cast<size_t>(a)], coarse_of[static_cast<size_t>(b)],
+                               coarse_of[static_cast<size_t>(cc)]});
+        if (!f.attribute.empty()) {
+            const int at = f.attribute[static_cast<size_t>(t)];
+            for (int e = 0; e < 3; ++e)
+                if (f.attribute[static_cast<size_t>(nb[static_cast<size_t>(t)][e])] != at)
+                    return std::nullopt;
+            c.attribute.push_back(at);
+        }
+    }
+    if (4 * c.n_triangles() != nt) return std::nullopt;
+    // Boundary edges and lines: the two halves (a, m), (m, b) of each coarse edge, same tag and
+    // curve, m the midpoint of (a, b).
+    auto join = [&](const std::vector<BoundaryEdge>& halves, std::vector<BoundaryEdge>& out,
+                    bool oriented) {
+        std::vector<int> first(static_cast<size_t>(nv), -1);
+        for (size_t h = 0; h < halves.size(); ++h) {
+            const BoundaryEdge& e = halves[h];
+            const bool c0 = coarse_of[static_cast<size_t>(e.v0)] >= 0 &&
+                            edge_of[static_cast<size_t>(e.v0)][0] < 0;
+            const bool c1 = coarse_of[static_cast<size_t>(e.v1)] >= 0 &&
+                            edge_of[static_cast<size_t>(e.v1)][0] < 0;
+            if (c0 == c1) return false; // one end coarse, one a midpoint
+            const int m = c0 ? e.v1 : e.v0;
+            int& other = first[static_cast<size_t>(m)];
+            if (other < 0) {
+                other = static_cast<int>(h);
+                continue;
+            }
+            const BoundaryEdge& g = halves[static_cast<size_t>(other)];
+            if (g.tag != e.tag || g.curve != e.curve) return false;
+            const int ga = g.v0 == m ? g.v1 : g.v0, ea = c0 ? e.v0 : e.v1;
+            const auto& pair = edge_of[static_cast<size_t>(m)];
+            if (std::array<int, 2>{std::min(ga, ea), std::max(ga, ea)} != pair) return false;
+            int a = ga, b = ea; // unoriented: any order
+            if (oriented) {
+                if (g.v1 == m && e.v0 == m) {
+                    a = g.v0;
+                    b = e.v1;
+                } else if (e.v1 == m && g.v0 == m) {
+                    a = e.v0;
+                    b = g.v1;
+                } else {
+                    return false;
+                }
+            }
+            out.push_back({coarse_of[static_cast<size_t>(a)], coarse_of[static_cast<size_t>(b)],
+                           e.tag, e.curve});
+            other = -2;
+        }
+        for (int v = 0; v < nv; ++v)
+            if (first[static_cast<size_t>(v)] >= 0) return false; // an unpaired half
+        return true;
+    };
+    if (!join(f.boundary, c.boundary, true) || !join(f.lines, c.lines, false)) return std::nullopt;
+    // The check that settles it: refining the coarse mesh gives back f, every vertex within tol
+    // and every triangle, boundary half and line half present.
+    const Mesh r = refine(c);
+    if (r.n_vertices() != nv || r.n_triangles() != nt || r.boundary.size() != f.boundary.size() ||
+        r.lines.size() != f.lines.size())
+        return std::nullopt;
+    std::vector<int> to_f(static_cast<size_t>(nv), -1); // r's vertex -> f's
+    for (int v = 0; v < nv; ++v) {
+        const int cv = coarse_of[static_cast<size_t>(v)];
+        if (cv >= 0 && edge_of[static_cast<size_t>(v)][0] < 0) to_f[static_cast<size_t>(cv)] = v;
+    }
+    // f's midpoint of each coarse edge, listed under the edge's first coarse vertex.
+    std::vector<int> mo_off(static_cast<size_t>(nc) + 1, 0);
+    std::vector<std::array<int, 2>> mo(static_cast<size_t>(nv - nc)); // (second vertex, midpoint)
+    for (int v = 0; v < nv; ++v)
+        if (const auto& pr = edge_of[static_cast<size_t>(v)]; pr[0] >= 0)
+            ++mo_off[static_cast<size_t>(coarse_of[static_cast<size_t>(pr[0])]) + 1];
+    for (int v = 0; v < nc; ++v)
+        mo_off[static_cast<size_t>(v) + 1] += mo_off[static_cast<size_t>(v)];
+    {
+        std::vector<int> fill(mo_off.begin(), mo_off.end() - 1);
+        for (int v = 0; v < nv; ++v)
+            if (const auto& pr = edge_of[static_cast<size_t>(v)]; pr[0] >= 0) {
+                const int a = coarse_of[static_cast<size_t>(pr[0])];
+                const int b = coarse_of[static_cast<size_t>(pr[1])];
+                mo[static_cast<size_t>(fill[static_cast<size_t>(std::min(a, b))]++)] = {
+                    std::max(a, b), v};
+            }
+    }
+    for (int v = nc; v < nv; ++v) {
+        const auto& pr = r.parents[static_cast<size_t>(v - nc)]; // (min, max)
+        for (int k = mo_off[static_cast<size_t>(pr[0])]; k < mo_off[static_cast<size_t>(pr[0]) + 1];
+             ++k)
+            if (mo[static_cast<size_t>(k)][0] == pr[1])
+                to_f[static_cast<size_t>(v)] = mo[static_cast<size_t>(k)][1];
+    }
+    for (int v = 0; v < nv; ++v) {
+        const int w = to_f[static_cast<size_t>(v)];
+        if (w < 0 ||
+            (r.vertices[static_cast<size_t>(v)] - f.vertices[static_cast<size_t>(w)]).norm() > tol)
+            return std::nullopt;
+    }
+    for (const auto& t : r.triangles) {
+        const int x = to_f[static_cast<size_t>(t[0])], y = to_f[static_cast<size_t>(t[1])],
+                  z = to_f[static_cast<size_t>(t[2])];
+        bool found = false;
+        for (int k = vt_off[static_cast<size_t>(x)];
+             k < vt_off[static_cast<size_t>(x) + 1] && !found; ++k)
+            found = has(vt[static_cast<size_t>(k)], y) && has(vt[static_cast<size_t>(k)], z);
+        if (!found) return std::nullopt;
+    }
+    return c;
+}
+
+} // namespace mlc::mesh

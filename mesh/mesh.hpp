@@ -101,6 +101,16 @@ void check_refined_quality(const Mesh& m);
 /// boundary edge is moved onto the circle. Coarse vertex indices are kept; `parents` is filled.
 Mesh refine(const Mesh& coarse);
 
+/// The inverse of `refine`, when `fine` is a uniform 1->4 refinement (what Gmsh's `RefineMesh`
+/// and `gmsh -refine`, or `mlcontact show --msh-level`, write): the coarse mesh c with
+/// refine(c) = fine up to the vertex numbering (every vertex of refine(c) within `tol` of its
+/// vertex of `fine`; the same triangles, boundary halves and interior-line halves, with their
+/// tags, curves and attributes). Found from the topology alone (the middle child of each coarse
+/// triangle has three midpoints; the children around it have one coarse vertex each), then
+/// checked by refining. nullopt when `fine` is not such a refinement. The coarse vertices keep
+/// the order of their indices in `fine`; `parents` is empty.
+std::optional<Mesh> unrefine(const Mesh& fine, double tol);
+
 /// The vertices in the order of a Hilbert curve through their bounding box (2^16 cells a side;
 /// ties keep index order): neighbours in the mesh get nearby positions, so vectors indexed in
 /// this order are read with few cache misses by the sparse mat-vecs and sweeps of a level.

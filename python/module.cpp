@@ -325,6 +325,11 @@ PYBIND11_MODULE(_core, m) {
         .def_property_readonly(
             "n_triangles", [](const Scene& s) { return s.problem.mesh0.n_triangles(); },
             "triangles of the level-0 mesh")
+        .def_property_readonly(
+            "recovered_levels", [](const Scene& s) { return s.problem.recovered_levels; },
+            "levels recovered from a Gmsh mesh that is a uniform refinement "
+            "([scene].recover_levels): the file's mesh is this level, the level-0 mesh its "
+            "coarsest ancestor; 0 otherwise")
         .def_property(
             "levels", [](const Scene& s) { return s.problem.levels; },
             [](Scene& s, int v) {

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
@@ -26,6 +27,8 @@ const std::map<std::string, std::string>& builtin_files();  // generated: scenes
 } // namespace detail
 
 namespace {
+
+constexpr int kMaxLevels = 12; // [scene].levels and the levels a Gmsh mesh is read with
 
 using levels::Problem;
 
@@ -440,11 +443,19 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
     rd.check_keys(root, {"scene", "body", "load", "support", "contact", "newton"}, "the scene");
     Problem p;
     fem::Plane plane = fem::Plane::strain;
+    bool recover = true;                      // [scene].recover_levels
+    const toml::node* recover_node = nullptr; // where it was stated, if it was
+    bool all_gmsh = true;                     // every body's mesh read from a Gmsh file
     {
         const toml::node* sn = rd.need(root, "scene", "the scene");
         const toml::table& s = rd.table(sn, "[scene]");
-        rd.check_keys(s, {"name", "description", "units", "plane", "load_steps", "levels"},
-                      "[scene]");
+        rd.check_keys(
+            s, {"name", "description", "units", "plane", "load_steps", "levels", "recover_levels"},
+            "[scene]");
+        if (const toml::node* rn = s.get("recover_levels")) {
+            recover_node = rn;
+            recover = rd.boolean_or(s, "recover_levels", true, "[scene]");
+        }
         p.name = rd.string(s, "name", "[scene]");
         p.description = rd.string_or(s, "description", "", "[scene]");
         p.units = rd.string_or(s, "units", "", "[scene]");
@@ -459,7 +470,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
             rd.fail(s.get("load_steps"),
                     "[scene].load_steps must be at least 1, found " + std::to_string(p.load_steps));
         p.levels = rd.integer_or(s, "levels", 0, "[scene]");
-        if (p.levels < 0 || p.levels > 12)
+        if (p.levels < 0 || p.levels > kMaxLevels)
             rd.fail(s.get("levels"), "[scene].levels must lie in [0, 12]");
     }
     const auto bodies = rd.tables(root, "body", "the scene");
@@ -479,7 +490,9 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         });
         if (b.get("body_force")) body.body_force = rd.vec2(b, "body_force", w);
         const toml::node* mn = rd.need(b, "mesh", w);
-        mesh::Mesh m = parse_mesh(rd, rd.table(mn, w + ".mesh"), w + ".mesh", base_dir);
+        const toml::table& mt = rd.table(mn, w + ".mesh");
+        if (mt["type"].value_or(std::string()) != "gmsh") all_gmsh = false;
+        mesh::Mesh m = parse_mesh(rd, mt, w + ".mesh", base_dir);
         if (const toml::node* tn = b.get("tags")) {
             // Renames this body's boundary tags before merging (tags merge by name).
             const toml::table& tt = rd.table(tn, w + ".tags");
@@ -518,6 +531,34 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         mesh::check_quality(p.mesh0);
         return 0;
     });
+    // A Gmsh mesh that is a uniform 1->4 refinement (Gmsh's RefineMesh, `gmsh -refine`,
+    // `mlcontact show --msh-level`) is read as its coarsest ancestor and the levels between:
+    // the multigrid and coarse-to-fine Newton then have the hierarchy a built-in scene has. The
+    // levels are solved on the refined ancestor, whose vertices lie within 1e-10 of the mesh's
+    // size of the file's (exact for a file written with 17 digits).
+    if (recover_node != nullptr && recover && !all_gmsh)
+        rd.fail(recover_node, "[scene].recover_levels applies to meshes read from Gmsh files "
+                              "(type = \"gmsh\"), and a body here has another mesh");
+    if (recover && all_gmsh) {
+        Vec2 lo = p.mesh0.vertices.front(), hi = lo;
+        for (const Vec2& v : p.mesh0.vertices) {
+            lo = lo.cwiseMin(v);
+            hi = hi.cwiseMax(v);
+        }
+        const double tol = 1e-10 * (hi - lo).norm();
+        while (p.levels < kMaxLevels) {
+            std::optional<mesh::Mesh> c = mesh::unrefine(p.mesh0, tol);
+            if (!c) break;
+            try {
+                mesh::check_quality(*c);
+            } catch (const InvalidInput&) {
+                break; // an ancestor our checks refuse is not used
+            }
+            p.mesh0 = std::move(*c);
+            ++p.levels;
+            ++p.recovered_levels;
+        }
+    }
     // Loads and contact pairs need a tag on boundary edges; supports may also name a tagged
     // interior line (Mesh::lines).
     auto check_tag = [&](const toml::table& t, const std::string& tag, const std::string& w,

@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# The square exported from level L as a Gmsh file (one level, no hierarchy) against the refined
-# square (README "`mg` on a mesh without levels"): the default (schur there), `--linear schur`,
-# `--linear krylov` (the default mg pair over the aggregation hierarchy), `--pc mg` (CGS +
-# V(1,1)) on the export, and `run square --levels L --cold` (geometric mg), alternated REPEAT
-# times; prints one line per run (configuration, run, wall milliseconds) and the medians.
+# The square exported from level L as a Gmsh file against the refined square (README "`mg` on a
+# mesh without levels" and "Levels recovered from a Gmsh mesh"). The export is a uniform
+# refinement, so by default the scene recovers its levels ([scene].recover_levels): the default
+# solver (coarse-to-fine, mg) and `--linear schur` on it; then the same file read flat
+# (`recover_levels = false`: one level, no hierarchy) with its default (schur there),
+# `--linear krylov` (the default mg pair over the aggregation hierarchy) and `--pc mg` (CGS +
+# V(1,1)); and `run square --levels L --cold` (geometric mg), alternated REPEAT times. Prints one
+# line per run (configuration, run, wall milliseconds) and the medians.
 # Run it on an idle machine: it measures wall time.
 #
 #   bash scripts/bench_gmsh_export.sh [L [REPEAT]]     # default: level 4, 3 repeats
@@ -20,14 +23,18 @@ mkdir -p "$work"
   -e "s|^mesh = .*|mesh = { type = \"gmsh\", file = \"square_L$level.msh\" }|" > "$work/square_L$level.toml"
 grep -q "square_L$level.msh" "$work/square_L$level.toml" || { echo "could not point the scene at the mesh"; exit 1; }
 scene=$work/square_L$level.toml
+flat=$work/square_L${level}_flat.toml
+sed -e "s|^\[scene\]$|[scene]\nrecover_levels = false|" "$scene" > "$flat"
+grep -q "recover_levels = false" "$flat" || { echo "could not write the flat scene"; exit 1; }
 declare -A args=(
   [default]="run $scene"
   [schur]="run $scene --linear schur"
-  [krylov]="run $scene --linear krylov"
-  [pc_mg]="run $scene --pc mg"
+  [flat_default]="run $flat"
+  [flat_krylov]="run $flat --linear krylov"
+  [flat_pc_mg]="run $flat --pc mg"
   [cold]="run square --levels $level --cold"
 )
-names=(default schur krylov pc_mg cold)
+names=(default schur flat_default flat_krylov flat_pc_mg cold)
 declare -A times
 for ((r = 1; r <= repeat; r++)); do
   for k in "${names[@]}"; do

@@ -2,9 +2,12 @@
 """The scene keys of issue 16 from Python: the Scene reads them through the C++ parser, exposes
 the supports with their activity per load step and the mesh's tags (boundary and interior lines),
 and solves the built-in scenes that use them."""
+import json
+
 import pytest
 
 import mlcontact
+from conftest import run_cli
 
 
 def test_axis_release_supports_and_interior_line_tags():
@@ -57,3 +60,72 @@ mesh = { type = "rectangle", corner = [0, 0], size = [1, 1], divisions = [2, 2],
         mlcontact.Scene.from_toml(base.replace("T", "{ shear = 1.0 }"))
     s = mlcontact.Scene.from_toml(base.replace("T", "{ rotate_deg = 90.0, translate = [1, 0] }"))
     assert s.n_vertices == 9
+
+
+def _refined_square_msh(n):
+    """A Gmsh 2.2 file of the unit square in n x n squares cut along "/" (n = 2^k: k uniform
+    refinements of one square cut in two), boundary lines in physical groups."""
+    nodes = [(i / n, j / n) for j in range(n + 1) for i in range(n + 1)]
+    vid = lambda i, j: j * (n + 1) + i + 1
+    lines = []
+    for i in range(n):
+        lines += [(1, vid(i, 0), vid(i + 1, 0)), (3, vid(i + 1, n), vid(i, n))]
+        lines += [(2, vid(n, i), vid(n, i + 1)), (4, vid(0, i + 1), vid(0, i))]
+    tris = []
+    for j in range(n):
+        for i in range(n):
+            a, b, c, d = vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)
+            tris += [(a, b, c), (a, c, d)]
+    out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", "5",
+           '1 1 "bottom"', '1 2 "right"', '1 3 "top"', '1 4 "left"', '2 5 "body"',
+           "$EndPhysicalNames", "$Nodes", str(len(nodes))]
+    out += [f"{k + 1} {x!r} {y!r} 0" for k, (x, y) in enumerate(nodes)]
+    out += ["$EndNodes", "$Elements", str(len(lines) + len(tris))]
+    e = 0
+    for tag, v0, v1 in lines:
+        e += 1
+        out.append(f"{e} 1 2 {tag} {tag} {v0} {v1}")
+    for a, b, c in tris:
+        e += 1
+        out.append(f"{e} 2 2 5 1 {a} {b} {c}")
+    out.append("$EndElements")
+    return "\n".join(out) + "\n"
+
+
+def test_a_gmsh_mesh_that_is_a_uniform_refinement_is_read_with_its_levels(tmp_path):
+    (tmp_path / "sq.msh").write_text(_refined_square_msh(16))
+    text = """
+[scene]
+name = "pressed square"
+load_steps = 2
+[[body]]
+E = 1.0
+nu = 0.3
+mesh = { type = "gmsh", file = "sq.msh" }
+[[load]]
+tag = "top"
+pressure = 1e-3
+[[contact]]
+contactor = "bottom"
+mu = 0.3
+obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
+"""
+    s = mlcontact.Scene.from_toml(text, "sq.toml", str(tmp_path))
+    # 16 x 16 squares = four refinements of one square cut in two
+    assert s.recovered_levels == 4 and s.levels == 4 and s.n_triangles == 2
+    flat = mlcontact.Scene.from_toml(text.replace("[scene]\n", "[scene]\nrecover_levels = false\n"),
+                                     "sq.toml", str(tmp_path))
+    assert flat.recovered_levels == 0 and flat.levels == 0 and flat.n_triangles == 512
+    a, b = mlcontact.solve(s), mlcontact.solve(flat)
+    assert a.converged and b.converged
+    # The same finest mesh: the contact resultant balances the load (1e-3 over the unit top).
+    for r in (a, b):
+        assert r.resultants[0]["force"][1] == pytest.approx(1e-3, rel=1e-8)
+    assert a.resultants[0]["force"][0] == pytest.approx(b.resultants[0]["force"][0], rel=1e-8,
+                                                        abs=1e-12)
+    # The command line says so in its report and summary.json.
+    (tmp_path / "sq.toml").write_text(text)
+    out = run_cli("run", str(tmp_path / "sq.toml"), "--out", str(tmp_path / "out")).stdout
+    assert "the Gmsh file's mesh is level 4, a uniform refinement of a 2-triangle mesh" in out
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["recovered_levels"] == 4 and summary["levels"][-1]["level"] == 4

@@ -8,12 +8,15 @@
 #include "levels/solve.hpp"
 #include "mesh/io/gmsh.hpp"
 #include "scene/scene.hpp"
+#include "tests/common/scene_text.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <utility>
 
 using namespace mlc;
 using namespace mlc::levels;
@@ -260,8 +263,9 @@ TEST(MultilevelPreconditioner, TheDampedTwoBodyDefaultSolvesTheDovetail) {
 namespace {
 
 // A level-0 scene whose mesh is level `level` of the square written as a Gmsh file and read
-// back (no levels: a fine mesh brought from Gmsh).
-Problem exported_square(int level) {
+// back. With `recover` false ([scene].recover_levels = false) it has no levels: a fine mesh
+// brought from Gmsh that is no refinement; with true the scene recovers the levels.
+Problem exported_square(int level, bool recover = false) {
     const std::string built_in = scene::builtin_scene_text("square");
     auto p = scene::load_scene("square");
     mesh::Mesh m = p.mesh0;
@@ -277,9 +281,10 @@ Problem exported_square(int level) {
     const std::string from = "mesh = { type = \"rectangle\"";
     const auto at = built_in.find(from);
     EXPECT_NE(at, std::string::npos);
-    const std::string text = built_in.substr(0, at) +
-                             "mesh = { type = \"gmsh\", file = " + "\"square.msh\" }" +
-                             built_in.substr(built_in.find('\n', at));
+    std::string text = built_in.substr(0, at) +
+                       "mesh = { type = \"gmsh\", file = " + "\"square.msh\" }" +
+                       built_in.substr(built_in.find('\n', at));
+    if (!recover) text = test::replace(text, "[scene]\n", "[scene]\nrecover_levels = false\n");
     return scene::parse_scene(text, (dir / "square.toml").string(), dir);
 }
 
@@ -352,4 +357,64 @@ TEST(AlgebraicMultigrid, IsAskedForOnASingleLevelAndEstimated) {
     krylov.linear = "krylov";
     EXPECT_EQ(choose_solver(p, krylov).spec.pc, "mg:pre=0,post=2");
     EXPECT_EQ(choose_solver(p, krylov).spec.krylov, "bicgstab");
+}
+
+// The levels of a Gmsh mesh that is a uniform refinement (scene/scene.cpp, mesh::unrefine).
+TEST(RecoveredLevels, TheExportedSquareSolvesAsTheRefinedSquareDoes) {
+    // The built-in square's 16 x 16 level-0 mesh is itself four refinements of one square cut
+    // in two, so its level-3 export recovers 7 levels down to 2 triangles.
+    const Problem p = exported_square(3, true);
+    EXPECT_EQ(p.recovered_levels, 7);
+    EXPECT_EQ(p.levels, 7);
+    EXPECT_EQ(p.mesh0.n_triangles(), 2);
+    auto q = scene::load_scene("square");
+    q.levels = 3;
+    const RunResult a = solve(p, {});
+    const RunResult b = solve(q, {});
+    ASSERT_TRUE(a.converged) << a.failure;
+    ASSERT_TRUE(b.converged) << b.failure;
+    // The same finest mesh in another numbering: the displacement of every vertex, found by its
+    // coordinates, agrees to the Newton tolerance's scale.
+    const auto& La = a.finest();
+    const auto& Lb = b.finest();
+    ASSERT_EQ(La.mesh.n_vertices(), Lb.mesh.n_vertices());
+    std::map<std::pair<double, double>, Vec2> ub;
+    auto u_of = [](const auto& L, const Vector& x, int v) {
+        Vec2 u = Vec2::Zero();
+        for (int c = 0; c < 2; ++c)
+            if (const int i = L.dofs.u_dof(v, c); i >= 0) u[c] = x[i];
+        return u;
+    };
+    double umax = 0.0;
+    for (int v = 0; v < Lb.mesh.n_vertices(); ++v) {
+        const Vec2& xv = Lb.mesh.vertices[static_cast<size_t>(v)];
+        ub[{xv.x(), xv.y()}] = u_of(Lb, b.x, v);
+        umax = std::max(umax, ub[{xv.x(), xv.y()}].norm());
+    }
+    double worst = 0.0;
+    for (int v = 0; v < La.mesh.n_vertices(); ++v) {
+        const Vec2& xv = La.mesh.vertices[static_cast<size_t>(v)];
+        const auto it = ub.find({xv.x(), xv.y()});
+        ASSERT_NE(it, ub.end()) << "vertex (" << xv.x() << ", " << xv.y() << ")";
+        worst = std::max(worst, (u_of(La, a.x, v) - it->second).norm());
+    }
+    EXPECT_LT(worst, 1e-8 * umax);
+    // Above the crossover the default is the multigrid over the recovered levels.
+    EXPECT_EQ(choose_solver(p, {}).spec.pc, "mg:pre=0,post=2");
+}
+
+TEST(RecoveredLevels, AnUnstructuredGmshMeshHasNoneAndTheKeyNeedsGmshMeshes) {
+    EXPECT_EQ(scene::load_scene("hertz_gmsh").recovered_levels, 0);
+    EXPECT_EQ(exported_square(2, false).recovered_levels, 0);
+    const std::string text = test::replace(scene::builtin_scene_text("square"), "[scene]\n",
+                                           "[scene]\nrecover_levels = true\n");
+    EXPECT_NE(test::error_of(text).find("recover_levels applies to meshes read from Gmsh files"),
+              std::string::npos)
+        << test::error_of(text);
+    // Stated false on the built-in square's rectangle: nothing to recover, no error.
+    EXPECT_EQ(scene::parse_scene(test::replace(scene::builtin_scene_text("square"), "[scene]\n",
+                                               "[scene]\nrecover_levels = false\n"),
+                                 "square")
+                  .levels,
+              0);
 }

@@ -5,6 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
 using namespace mlc;
 
 TEST(StructuredRectangle, SquareLadderCounts) {
@@ -120,4 +125,132 @@ TEST(HilbertOrder, IsAPermutationThatKeepsMeshNeighboursClose) {
     EXPECT_EQ(mesh::hilbert_order({Vec2(1, 2)}), std::vector<int>{0});
     EXPECT_EQ(mesh::hilbert_order({Vec2(1, 2), Vec2(1, 2), Vec2(1, 2)}),
               (std::vector<int>{0, 1, 2}));
+}
+
+namespace {
+
+// f with its vertices renumbered by a fixed shuffle and each triangle's vertices rotated: the
+// same mesh in another file's order.
+mesh::Mesh shuffled(const mesh::Mesh& f) {
+    const int n = f.n_vertices();
+    std::vector<int> to(static_cast<size_t>(n));
+    for (int v = 0; v < n; ++v)
+        to[static_cast<size_t>(v)] = static_cast<int>((static_cast<long>(v) * 7919 + 13) % n);
+    mesh::Mesh g = f;
+    g.parents.clear();
+    g.n_coarse_vertices = 0;
+    for (int v = 0; v < n; ++v)
+        g.vertices[static_cast<size_t>(to[static_cast<size_t>(v)])] =
+            f.vertices[static_cast<size_t>(v)];
+    for (size_t t = 0; t < g.triangles.size(); ++t) {
+        const auto& a = f.triangles[t];
+        const size_t r = t % 3;
+        for (size_t i = 0; i < 3; ++i)
+            g.triangles[t][i] = to[static_cast<size_t>(a[(i + r) % 3])];
+    }
+    for (auto* edges : {&g.boundary, &g.lines})
+        for (auto& e : *edges) {
+            e.v0 = to[static_cast<size_t>(e.v0)];
+            e.v1 = to[static_cast<size_t>(e.v1)];
+        }
+    return g;
+}
+
+// The largest distance from a vertex of a to the nearest vertex of b (both the same size).
+double vertex_set_distance(const mesh::Mesh& a, const mesh::Mesh& b) {
+    auto key = [](const Vec2& p) { return std::make_pair(p.x(), p.y()); };
+    std::vector<std::pair<double, double>> pa, pb;
+    for (const Vec2& p : a.vertices)
+        pa.push_back(key(p));
+    for (const Vec2& p : b.vertices)
+        pb.push_back(key(p));
+    std::sort(pa.begin(), pa.end());
+    std::sort(pb.begin(), pb.end());
+    double d = 0.0;
+    for (size_t i = 0; i < pa.size(); ++i)
+        d = std::max(d, std::hypot(pa[i].first - pb[i].first, pa[i].second - pb[i].second));
+    return d;
+}
+
+} // namespace
+
+TEST(Unrefine, RecoversEveryCoarserMeshOfARefinementInAnyNumbering) {
+    // 3 x 2 squares with alternating diagonals (12 triangles): itself no refinement of ours.
+    auto c = mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 3, 2, mesh::Diagonal::alternate);
+    c.attribute.assign(c.triangles.size(), 0);
+    c.attribute[5] = 1; // a second body id must survive
+    ASSERT_FALSE(mesh::unrefine(c, 1e-12).has_value());
+    const auto f2 = shuffled(mesh::refine(mesh::refine(c)));
+    const auto f1 = mesh::unrefine(f2, 1e-12);
+    ASSERT_TRUE(f1.has_value());
+    EXPECT_EQ(f1->n_triangles(), 48);
+    EXPECT_EQ(f1->n_vertices(), mesh::refine(c).n_vertices());
+    EXPECT_NO_THROW(mesh::check_quality(*f1));
+    const auto c0 = mesh::unrefine(*f1, 1e-12);
+    ASSERT_TRUE(c0.has_value());
+    EXPECT_FALSE(mesh::unrefine(*c0, 1e-12).has_value());
+    EXPECT_EQ(c0->n_triangles(), 12);
+    EXPECT_EQ(vertex_set_distance(*c0, c), 0.0);
+    // Refining the recovered mesh gives the file's mesh back: vertices, boundary with its tags,
+    // and the body ids (one coarse triangle of body 1, four children of it per level).
+    const auto r = mesh::refine(mesh::refine(*c0));
+    EXPECT_EQ(vertex_set_distance(r, f2), 0.0);
+    EXPECT_EQ(r.boundary.size(), f2.boundary.size());
+    for (const char* tag : {"bottom", "right", "top", "left"})
+        EXPECT_EQ(r.vertices_with_tag(r.tag(tag)).size(), f2.vertices_with_tag(f2.tag(tag)).size())
+            << tag;
+    EXPECT_EQ(std::count(c0->attribute.begin(), c0->attribute.end(), 1), 1);
+    EXPECT_EQ(std::count(f1->attribute.begin(), f1->attribute.end(), 1), 4);
+}
+
+TEST(Unrefine, KeepsArcsAndPutsTheirMidpointsBackOnTheCircle) {
+    auto m = mesh::structured_rectangle(Vec2(-1, 0), Vec2(2, 1), 2, 1);
+    m.circles.push_back({Vec2(0, 5), 5.0});
+    for (auto& e : m.boundary)
+        if (e.tag == m.tag("bottom")) e.curve = 0;
+    const auto f = mesh::refine(mesh::refine(m));
+    const auto c = mesh::unrefine(mesh::unrefine(f, 1e-12).value(), 1e-12);
+    ASSERT_TRUE(c.has_value());
+    EXPECT_EQ(vertex_set_distance(*c, m), 0.0);
+    int on_arc = 0;
+    for (const auto& e : c->boundary)
+        on_arc += e.curve == 0;
+    EXPECT_EQ(on_arc, 2);
+}
+
+TEST(Unrefine, RefusesAMeshThatIsNoUniformRefinement) {
+    const auto c =
+        mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 3, 2, mesh::Diagonal::alternate);
+    const auto f = mesh::refine(c);
+    ASSERT_TRUE(mesh::unrefine(f, 1e-12).has_value());
+    // A midpoint moved by 1e-6: the refinement of the recovered mesh misses it.
+    auto moved = f;
+    moved.vertices[static_cast<size_t>(c.n_vertices() + 3)] += Vec2(1e-6, 0.0);
+    EXPECT_FALSE(mesh::unrefine(moved, 1e-10).has_value());
+    EXPECT_TRUE(mesh::unrefine(moved, 1e-5).has_value()); // within a looser tolerance it is one
+    // One diagonal flipped: the topology is no 1->4 split any more.
+    auto flipped = f;
+    bool done = false;
+    for (size_t t = 0; t < flipped.triangles.size() && !done; ++t)
+        for (size_t u = t + 1; u < flipped.triangles.size() && !done; ++u) {
+            auto& A = flipped.triangles[t];
+            auto& B = flipped.triangles[u];
+            // shared edge (A[1], A[2]) = (B[2], B[1]): flip to (A[0], B[0])
+            for (int i = 0; i < 3 && !done; ++i) {
+                const int a0 = A[i], a1 = A[(i + 1) % 3], a2 = A[(i + 2) % 3];
+                for (int j = 0; j < 3 && !done; ++j)
+                    if (B[(j + 1) % 3] == a2 && B[(j + 2) % 3] == a1) {
+                        const int b0 = B[j];
+                        A = {a0, a1, b0};
+                        B = {b0, a2, a0};
+                        done = true;
+                    }
+            }
+        }
+    ASSERT_TRUE(done);
+    EXPECT_FALSE(mesh::unrefine(flipped, 1e-12).has_value());
+    // Triangle counts that are no multiple of 4.
+    auto fewer = f;
+    fewer.triangles.pop_back();
+    EXPECT_FALSE(mesh::unrefine(fewer, 1e-12).has_value());
 }
