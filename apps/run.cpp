@@ -20,9 +20,17 @@ namespace mlc::apps {
 
 void apply_overrides(levels::Problem& p, const RunOptions& opt) {
     if (opt.levels) {
-        MLC_CHECK(*opt.levels >= 0 && *opt.levels <= 12,
-                  "--levels must lie in [0, 12], found " << *opt.levels);
-        p.levels = *opt.levels;
+        // Refinements of the scene's mesh: of the file's mesh when its levels were recovered
+        // (the file's mesh is then level p.recovered_levels), as [scene].levels counts them.
+        const int k = p.recovered_levels;
+        MLC_CHECK(*opt.levels >= 0 && *opt.levels <= 12 - k,
+                  "--levels must lie in [0, "
+                      << 12 - k << "], found " << *opt.levels
+                      << (k > 0 ? " (the scene's Gmsh mesh is already "
+                                  "level " +
+                                      std::to_string(k) + " of its recovered levels)"
+                                : std::string()));
+        p.levels = k + *opt.levels;
     }
     if (opt.load_steps) {
         MLC_CHECK(*opt.load_steps >= 1, "--steps must be at least 1, found " << *opt.load_steps);

@@ -601,7 +601,12 @@ std::optional<Mesh> unrefine(const Mesh& f, double tol) {
     if (!join(f.boundary, c.boundary, true) || !join(f.lines, c.lines, false)) return std::nullopt;
     // The check that settles it: refining the coarse mesh gives back f, every vertex within tol
     // and every triangle, boundary half and line half present.
-    const Mesh r = refine(c);
+    Mesh r;
+    try {
+        r = refine(c);
+    } catch (const InvalidInput&) {
+        return std::nullopt; // e.g. an arc whose chord's midpoint is its centre
+    }
     if (r.n_vertices() != nv || r.n_triangles() != nt || r.boundary.size() != f.boundary.size() ||
         r.lines.size() != f.lines.size())
         return std::nullopt;

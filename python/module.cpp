@@ -331,14 +331,16 @@ PYBIND11_MODULE(_core, m) {
             "([scene].recover_levels): the file's mesh is this level, the level-0 mesh its "
             "coarsest ancestor; 0 otherwise")
         .def_property(
-            "levels", [](const Scene& s) { return s.problem.levels; },
+            "levels", [](const Scene& s) { return s.problem.levels - s.problem.recovered_levels; },
             [](Scene& s, int v) {
-                if (v < 0 || v > 12)
-                    throw InvalidInput("levels: [scene].levels must lie in [0, 12], found " +
-                                       std::to_string(v));
-                set_checked(s, "levels", [&](levels::Problem& p) { p.levels = v; });
+                const int k = s.problem.recovered_levels;
+                if (v < 0 || v > 12 - k)
+                    throw InvalidInput("levels: [scene].levels must lie in [0, " +
+                                       std::to_string(12 - k) + "], found " + std::to_string(v));
+                set_checked(s, "levels", [&](levels::Problem& p) { p.levels = k + v; });
             },
-            "number of 1->4 refinements of the level-0 mesh ([scene].levels, 0..12)")
+            "number of 1->4 refinements of the scene's mesh ([scene].levels, 0..12; of the "
+            "file's mesh when its levels were recovered, see recovered_levels)")
         .def_property(
             "load_steps", [](const Scene& s) { return s.problem.load_steps; },
             [](Scene& s, int v) {

@@ -3,6 +3,7 @@
 #include "scene/scene.hpp"
 
 #include "core/check.hpp"
+#include "levels/level.hpp"
 #include "mesh/mesh.hpp"
 #ifdef MLC_HAVE_CGAL
 #include "mesh/cgal/domain_mesher.hpp"
@@ -427,6 +428,50 @@ mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::s
             where + ".type must be \"rectangle\", \"domain\" or \"gmsh\", found \"" + type + "\"");
 }
 
+// A Gmsh mesh that is a uniform 1->4 refinement (Gmsh's RefineMesh, `gmsh -refine`, `mlcontact
+// show --msh-level`) is read as a coarse ancestor and the levels between: coarse-to-fine Newton
+// and the multigrid then have the hierarchy a built-in scene has. The ancestors are found by
+// mesh::unrefine (its vertices within tol of the file's: exact for a file written with 17
+// digits; tol also allows the rounding of coordinates far from the origin); the coarsest one on
+// which the scene's level 0 builds (its support points are vertices, every contact pair finds
+// contactor nodes, matching node pairs match) becomes mesh0. Called on a parsed, valid problem.
+void recover_levels(levels::Problem& p) {
+    Vec2 lo = p.mesh0.vertices.front(), hi = lo;
+    double far = 0.0;
+    for (const Vec2& v : p.mesh0.vertices) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+        far = std::max(far, v.cwiseAbs().maxCoeff());
+    }
+    const double tol = std::max(1e-10 * (hi - lo).norm(), 1e-14 * far);
+    std::vector<mesh::Mesh> ancestors; // ancestors[i]: the file's mesh unrefined i + 1 times
+    const mesh::Mesh* m = &p.mesh0;
+    while (p.levels + static_cast<int>(ancestors.size()) < kMaxLevels) {
+        std::optional<mesh::Mesh> c = mesh::unrefine(*m, tol);
+        if (!c) break;
+        try {
+            mesh::check_quality(*c);
+        } catch (const InvalidInput&) {
+            break; // an ancestor our checks refuse is not used, nor are coarser ones
+        }
+        ancestors.push_back(std::move(*c));
+        m = &ancestors.back();
+    }
+    for (auto k = static_cast<int>(ancestors.size()); k >= 1; --k) {
+        mesh::Mesh& a = ancestors[static_cast<size_t>(k) - 1];
+        std::swap(p.mesh0, a); // level 0 reads mesh0 too (the contact search's level-0 facets)
+        try {
+            (void)levels::build_level(p, p.mesh0);
+        } catch (const InvalidInput&) {
+            std::swap(p.mesh0, a);
+            continue; // e.g. a support point that is no vertex of this ancestor: a finer one
+        }
+        p.levels += k;
+        p.recovered_levels = k;
+        return;
+    }
+}
+
 } // namespace
 
 levels::Problem parse_scene(const std::string& text, const std::string& origin,
@@ -531,34 +576,9 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         mesh::check_quality(p.mesh0);
         return 0;
     });
-    // A Gmsh mesh that is a uniform 1->4 refinement (Gmsh's RefineMesh, `gmsh -refine`,
-    // `mlcontact show --msh-level`) is read as its coarsest ancestor and the levels between:
-    // the multigrid and coarse-to-fine Newton then have the hierarchy a built-in scene has. The
-    // levels are solved on the refined ancestor, whose vertices lie within 1e-10 of the mesh's
-    // size of the file's (exact for a file written with 17 digits).
     if (recover_node != nullptr && recover && !all_gmsh)
         rd.fail(recover_node, "[scene].recover_levels applies to meshes read from Gmsh files "
                               "(type = \"gmsh\"), and a body here has another mesh");
-    if (recover && all_gmsh) {
-        Vec2 lo = p.mesh0.vertices.front(), hi = lo;
-        for (const Vec2& v : p.mesh0.vertices) {
-            lo = lo.cwiseMin(v);
-            hi = hi.cwiseMax(v);
-        }
-        const double tol = 1e-10 * (hi - lo).norm();
-        while (p.levels < kMaxLevels) {
-            std::optional<mesh::Mesh> c = mesh::unrefine(p.mesh0, tol);
-            if (!c) break;
-            try {
-                mesh::check_quality(*c);
-            } catch (const InvalidInput&) {
-                break; // an ancestor our checks refuse is not used
-            }
-            p.mesh0 = std::move(*c);
-            ++p.levels;
-            ++p.recovered_levels;
-        }
-    }
     // Loads and contact pairs need a tag on boundary edges; supports may also name a tagged
     // interior line (Mesh::lines).
     auto check_tag = [&](const toml::table& t, const std::string& tag, const std::string& w,
@@ -781,6 +801,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         p.validate();
         return 0;
     });
+    if (recover && all_gmsh) recover_levels(p);
     return p;
 }
 

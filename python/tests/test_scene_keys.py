@@ -92,6 +92,11 @@ def _refined_square_msh(n):
     return "\n".join(out) + "\n"
 
 
+def _by_position(x, values):
+    order = sorted(range(len(x)), key=lambda i: (x[i][0], x[i][1]))
+    return [tuple(x[i]) for i in order], [values[i] for i in order]
+
+
 def test_a_gmsh_mesh_that_is_a_uniform_refinement_is_read_with_its_levels(tmp_path):
     (tmp_path / "sq.msh").write_text(_refined_square_msh(16))
     text = """
@@ -105,27 +110,42 @@ mesh = { type = "gmsh", file = "sq.msh" }
 [[load]]
 tag = "top"
 pressure = 1e-3
+[[load]]
+tag = "left"
+pressure = 3e-4
+[[support]]
+tag = "right"
+ux = 0.0
 [[contact]]
 contactor = "bottom"
 mu = 0.3
 obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
 """
     s = mlcontact.Scene.from_toml(text, "sq.toml", str(tmp_path))
-    # 16 x 16 squares = four refinements of one square cut in two
-    assert s.recovered_levels == 4 and s.levels == 4 and s.n_triangles == 2
+    # 16 x 16 squares = four refinements of one square cut in two; levels count the file's
+    # refinements (0 here), recovered_levels the ones found below it.
+    assert s.recovered_levels == 4 and s.levels == 0 and s.n_triangles == 2
     flat = mlcontact.Scene.from_toml(text.replace("[scene]\n", "[scene]\nrecover_levels = false\n"),
                                      "sq.toml", str(tmp_path))
     assert flat.recovered_levels == 0 and flat.levels == 0 and flat.n_triangles == 512
     a, b = mlcontact.solve(s), mlcontact.solve(flat)
-    assert a.converged and b.converged
-    # The same finest mesh: the contact resultant balances the load (1e-3 over the unit top).
-    for r in (a, b):
-        assert r.resultants[0]["force"][1] == pytest.approx(1e-3, rel=1e-8)
-    assert a.resultants[0]["force"][0] == pytest.approx(b.resultants[0]["force"][0], rel=1e-8,
-                                                        abs=1e-12)
-    # The command line says so in its report and summary.json.
+    assert a.converged and b.converged and a.level == 4 and b.level == 0
+    # The same finest mesh in another numbering: every vertex's displacement and every contact
+    # node's multipliers agree, matched by position.
+    xa, ua = _by_position(a.vertices.tolist(), a.displacement.tolist())
+    xb, ub = _by_position(b.vertices.tolist(), b.displacement.tolist())
+    assert xa == xb
+    umax = max(abs(c) for u in ub for c in u)
+    assert max(abs(p - q) for u, v in zip(ua, ub) for p, q in zip(u, v)) < 1e-8 * umax
+    ca, la = _by_position(a.contact_x.tolist(), a.lambda_n.tolist())
+    cb, lb = _by_position(b.contact_x.tolist(), b.lambda_n.tolist())
+    assert ca == cb and max(abs(p - q) for p, q in zip(la, lb)) < 1e-8 * max(abs(q) for q in lb)
+    # The command line says so in its report and summary.json; --levels counts from the file.
     (tmp_path / "sq.toml").write_text(text)
     out = run_cli("run", str(tmp_path / "sq.toml"), "--out", str(tmp_path / "out")).stdout
     assert "the Gmsh file's mesh is level 4, a uniform refinement of a 2-triangle mesh" in out
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["recovered_levels"] == 4 and summary["levels"][-1]["level"] == 4
+    run_cli("run", str(tmp_path / "sq.toml"), "--levels", "1", "--out", str(tmp_path / "out1"))
+    summary = json.loads((tmp_path / "out1" / "summary.json").read_text())
+    assert summary["levels"][-1]["level"] == 5

@@ -405,7 +405,6 @@ TEST(RecoveredLevels, TheExportedSquareSolvesAsTheRefinedSquareDoes) {
 
 TEST(RecoveredLevels, AnUnstructuredGmshMeshHasNoneAndTheKeyNeedsGmshMeshes) {
     EXPECT_EQ(scene::load_scene("hertz_gmsh").recovered_levels, 0);
-    EXPECT_EQ(exported_square(2, false).recovered_levels, 0);
     const std::string text = test::replace(scene::builtin_scene_text("square"), "[scene]\n",
                                            "[scene]\nrecover_levels = true\n");
     EXPECT_NE(test::error_of(text).find("recover_levels applies to meshes read from Gmsh files"),
@@ -417,4 +416,29 @@ TEST(RecoveredLevels, AnUnstructuredGmshMeshHasNoneAndTheKeyNeedsGmshMeshes) {
                                  "square")
                   .levels,
               0);
+}
+
+TEST(RecoveredLevels, StopAtTheCoarsestMeshWhoseLevel0TheSceneCanBuild) {
+    // A support point at x = 5 on the 40 mm square is a vertex from 8 x 8 squares on (spacing
+    // 5): of the level-3 export's 7 ancestors only the 4 finest can be level 0.
+    const std::string built_in = scene::builtin_scene_text("square");
+    const auto dir = std::filesystem::temp_directory_path() / "mlc_test_recovered_support";
+    std::filesystem::create_directories(dir);
+    {
+        mesh::Mesh m = scene::load_scene("square").mesh0;
+        for (int l = 0; l < 3; ++l)
+            m = mesh::refine(m);
+        std::ofstream msh(dir / "square.msh");
+        mesh::write_gmsh(m, msh);
+    }
+    const std::string from = "mesh = { type = \"rectangle\"";
+    const auto at = built_in.find(from);
+    ASSERT_NE(at, std::string::npos);
+    const std::string text =
+        built_in.substr(0, at) + "mesh = { type = \"gmsh\", file = \"square.msh\" }" +
+        built_in.substr(built_in.find('\n', at)) + "\n[[support]]\npoint = [5.0, 40.0]\nux = 0.0\n";
+    const Problem p = scene::parse_scene(text, (dir / "square.toml").string(), dir);
+    EXPECT_EQ(p.recovered_levels, 4);
+    EXPECT_EQ(p.mesh0.n_triangles(), 2 * 8 * 8);
+    EXPECT_NO_THROW(build_level(p, p.mesh0));
 }

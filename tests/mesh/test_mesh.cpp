@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -156,8 +157,10 @@ mesh::Mesh shuffled(const mesh::Mesh& f) {
     return g;
 }
 
-// The largest distance from a vertex of a to the nearest vertex of b (both the same size).
+// The largest distance between the i-th vertices of a and b sorted by coordinates (infinite when
+// their numbers differ): 0 for the same vertex set in any numbering.
 double vertex_set_distance(const mesh::Mesh& a, const mesh::Mesh& b) {
+    if (a.n_vertices() != b.n_vertices()) return std::numeric_limits<double>::infinity();
     auto key = [](const Vec2& p) { return std::make_pair(p.x(), p.y()); };
     std::vector<std::pair<double, double>> pa, pb;
     for (const Vec2& p : a.vertices)
@@ -253,4 +256,60 @@ TEST(Unrefine, RefusesAMeshThatIsNoUniformRefinement) {
     auto fewer = f;
     fewer.triangles.pop_back();
     EXPECT_FALSE(mesh::unrefine(fewer, 1e-12).has_value());
+}
+
+TEST(Unrefine, JoinsInteriorLineHalvesAndRefusesHalvesWithDifferentTags) {
+    // A tagged interior line along y = 1 of a 2 x 2 rectangle (4 x 4 squares after one
+    // refinement): its two fine halves per coarse edge are joined back.
+    auto c = mesh::structured_rectangle(Vec2(0, 0), Vec2(2, 2), 2, 2);
+    const int mid = c.add_tag("middle");
+    c.lines.push_back({3, 4, mid, -1}); // (0,1)-(1,1)
+    c.lines.push_back({4, 5, mid, -1}); // (1,1)-(2,1)
+    const auto f = mesh::refine(c);
+    const auto back = mesh::unrefine(f, 1e-12);
+    ASSERT_TRUE(back.has_value());
+    ASSERT_EQ(back->lines.size(), 2u);
+    for (const auto& e : back->lines) {
+        EXPECT_EQ(e.tag, mid);
+        EXPECT_EQ(back->vertices[static_cast<size_t>(e.v0)].y(), 1.0);
+        EXPECT_EQ(back->vertices[static_cast<size_t>(e.v1)].y(), 1.0);
+    }
+    // One half of the line under another tag: no coarse edge carries both.
+    auto retagged = f;
+    retagged.lines[0].tag = retagged.add_tag("other");
+    EXPECT_FALSE(mesh::unrefine(retagged, 1e-12).has_value());
+    // The same for a boundary half, and for a child of another body.
+    auto boundary = f;
+    boundary.boundary[0].tag = boundary.tag("top");
+    EXPECT_FALSE(mesh::unrefine(boundary, 1e-12).has_value());
+    auto bodies = f;
+    bodies.attribute.assign(bodies.triangles.size(), 0);
+    bodies.attribute[0] = 1;
+    EXPECT_FALSE(mesh::unrefine(bodies, 1e-12).has_value());
+}
+
+TEST(Unrefine, ReturnsNothingWhereRefiningTheAncestorWouldThrow) {
+    // Four triangles whose outer edges (a, m), (m, b) lie on the unit circle: the ancestor's
+    // chord (a, b) passes through the centre, which refine refuses (an arc midpoint at its
+    // centre). unrefine says "no refinement" instead of throwing.
+    mesh::Mesh f;
+    f.vertices = {Vec2(-1, 0),    Vec2(0, -1), Vec2(1, 0),
+                  Vec2(0.5, 0.5), Vec2(0, 1),  Vec2(-0.5, 0.5)};
+    // a = 0, m = 1, b = 2, bc = 3, c = 4, ca = 5
+    f.triangles = {{0, 1, 5}, {1, 2, 3}, {5, 3, 4}, {1, 3, 5}};
+    f.circles.push_back({Vec2(0, 0), 1.0});
+    const int arc = f.add_tag("arc"), rest = f.add_tag("rest");
+    f.boundary = {{0, 1, arc, 0},   {1, 2, arc, 0},   {2, 3, rest, -1},
+                  {3, 4, rest, -1}, {4, 5, rest, -1}, {5, 0, rest, -1}};
+    EXPECT_NO_THROW(mesh::check_quality(f));
+    EXPECT_NO_THROW(EXPECT_FALSE(mesh::unrefine(f, 1e-12).has_value()));
+    // Without the arc, m = (0, -1) is no midpoint of its chord: refused. At the chord's
+    // midpoint (0, 0) it is an ordinary refinement of one triangle.
+    for (auto& e : f.boundary)
+        e.curve = -1;
+    EXPECT_FALSE(mesh::unrefine(f, 1e-12).has_value());
+    f.vertices[1] = Vec2(0, 0);
+    const auto c = mesh::unrefine(f, 1e-12);
+    ASSERT_TRUE(c.has_value());
+    EXPECT_EQ(c->n_triangles(), 1);
 }
