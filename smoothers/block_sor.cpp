@@ -442,8 +442,10 @@ void BlockSOR::sweep_part(const Value* av, const Value* dinv, const double* bp, 
             c0 += D[1] * t1;
             c1 += D[2] * t0;
             c1 += D[3] * t1;
-            xp[s0] += post_ * c0;
-            xp[s0 + 1] += post_ * c1;
+            // post_ is 1 for the unrolled kernel (omega is in the inverses): 1 * c == c exactly,
+            // and the multiplication would lengthen the chain from one vertex to the next.
+            xp[s0] += c0;
+            xp[s0 + 1] += c1;
             continue;
         }
         for (Index i = s0; i < s1; ++i) {
