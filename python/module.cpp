@@ -521,9 +521,11 @@ PYBIND11_MODULE(_core, m) {
             py::arg("body"), py::arg("E") = py::none(), py::arg("nu") = py::none(),
             "Sets Young's modulus and/or Poisson's ratio of one body (by index or name)")
         .def("__repr__", [](const Scene& s) {
+            const int k = s.problem.recovered_levels;
             return "<mlcontact.Scene '" + s.problem.name + "' from " + s.origin + ", levels " +
-                   std::to_string(s.problem.levels) + ", " + std::to_string(s.problem.load_steps) +
-                   " load steps>";
+                   std::to_string(s.problem.levels - k) +
+                   (k > 0 ? " (on " + std::to_string(k) + " recovered)" : std::string()) + ", " +
+                   std::to_string(s.problem.load_steps) + " load steps>";
         });
 
     py::class_<Result, std::shared_ptr<Result>>(m, "Result", "A solved scene")
