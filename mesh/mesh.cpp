@@ -179,10 +179,10 @@ void check_quality(const Mesh& m) {
                 if (body[static_cast<size_t>(v)] < 0)
                     body[static_cast<size_t>(v)] = m.attribute[static_cast<size_t>(t)];
     // Each vertex goes into a square cell of side h >= tol, so that a pair closer than tol lies in
-    // one cell or in two neighbouring ones, and is compared with the vertices of its own and the 8
-    // neighbouring cells (found by binary search in the vertices sorted by cell): O(n log n) for
-    // any mesh. Sorting by x alone and scanning the x-window was quadratic in the number of
-    // vertices sharing an x, as the columns of a structured mesh do (35 s for a 1 x 100000 strip).
+    // one cell or in two neighbouring ones, and is compared with the vertices of its own and the
+    // neighbouring cells (in the vertices sorted by cell): O(n log n) for any mesh. Sorting by x
+    // alone and scanning the x-window was quadratic in the number of vertices sharing an x, as the
+    // columns of a structured mesh do (35 s for a 1 x 100000 strip).
     const double tol = 1e-10 * diam;
     const double h = std::max(tol, 1e-9 * diam); // <= 1e9 + 1 cells per axis: 32-bit indices
     Vec2 lo = m.vertices[0];
@@ -201,34 +201,58 @@ void check_quality(const Mesh& m) {
         by_cell[static_cast<size_t>(v)] = {key(cx, cy), v};
     }
     std::sort(by_cell.begin(), by_cell.end());
-    for (int v = 0; v < nv; ++v) {
+    // Each pair once, from the vertex that comes first in cell order: the rest of its own column
+    // up to the cell above it, and the next column's cells beside it (found by a pointer that
+    // only moves forward: the cells beside a vertex move up and right with it).
+    const size_t n_sorted = by_cell.size();
+    auto compare = [&](int v, int w) {
+        if (body[static_cast<size_t>(v)] != body[static_cast<size_t>(w)]) return;
+        if (w < v) std::swap(v, w);
         const Vec2& a = m.vertices[static_cast<size_t>(v)];
-        for (std::int64_t dx = -1; dx <= 1; ++dx)
-            for (std::int64_t dy = -1; dy <= 1; ++dy) {
-                const std::int64_t cx = cell_of[static_cast<size_t>(v)][0] + dx;
-                const std::int64_t cy = cell_of[static_cast<size_t>(v)][1] + dy;
-                if (cx < 0 || cy < 0) continue;
-                const std::uint64_t k = key(cx, cy);
-                for (auto it = std::lower_bound(by_cell.begin(), by_cell.end(), std::pair(k, 0));
-                     it != by_cell.end() && it->first == k; ++it) {
-                    const int w = it->second; // each pair once, from its smaller vertex
-                    if (w <= v || body[static_cast<size_t>(v)] != body[static_cast<size_t>(w)])
-                        continue;
-                    const Vec2& b = m.vertices[static_cast<size_t>(w)];
-                    MLC_CHECK((a - b).norm() > tol, "duplicate vertices " << v << " and " << w
-                                                                          << " at (" << a.x()
-                                                                          << ", " << a.y() << ")");
-                }
-            }
+        const Vec2& b = m.vertices[static_cast<size_t>(w)];
+        MLC_CHECK((a - b).norm() > tol, "duplicate vertices " << v << " and " << w << " at ("
+                                                              << a.x() << ", " << a.y() << ")");
+    };
+    size_t next = 0;
+    for (size_t i = 0; i < n_sorted; ++i) {
+        const int v = by_cell[i].second;
+        const std::int64_t cx = cell_of[static_cast<size_t>(v)][0];
+        const std::int64_t cy = cell_of[static_cast<size_t>(v)][1];
+        const std::uint64_t above = key(cx, cy + 1);
+        for (size_t k = i + 1; k < n_sorted && by_cell[k].first <= above; ++k)
+            compare(v, by_cell[k].second);
+        const std::uint64_t lo = key(cx + 1, std::max<std::int64_t>(cy - 1, 0));
+        const std::uint64_t hi = key(cx + 1, cy + 1);
+        while (next < n_sorted && by_cell[next].first < lo)
+            ++next;
+        for (size_t k = next; k < n_sorted && by_cell[k].first <= hi; ++k)
+            compare(v, by_cell[k].second);
     }
-    std::unordered_map<std::uint64_t, int> edges;
-    edges.reserve(static_cast<size_t>(3 * m.n_triangles()));
+    // Triangles per vertex: a boundary edge lies on one triangle, an interior line on two.
+    std::vector<int> vt_off(static_cast<size_t>(nv) + 1, 0);
     for (const auto& tri : m.triangles)
-        for (int k = 0; k < 3; ++k)
-            ++edges[edge_key(tri[static_cast<size_t>(k)], tri[static_cast<size_t>((k + 1) % 3)])];
+        for (int v : tri)
+            ++vt_off[static_cast<size_t>(v) + 1];
+    for (int v = 0; v < nv; ++v)
+        vt_off[static_cast<size_t>(v) + 1] += vt_off[static_cast<size_t>(v)];
+    std::vector<int> vt(static_cast<size_t>(vt_off.back()));
+    {
+        std::vector<int> fill(vt_off.begin(), vt_off.end() - 1);
+        for (int t = 0; t < m.n_triangles(); ++t)
+            for (int v : m.triangles[static_cast<size_t>(t)])
+                vt[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
+    }
+    auto triangles_on = [&](int a, int b) { // triangles with the edge (a, b)
+        if (a < 0 || a >= nv || b < 0 || b >= nv || a == b) return 0;
+        int count = 0;
+        for (int k = vt_off[static_cast<size_t>(a)]; k < vt_off[static_cast<size_t>(a) + 1]; ++k) {
+            const auto& tri = m.triangles[static_cast<size_t>(vt[static_cast<size_t>(k)])];
+            count += tri[0] == b || tri[1] == b || tri[2] == b;
+        }
+        return count;
+    };
     for (const auto& e : m.boundary) {
-        auto it = edges.find(edge_key(e.v0, e.v1));
-        MLC_CHECK(it != edges.end() && it->second == 1,
+        MLC_CHECK(triangles_on(e.v0, e.v1) == 1,
                   "boundary edge (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
                                     << "' is not a boundary edge of the triangulation");
     }
@@ -236,8 +260,7 @@ void check_quality(const Mesh& m) {
         MLC_CHECK(e.v0 >= 0 && e.v0 < nv && e.v1 >= 0 && e.v1 < nv,
                   "interior line (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
                                     << "' refers to a vertex out of range");
-        auto it = edges.find(edge_key(e.v0, e.v1));
-        MLC_CHECK(it != edges.end() && it->second == 2,
+        MLC_CHECK(triangles_on(e.v0, e.v1) == 2,
                   "interior line (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
                                     << "' is not an interior edge of the triangulation");
     }

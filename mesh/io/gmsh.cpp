@@ -580,29 +580,49 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
     if (std::any_of(tri_phys.begin(), tri_phys.end(), [](int p) { return p != 0; }))
         m.attribute = tri_phys;
 
-    // Boundary edges of the selection, with the direction they have in their triangle.
-    std::unordered_map<std::uint64_t, std::pair<int, std::array<int, 2>>> edges;
-    edges.reserve(3 * m.triangles.size());
+    // The triangles of every vertex, in triangle order: a line element (a, b) lies on the
+    // triangles that hold both, with the direction it has in the first of them.
+    const std::size_t nv = m.vertices.size();
+    std::vector<int> vt_off(nv + 1, 0);
     for (const auto& t : m.triangles)
-        for (int k = 0; k < 3; ++k) {
-            auto& [count, dir] = edges[edge_key(t[k], t[(k + 1) % 3])];
-            if (count++ == 0) dir = {t[k], t[(k + 1) % 3]};
-        }
+        for (int v : t)
+            ++vt_off[static_cast<std::size_t>(v) + 1];
+    for (std::size_t v = 0; v < nv; ++v)
+        vt_off[v + 1] += vt_off[v];
+    std::vector<int> vt(static_cast<std::size_t>(vt_off.back()));
+    {
+        std::vector<int> fill(vt_off.begin(), vt_off.end() - 1);
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            for (int v : m.triangles[t])
+                vt[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] =
+                    static_cast<int>(t);
+    }
     std::set<std::uint64_t> tagged;
     for (std::size_t e : lines) {
         const int a = new_index[node(e, 0)], b = new_index[node(e, 1)];
-        if (a < 0 || b < 0) continue;
+        if (a < 0 || b < 0 || a == b) continue;
+        int count = 0;
+        std::array<int, 2> dir{};
+        for (int k = vt_off[static_cast<std::size_t>(a)];
+             k < vt_off[static_cast<std::size_t>(a) + 1]; ++k) {
+            const auto& t = m.triangles[static_cast<std::size_t>(vt[static_cast<std::size_t>(k)])];
+            for (int i = 0; i < 3; ++i) {
+                const int u = t[i], w = t[(i + 1) % 3];
+                if ((u == a && w == b) || (u == b && w == a)) {
+                    if (count++ == 0) dir = {u, w};
+                }
+            }
+        }
         const std::uint64_t key = edge_key(a, b);
-        auto it = edges.find(key);
-        if (it == edges.end() || it->second.first > 2 || !tagged.insert(key).second) continue;
+        if (count == 0 || count > 2 || !tagged.insert(key).second) continue;
         const int p = d.phys[d.phys_begin[e]];
         auto name = d.names.find({1, p});
         BoundaryEdge be;
-        be.v0 = it->second.second[0];
-        be.v1 = it->second.second[1];
+        be.v0 = dir[0];
+        be.v1 = dir[1];
         be.tag = m.add_tag(name == d.names.end() ? "tag" + std::to_string(p) : name->second);
         // An edge of two selected triangles is a tagged interior line.
-        (it->second.first == 1 ? m.boundary : m.lines).push_back(be);
+        (count == 1 ? m.boundary : m.lines).push_back(be);
     }
     check_quality(m);
     return m;
