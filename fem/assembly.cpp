@@ -70,20 +70,10 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
     // component of v when v and w share a triangle. (Triplets and setFromTriplets took 36 x 16
     // bytes per triangle, 2.4 GB at level 6 of the square, and a sort.) Each vertex's rows are
     // written by one thread: the loops over vertices below run over core/parallel's threads.
-    const int nt = m.n_triangles();
-    std::vector<int> vt_start(static_cast<size_t>(nv) + 1, 0); // triangles of each vertex
-    for (const auto& tri : m.triangles)
-        for (int v : tri)
-            ++vt_start[static_cast<size_t>(v) + 1];
-    for (int v = 0; v < nv; ++v)
-        vt_start[static_cast<size_t>(v) + 1] += vt_start[static_cast<size_t>(v)];
-    std::vector<int> vt(static_cast<size_t>(vt_start.back()));
-    {
-        std::vector<int> fill(vt_start.begin(), vt_start.end() - 1);
-        for (int t = 0; t < nt; ++t) // ascending per vertex: the serial summation order
-            for (int v : m.triangles[static_cast<size_t>(t)])
-                vt[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
-    }
+    // Triangles of each vertex, ascending per vertex: the serial summation order.
+    const mesh::VertexTriangles vtri = mesh::vertex_triangles(m);
+    const std::vector<int>& vt_start = vtri.offset;
+    const std::vector<int>& vt = vtri.triangles;
     constexpr size_t kVerticesPerChunk = 2048;
     auto for_vertices = [&](auto&& fn) {
         parallel::for_rows(static_cast<size_t>(nv), kVerticesPerChunk, [&](size_t b, size_t e) {

@@ -221,27 +221,17 @@ void check_quality(const Mesh& m) {
         const std::uint64_t above = key(cx, cy + 1);
         for (size_t k = i + 1; k < n_sorted && by_cell[k].first <= above; ++k)
             compare(v, by_cell[k].second);
-        const std::uint64_t lo = key(cx + 1, std::max<std::int64_t>(cy - 1, 0));
-        const std::uint64_t hi = key(cx + 1, cy + 1);
-        while (next < n_sorted && by_cell[next].first < lo)
+        const std::uint64_t first = key(cx + 1, std::max<std::int64_t>(cy - 1, 0));
+        const std::uint64_t last = key(cx + 1, cy + 1);
+        while (next < n_sorted && by_cell[next].first < first)
             ++next;
-        for (size_t k = next; k < n_sorted && by_cell[k].first <= hi; ++k)
+        for (size_t k = next; k < n_sorted && by_cell[k].first <= last; ++k)
             compare(v, by_cell[k].second);
     }
     // Triangles per vertex: a boundary edge lies on one triangle, an interior line on two.
-    std::vector<int> vt_off(static_cast<size_t>(nv) + 1, 0);
-    for (const auto& tri : m.triangles)
-        for (int v : tri)
-            ++vt_off[static_cast<size_t>(v) + 1];
-    for (int v = 0; v < nv; ++v)
-        vt_off[static_cast<size_t>(v) + 1] += vt_off[static_cast<size_t>(v)];
-    std::vector<int> vt(static_cast<size_t>(vt_off.back()));
-    {
-        std::vector<int> fill(vt_off.begin(), vt_off.end() - 1);
-        for (int t = 0; t < m.n_triangles(); ++t)
-            for (int v : m.triangles[static_cast<size_t>(t)])
-                vt[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
-    }
+    const VertexTriangles vtri = vertex_triangles(m);
+    const std::vector<int>& vt_off = vtri.offset;
+    const std::vector<int>& vt = vtri.triangles;
     auto triangles_on = [&](int a, int b) { // triangles with the edge (a, b)
         if (a < 0 || a >= nv || b < 0 || b >= nv || a == b) return 0;
         int count = 0;
@@ -416,24 +406,31 @@ Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diago
 
 namespace mlc::mesh {
 
+VertexTriangles vertex_triangles(const Mesh& m) {
+    const size_t nv = m.vertices.size();
+    VertexTriangles r;
+    r.offset.assign(nv + 1, 0);
+    for (const auto& tri : m.triangles)
+        for (int v : tri)
+            ++r.offset[static_cast<size_t>(v) + 1];
+    for (size_t v = 0; v < nv; ++v)
+        r.offset[v + 1] += r.offset[v];
+    r.triangles.resize(static_cast<size_t>(r.offset.back()));
+    std::vector<int> fill(r.offset.begin(), r.offset.end() - 1);
+    for (size_t t = 0; t < m.triangles.size(); ++t) // ascending per vertex
+        for (int v : m.triangles[t])
+            r.triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(t);
+    return r;
+}
+
 std::optional<Mesh> unrefine(const Mesh& f, double tol) {
     const int nt = f.n_triangles(), nv = f.n_vertices();
     if (nt < 4 || nt % 4 != 0) return std::nullopt;
-    // The triangles of every vertex (CSR), then the neighbour across local edge e (opposite local
-    // vertex e) of every triangle, -1 on the boundary; an edge of more than two triangles is no
-    // refinement of ours.
-    std::vector<int> vt_off(static_cast<size_t>(nv) + 1, 0), vt(3 * static_cast<size_t>(nt));
-    for (const auto& tri : f.triangles)
-        for (int v : tri)
-            ++vt_off[static_cast<size_t>(v) + 1];
-    for (int v = 0; v < nv; ++v)
-        vt_off[static_cast<size_t>(v) + 1] += vt_off[static_cast<size_t>(v)];
-    {
-        std::vector<int> fill(vt_off.begin(), vt_off.end() - 1);
-        for (int t = 0; t < nt; ++t)
-            for (int v : f.triangles[static_cast<size_t>(t)])
-                vt[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = t;
-    }
+    // The neighbour across local edge e (opposite local vertex e) of every triangle, -1 on the
+    // boundary; an edge of more than two triangles is no refinement of ours.
+    const VertexTriangles vtri = vertex_triangles(f);
+    const std::vector<int>& vt_off = vtri.offset;
+    const std::vector<int>& vt = vtri.triangles;
     auto has = [&](int t, int v) {
         const auto& tri = f.triangles[static_cast<size_t>(t)];
         return tri[0] == v || tri[1] == v || tri[2] == v;

@@ -101,6 +101,15 @@ void check_refined_quality(const Mesh& m);
 /// boundary edge is moved onto the circle. Coarse vertex indices are kept; `parents` is filled.
 Mesh refine(const Mesh& coarse);
 
+/// The triangles of every vertex (CSR): those of vertex v are triangles[offset[v] ..
+/// offset[v + 1]), in ascending triangle order.
+struct VertexTriangles {
+    std::vector<int> offset;    ///< n_vertices + 1 entries
+    std::vector<int> triangles; ///< 3 n_triangles entries
+};
+/// The VertexTriangles of m (its triangles' indices must lie in [0, n_vertices)).
+VertexTriangles vertex_triangles(const Mesh& m);
+
 /// The inverse of `refine`, when `fine` is a uniform 1->4 refinement (what Gmsh's `RefineMesh`
 /// and `gmsh -refine`, or `mlcontact show --msh-level`, write): the coarse mesh c with
 /// refine(c) = fine up to the vertex numbering (every vertex of refine(c) within `tol` of its

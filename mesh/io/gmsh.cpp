@@ -582,21 +582,9 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
 
     // The triangles of every vertex, in triangle order: a line element (a, b) lies on the
     // triangles that hold both, with the direction it has in the first of them.
-    const std::size_t nv = m.vertices.size();
-    std::vector<int> vt_off(nv + 1, 0);
-    for (const auto& t : m.triangles)
-        for (int v : t)
-            ++vt_off[static_cast<std::size_t>(v) + 1];
-    for (std::size_t v = 0; v < nv; ++v)
-        vt_off[v + 1] += vt_off[v];
-    std::vector<int> vt(static_cast<std::size_t>(vt_off.back()));
-    {
-        std::vector<int> fill(vt_off.begin(), vt_off.end() - 1);
-        for (std::size_t t = 0; t < m.triangles.size(); ++t)
-            for (int v : m.triangles[t])
-                vt[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] =
-                    static_cast<int>(t);
-    }
+    const VertexTriangles vtri = vertex_triangles(m);
+    const std::vector<int>& vt_off = vtri.offset;
+    const std::vector<int>& vt = vtri.triangles;
     std::set<std::uint64_t> tagged;
     for (std::size_t e : lines) {
         const int a = new_index[node(e, 0)], b = new_index[node(e, 1)];
