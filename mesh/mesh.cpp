@@ -228,19 +228,9 @@ void check_quality(const Mesh& m) {
         for (size_t k = next; k < n_sorted && by_cell[k].first <= last; ++k)
             compare(v, by_cell[k].second);
     }
-    // Triangles per vertex: a boundary edge lies on one triangle, an interior line on two.
+    // A boundary edge lies on one triangle, an interior line on two.
     const VertexTriangles vtri = vertex_triangles(m);
-    const std::vector<int>& vt_off = vtri.offset;
-    const std::vector<int>& vt = vtri.triangles;
-    auto triangles_on = [&](int a, int b) { // triangles with the edge (a, b)
-        if (a < 0 || a >= nv || b < 0 || b >= nv || a == b) return 0;
-        int count = 0;
-        for (int k = vt_off[static_cast<size_t>(a)]; k < vt_off[static_cast<size_t>(a) + 1]; ++k) {
-            const auto& tri = m.triangles[static_cast<size_t>(vt[static_cast<size_t>(k)])];
-            count += tri[0] == b || tri[1] == b || tri[2] == b;
-        }
-        return count;
-    };
+    auto triangles_on = [&](int a, int b) { return vtri.on_edge(m, a, b).count; };
     for (const auto& e : m.boundary) {
         MLC_CHECK(triangles_on(e.v0, e.v1) == 1,
                   "boundary edge (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
@@ -402,10 +392,6 @@ Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diago
     return m;
 }
 
-} // namespace mlc::mesh
-
-namespace mlc::mesh {
-
 VertexTriangles vertex_triangles(const Mesh& m) {
     const size_t nv = m.vertices.size();
     VertexTriangles r;
@@ -423,32 +409,35 @@ VertexTriangles vertex_triangles(const Mesh& m) {
     return r;
 }
 
+VertexTriangles::OnEdge VertexTriangles::on_edge(const Mesh& m, int a, int b) const {
+    OnEdge r;
+    const int nv = static_cast<int>(offset.size()) - 1;
+    if (a < 0 || a >= nv || b < 0 || b >= nv || a == b) return r;
+    for (int k = offset[static_cast<size_t>(a)]; k < offset[static_cast<size_t>(a) + 1]; ++k) {
+        const int t = triangles[static_cast<size_t>(k)];
+        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        if (tri[0] != b && tri[1] != b && tri[2] != b) continue;
+        if (r.count < 2) r.first[static_cast<size_t>(r.count)] = t;
+        ++r.count;
+    }
+    return r;
+}
+
 std::optional<Mesh> unrefine(const Mesh& f, double tol) {
     const int nt = f.n_triangles(), nv = f.n_vertices();
     if (nt < 4 || nt % 4 != 0) return std::nullopt;
     // The neighbour across local edge e (opposite local vertex e) of every triangle, -1 on the
     // boundary; an edge of more than two triangles is no refinement of ours.
     const VertexTriangles vtri = vertex_triangles(f);
-    const std::vector<int>& vt_off = vtri.offset;
-    const std::vector<int>& vt = vtri.triangles;
-    auto has = [&](int t, int v) {
-        const auto& tri = f.triangles[static_cast<size_t>(t)];
-        return tri[0] == v || tri[1] == v || tri[2] == v;
-    };
     std::vector<std::array<int, 3>> nb(static_cast<size_t>(nt), {-1, -1, -1});
     for (int t = 0; t < nt; ++t)
         for (int e = 0; e < 3; ++e) {
             const auto& tri = f.triangles[static_cast<size_t>(t)];
-            const int a = tri[(e + 1) % 3], b = tri[(e + 2) % 3];
-            int found = 0;
-            for (int k = vt_off[static_cast<size_t>(a)]; k < vt_off[static_cast<size_t>(a) + 1];
-                 ++k) {
-                const int u = vt[static_cast<size_t>(k)];
-                if (u == t || !has(u, b)) continue;
-                nb[static_cast<size_t>(t)][static_cast<size_t>(e)] = u;
-                ++found;
-            }
-            if (found > 1) return std::nullopt; // a third triangle on an edge
+            const auto on = vtri.on_edge(f, tri[(e + 1) % 3], tri[(e + 2) % 3]);
+            if (on.count > 2) return std::nullopt; // a third triangle on an edge
+            if (on.count == 2)
+                nb[static_cast<size_t>(t)][static_cast<size_t>(e)] =
+                    on.first[0] == t ? on.first[1] : on.first[0];
         }
     auto local = [&](int t, int v) {
         const auto& tri = f.triangles[static_cast<size_t>(t)];
@@ -669,10 +658,12 @@ std::optional<Mesh> unrefine(const Mesh& f, double tol) {
     for (const auto& t : r.triangles) {
         const int x = to_f[static_cast<size_t>(t[0])], y = to_f[static_cast<size_t>(t[1])],
                   z = to_f[static_cast<size_t>(t[2])];
-        bool found = false;
-        for (int k = vt_off[static_cast<size_t>(x)];
-             k < vt_off[static_cast<size_t>(x) + 1] && !found; ++k)
-            found = has(vt[static_cast<size_t>(k)], y) && has(vt[static_cast<size_t>(k)], z);
+        bool found = false; // a triangle of f on the edge (x, y) holds z (f's edges hold <= 2)
+        for (const int u : vtri.on_edge(f, x, y).first) {
+            if (u < 0) continue;
+            const auto& tu = f.triangles[static_cast<size_t>(u)];
+            found = found || tu[0] == z || tu[1] == z || tu[2] == z;
+        }
         if (!found) return std::nullopt;
     }
     return c;

@@ -106,6 +106,13 @@ Mesh refine(const Mesh& coarse);
 struct VertexTriangles {
     std::vector<int> offset;    ///< n_vertices + 1 entries
     std::vector<int> triangles; ///< 3 n_triangles entries
+    /// The triangles of m with the edge (a, b): how many, and the first two in triangle order
+    /// (-1 where there are fewer). None for a == b or a vertex out of range.
+    struct OnEdge {
+        int count = 0;
+        std::array<int, 2> first{-1, -1};
+    };
+    OnEdge on_edge(const Mesh& m, int a, int b) const;
 };
 /// The VertexTriangles of m (its triangles' indices must lie in [0, n_vertices)).
 VertexTriangles vertex_triangles(const Mesh& m);

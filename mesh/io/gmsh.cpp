@@ -583,23 +583,18 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
     // The triangles of every vertex, in triangle order: a line element (a, b) lies on the
     // triangles that hold both, with the direction it has in the first of them.
     const VertexTriangles vtri = vertex_triangles(m);
-    const std::vector<int>& vt_off = vtri.offset;
-    const std::vector<int>& vt = vtri.triangles;
     std::set<std::uint64_t> tagged;
     for (std::size_t e : lines) {
         const int a = new_index[node(e, 0)], b = new_index[node(e, 1)];
-        if (a < 0 || b < 0 || a == b) continue;
-        int count = 0;
+        if (a < 0 || b < 0) continue;
+        const auto on = vtri.on_edge(m, a, b); // its direction in the first triangle holding it
+        const int count = on.count;
         std::array<int, 2> dir{};
-        for (int k = vt_off[static_cast<std::size_t>(a)];
-             k < vt_off[static_cast<std::size_t>(a) + 1]; ++k) {
-            const auto& t = m.triangles[static_cast<std::size_t>(vt[static_cast<std::size_t>(k)])];
-            for (int i = 0; i < 3; ++i) {
-                const int u = t[i], w = t[(i + 1) % 3];
-                if ((u == a && w == b) || (u == b && w == a)) {
-                    if (count++ == 0) dir = {u, w};
-                }
-            }
+        if (count > 0) {
+            const auto& t = m.triangles[static_cast<std::size_t>(on.first[0])];
+            for (int i = 0; i < 3; ++i)
+                if ((t[i] == a && t[(i + 1) % 3] == b) || (t[i] == b && t[(i + 1) % 3] == a))
+                    dir = {t[i], t[(i + 1) % 3]};
         }
         const std::uint64_t key = edge_key(a, b);
         if (count == 0 || count > 2 || !tagged.insert(key).second) continue;

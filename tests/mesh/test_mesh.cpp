@@ -313,3 +313,33 @@ TEST(Unrefine, ReturnsNothingWhereRefiningTheAncestorWouldThrow) {
     ASSERT_TRUE(c.has_value());
     EXPECT_EQ(c->n_triangles(), 1);
 }
+
+TEST(CheckQuality, FindsDuplicatesInEveryNeighbouringCellOfItsGrid) {
+    // check_quality puts the vertices in cells of side h = 1e-9 diameter (origin: the lowest
+    // corner) and compares each vertex with its own cell and the neighbouring ones. Two vertices
+    // 3e-3 h apart (the tolerance is 0.1 h) placed across a cell corner or side, in each of the
+    // eight directions: each pair is found, whichever cell comes first.
+    auto mesh_with = [](Vec2 a, Vec2 b) {
+        mesh::Mesh m;
+        m.vertices = {Vec2(0, 0), Vec2(1, 0), a, b, Vec2(1, 1), Vec2(0, 1)};
+        m.triangles = {{0, 1, 2}, {3, 4, 5}}; // a and b in different triangles
+        return m;
+    };
+    const mesh::Mesh probe = mesh_with(Vec2(0.5, 0.5), Vec2(0.5, 0.5));
+    const double h = 1e-9 * probe.diameter();
+    const double k = std::round(0.5 / h) * h; // a cell corner at (k, k)
+    const double d = 1e-3 * h;
+    int found = 0;
+    for (int sx = -1; sx <= 1; ++sx)
+        for (int sy = -1; sy <= 1; ++sy) {
+            if (sx == 0 && sy == 0) continue;
+            const Vec2 a(k - sx * d, k - sy * d), b(k + sx * d, k + sy * d);
+            try {
+                mesh::check_quality(mesh_with(a, b));
+            } catch (const InvalidInput& e) {
+                found += std::string(e.what()).find("duplicate vertices 2 and 3") !=
+                         std::string::npos;
+            }
+        }
+    EXPECT_EQ(found, 8);
+}
