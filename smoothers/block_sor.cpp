@@ -158,47 +158,58 @@ void BlockSOR::derive_structure() {
             ++p;
         }
     part_block_.push_back(nb);
-    // Own-part entry range of every row, and the columns read across a cut.
+    // Own-part entry range of every row, and the columns read across a cut: the rows of each
+    // part over the threads, each chunk listing the columns it reads across.
     own_begin_.resize(static_cast<size_t>(n));
     own_end_.resize(static_cast<size_t>(n));
     std::vector<char> across(static_cast<size_t>(n), 0);
     for (size_t p = 0; p + 1 < part_block_.size(); ++p) {
         const Index r0 = starts_[static_cast<size_t>(part_block_[p])];
         const Index r1 = starts_[static_cast<size_t>(part_block_[p + 1])];
-        for (Index i = r0; i < r1; ++i) {
-            const int* b = inner + outer[i];
-            const int* e = inner + outer[i + 1];
-            const int* lo = std::lower_bound(b, e, static_cast<int>(r0));
-            const int* hi = std::lower_bound(lo, e, static_cast<int>(r1));
-            own_begin_[static_cast<size_t>(i)] = static_cast<int>(lo - inner);
-            own_end_[static_cast<size_t>(i)] = static_cast<int>(hi - inner);
-            for (const int* c = b; c < lo; ++c)
-                across[static_cast<size_t>(*c)] = 1;
-            for (const int* c = hi; c < e; ++c)
-                across[static_cast<size_t>(*c)] = 1;
-        }
+        const parallel::RowChunks rc = parallel::row_chunks(static_cast<size_t>(r1 - r0),
+                                                            static_cast<size_t>(kMinRowsPerThread));
+        std::vector<std::vector<int>> read_across(rc.count);
+        parallel::for_chunks(rc.count, [&](size_t c) {
+            for (Index i = r0 + static_cast<Index>(rc.begin(c));
+                 i < r0 + static_cast<Index>(rc.end(c)); ++i) {
+                const int* b = inner + outer[i];
+                const int* e = inner + outer[i + 1];
+                const int* lo = std::lower_bound(b, e, static_cast<int>(r0));
+                const int* hi = std::lower_bound(lo, e, static_cast<int>(r1));
+                own_begin_[static_cast<size_t>(i)] = static_cast<int>(lo - inner);
+                own_end_[static_cast<size_t>(i)] = static_cast<int>(hi - inner);
+                read_across[c].insert(read_across[c].end(), b, lo);
+                read_across[c].insert(read_across[c].end(), hi, e);
+            }
+        });
+        for (const auto& cols : read_across)
+            for (const int j : cols)
+                across[static_cast<size_t>(j)] = 1;
     }
     interface_.clear();
     for (Index j = 0; j < n; ++j)
         if (across[static_cast<size_t>(j)]) interface_.push_back(static_cast<int>(j));
     parallel::set_zero(snap_, n);
-    // First entry of every row in or right of its own diagonal block.
+    // Per block over the threads: the first entry of every row in or right of its own diagonal
+    // block, and twin rows (a 2x2 block whose two rows have the same columns: a vertex of K, both
+    // displacement rows couple to the same vertices; the sweep reads their columns and x once).
     diag_begin_.resize(static_cast<size_t>(n));
-    for (Index I = 0; I < nb; ++I)
-        for (Index i = starts_[I]; i < starts_[I + 1]; ++i)
-            diag_begin_[static_cast<size_t>(i)] = static_cast<int>(
-                std::lower_bound(inner + outer[i], inner + outer[i + 1], starts_[I]) - inner);
-    // Twin rows: a 2x2 block whose two rows have the same columns (a vertex of K: both
-    // displacement rows couple to the same vertices). The sweep reads their columns and x once.
     twin_.assign(static_cast<size_t>(std::max<Index>(nb, 0)), 0);
-    for (Index I = 0; I < nb; ++I) {
-        const Index i = starts_[I];
-        if (starts_[I + 1] - i != 2) continue;
-        const int len = outer[i + 1] - outer[i];
-        twin_[static_cast<size_t>(I)] =
-            outer[i + 2] - outer[i + 1] == len &&
-            std::equal(inner + outer[i], inner + outer[i + 1], inner + outer[i + 1]);
-    }
+    parallel::for_rows(
+        static_cast<size_t>(std::max<Index>(nb, 0)), static_cast<size_t>(kMinRowsPerThread) / 2,
+        [&](size_t I0, size_t I1) {
+            for (size_t I = I0; I < I1; ++I) {
+                const Index i0 = starts_[I], i1 = starts_[I + 1];
+                for (Index i = i0; i < i1; ++i)
+                    diag_begin_[static_cast<size_t>(i)] = static_cast<int>(
+                        std::lower_bound(inner + outer[i], inner + outer[i + 1], i0) - inner);
+                if (i1 - i0 != 2) continue;
+                const int len = outer[i0 + 1] - outer[i0];
+                twin_[I] =
+                    outer[i0 + 2] - outer[i0 + 1] == len &&
+                    std::equal(inner + outer[i0], inner + outer[i0 + 1], inner + outer[i0 + 1]);
+            }
+        });
     pattern_ = SparsityPattern(A);
     work_.resize(max_block_ * P);
 }
@@ -338,12 +349,35 @@ void BlockSOR::invert_blocks() {
 void BlockSOR::invert_block_range(Index b_begin, Index b_end, const int* ao, const int* ai,
                                   const double* av, double omega, double tol) {
     Eigen::MatrixXd block;
+    const bool unrolled = params_.kernel == Kernel::unrolled;
     for (Index b = b_begin; b < b_end; ++b) {
         const Index s0 = starts_[b], s = starts_[b + 1] - s0;
+        if (unrolled && s == 2) {
+            // The common vertex block in closed form, read straight from the rows (the same
+            // arithmetic as the 2x2 case below; a block it rejects takes that path).
+            double a[4] = {0.0, 0.0, 0.0, 0.0};
+            for (Index r = 0; r < 2; ++r)
+                for (int p = diag_begin_[static_cast<size_t>(s0 + r)];
+                     p < ao[s0 + r + 1] && ai[p] < s0 + 2; ++p)
+                    a[2 * r + (ai[p] - s0)] = av[p];
+            const double det = a[0] * a[3] - a[1] * a[2];
+            const double dscale = std::abs(a[0] * a[3]) + std::abs(a[1] * a[2]);
+            if (dscale > 0.0 && std::abs(det) > tol * dscale) {
+                double* out = dinv_.data() + offset_[b];
+                const double f = omega / det;
+                out[0] = f * a[3];
+                out[1] = -f * a[1];
+                out[2] = -f * a[2];
+                out[3] = f * a[0];
+                continue;
+            }
+        }
         block.setZero(s, s);
+        // A row's entries in its block start at diag_begin_ (columns are sorted): the block is
+        // read without the rest of the row.
         for (Index i = s0; i < s0 + s; ++i)
-            for (int p = ao[i]; p < ao[i + 1]; ++p)
-                if (ai[p] >= s0 && ai[p] < s0 + s) block(i - s0, ai[p] - s0) = av[p];
+            for (int p = diag_begin_[static_cast<size_t>(i)]; p < ao[i + 1] && ai[p] < s0 + s; ++p)
+                block(i - s0, ai[p] - s0) = av[p];
         double* out = dinv_.data() + offset_[b];
         Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> inv(
             out, s, s);

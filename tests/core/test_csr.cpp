@@ -199,5 +199,46 @@ TEST(SparsityPattern, MatchesTheSamePatternWhateverTheValues) {
     EXPECT_FALSE(same_pattern(U, A));
 }
 
+TEST(SparsityPattern, AChangeInAnyRowChunkIsSeen) {
+    // Five chunks of kMinRowsPerThread rows (the comparison runs over the threads by chunk): a
+    // column moved in the last row, and an entry moved to the next row across a chunk boundary
+    // (same count, so only the row offsets differ there), are both found.
+    const Index n = 5 * kMinRowsPerThread;
+    const SparseMatrix A = random_matrix(n, 4, 11);
+    const SparsityPattern p(A);
+    SparseMatrix B = 2.0 * A;
+    B.makeCompressed();
+    EXPECT_TRUE(p.matches(B));
+    EXPECT_TRUE(same_pattern(A, B));
+    auto moved = [&](Index from_row, Index to_row) {
+        std::vector<Triplet> t;
+        bool done = false;
+        for (int i = 0; i < A.outerSize(); ++i)
+            for (SparseMatrix::InnerIterator it(A, i); it; ++it) {
+                Index r = i, c = it.col();
+                if (!done && r == from_row && c != r) {
+                    r = to_row;
+                    while (A.coeff(r, c) != 0.0 || c == r)
+                        c = (c + 1) % n;
+                    done = true;
+                }
+                t.emplace_back(static_cast<int>(r), static_cast<int>(c), it.value());
+            }
+        SparseMatrix M(n, n);
+        M.setFromTriplets(t.begin(), t.end());
+        M.makeCompressed();
+        return M;
+    };
+    const SparseMatrix last = moved(n - 1, n - 1);
+    ASSERT_EQ(last.nonZeros(), A.nonZeros());
+    EXPECT_FALSE(p.matches(last));
+    EXPECT_FALSE(same_pattern(A, last));
+    const Index edge = 3 * kMinRowsPerThread - 1; // the last row of chunk 2
+    const SparseMatrix across = moved(edge, edge + 1);
+    ASSERT_EQ(across.nonZeros(), A.nonZeros());
+    EXPECT_FALSE(p.matches(across));
+    EXPECT_FALSE(same_pattern(A, across));
+}
+
 } // namespace
 } // namespace mlc

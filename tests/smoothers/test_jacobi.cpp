@@ -4,6 +4,9 @@
 #include "smoothers/jacobi.hpp"
 #include "tests/smoothers/matrices.hpp"
 
+#include "core/csr.hpp"
+#include "smoothers/matrix_checks.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -97,4 +100,24 @@ TEST(Jacobi, RejectsBadInput) {
     std::ostringstream os;
     os << JacobiParams{};
     EXPECT_NE(os.str().find("zero_tol"), std::string::npos);
+}
+
+TEST(MatrixChecks, NameTheFirstNonFiniteEntryWhateverChunkHoldsIt) {
+    // check_setup_matrix scans the rows in chunks over the threads: with non-finite entries in
+    // several chunks, the message names the first one in row order, as a serial scan would.
+    const Index n = 4 * kMinRowsPerThread;
+    SparseMatrix A = testmat::laplace_1d(n);
+    check_setup_matrix(A, "test");
+    A.coeffRef(3 * kMinRowsPerThread + 5, 3 * kMinRowsPerThread + 4) = std::nan("");
+    A.coeffRef(kMinRowsPerThread + 7, kMinRowsPerThread + 8) = INFINITY;
+    A.coeffRef(kMinRowsPerThread + 9, kMinRowsPerThread + 9) = std::nan("");
+    try {
+        check_setup_matrix(A, "test");
+        FAIL() << "no throw";
+    } catch (const InvalidInput& e) {
+        const std::string want = "non-finite entry inf at (" +
+                                 std::to_string(kMinRowsPerThread + 7) + ", " +
+                                 std::to_string(kMinRowsPerThread + 8) + ")";
+        EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
 }
