@@ -313,6 +313,10 @@ void Multigrid::apply(const Vector& r, Vector& z) const {
     cycle(n_levels() - 1, r, z);
 }
 
+const SparseMatrix* Multigrid::finest_operator() const {
+    return levels_.back()->A;
+}
+
 std::string Multigrid::name() const {
     const MultigridParams& p = levels_.back()->params;
     std::ostringstream os;

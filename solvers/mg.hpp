@@ -121,6 +121,10 @@ public:
     /// How the coarse operators are filled.
     CoarseOperators coarse_operators() const { return coarse_operators_; }
 
+    /// The finest level's operator as last set up (borrowed), or null before `setup`: the matrix
+    /// a MatrixOperator must wrap for `apply_then_multiply` to fuse its product.
+    const SparseMatrix* finest_operator() const;
+
     /// Number of levels (the finest is n_levels() - 1).
     int n_levels() const { return static_cast<int>(levels_.size()); }
 
