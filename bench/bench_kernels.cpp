@@ -5,6 +5,8 @@
 //   matvec            one product with the finest Jacobian (MatrixOperator, MatVec::unrolled);
 //   sweep             one backward sweep of a smoother built as the multigrid's finest one
 //                     (vertex blocks, unrolled kernel, smoothers::kHybridParts parts);
+//   sweep single      the same sweep with single-precision values and block inverses
+//                     (mg:precision=single);
 //   smoother refresh  BlockSOR::update_values on the same matrix (what each Newton system after
 //                     the first costs the finest level's smoother: checks and block inverses);
 //   smoother setup    BlockSOR::setup on the same matrix (a level's first Newton system);
@@ -97,12 +99,21 @@ public:
                                  .parts = 0,
                                  .kernel = smoothers::Kernel::unrolled});
         sor.setup(*mg->finest_operator());
+        smoothers::BlockSOR sor32({.omega = 1.0,
+                                   .block_size = 2,
+                                   .block_starts = block_starts_,
+                                   .parts = 0,
+                                   .kernel = smoothers::Kernel::unrolled,
+                                   .precision = Precision::float32});
+        sor32.setup(*mg->finest_operator());
         Vector z = parallel::zeros(n), y = parallel::zeros(n), xs = parallel::zeros(n);
         for (int k = 0; k < reps_; ++k) {
             out_["vcycle"].ms.push_back(time_ms([&] { mg->apply(b, z); }));
             out_["matvec"].ms.push_back(time_ms([&] { op.apply(z, y); }));
             out_["sweep"].ms.push_back(
                 time_ms([&] { sor.sweep(b, xs, smoothers::Sweep::backward); }));
+            out_["sweep single"].ms.push_back(
+                time_ms([&] { sor32.sweep(b, xs, smoothers::Sweep::backward); }));
             out_["smoother refresh"].ms.push_back(
                 time_ms([&] { sor.update_values(*mg->finest_operator()); }));
             out_["smoother setup"].ms.push_back(

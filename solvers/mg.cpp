@@ -275,10 +275,11 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
     MLC_CHECK(L.A != nullptr, "Multigrid: the operator of level " << k << " is not set");
     const MultigridParams& p = L.params;
     const bool single = p.precision == Precision::float32;
-    if (p.pre_sweeps == 0) {
-        z.setZero(r.size());
-        L.res = r;
-    } else {
+    // Without pre-smoothing z is zero until the coarse correction: the residual is r itself
+    // (restricted as it is, not copied) and the prolongation writes z = T e instead of adding
+    // T e to zeros (the same values: a row_dot is never -0.0, and 0.0 + v is v).
+    const bool from_zero = p.pre_sweeps == 0;
+    if (!from_zero) {
         L.smoother.forward_from_zero(r, z, L.res);
         for (int s = 1; s < p.pre_sweeps; ++s)
             L.smoother.sweep(r, z, smoothers::Sweep::forward);
@@ -293,14 +294,15 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
             L.res.noalias() -= *L.A * z;
         }
     }
+    const Vector& res = from_zero ? r : L.res;
     if (single) {
-        csr_multiply(csr_arrays(*L.R, L.R32.data()), L.res, L.rc, false, traffic::Kind::transfer);
+        csr_multiply(csr_arrays(*L.R, L.R32.data()), res, L.rc, false, traffic::Kind::transfer);
         cycle(k - 1, L.rc, L.ec);
-        csr_multiply(csr_arrays(*L.T, L.T32.data()), L.ec, z, true, traffic::Kind::transfer);
+        csr_multiply(csr_arrays(*L.T, L.T32.data()), L.ec, z, !from_zero, traffic::Kind::transfer);
     } else {
-        csr_multiply(*L.R, L.res, L.rc, false, traffic::Kind::transfer);
+        csr_multiply(*L.R, res, L.rc, false, traffic::Kind::transfer);
         cycle(k - 1, L.rc, L.ec);
-        csr_multiply(*L.T, L.ec, z, true, traffic::Kind::transfer);
+        csr_multiply(*L.T, L.ec, z, !from_zero, traffic::Kind::transfer);
     }
     for (int s = 0; s < p.post_sweeps; ++s)
         L.smoother.sweep(r, z, smoothers::Sweep::backward);
