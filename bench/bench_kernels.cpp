@@ -9,6 +9,7 @@
 //                     (mg:precision=single);
 //   smoother refresh  BlockSOR::update_values on the same matrix (what each Newton system after
 //                     the first costs the finest level's smoother: checks and block inverses);
+//   smoother refresh single  the same with single-precision data (values and inverses rounded);
 //   smoother setup    BlockSOR::setup on the same matrix (a level's first Newton system);
 //   vectors           BiCGStab's vector statements of one iteration as solvers/krylov.cpp has
 //                     them (Eigen whole-vector statements, one thread);
@@ -116,6 +117,8 @@ public:
                 time_ms([&] { sor32.sweep(b, xs, smoothers::Sweep::backward); }));
             out_["smoother refresh"].ms.push_back(
                 time_ms([&] { sor.update_values(*mg->finest_operator()); }));
+            out_["smoother refresh single"].ms.push_back(
+                time_ms([&] { sor32.update_values(*mg->finest_operator()); }));
             out_["smoother setup"].ms.push_back(
                 time_ms([&] { sor.setup(*mg->finest_operator()); }));
         }

@@ -131,13 +131,20 @@ void BlockSOR::update_values(const SparseMatrix& A) {
 void BlockSOR::round_data() {
     if (params_.precision != Precision::float32) return;
     round_values(*A_, values32_, "BlockSOR (single precision)");
+    // The inverses over the threads; the first entry without a float value is reported.
     dinv32_.resize(dinv_.size());
-    for (size_t k = 0; k < dinv_.size(); ++k) {
-        dinv32_[k] = static_cast<float>(dinv_[k]);
-        MLC_CHECK(std::isfinite(dinv32_[k]),
-                  "BlockSOR (single precision): a block inverse entry "
-                      << dinv_[k] << " has no single-precision value; use precision=double");
-    }
+    const parallel::RowChunks rc = parallel::row_chunks(dinv_.size(), parallel::kTouchRowsPerChunk);
+    std::vector<size_t> first_bad(rc.count, dinv_.size());
+    parallel::for_chunks(rc.count, [&](size_t c) {
+        for (size_t k = rc.begin(c); k < rc.end(c); ++k) {
+            dinv32_[k] = static_cast<float>(dinv_[k]);
+            if (!std::isfinite(dinv32_[k]) && first_bad[c] == dinv_.size()) first_bad[c] = k;
+        }
+    });
+    for (const size_t k : first_bad)
+        MLC_CHECK(k == dinv_.size(), "BlockSOR (single precision): a block inverse entry "
+                                         << dinv_[k]
+                                         << " has no single-precision value; use precision=double");
     std::vector<double>().swap(dinv_); // the double inverses are not read by float32 sweeps
 }
 

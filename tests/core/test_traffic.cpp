@@ -5,6 +5,7 @@
 // when switched on; STREAM returns positive finite bandwidths.
 #include "core/check.hpp"
 #include "core/csr.hpp"
+#include "core/first_touch.hpp"
 #include "core/linear_operator.hpp"
 #include "core/parallel.hpp"
 #include "core/traffic.hpp"
@@ -79,6 +80,31 @@ TEST(Traffic, SinglePrecisionValuesCountFourBytes) {
     EXPECT_EQ(v32[0], 0.1f);
     B.valuePtr()[4] = 1e39;
     EXPECT_THROW(round_values(B, v32, "test"), InvalidInput);
+}
+
+TEST(Traffic, RoundingNamesTheFirstEntryWithoutAFloatValueWhateverChunkHoldsIt) {
+    // round_values runs over the threads in chunks of parallel::kTouchRowsPerChunk entries: with
+    // such entries in several chunks the message names the first one, as a serial loop would.
+    const Index n = 5 * static_cast<Index>(parallel::kTouchRowsPerChunk);
+    SparseMatrix D(n, n);
+    D.setIdentity();
+    D.makeCompressed();
+    std::vector<float> v32;
+    round_values(D, v32, "test");
+    ASSERT_EQ(v32.size(), static_cast<size_t>(n));
+    EXPECT_EQ(v32[static_cast<size_t>(n) - 1], 1.0f);
+    const Index late = 4 * static_cast<Index>(parallel::kTouchRowsPerChunk) + 3;
+    const Index early = 2 * static_cast<Index>(parallel::kTouchRowsPerChunk) + 11;
+    D.valuePtr()[late] = -1e300;
+    D.valuePtr()[early] = 1e39;
+    try {
+        round_values(D, v32, "test");
+        FAIL() << "no throw";
+    } catch (const InvalidInput& e) {
+        const std::string want =
+            "entry (" + std::to_string(early) + ", " + std::to_string(early) + ") = 1e+39";
+        EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
 }
 
 TEST(Traffic, MatrixOperatorCountsOneMatVecWhicheverKernel) {
