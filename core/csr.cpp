@@ -123,7 +123,8 @@ template void csr_residual(const CsrArrays<double>&, const Vector&, const Vector
 template void csr_residual(const CsrArrays<float>&, const Vector&, const Vector&, Vector&,
                            traffic::Kind);
 
-void round_values(const SparseMatrix& A, std::vector<float>& out, const char* who) {
+void round_values(const SparseMatrix& A, parallel::UninitializedVector<float>& out,
+                  const char* who) {
     MLC_CHECK(A.isCompressed(), who << ": the matrix must be compressed");
     const Index nnz = A.nonZeros();
     out.resize(static_cast<size_t>(nnz));

@@ -4,6 +4,7 @@
 /// decides whether a preconditioner may only refresh its values.
 #pragma once
 
+#include "core/first_touch.hpp"
 #include "core/traffic.hpp"
 #include "core/types.hpp"
 
@@ -128,7 +129,8 @@ template <class Value> CsrArrays<Value> csr_arrays(const SparseMatrix& A, const 
 /// A's stored values rounded to float into `out` (resized to A.nonZeros(); no allocation when it
 /// has that size). A must be compressed. Throws mlc::InvalidInput, naming `who`, if a finite
 /// value overflows float (|a| > 3.4e38) or A holds NaN or Inf.
-void round_values(const SparseMatrix& A, std::vector<float>& out, const char* who);
+void round_values(const SparseMatrix& A, parallel::UninitializedVector<float>& out,
+                  const char* who);
 
 /// y = A x (or y += A x with `add`) on CSR arrays with values of type Value (double or float),
 /// each row by `row_dot`, rows split as in the SparseMatrix overload below (so with Value =

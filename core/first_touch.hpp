@@ -16,6 +16,10 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <new>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 namespace mlc::parallel {
 
@@ -47,6 +51,25 @@ inline void set_zero(Vector& v, Index n) {
     v.resize(n);
     fill(v.data(), static_cast<std::size_t>(n), 0.0);
 }
+
+/// std::allocator whose value-less construct default-initialises: `resize` of a vector of
+/// doubles or floats then writes nothing, and the (parallel) loop that first writes the elements
+/// decides which threads touch the pages (a std::vector<T> writes zeros from one thread).
+template <class T> struct DefaultInitAllocator : std::allocator<T> {
+    template <class U> struct rebind { using other = DefaultInitAllocator<U>; };
+    DefaultInitAllocator() noexcept = default;
+    template <class U> DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+    template <class U> void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args> void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+/// A std::vector whose `resize` leaves new elements uninitialised (DefaultInitAllocator): for
+/// arrays that a parallel loop fills completely before anything reads them.
+template <class T> using UninitializedVector = std::vector<T, DefaultInitAllocator<T>>;
 
 /// An array of n uninitialised T (new T[n]: no value is written, so the loop that first writes it
 /// decides which threads touch its pages; std::vector<T>(n) writes zeros from one thread).

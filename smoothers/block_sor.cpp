@@ -145,7 +145,7 @@ void BlockSOR::round_data() {
         MLC_CHECK(k == dinv_.size(), "BlockSOR (single precision): a block inverse entry "
                                          << dinv_[k]
                                          << " has no single-precision value; use precision=double");
-    std::vector<double>().swap(dinv_); // the double inverses are not read by float32 sweeps
+    decltype(dinv_)().swap(dinv_); // the double inverses are not read by float32 sweeps
 }
 
 void BlockSOR::derive_structure() {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/csr.hpp"
+#include "core/first_touch.hpp"
 #include "core/linear_operator.hpp"
 
 #include <Eigen/Dense>
@@ -220,9 +221,11 @@ private:
     SparsityPattern pattern_;   // of A at the last derive_structure
     std::vector<Index> starts_; // block starts followed by n
     std::vector<Index> offset_; // offset of block I's inverse in dinv_
-    std::vector<double> dinv_;  // row-major inverses (times omega for `unrolled`); float64 only
-    std::vector<float> values32_, dinv32_; // float32: A's values and the inverses, rounded
-    double post_ = 1.0;                    // factor of the block correction: omega or 1 (unrolled)
+    // Row-major inverses (times omega for `unrolled`); float64 only. Uninitialised on resize:
+    // invert_blocks writes every entry, over the threads.
+    parallel::UninitializedVector<double> dinv_;
+    parallel::UninitializedVector<float> values32_, dinv32_; // float32: A's values, inverses
+    double post_ = 1.0; // factor of the block correction: omega or 1 (unrolled)
     Index max_block_ = 0;
     std::vector<int> diag_begin_;          // per row: first stored entry in or right of its block
     std::vector<int> own_begin_, own_end_; // per row: its entries with columns in its own part

@@ -57,7 +57,7 @@ struct Multigrid::Level {
     const SparseMatrix* T = nullptr;
     const SparseMatrix* R = nullptr;
     std::shared_ptr<const SparseMatrix> T_storage, R_storage; // owned transfers, or null
-    std::vector<float> T32, R32; // float32: T's and R's values, rounded (patterns are theirs)
+    parallel::UninitializedVector<float> T32, R32; // float32: T's and R's values, rounded
     MultigridParams params;
     smoothers::BlockSOR smoother;           // levels >= 1
     std::unique_ptr<Preconditioner> coarse; // level 0

@@ -54,7 +54,7 @@ TEST(Traffic, SinglePrecisionValuesCountFourBytes) {
     EXPECT_EQ(traffic::csr_bytes(3, 4, 5, false, 4), 112.0);
     EXPECT_EQ(traffic::csr_bytes(3, 4, 5, true, 4), 136.0);
     const SparseMatrix A = known_matrix();
-    std::vector<float> v32;
+    parallel::UninitializedVector<float> v32;
     round_values(A, v32, "test");
     const Vector x = (Vector(4) << 1.0, 0.1, 0.5, 1.0 / 3.0).finished();
     Vector y, y64, res;
@@ -89,7 +89,7 @@ TEST(Traffic, RoundingNamesTheFirstEntryWithoutAFloatValueWhateverChunkHoldsIt) 
     SparseMatrix D(n, n);
     D.setIdentity();
     D.makeCompressed();
-    std::vector<float> v32;
+    parallel::UninitializedVector<float> v32;
     round_values(D, v32, "test");
     ASSERT_EQ(v32.size(), static_cast<size_t>(n));
     EXPECT_EQ(v32[static_cast<size_t>(n) - 1], 1.0f);
