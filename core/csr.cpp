@@ -123,40 +123,35 @@ template void csr_residual(const CsrArrays<double>&, const Vector&, const Vector
 template void csr_residual(const CsrArrays<float>&, const Vector&, const Vector&, Vector&,
                            traffic::Kind);
 
+Index row_of_entry(const SparseMatrix& A, Index k) {
+    const int* outer = A.outerIndexPtr();
+    return std::upper_bound(outer, outer + A.outerSize() + 1, k) - outer - 1;
+}
+
 void round_values(const SparseMatrix& A, parallel::UninitializedVector<float>& out,
                   const char* who) {
     MLC_CHECK(A.isCompressed(), who << ": the matrix must be compressed");
-    const Index nnz = A.nonZeros();
-    out.resize(static_cast<size_t>(nnz));
+    const auto nnz = static_cast<size_t>(A.nonZeros());
+    out.resize(nnz);
     const double* v = A.valuePtr();
     float* o = out.data();
     // The entries over the threads (a Newton Jacobian is rounded at every refresh: 29 million
-    // values at level 6 of the square); each chunk notes its first entry without a float value
-    // and the lowest chunk's is reported, the entry a serial loop would name.
-    const parallel::RowChunks rc =
-        parallel::row_chunks(static_cast<size_t>(nnz), parallel::kTouchRowsPerChunk);
-    std::vector<Index> first_bad(rc.count, -1);
-    parallel::for_chunks(rc.count, [&](size_t c) {
-        bool finite = true;
-        for (size_t k = rc.begin(c); k < rc.end(c); ++k) {
-            o[k] = static_cast<float>(v[k]);
-            finite &= std::isfinite(o[k]);
-        }
-        if (finite) return;
-        for (size_t k = rc.begin(c); k < rc.end(c); ++k)
-            if (!std::isfinite(o[k])) {
-                first_bad[c] = static_cast<Index>(k);
-                return;
+    // values at level 6 of the square); the first entry without a float value is named.
+    const size_t bad =
+        parallel::first_flagged(nnz, parallel::kTouchRowsPerChunk, [&](size_t b, size_t e) {
+            bool finite = true;
+            for (size_t k = b; k < e; ++k) {
+                o[k] = static_cast<float>(v[k]);
+                finite &= std::isfinite(o[k]);
             }
-    });
-    for (const Index k : first_bad) {
-        if (k < 0) continue;
-        const int* outer = A.outerIndexPtr();
-        const Index row = std::upper_bound(outer, outer + A.rows() + 1, k) - outer - 1;
-        MLC_CHECK(false, who << ": entry (" << row << ", " << A.innerIndexPtr()[k] << ") = " << v[k]
-                             << " has no single-precision value (beyond +-3.4e38, or not "
-                                "finite); use precision=double");
-    }
+            if (finite) return e;
+            return static_cast<size_t>(
+                std::find_if(o + b, o + e, [](float f) { return !std::isfinite(f); }) - o);
+        });
+    MLC_CHECK(bad == nnz, who << ": entry (" << row_of_entry(A, static_cast<Index>(bad)) << ", "
+                              << A.innerIndexPtr()[bad] << ") = " << v[bad]
+                              << " has no single-precision value (beyond +-3.4e38, or not "
+                                 "finite); use precision=double");
 }
 
 bool same_pattern(const SparseMatrix& A, const SparseMatrix& B) {

@@ -126,6 +126,9 @@ template <class Value> CsrArrays<Value> csr_arrays(const SparseMatrix& A, const 
     return {A.rows(), A.cols(), A.outerIndexPtr(), A.innerIndexPtr(), values};
 }
 
+/// The row of a compressed A's stored entry k (0 <= k < nnz), for messages naming an entry.
+Index row_of_entry(const SparseMatrix& A, Index k);
+
 /// A's stored values rounded to float into `out` (resized to A.nonZeros(); no allocation when it
 /// has that size). A must be compressed. Throws mlc::InvalidInput, naming `who`, if a finite
 /// value overflows float (|a| > 3.4e38) or A holds NaN or Inf.

@@ -84,6 +84,21 @@ template <class Fn> void for_rows(std::size_t n, std::size_t min_rows_per_chunk,
     for_chunks(rc.count, [&](std::size_t c) { fn(rc.begin(c), rc.end(c)); });
 }
 
+/// The smallest index in [0, n) that `scan` flags, or n when none is: scan(begin, end) runs on
+/// the chunks of row_chunks(n, min_rows_per_chunk) over the threads and returns the first index
+/// of [begin, end) it flags, or end. The lowest flagged chunk's index is returned: the one a
+/// serial scan finds, whatever the threads. For checks over large arrays that name the first
+/// offending entry.
+template <class Fn>
+std::size_t first_flagged(std::size_t n, std::size_t min_rows_per_chunk, Fn&& scan) {
+    const RowChunks rc = row_chunks(n, min_rows_per_chunk);
+    std::size_t first[RowChunks::max_chunks];
+    for_chunks(rc.count, [&](std::size_t c) { first[c] = scan(rc.begin(c), rc.end(c)); });
+    for (std::size_t c = 0; c < rc.count; ++c)
+        if (first[c] < rc.end(c)) return first[c];
+    return n;
+}
+
 /// Test hooks.
 namespace testing {
 /// While held, workers claim no chunk (as if descheduled): a worker that wakes for a loop waits

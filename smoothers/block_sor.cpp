@@ -131,20 +131,21 @@ void BlockSOR::update_values(const SparseMatrix& A) {
 void BlockSOR::round_data() {
     if (params_.precision != Precision::float32) return;
     round_values(*A_, values32_, "BlockSOR (single precision)");
-    // The inverses over the threads; the first entry without a float value is reported.
-    dinv32_.resize(dinv_.size());
-    const parallel::RowChunks rc = parallel::row_chunks(dinv_.size(), parallel::kTouchRowsPerChunk);
-    std::vector<size_t> first_bad(rc.count, dinv_.size());
-    parallel::for_chunks(rc.count, [&](size_t c) {
-        for (size_t k = rc.begin(c); k < rc.end(c); ++k) {
-            dinv32_[k] = static_cast<float>(dinv_[k]);
-            if (!std::isfinite(dinv32_[k]) && first_bad[c] == dinv_.size()) first_bad[c] = k;
-        }
-    });
-    for (const size_t k : first_bad)
-        MLC_CHECK(k == dinv_.size(), "BlockSOR (single precision): a block inverse entry "
-                                         << dinv_[k]
-                                         << " has no single-precision value; use precision=double");
+    // The inverses over the threads; the first entry without a float value is named.
+    const size_t n = dinv_.size();
+    dinv32_.resize(n);
+    const size_t bad =
+        parallel::first_flagged(n, parallel::kTouchRowsPerChunk, [&](size_t b, size_t e) {
+            size_t first = e;
+            for (size_t k = b; k < e; ++k) {
+                dinv32_[k] = static_cast<float>(dinv_[k]);
+                if (!std::isfinite(dinv32_[k]) && first == e) first = k;
+            }
+            return first;
+        });
+    MLC_CHECK(bad == n, "BlockSOR (single precision): a block inverse entry "
+                            << dinv_[bad]
+                            << " has no single-precision value; use precision=double");
     decltype(dinv_)().swap(dinv_); // the double inverses are not read by float32 sweeps
 }
 

@@ -4,11 +4,11 @@
 
 #include "core/check.hpp"
 #include "core/csr.hpp"
+#include "core/first_touch.hpp"
 #include "core/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
 
 namespace mlc::smoothers {
 
@@ -19,31 +19,21 @@ void check_setup_matrix(const SparseMatrix& A, std::string_view who) {
     MLC_CHECK(A.isCompressed(),
               who << ": expected a compressed CSR matrix; call A.makeCompressed() first");
     // The values over the threads (a Newton Jacobian is checked at every refresh: at level 6 of
-    // the square 29 million values); each chunk finds its first non-finite entry, and the
-    // lowest chunk's is reported, the entry a serial scan would name.
+    // the square 29 million values); the first non-finite entry is named.
     const double* v = A.valuePtr();
-    const int* outer = A.outerIndexPtr();
-    const parallel::RowChunks rc =
-        parallel::row_chunks(static_cast<size_t>(A.rows()), static_cast<size_t>(kMinRowsPerThread));
-    std::vector<int> first_bad(rc.count, -1);
-    parallel::for_chunks(rc.count, [&](size_t c) {
-        const int p0 = outer[rc.begin(c)], p1 = outer[rc.end(c)];
-        bool finite = true;
-        for (int p = p0; p < p1; ++p)
-            finite &= std::isfinite(v[p]);
-        if (finite) return;
-        for (int p = p0; p < p1; ++p)
-            if (!std::isfinite(v[p])) {
-                first_bad[c] = p;
-                return;
-            }
-    });
-    for (const int p : first_bad) {
-        if (p < 0) continue;
-        const Index row = std::upper_bound(outer, outer + A.rows() + 1, p) - outer - 1;
-        MLC_CHECK(false, who << ": non-finite entry " << v[p] << " at (" << row << ", "
-                             << A.innerIndexPtr()[p] << "); fix the assembly");
-    }
+    const auto nnz = static_cast<size_t>(A.nonZeros());
+    const size_t bad =
+        parallel::first_flagged(nnz, parallel::kTouchRowsPerChunk, [&](size_t b, size_t e) {
+            bool finite = true;
+            for (size_t k = b; k < e; ++k)
+                finite &= std::isfinite(v[k]);
+            if (finite) return e;
+            return static_cast<size_t>(
+                std::find_if(v + b, v + e, [](double x) { return !std::isfinite(x); }) - v);
+        });
+    MLC_CHECK(bad == nnz, who << ": non-finite entry " << v[bad] << " at ("
+                              << row_of_entry(A, static_cast<Index>(bad)) << ", "
+                              << A.innerIndexPtr()[bad] << "); fix the assembly");
 }
 
 void check_size(const Vector& v, Index n, std::string_view who, std::string_view what) {

@@ -271,3 +271,27 @@ TEST_F(Parallel, DefaultThreadCountFromOmpNumThreadsElseAffinity) {
     if (old) setenv("OMP_NUM_THREADS", saved.c_str(), 1);
     EXPECT_THROW(par::set_num_threads(-1), std::invalid_argument);
 }
+
+TEST_F(Parallel, FirstFlaggedIsTheSerialScansIndexWhateverTheThreads) {
+    // Flags in chunks 1 and 3 of 5: the chunk-1 index is returned with one thread or two (each
+    // chunk reports its own first flag, and the lowest chunk wins); none flagged gives n.
+    const std::size_t n = 5 * 1000;
+    std::vector<char> flag(n, 0);
+    flag[3 * 1000 + 7] = 1;
+    flag[1000 + 500] = 1;
+    flag[1000 + 900] = 1;
+    auto scan = [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k)
+            if (flag[k]) return k;
+        return e;
+    };
+    for (int threads : {1, 2}) {
+        par::set_num_threads(threads);
+        EXPECT_EQ(par::row_chunks(n, 1000).count, 5u);
+        EXPECT_EQ(par::first_flagged(n, 1000, scan), 1500u) << threads;
+    }
+    par::set_num_threads(0);
+    std::fill(flag.begin(), flag.end(), 0);
+    EXPECT_EQ(par::first_flagged(n, 1000, scan), n);
+    EXPECT_EQ(par::first_flagged(0, 1000, scan), 0u);
+}

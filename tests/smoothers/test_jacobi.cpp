@@ -103,7 +103,7 @@ TEST(Jacobi, RejectsBadInput) {
 }
 
 TEST(MatrixChecks, NameTheFirstNonFiniteEntryWhateverChunkHoldsIt) {
-    // check_setup_matrix scans the rows in chunks over the threads: with non-finite entries in
+    // check_setup_matrix scans the entries in chunks over the threads: with non-finite ones in
     // several chunks, the message names the first one in row order, as a serial scan would.
     const Index n = 4 * kMinRowsPerThread;
     SparseMatrix A = testmat::laplace_1d(n);
