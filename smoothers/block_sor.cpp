@@ -258,7 +258,8 @@ void print_block(std::ostream& os, const Eigen::MatrixXd& D) {
 // the block is a blocking that does not suit A (mlc::InvalidInput, as a zero point diagonal);
 // an equilibrated block that is still singular is a numerical breakdown (mlc::SolverBreakdown,
 // with the block printed).
-void BlockSOR::robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, InverseMap inv) const {
+void robust_block_inverse(const Eigen::MatrixXd& D, Index b, Index s0, double singular_tol,
+                          BlockInverseMap inv) {
     const Index s = D.rows();
     // An unknown whose row and column are both zero in the block is decoupled from the others
     // (e.g. the tangential multiplier of a stuck node whose tangential displacement is
@@ -283,7 +284,7 @@ void BlockSOR::robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, Inver
             for (Index j = 0; j < k; ++j)
                 Dk(i, j) = D(keep[static_cast<size_t>(i)], keep[static_cast<size_t>(j)]);
         Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Ik(k, k);
-        robust_inverse(Dk, b, s0, InverseMap(Ik.data(), k, k));
+        robust_block_inverse(Dk, b, s0, singular_tol, BlockInverseMap(Ik.data(), k, k));
         for (Index i = 0; i < k; ++i)
             for (Index j = 0; j < k; ++j)
                 inv(keep[static_cast<size_t>(i)], keep[static_cast<size_t>(j)]) = Ik(i, j);
@@ -324,18 +325,52 @@ void BlockSOR::robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, Inver
         if (balanced) break;
     }
     Eigen::FullPivLU<Eigen::MatrixXd> lu(Ds);
-    lu.setThreshold(params_.singular_tol);
+    lu.setThreshold(singular_tol);
     if (!lu.isInvertible()) {
         std::ostringstream os;
         os << "BlockSOR::setup: diagonal block " << b << " (rows " << s0 << ".." << s0 + s - 1
            << ") is singular even after equilibration (rank " << lu.rank() << " of " << s
-           << " at relative pivot threshold " << params_.singular_tol << "); block ";
+           << " at relative pivot threshold " << singular_tol << "); block ";
         print_block(os, D);
         os << "; the Jacobian is singular at this node: check its supports and contact "
               "statuses, or solve with --linear schur/lu";
         throw SolverBreakdown(os.str());
     }
     inv = c.asDiagonal() * lu.inverse() * r.asDiagonal();
+}
+
+void BlockSOR::robust_inverse(const Eigen::MatrixXd& D, Index b, Index s0, InverseMap inv) const {
+    robust_block_inverse(D, b, s0, params_.singular_tol, inv);
+}
+
+void invert_block_unrolled(const Eigen::MatrixXd& block, Index b, Index s0, double omega,
+                           double tol, BlockInverseMap inv) {
+    const Index s = block.rows();
+    if (s == 2) {
+        // Closed form (the common vertex block without multipliers).
+        const double det = block(0, 0) * block(1, 1) - block(0, 1) * block(1, 0);
+        const double dscale =
+            std::abs(block(0, 0) * block(1, 1)) + std::abs(block(0, 1) * block(1, 0));
+        if (!(dscale > 0.0 && std::abs(det) > tol * dscale)) {
+            robust_block_inverse(block, b, s0, tol, inv);
+            inv *= omega;
+            return;
+        }
+        const double f = omega / det;
+        inv(0, 0) = f * block(1, 1);
+        inv(0, 1) = -f * block(0, 1);
+        inv(1, 0) = -f * block(1, 0);
+        inv(1, 1) = f * block(0, 0);
+        return;
+    }
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(block);
+    lu.setThreshold(tol);
+    if (!lu.isInvertible()) {
+        robust_block_inverse(block, b, s0, tol, inv);
+        inv *= omega;
+        return;
+    }
+    inv = omega * lu.inverse();
 }
 
 void BlockSOR::invert_blocks() {
@@ -400,31 +435,7 @@ void BlockSOR::invert_block_range(Index b_begin, Index b_end, const int* ao, con
             robust_inverse(block, b, s0, inv);
             continue;
         }
-        if (s == 2) {
-            // Closed form (the common vertex block without multipliers).
-            const double det = block(0, 0) * block(1, 1) - block(0, 1) * block(1, 0);
-            const double dscale =
-                std::abs(block(0, 0) * block(1, 1)) + std::abs(block(0, 1) * block(1, 0));
-            if (!(dscale > 0.0 && std::abs(det) > tol * dscale)) {
-                robust_inverse(block, b, s0, inv);
-                inv *= omega;
-                continue;
-            }
-            const double f = omega / det;
-            out[0] = f * block(1, 1);
-            out[1] = -f * block(0, 1);
-            out[2] = -f * block(1, 0);
-            out[3] = f * block(0, 0);
-            continue;
-        }
-        Eigen::FullPivLU<Eigen::MatrixXd> lu(block);
-        lu.setThreshold(tol);
-        if (!lu.isInvertible()) {
-            robust_inverse(block, b, s0, inv);
-            inv *= omega;
-            continue;
-        }
-        inv = omega * lu.inverse();
+        invert_block_unrolled(block, b, s0, omega, tol, inv);
     }
 }
 

@@ -97,6 +97,21 @@ struct BlockSORParams {
     void validate() const;
 };
 
+/// Row-major view of one block's inverse.
+using BlockInverseMap =
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+
+/// D^{-1} of a diagonal block that a fast path rejected: equilibrated full-pivoting LU with the
+/// relative pivot threshold `singular_tol` (see BlockSOR). Block b (rows s0 ..) names it in the
+/// messages: a zero row or column throws mlc::InvalidInput, a singular block SolverBreakdown.
+void robust_block_inverse(const Eigen::MatrixXd& D, Index b, Index s0, double singular_tol,
+                          BlockInverseMap inv);
+
+/// omega D^{-1} as the unrolled kernel forms it: 2x2 in closed form, larger blocks by
+/// full-pivoting LU, robust_block_inverse for the blocks those reject.
+void invert_block_unrolled(const Eigen::MatrixXd& D, Index b, Index s0, double omega, double tol,
+                           BlockInverseMap inv);
+
 /// Prints every field of `p` on one line (block_starts as a count and the largest block).
 std::ostream& operator<<(std::ostream& os, const BlockSORParams& p);
 
