@@ -211,6 +211,11 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     check_preconditioner_names(named, true);
     levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
+    MLC_CHECK(opt.numbering == "hilbert" || opt.numbering == "lattice",
+              "bench square: --numbering must be hilbert or lattice, found '" << opt.numbering
+                                                                              << "'");
+    base.numbering = opt.numbering == "lattice" ? levels::Problem::Numbering::lattice
+                                                : levels::Problem::Numbering::hilbert;
     const bool two_body = levels::has_two_body_pair(base);
     const BenchSolver def = bench_solver(opt, "default", two_body);
     const std::string named_krylov = opt.krylov.value_or("cgs");
@@ -221,7 +226,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
        << ",\n  \"krylov\": " << json_string(krylov_label) << ",\n  \"rel_tol\": " << opt.rel_tol
-       << ",\n  \"repeat\": " << opt.repeat
+       << ",\n  \"repeat\": " << opt.repeat << ",\n  \"numbering\": " << json_string(opt.numbering)
        << ",\n  \"extrapolate\": " << (opt.extrapolate ? "true" : "false") << ",\n  \"runs\": [";
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
        << base.load_steps << " load steps, Krylov " << krylov_label << " rel_tol " << opt.rel_tol

@@ -45,6 +45,8 @@ struct BenchSquareOptions {
     std::vector<std::string> pcs = {"default"};
     /// Krylov method for the preconditioner specs; unset: CGS, and for "default" the run's.
     std::optional<std::string> krylov;
+    /// Order of the unknowns, "hilbert" or "lattice" (levels::Problem::numbering).
+    std::string numbering = "hilbert";
     double rel_tol = 1e-8; ///< Krylov relative tolerance
     int max_iter = 5000;   ///< Krylov iterations per Newton step
     int repeat = 1;        ///< runs per solver; times are medians over them

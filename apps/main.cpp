@@ -38,6 +38,11 @@ int main(int argc, char** argv) {
     auto* run = app.add_subcommand("run", "solve a scene (default: the built-in 'square')");
     run->add_option("scene", ro.scene, "scene file (.toml) or built-in scene name");
     run->add_option("--levels,-l", ro.levels, "number of 1->4 refinements of the level-0 mesh");
+    run->add_option("--numbering", ro.numbering,
+                    "order of each level's unknowns: hilbert (default, along a Hilbert curve) or "
+                    "lattice (macro triangle by macro triangle, the order mg:smoother=lattice "
+                    "sweeps in without copies; levels that are not refinements keep hilbert)")
+        ->check(CLI::IsMember({"hilbert", "lattice"}));
     run->add_option("--mu", ro.mu, "friction coefficient for every contact pair");
     run->add_option("--r", ro.r, "augmentation parameter r for every contact pair");
     run->add_option("--steps", ro.load_steps, "number of load steps");
@@ -186,6 +191,9 @@ int main(int argc, char** argv) {
     bsq->add_option("--krylov", bso.krylov,
                     "Krylov method for the preconditioners (default cgs; for `default` the run's, "
                     "bicgstab)");
+    bsq->add_option("--numbering", bso.numbering,
+                    "order of each level's unknowns: hilbert (default) or lattice (as run's)")
+        ->check(CLI::IsMember({"hilbert", "lattice"}));
     bsq->add_option("--tol", bso.rel_tol, "Krylov relative tolerance (default 1e-8)");
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");
     bsq->add_option("--repeat", bso.repeat, "runs per solver, times are medians (default 1)");

@@ -15,8 +15,10 @@ namespace mlc::apps {
 
 /// Options of `mlcontact run`.
 struct RunOptions {
-    std::string scene = "square";  ///< file path or built-in scene name
-    std::optional<int> levels;     ///< overrides [scene].levels
+    std::string scene = "square"; ///< file path or built-in scene name
+    std::optional<int> levels;    ///< overrides [scene].levels
+    /// "hilbert" or "lattice" (levels::Problem::numbering); unset: hilbert.
+    std::optional<std::string> numbering;
     std::optional<double> mu;      ///< overrides mu of every contact pair
     std::optional<double> r;       ///< overrides r of every contact pair
     std::optional<int> load_steps; ///< overrides [scene].load_steps

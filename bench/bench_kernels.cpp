@@ -15,17 +15,26 @@
 //                     them (Eigen whole-vector statements, one thread);
 //   vectors threaded  the same statements threaded and fused into four passes with chunked
 //                     reductions (a candidate, not used: its sums differ in the last bits).
+//   two sweeps        two backward sweeps of that smoother (what the default cycle does);
+//   two sweeps lattice, sweep lattice, lattice refresh, lattice setup: the same for
+//                     smoothers::LatticeGS (mg:smoother=lattice) on the finest level's lattice;
+//                     with --numbering lattice its structured kernels apply (without it, the
+//                     macros are not numbered as lattices and every block is swept by rows).
 // The variants alternate in one process, so that a slow phase of the machine hits them alike:
 // compare them with each other, not with another run's. Output: one JSON object on stdout
 // (times in ms: median and minimum over --reps).
 //
-// usage: bench_kernels [--levels L] [--reps R]   (defaults 6 and 15)
+// usage: bench_kernels [--levels L] [--reps R] [--numbering hilbert|lattice] [--pc SPEC]
+//        (defaults 6, 15, hilbert and the run's mg:pre=0,post=2; --pc sets the run's
+//        preconditioner, whose cycle the vcycle row times)
 #include "core/first_touch.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
+#include "levels/level.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 #include "smoothers/block_sor.hpp"
+#include "smoothers/lattice_gs.hpp"
 #include "solvers/mg.hpp"
 
 #include <algorithm>
@@ -36,6 +45,8 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -76,9 +87,11 @@ template <size_t K, class Fn> std::array<double, K> chunk_sums(Index n, Fn&& fn)
 
 class Probe final : public levels::ForwardingSystemSolver {
 public:
-    Probe(std::unique_ptr<levels::NewtonSystemSolver> inner, const levels::Level& level, int reps,
-          std::map<std::string, Stat>& out)
-        : ForwardingSystemSolver(std::move(inner)), reps_(reps), out_(out) {
+    Probe(std::unique_ptr<levels::NewtonSystemSolver> inner, const levels::Level& level, int depth,
+          int reps, std::map<std::string, Stat>& out)
+        : ForwardingSystemSolver(std::move(inner)), reps_(reps), out_(out),
+          lattice_(level.lattice ? std::optional<smoothers::LatticeRows>(*level.lattice)
+                                 : levels::lattice_rows(level, depth)) {
         std::vector<int> owner(static_cast<size_t>(level.n_unknowns()));
         for (Index i = 0; i < level.n_unknowns(); ++i)
             owner[static_cast<size_t>(i)] = level.dofs.vertex_of(i);
@@ -108,6 +121,14 @@ public:
                                    .precision = Precision::float32});
         sor32.setup(*mg->finest_operator());
         Vector z = parallel::zeros(n), y = parallel::zeros(n), xs = parallel::zeros(n);
+        std::unique_ptr<smoothers::LatticeGS> lat;
+        if (lattice_) {
+            lat = std::make_unique<smoothers::LatticeGS>(block_starts_, *lattice_);
+            lat->setup(*mg->finest_operator());
+            std::cerr << "bench_kernels: lattice smoother " << lat->name() << ", "
+                      << lat->deep_points() << " deep points of " << n / 2 << " vertices\n";
+        }
+        Vector xl = parallel::zeros(n);
         for (int k = 0; k < reps_; ++k) {
             out_["vcycle"].ms.push_back(time_ms([&] { mg->apply(b, z); }));
             out_["matvec"].ms.push_back(time_ms([&] { op.apply(z, y); }));
@@ -121,6 +142,20 @@ public:
                 time_ms([&] { sor32.update_values(*mg->finest_operator()); }));
             out_["smoother setup"].ms.push_back(
                 time_ms([&] { sor.setup(*mg->finest_operator()); }));
+            out_["two sweeps"].ms.push_back(time_ms([&] {
+                sor.sweep(b, xs, smoothers::Sweep::backward);
+                sor.sweep(b, xs, smoothers::Sweep::backward);
+            }));
+            if (lat) {
+                out_["two sweeps lattice"].ms.push_back(
+                    time_ms([&] { lat->smooth(b, xl, smoothers::Sweep::backward, 2); }));
+                out_["sweep lattice"].ms.push_back(
+                    time_ms([&] { lat->smooth(b, xl, smoothers::Sweep::backward, 1); }));
+                out_["lattice refresh"].ms.push_back(
+                    time_ms([&] { lat->update_values(*mg->finest_operator()); }));
+                out_["lattice setup"].ms.push_back(
+                    time_ms([&] { lat->setup(*mg->finest_operator()); }));
+            }
         }
         // One BiCGStab iteration's vector statements, as krylov.cpp has them and threaded.
         Vector r0 = b, rh = b, p = z, v = y, ph = z, sh = z, t = y, x = z;
@@ -176,6 +211,7 @@ private:
     int reps_;
     std::map<std::string, Stat>& out_;
     std::vector<Index> block_starts_;
+    std::optional<smoothers::LatticeRows> lattice_;
     bool done_ = false;
 };
 
@@ -183,13 +219,20 @@ private:
 
 int main(int argc, char** argv) {
     int levels = 6, reps = 15;
+    bool lattice_numbering = false;
+    std::string pc = "mg:pre=0,post=2";
     for (int i = 1; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--levels"))
             levels = std::atoi(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--reps"))
             reps = std::atoi(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--pc"))
+            pc = argv[i + 1];
+        else if (!std::strcmp(argv[i], "--numbering"))
+            lattice_numbering = !std::strcmp(argv[i + 1], "lattice");
         else {
-            std::cerr << "usage: bench_kernels [--levels L] [--reps R]\n";
+            std::cerr << "usage: bench_kernels [--levels L] [--reps R] [--numbering "
+                         "hilbert|lattice] [--pc SPEC]\n";
             return 2;
         }
     }
@@ -200,16 +243,16 @@ int main(int argc, char** argv) {
     levels::Problem pr = scene::load_scene("square");
     pr.levels = levels;
     pr.load_steps = 1;
+    if (lattice_numbering) pr.numbering = levels::Problem::Numbering::lattice;
     levels::SolveOptions so;
-    so.linear = {
-        .method = "krylov", .krylov = "bicgstab", .pc = "mg:pre=0,post=2", .rel_tol = 1e-8};
+    so.linear = {.method = "krylov", .krylov = "bicgstab", .pc = pc, .rel_tol = 1e-8};
     std::map<std::string, Stat> out;
     Index n = 0;
     so.wrap_system_solver = [&](int level, const levels::Level& L,
                                 std::unique_ptr<levels::NewtonSystemSolver> s)
         -> std::unique_ptr<levels::NewtonSystemSolver> {
         if (level != levels) return s;
-        return std::make_unique<Probe>(std::move(s), L, reps, out);
+        return std::make_unique<Probe>(std::move(s), L, level, reps, out);
     };
     const levels::RunResult r = levels::solve(pr, so);
     n = r.finest().n_unknowns();

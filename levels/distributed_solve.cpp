@@ -509,6 +509,11 @@ solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
               "mg:precision=" << precision
                               << " has no distributed form; on several processes mg's data is "
                                  "double (precision=double)");
+    const std::string smoother = o.get_string("smoother", "block");
+    MLC_CHECK(smoother == "block",
+              "mg:smoother=" << smoother
+                             << " has no distributed form; on several processes mg smooths by "
+                                "vertex blocks (smoother=block)");
     o.finish();
     p.validate();
     return p;

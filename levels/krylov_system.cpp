@@ -203,6 +203,7 @@ private:
             if (c->below == nullptr || !c->below->available()) break;
         }
         d.hierarchy_from_level0 = lv.back()->mesh.n_coarse_vertices == 0;
+        d.top_lattice = [this]() { return level_.lattice; };
         d.hierarchy = [lv, tr]() {
             std::vector<solvers::MultigridLevelData> h;
             for (size_t k = lv.size(); k-- > 0;) {

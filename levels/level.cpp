@@ -5,6 +5,7 @@
 #include "contact/search.hpp"
 #include "core/check.hpp"
 #include "core/first_touch.hpp"
+#include "mesh/lattice.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -229,9 +230,27 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
         part->complete(L, n_extra, contact_pair);
         build_ghost_contacts(problem, L, contact_pair, owned);
     }
-    L.dofs = fem::DofMap(L.fixed, n_extra,
-                         part && !part->order.empty() ? part->order
-                                                      : mesh::hilbert_order(L.mesh.vertices));
+    std::vector<int> order;
+    std::optional<mesh::MacroLattice> lattice;
+    if (part) {
+        MLC_CHECK(problem.numbering == Problem::Numbering::hilbert,
+                  "the lattice numbering has no distributed form: on several processes each "
+                  "process numbers its unknowns along a Hilbert curve (drop --numbering lattice)");
+        if (!part->order.empty()) order = part->order;
+    } else if (problem.numbering == Problem::Numbering::lattice) {
+        // The refinements of mesh0 this level is, when it is (4^d times mesh0's triangles).
+        const long t0 = problem.mesh0.n_triangles(), t = L.mesh.n_triangles();
+        int depth = -1;
+        for (int d = 0; d <= 14 && t0 > 0; ++d)
+            if (t0 << (2 * d) == t) depth = d;
+        if (depth >= 4) // levels with lattice smoothing (solvers::kMinLatticeSubdivisions)
+            lattice = mesh::macro_lattice(L.mesh, depth);
+        if (lattice) order = mesh::lattice_vertex_order(L.mesh, *lattice);
+    }
+    if (order.empty()) order = mesh::hilbert_order(L.mesh.vertices);
+    L.dofs = fem::DofMap(L.fixed, n_extra, order);
+    if (lattice)
+        L.lattice = std::make_shared<const smoothers::LatticeRows>(lattice_rows(L, *lattice));
     L.lambda_dof.reserve(L.contacts.size());
     for (const auto& e : L.contacts)
         L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
@@ -289,6 +308,25 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
         L.path_f_nodal.shrink_to_fit();
     }
     return L;
+}
+
+std::optional<smoothers::LatticeRows> lattice_rows(const Level& L, int depth) {
+    const auto lat = mesh::macro_lattice(L.mesh, depth);
+    if (!lat) return std::nullopt;
+    return lattice_rows(L, *lat);
+}
+
+smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& lattice) {
+    const mesh::MacroLattice* lat = &lattice;
+    smoothers::LatticeRows rows;
+    rows.n = lat->n;
+    rows.first_row.resize(lat->vertex.size());
+    for (size_t k = 0; k < lat->vertex.size(); ++k) {
+        const int v = lat->vertex[k];
+        const int d0 = L.dofs.u_dof(v, 0), d1 = L.dofs.u_dof(v, 1);
+        rows.first_row[k] = d0 >= 0 && d1 == d0 + 1 && L.dofs.extra_dof(v) < 0 ? d0 : -1;
+    }
+    return rows;
 }
 
 } // namespace mlc::levels

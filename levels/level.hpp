@@ -7,9 +7,13 @@
 #include "fem/assembly.hpp"
 #include "fem/dof_map.hpp"
 #include "levels/problem.hpp"
+#include "mesh/lattice.hpp"
 #include "mesh/mesh.hpp"
+#include "smoothers/lattice_gs.hpp"
 
 #include <functional>
+#include <memory>
+#include <optional>
 #include <vector>
 
 namespace mlc::levels {
@@ -55,6 +59,10 @@ struct Level {
     void u_fixed_at(double s, Vector& out) const;
     void f_at(double s, Vector& out) const;
 
+    /// With Problem::Numbering::lattice on a level that is 4 or more refinements of mesh0: the
+    /// rows of its macro triangles' interiors (mg:smoother=lattice); null otherwise.
+    std::shared_ptr<const smoothers::LatticeRows> lattice;
+
     Index n_unknowns() const { return dofs.n_dofs(); }
     int n_contact_nodes() const { return static_cast<int>(contacts.size()); }
 };
@@ -94,5 +102,12 @@ struct LevelPart {
 /// `complete`) are searched again here, and their elements kept where they reach an owned
 /// vertex. Null `part`: build_level(problem, m).
 Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part);
+
+/// The rows of the macro triangles' interior points (smoothers::LatticeGS) when L's mesh is
+/// `depth` refinements of a level-0 mesh in refine's order (mesh::macro_lattice), else nullopt.
+/// A vertex whose unknowns are not its two displacements, in a row, gets -1.
+std::optional<smoothers::LatticeRows> lattice_rows(const Level& L, int depth);
+/// The same for a lattice of L's mesh already found.
+smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& lattice);
 
 } // namespace mlc::levels

@@ -139,6 +139,12 @@ struct Problem {
     /// Load steps: step j solves at the path parameter s = j / load_steps (equal increments).
     int load_steps = 1;
     int levels = 0; ///< number of 1->4 refinements of mesh0
+    /// Order of the unknowns of each level (fem::DofMap). hilbert (default): the vertices along a
+    /// Hilbert curve. lattice: on a level that is uniform refinements of mesh0, macro triangle by
+    /// macro triangle, each one's interior row by row (mesh::lattice_vertex_order), the order in
+    /// which mg:smoother=lattice sweeps without copies; other levels keep the Hilbert order.
+    enum class Numbering { hilbert, lattice };
+    Numbering numbering = Numbering::hilbert;
     /// Levels recovered from a Gmsh mesh that is a uniform refinement (scene/scene.cpp,
     /// mesh::unrefine): mesh0 is then its coarsest ancestor and the file's mesh is level
     /// `recovered_levels`; 0 otherwise.

@@ -51,8 +51,8 @@ inline constexpr double kMgCrossoverTwoBody = 10000;
 /// Newton step than V(1,1) for the same or fewer Krylov iterations (square level 6: a Newton
 /// step 1.09 -> 0.81 s, README "The default cycle: V(0,2) with BiCGStab"); with a two-body pair
 /// the sweeps are also damped (omega = 0.8), which halved BiCGStab's iterations on dovetail
-/// level 4 with V(1,1) and keeps them on levels 2 and 3 (with V(0,2): 20 against 85); with rigid obstacles only they are not (the
-/// square's iterations grow with omega = 0.8).
+/// level 4 with V(1,1) and keeps them on levels 2 and 3 (with V(0,2): 20 against 85); with rigid
+/// obstacles only they are not (the square's iterations grow with omega = 0.8).
 inline constexpr const char* kMgDefaultOneBody = "mg:pre=0,post=2";
 inline constexpr const char* kMgDefaultTwoBody = "mg:omega=0.8,pre=0,post=2";
 /// The Krylov method the driver takes with its default mg (the V(0,2) cycle is not symmetric,
@@ -86,6 +86,11 @@ struct SolverChoice {
     bool automatic = false; ///< chosen by size (no solver flag given)
     std::string reason;     ///< one sentence, for the report and summary.json
 };
+
+/// Refuses mg:smoother=lattice (InvalidInput naming the fix) where it cannot take effect: a
+/// finest level below 4, or the levels not numbered as lattices (Problem::Numbering::lattice).
+/// Called by choose_solver and solve.
+void check_lattice_smoother(const Problem& problem, const std::string& pc);
 
 /// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
 /// without `pc` uses the default mg (damped, kMgDefaultTwoBody, with a two-body pair; over an

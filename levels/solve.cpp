@@ -2,6 +2,8 @@
 // Load stepping on the finest level.
 #include "levels/solve.hpp"
 
+#include "levels/resources.hpp"
+
 #include "core/check.hpp"
 #include "core/first_touch.hpp"
 #include "core/memory.hpp"
@@ -212,6 +214,7 @@ StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonPar
 RunResult solve(const Problem& problem, const SolveOptions& options) {
     problem.validate();
     options.linear.validate();
+    if (options.linear.method == "krylov") check_lattice_smoother(problem, options.linear.pc);
     RunResult res;
     res.solver.spec = options.linear;
     res.solver.reason = "as given";

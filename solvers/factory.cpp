@@ -169,8 +169,22 @@ std::unique_ptr<Preconditioner> build_mg(SpecOptions& o, const LevelData* level)
     MLC_CHECK(precision == "double" || precision == "single",
               "option precision=" << precision << " of mg: valid double, single");
     p.precision = precision == "single" ? Precision::float32 : Precision::float64;
+    const std::string smoother = o.get_string("smoother", "block");
+    MLC_CHECK(smoother == "block" || smoother == "lattice",
+              "option smoother=" << smoother << " of mg: valid block, lattice");
+    p.smoother = smoother == "lattice" ? MultigridParams::Smoother::lattice
+                                       : MultigridParams::Smoother::block;
     o.finish();
     p.validate();
+    MultigridLevelData top = L.top;
+    if (p.smoother == MultigridParams::Smoother::lattice) {
+        MLC_CHECK(coarse != "aggregation",
+                  "mg:smoother=lattice needs the refined levels (their macro triangles); an "
+                  "algebraic hierarchy (coarse=aggregation, or a mesh without levels) has none");
+        // Levels below 4 (or not refined from level 0) keep the block smoother; the driver
+        // refuses the option when the finest level is below 4 (levels::choose_solver).
+        if (L.top_lattice) top.lattice = L.top_lattice();
+    }
     if (coarse == "aggregation") {
         ap.validate();
         MLC_CHECK(L.aggregation != nullptr,
@@ -188,16 +202,18 @@ std::unique_ptr<Preconditioner> build_mg(SpecOptions& o, const LevelData* level)
     if (coarse == "galerkin") {
         MLC_CHECK(L.hierarchy_from_level0,
                   "mg:coarse=galerkin needs every level below in the coarse-to-fine solve");
-        return std::make_unique<Multigrid>(L.hierarchy(), p, CoarseOperators::galerkin);
+        std::vector<MultigridLevelData> h = L.hierarchy();
+        h.back().lattice = top.lattice;
+        return std::make_unique<Multigrid>(std::move(h), p, CoarseOperators::galerkin);
     }
-    if (L.below_multigrid != nullptr) return Multigrid::above(*L.below_multigrid, L.top, p);
+    if (L.below_multigrid != nullptr) return Multigrid::above(*L.below_multigrid, top, p);
     // Two levels: the level below (its operator set by the caller, factored) and this one.
     std::vector<MultigridLevelData> h = L.hierarchy();
     MLC_CHECK(h.size() >= 2, "mg: the level data holds " << h.size() << " level(s), at least two");
     MultigridLevelData below_level = std::move(h[h.size() - 2]);
     below_level.T = below_level.R = nullptr;
     return std::make_unique<Multigrid>(
-        std::vector<MultigridLevelData>{std::move(below_level), L.top}, p);
+        std::vector<MultigridLevelData>{std::move(below_level), std::move(top)}, p);
 }
 
 std::unique_ptr<Preconditioner> build_amg(SpecOptions& o, const LevelData* level) {
@@ -292,13 +308,15 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          &build_ebe},
         {"mg",
          "mg[:pre=N,post=N,omega=W,coarse=rediscretize|galerkin|aggregation,csize=N,smooth=S,"
-         "precision=double|single] "
+         "precision=double|single,smoother=block|lattice] "
          "(multilevel V-cycle over all levels, vertex-block Gauss-Seidel; on a single level, "
          "or with coarse=aggregation, over an algebraic hierarchy of vertex aggregates coarsened "
          "to at most N = 3000 unknowns, prolongation smoothing S = 4/3; precision=single stores "
-         "the smoother's matrices, block inverses and transfers as float, vectors stay double)",
+         "the smoother's matrices, block inverses and transfers as float, vectors stay double; "
+         "smoother=lattice sweeps the interiors of the level-0 triangles of levels 4 and finer "
+         "with structured kernels; it needs --numbering lattice)",
          "",
-         {"pre", "post", "omega", "coarse", "csize", "smooth", "precision"},
+         {"pre", "post", "omega", "coarse", "csize", "smooth", "precision", "smoother"},
          true,
          true,
          &build_mg,

@@ -91,6 +91,9 @@ struct LevelData {
     MultigridLevelData top;
     /// mg: the levels from the lowest one solved up to this one (coarsest first; the lowest
     /// entry has no T or R), their transfers and smoother blocks; computed when asked.
+    /// The lattice rows of this level (MultigridLevelData::lattice, for mg:smoother=lattice),
+    /// computed on request; null (or an empty function) when the level has none.
+    std::function<std::shared_ptr<const smoothers::LatticeRows>()> top_lattice;
     std::function<std::vector<MultigridLevelData>()> hierarchy;
     /// hierarchy() starts at level 0 (mg:coarse=galerkin needs it).
     bool hierarchy_from_level0 = false;

@@ -21,11 +21,14 @@ void MultigridParams::validate() const {
     MLC_CHECK(post_sweeps >= 0, "mg: post must be >= 0, found " << post_sweeps);
     MLC_CHECK(pre_sweeps + post_sweeps >= 1, "mg: pre + post must be >= 1 (no smoothing at all)");
     MLC_CHECK(omega > 0.0 && omega < 2.0, "mg: omega must be in (0, 2), found " << omega);
+    MLC_CHECK(smoother == Smoother::block || precision == Precision::float64,
+              "mg: smoother=lattice keeps double data; precision=single is for smoother=block");
 }
 
 std::ostream& operator<<(std::ostream& os, const MultigridParams& p) {
     return os << "MultigridParams{pre=" << p.pre_sweeps << ", post=" << p.post_sweeps
-              << ", omega=" << p.omega << ", precision=" << to_string(p.precision) << "}";
+              << ", omega=" << p.omega << ", precision=" << to_string(p.precision) << ", smoother="
+              << (p.smoother == MultigridParams::Smoother::lattice ? "lattice" : "block") << "}";
 }
 
 namespace {
@@ -49,6 +52,10 @@ struct Multigrid::Level {
     Level(const MultigridLevelData& d, const MultigridParams& p)
         : T(d.T), R(d.R), T_storage(d.T_storage), R_storage(d.R_storage), params(p),
           smoother(smoother_params(p, d.block_starts)) {
+        if (T && p.smoother == MultigridParams::Smoother::lattice && d.lattice &&
+            d.lattice->n >= kMinLatticeSubdivisions)
+            lattice = std::make_unique<smoothers::LatticeGS>(
+                d.block_starts, *d.lattice, smoothers::LatticeGSParams{.omega = p.omega});
         if (T && p.precision == Precision::float32) {
             round_values(*T, T32, "mg:precision=single (prolongation)");
             round_values(*R, R32, "mg:precision=single (restriction)");
@@ -59,12 +66,13 @@ struct Multigrid::Level {
     std::shared_ptr<const SparseMatrix> T_storage, R_storage; // owned transfers, or null
     parallel::UninitializedVector<float> T32, R32; // float32: T's and R's values, rounded
     MultigridParams params;
-    smoothers::BlockSOR smoother;           // levels >= 1
-    std::unique_ptr<Preconditioner> coarse; // level 0
-    bool coarse_replaced = false;           // level 0: set_coarse_solver was called
-    const SparseMatrix* A = nullptr;        // the operator (borrowed, or `owned`)
-    SparseMatrix owned;                     // Galerkin operator
-    mutable Vector res, rc, ec;             // levels >= 1
+    smoothers::BlockSOR smoother;                  // levels >= 1
+    std::unique_ptr<smoothers::LatticeGS> lattice; // mg:smoother=lattice: used instead
+    std::unique_ptr<Preconditioner> coarse;        // level 0
+    bool coarse_replaced = false;                  // level 0: set_coarse_solver was called
+    const SparseMatrix* A = nullptr;               // the operator (borrowed, or `owned`)
+    SparseMatrix owned;                            // Galerkin operator
+    mutable Vector res, rc, ec;                    // levels >= 1
 
     // Full setup (`full`) or a refresh reusing the structure; the first call is always full.
     void set(const SparseMatrix& M, bool full) {
@@ -83,13 +91,19 @@ struct Multigrid::Level {
                                              << T->rows());
         if (full || A == nullptr || res.size() != M.rows()) {
             A = &M;
-            smoother.setup(M);
+            if (lattice)
+                lattice->setup(M);
+            else
+                smoother.setup(M);
             res.resize(M.rows());
             rc.resize(R->rows());
             ec.resize(R->rows());
         } else {
             A = &M;
-            smoother.update_values(M);
+            if (lattice)
+                lattice->update_values(M);
+            else
+                smoother.update_values(M);
         }
     }
 };
@@ -280,9 +294,14 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
     // T e to zeros (the same values: a row_dot is never -0.0, and 0.0 + v is v).
     const bool from_zero = p.pre_sweeps == 0;
     if (!from_zero) {
-        L.smoother.forward_from_zero(r, z, L.res);
-        for (int s = 1; s < p.pre_sweeps; ++s)
-            L.smoother.sweep(r, z, smoothers::Sweep::forward);
+        if (L.lattice) {
+            L.lattice->forward_from_zero(r, z, L.res);
+            L.lattice->smooth(r, z, smoothers::Sweep::forward, p.pre_sweeps - 1);
+        } else {
+            L.smoother.forward_from_zero(r, z, L.res);
+            for (int s = 1; s < p.pre_sweeps; ++s)
+                L.smoother.sweep(r, z, smoothers::Sweep::forward);
+        }
         if (p.pre_sweeps > 1 && single) {
             csr_residual(csr_arrays(*L.A, L.smoother.values32()), r, z, L.res,
                          traffic::Kind::matvec);
@@ -304,6 +323,10 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
         cycle(k - 1, L.rc, L.ec);
         csr_multiply(*L.T, L.ec, z, !from_zero, traffic::Kind::transfer);
     }
+    if (L.lattice) {
+        L.lattice->smooth(r, z, smoothers::Sweep::backward, p.post_sweeps);
+        return;
+    }
     for (int s = 0; s < p.post_sweeps; ++s)
         L.smoother.sweep(r, z, smoothers::Sweep::backward);
 }
@@ -324,6 +347,7 @@ std::string Multigrid::name() const {
     std::ostringstream os;
     os << "mg(pre=" << p.pre_sweeps << ",post=" << p.post_sweeps << ",omega=" << p.omega;
     if (p.precision == Precision::float32) os << ",precision=single";
+    if (p.smoother == MultigridParams::Smoother::lattice) os << ",smoother=lattice";
     os << ")";
     return os.str();
 }
@@ -337,7 +361,10 @@ MultigridReport Multigrid::report() const {
         row.level = static_cast<int>(k);
         row.rows = L.A ? L.A->rows() : (L.T ? L.T->rows() : 0);
         row.nonzeros = L.A ? L.A->nonZeros() : 0;
-        row.solve = k == 0 ? L.coarse->name() : "smoother";
+        row.solve = k == 0      ? L.coarse->name()
+                    : L.lattice ? "smoother (lattice, " + std::to_string(L.lattice->deep_points()) +
+                                      " deep points)"
+                                : "smoother";
         nnz += static_cast<double>(row.nonzeros);
         rows += static_cast<double>(row.rows);
         r.levels.push_back(row);
@@ -354,6 +381,9 @@ MultigridReport Multigrid::report() const {
        << " threaded parts";
     if (p.precision == Precision::float32)
         sm << ", single-precision matrices, block inverses and transfers";
+    if (p.smoother == MultigridParams::Smoother::lattice)
+        sm << "; structured kernels on the macro triangles' interiors (smoother=lattice) on the "
+              "levels marked lattice";
     r.smoother = sm.str();
     const Level& L0 = *levels_.front();
     r.coarse_solver =

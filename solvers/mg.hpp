@@ -31,6 +31,7 @@
 
 #include "core/linear_operator.hpp"
 #include "smoothers/block_sor.hpp"
+#include "smoothers/lattice_gs.hpp"
 
 #include <memory>
 #include <ostream>
@@ -50,6 +51,12 @@ struct MultigridParams {
     /// the coarsest level's LU and the Krylov method stay double. Default float64; float32 is
     /// `mg:precision=single`.
     Precision precision = Precision::float64;
+    /// The smoother of the levels above the coarsest. block (default): smoothers::BlockSOR.
+    /// lattice (`mg:smoother=lattice`): smoothers::LatticeGS on every level whose
+    /// MultigridLevelData gives lattice rows with at least 16 subdivisions per macro edge
+    /// (BlockSOR on the others); double precision only.
+    enum class Smoother { block, lattice };
+    Smoother smoother = Smoother::block;
     /// Throws mlc::InvalidInput naming the first field out of range.
     void validate() const;
 };
@@ -70,7 +77,14 @@ struct MultigridLevelData {
     /// When set, the level keeps T and R alive (an algebraic hierarchy built for this multigrid
     /// alone, solvers/aggregation.hpp); T and R then point to them.
     std::shared_ptr<const SparseMatrix> T_storage, R_storage;
+    /// The rows of the level's macro-triangle lattice (smoothers::LatticeGS), or null.
+    std::shared_ptr<const smoothers::LatticeRows> lattice;
 };
+
+/// Lattices of at least this many subdivisions per macro edge get mg:smoother=lattice's
+/// smoother (level 4 of a hierarchy refined from level 0 and above): below it too few of the
+/// interior points are deep for the renumbering to pay.
+inline constexpr int kMinLatticeSubdivisions = 16;
 
 /// How the coarse operators are obtained.
 enum class CoarseOperators {

@@ -1,0 +1,533 @@
+// SPDX-License-Identifier: MIT
+#include "smoothers/lattice_gs.hpp"
+
+#include "core/check.hpp"
+#include "core/parallel.hpp"
+#include "core/traffic.hpp"
+#include "smoothers/matrix_checks.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+
+namespace mlc::smoothers {
+
+namespace {
+
+constexpr int kSlots = 7;    // centre, then (1,0), (-1,0), (0,1), (0,-1), (1,-1), (-1,1)
+constexpr int kStencil = 32; // 7 slots x 4 entries, then omega D^{-1} of the centre
+constexpr int kDi[kSlots] = {0, 1, -1, 0, 0, 1, -1};
+constexpr int kDj[kSlots] = {0, 0, 0, 1, -1, -1, 1};
+constexpr int kLenCodes = 4096; // visit code = macro * kLenCodes + row length
+
+long interior_points(int n) {
+    return n < 3 ? 0 : static_cast<long>(n - 1) * (n - 2) / 2;
+}
+long point_index(int n, int i, int j) {
+    return static_cast<long>(j - 1) * (2 * n - 2 - j) / 2 + (i - 1);
+}
+
+// One deep point: r = b - sum_s S_s x_s over the seven 2x2 blocks, x += omega D^{-1} r, its
+// neighbours `len` (the length of its lattice row) points up and down.
+inline void deep_update(const double* S, const double* b, double* x, long len) {
+    const long nn = 2 * len, nw = 2 * len - 2, so = -2 * (len + 1), se = -2 * len;
+    double a0 = b[0], a1 = b[1];
+    auto acc = [&](const double* B, const double* y) {
+        a0 -= B[0] * y[0] + B[1] * y[1];
+        a1 -= B[2] * y[0] + B[3] * y[1];
+    };
+    acc(S + 0, x);
+    acc(S + 4, x + 2);
+    acc(S + 8, x - 2);
+    acc(S + 12, x + nn);
+    acc(S + 16, x + so);
+    acc(S + 20, x + se);
+    acc(S + 24, x + nw);
+    const double* D = S + 28;
+    x[0] += D[0] * a0 + D[1] * a1;
+    x[1] += D[2] * a0 + D[3] * a1;
+}
+
+} // namespace
+
+LatticeGS::LatticeGS(std::vector<Index> block_starts, LatticeRows lattice, LatticeGSParams params)
+    : block_starts_in_(std::move(block_starts)), lattice_(std::move(lattice)), params_(params) {
+    MLC_CHECK(params_.omega > 0.0 && params_.omega < 2.0,
+              "lattice smoother: omega must be in (0, 2), found " << params_.omega);
+    MLC_CHECK(params_.parts >= 0, "lattice smoother: parts must be >= 0, found " << params_.parts);
+    MLC_CHECK(lattice_.n >= 1 && lattice_.n < kLenCodes,
+              "lattice smoother: n must be in [1, " << kLenCodes << "), found " << lattice_.n);
+    const long np = interior_points(lattice_.n);
+    MLC_CHECK(np == 0 ? lattice_.first_row.empty()
+                      : lattice_.first_row.size() % static_cast<size_t>(np) == 0,
+              "lattice smoother: " << lattice_.first_row.size()
+                                   << " lattice rows are not a whole number of macros of " << np
+                                   << " interior points");
+}
+
+std::string LatticeGS::name() const {
+    std::ostringstream os;
+    os << "lattice-gs(omega=" << params_.omega << ",parts=" << parts() << ")";
+    return os.str();
+}
+
+void LatticeGS::setup(const SparseMatrix& A) {
+    check_setup_matrix(A, "lattice smoother");
+    derive(A);
+    load_rows(A);
+}
+
+void LatticeGS::update_values(const SparseMatrix& A) {
+    if (A_ == nullptr || A.rows() != n_ || A.cols() != n_ || !same_pattern(A) ||
+        !deep_rows_match(A)) {
+        setup(A);
+        return;
+    }
+    load_rows(A);
+}
+
+void LatticeGS::derive(const SparseMatrix& A) {
+    A_ = &A;
+    n_ = A.rows();
+    const int* ao = A.outerIndexPtr();
+    const int* ai = A.innerIndexPtr();
+    const double* av = A.valuePtr();
+    // Blocks.
+    starts_ = block_starts_in_.empty() ? uniform_block_starts(n_, 2) : block_starts_in_;
+    if (starts_.back() != n_) starts_.push_back(n_);
+    MLC_CHECK(starts_.front() == 0, "lattice smoother: the blocks must start at row 0");
+    const Index nb = static_cast<Index>(starts_.size()) - 1;
+    std::vector<int> block_of_row(static_cast<size_t>(n_));
+    for (Index b = 0; b < nb; ++b) {
+        MLC_CHECK(starts_[b] < starts_[b + 1], "lattice smoother: block starts must increase");
+        for (Index r = starts_[b]; r < starts_[b + 1]; ++r)
+            block_of_row[static_cast<size_t>(r)] = static_cast<int>(b);
+    }
+    // The visit order and its parts: runs of about equal nonzeros (BlockSOR's cut).
+    std::vector<int> order(static_cast<size_t>(nb));
+    if (lattice_.visit.empty()) {
+        for (Index b = 0; b < nb; ++b)
+            order[static_cast<size_t>(b)] = static_cast<int>(b);
+    } else {
+        MLC_CHECK(static_cast<Index>(lattice_.visit.size()) == nb,
+                  "lattice smoother: the visit lists " << lattice_.visit.size() << " blocks of "
+                                                       << nb);
+        std::vector<char> seen(static_cast<size_t>(nb), 0);
+        for (size_t i = 0; i < lattice_.visit.size(); ++i) {
+            const Index r = lattice_.visit[i];
+            MLC_CHECK(r >= 0 && r < n_ && starts_[block_of_row[static_cast<size_t>(r)]] == r &&
+                          !seen[static_cast<size_t>(block_of_row[static_cast<size_t>(r)])],
+                      "lattice smoother: visit entry " << i << " (row " << r
+                                                       << ") is not a block's first row, or "
+                                                          "repeats one");
+            order[i] = block_of_row[static_cast<size_t>(r)];
+            seen[static_cast<size_t>(order[i])] = 1;
+        }
+    }
+    const Index want = params_.parts > 0 ? params_.parts : kHybridParts;
+    const Index P =
+        std::clamp<Index>(std::min(want, n_ / kMinRowsPerThread), 1, std::max<Index>(nb, 1));
+    std::vector<int> part_of_block(static_cast<size_t>(nb), 0);
+    std::vector<int> cut{0};
+    {
+        const double per_part = static_cast<double>(A.nonZeros()) / static_cast<double>(P);
+        double cum = 0.0;
+        int p = 0;
+        for (Index i = 0; i < nb; ++i) {
+            const int b = order[static_cast<size_t>(i)];
+            part_of_block[static_cast<size_t>(b)] = p;
+            cum += static_cast<double>(ao[starts_[b + 1]] - ao[starts_[b]]);
+            if (p + 1 < P && cum >= per_part * (p + 1)) {
+                cut.push_back(static_cast<int>(i + 1));
+                ++p;
+            }
+        }
+        while (static_cast<Index>(cut.size()) < P + 1)
+            cut.push_back(static_cast<int>(nb));
+        cut.back() = static_cast<int>(nb);
+    }
+    // Macros numbered as a lattice: every interior point a plain 2x2 block at row0 + 2p.
+    const int N = lattice_.n;
+    const long np = interior_points(N);
+    const long n_macros = np == 0 ? 0 : static_cast<long>(lattice_.first_row.size()) / np;
+    // Deep points, macro by macro over the threads (each writes its own stencil and lists).
+    std::vector<int> deep_len(static_cast<size_t>(nb), -1); // per block: row length if deep
+    std::vector<int> deep_mac(static_cast<size_t>(nb), -1);
+    stencils_.assign(static_cast<size_t>(n_macros) * kStencil, 0.0);
+    std::vector<std::vector<int>> macro_rows(static_cast<size_t>(n_macros));
+    std::vector<std::vector<std::uint8_t>> macro_slots(static_cast<size_t>(n_macros));
+    std::vector<std::vector<int>> macro_lens(static_cast<size_t>(n_macros));
+    parallel::for_chunks(static_cast<size_t>(n_macros), [&](size_t m) {
+        const Index* fr = lattice_.first_row.data() + static_cast<long>(m) * np;
+        const Index row0 = fr[0];
+        for (long q = 0; q < np; ++q) {
+            const Index r = fr[q];
+            if (r != row0 + 2 * q || r < 0 || r + 2 > n_) return;
+            const int b = block_of_row[static_cast<size_t>(r)];
+            if (starts_[b] != r || starts_[b + 1] != r + 2) return;
+        }
+        double* S = stencils_.data() + m * kStencil;
+        bool have = false;
+        double tol = 0.0;
+        for (int j = 2; j <= N - 4; ++j)
+            for (int i = 2; i + j <= N - 2; ++i) {
+                std::array<Index, kSlots> nbr{};
+                for (int s = 0; s < kSlots; ++s)
+                    nbr[static_cast<size_t>(s)] = fr[point_index(N, i + kDi[s], j + kDj[s])];
+                const Index r = nbr[0];
+                const int part =
+                    part_of_block[static_cast<size_t>(block_of_row[static_cast<size_t>(r)])];
+                bool same_part = true;
+                for (int s = 1; s < kSlots; ++s)
+                    same_part =
+                        same_part &&
+                        part_of_block[static_cast<size_t>(
+                            block_of_row[static_cast<size_t>(nbr[static_cast<size_t>(s)])])] ==
+                            part;
+                if (!same_part) continue;
+                if (ao[r + 1] - ao[r] != 2 * kSlots || ao[r + 2] - ao[r + 1] != 2 * kSlots)
+                    continue;
+                std::array<double, 28> v{};
+                std::array<std::uint8_t, kSlots> slots{};
+                bool fits = true;
+                for (int q = 0; q < kSlots && fits; ++q) {
+                    const int c0 = ai[ao[r] + 2 * q], c1 = ai[ao[r] + 2 * q + 1];
+                    const int d0 = ai[ao[r + 1] + 2 * q], d1 = ai[ao[r + 1] + 2 * q + 1];
+                    int s = 0;
+                    while (s < kSlots && nbr[static_cast<size_t>(s)] != c0)
+                        ++s;
+                    fits = s < kSlots && c1 == c0 + 1 && d0 == c0 && d1 == c1;
+                    if (!fits) break;
+                    slots[static_cast<size_t>(q)] = static_cast<std::uint8_t>(s);
+                    v[static_cast<size_t>(4 * s)] = av[ao[r] + 2 * q];
+                    v[static_cast<size_t>(4 * s + 1)] = av[ao[r] + 2 * q + 1];
+                    v[static_cast<size_t>(4 * s + 2)] = av[ao[r + 1] + 2 * q];
+                    v[static_cast<size_t>(4 * s + 3)] = av[ao[r + 1] + 2 * q + 1];
+                }
+                if (!fits) continue;
+                if (!have) {
+                    // The macro's stencil: this point's rows, with omega D^{-1} of the centre.
+                    const double det = v[0] * v[3] - v[1] * v[2];
+                    const double dscale = std::abs(v[0] * v[3]) + std::abs(v[1] * v[2]);
+                    if (!(dscale > 0.0 && std::abs(det) > params_.singular_tol * dscale)) continue;
+                    have = true;
+                    std::copy(v.begin(), v.end(), S);
+                    const double f = params_.omega / det;
+                    S[28] = f * v[3];
+                    S[29] = -f * v[1];
+                    S[30] = -f * v[2];
+                    S[31] = f * v[0];
+                    double mx = 0.0;
+                    for (double x : v)
+                        mx = std::max(mx, std::abs(x));
+                    tol = params_.stencil_tol * mx;
+                } else {
+                    bool match = true;
+                    for (int e = 0; e < 28 && match; ++e)
+                        match = std::abs(v[static_cast<size_t>(e)] - S[e]) <= tol;
+                    if (!match) continue;
+                }
+                const int b = block_of_row[static_cast<size_t>(r)];
+                deep_len[static_cast<size_t>(b)] = N - 1 - j;
+                deep_mac[static_cast<size_t>(b)] = static_cast<int>(m);
+                macro_rows[m].push_back(static_cast<int>(r));
+                macro_lens[m].push_back(N - 1 - j);
+                macro_slots[m].insert(macro_slots[m].end(), slots.begin(), slots.end());
+            }
+    });
+    deep_row_.clear();
+    deep_len_.clear();
+    deep_macro_.clear();
+    deep_slots_.clear();
+    for (long m = 0; m < n_macros; ++m) {
+        const auto& rows = macro_rows[static_cast<size_t>(m)];
+        deep_row_.insert(deep_row_.end(), rows.begin(), rows.end());
+        deep_len_.insert(deep_len_.end(), macro_lens[static_cast<size_t>(m)].begin(),
+                         macro_lens[static_cast<size_t>(m)].end());
+        deep_macro_.insert(deep_macro_.end(), rows.size(), static_cast<int>(m));
+        deep_slots_.insert(deep_slots_.end(), macro_slots[static_cast<size_t>(m)].begin(),
+                           macro_slots[static_cast<size_t>(m)].end());
+    }
+    n_deep_ = static_cast<Index>(deep_row_.size());
+    // The visit entries and the row-swept blocks, in visit order.
+    part_visit_ = cut;
+    visit_row_.resize(static_cast<size_t>(nb));
+    visit_code_.resize(static_cast<size_t>(nb));
+    cb_row_.clear();
+    cb_size_.clear();
+    cb_block_.clear();
+    for (Index i = 0; i < nb; ++i) {
+        const int b = order[static_cast<size_t>(i)];
+        visit_row_[static_cast<size_t>(i)] = static_cast<int>(starts_[b]);
+        if (deep_len[static_cast<size_t>(b)] >= 0) {
+            visit_code_[static_cast<size_t>(i)] =
+                deep_mac[static_cast<size_t>(b)] * kLenCodes + deep_len[static_cast<size_t>(b)];
+        } else {
+            visit_code_[static_cast<size_t>(i)] = -1 - static_cast<int>(cb_row_.size());
+            cb_row_.push_back(static_cast<int>(starts_[b]));
+            cb_size_.push_back(static_cast<int>(starts_[b + 1] - starts_[b]));
+            cb_block_.push_back(b);
+        }
+    }
+    // Rows of the row-swept blocks: the own part's entries first (column order), then the
+    // entries read across a cut; sizes first, then the rows over the threads.
+    const size_t ncb = cb_row_.size();
+    cb_crow_.assign(ncb, 0);
+    cb_twin_.assign(ncb, 0);
+    cb_inv_.assign(ncb + 1, 0);
+    for (size_t c = 0; c < ncb; ++c) {
+        cb_crow_[c] = c == 0 ? 0 : cb_crow_[c - 1] + cb_size_[c - 1];
+        cb_inv_[c + 1] = cb_inv_[c] + static_cast<Index>(cb_size_[c]) * cb_size_[c];
+    }
+    const size_t n_crows = ncb == 0 ? 0 : static_cast<size_t>(cb_crow_.back() + cb_size_.back());
+    crow_ptr_.assign(n_crows + 1, 0);
+    for (size_t c = 0; c < ncb; ++c)
+        for (int k = 0; k < cb_size_[c]; ++k) {
+            const int row = cb_row_[c] + k;
+            crow_ptr_[static_cast<size_t>(cb_crow_[c] + k) + 1] = ao[row + 1] - ao[row];
+        }
+    for (size_t r = 0; r < n_crows; ++r)
+        crow_ptr_[r + 1] += crow_ptr_[r];
+    ccol_.resize(static_cast<size_t>(crow_ptr_.back()));
+    csrc_.resize(ccol_.size());
+    crow_own_end_.assign(n_crows, 0);
+    parallel::for_rows(ncb, 4096, [&](size_t c0, size_t c1) {
+        for (size_t c = c0; c < c1; ++c) {
+            const int part = part_of_block[static_cast<size_t>(cb_block_[c])];
+            for (int k = 0; k < cb_size_[c]; ++k) {
+                const int row = cb_row_[c] + k;
+                const size_t cr = static_cast<size_t>(cb_crow_[c] + k);
+                int e = crow_ptr_[cr];
+                for (int pass = 0; pass < 2; ++pass) {
+                    for (int q = ao[row]; q < ao[row + 1]; ++q) {
+                        const bool own = part_of_block[static_cast<size_t>(
+                                             block_of_row[static_cast<size_t>(ai[q])])] == part;
+                        if (own != (pass == 0)) continue;
+                        ccol_[static_cast<size_t>(e)] = ai[q];
+                        csrc_[static_cast<size_t>(e)] = q;
+                        ++e;
+                    }
+                    if (pass == 0) crow_own_end_[cr] = e;
+                }
+            }
+            if (cb_size_[c] == 2) { // two rows with the same columns: swept together
+                const int r0 = cb_crow_[c];
+                const int a = crow_ptr_[static_cast<size_t>(r0)];
+                const int m = crow_ptr_[static_cast<size_t>(r0) + 1];
+                const int e = crow_ptr_[static_cast<size_t>(r0) + 2];
+                cb_twin_[c] = m - a == e - m &&
+                              crow_own_end_[static_cast<size_t>(r0)] - a ==
+                                  crow_own_end_[static_cast<size_t>(r0) + 1] - m &&
+                              std::equal(ccol_.begin() + a, ccol_.begin() + m, ccol_.begin() + m);
+            }
+        }
+    });
+    std::vector<char> across(static_cast<size_t>(n_), 0);
+    for (size_t r = 0; r < n_crows; ++r)
+        for (int e = crow_own_end_[r]; e < crow_ptr_[r + 1]; ++e)
+            across[static_cast<size_t>(ccol_[static_cast<size_t>(e)])] = 1;
+    interface_.clear();
+    for (Index col = 0; col < n_; ++col)
+        if (across[static_cast<size_t>(col)]) interface_.push_back(static_cast<int>(col));
+    cval_.resize(ccol_.size());
+    cinv_.resize(static_cast<size_t>(cb_inv_.back()));
+    parallel::set_zero(snap_, n_);
+    outer_.assign(ao, ao + n_ + 1);
+    nnz_ = A.nonZeros();
+}
+
+// A's pattern is the last setup's: the same row pointers, every row-swept entry's column at its
+// position, and every deep row's columns at its lattice neighbours' rows (every row is one or
+// the other, so no copy of the column indices is kept).
+bool LatticeGS::same_pattern(const SparseMatrix& A) const {
+    if (!A.isCompressed() || A.nonZeros() != nnz_) return false;
+    const int* ao = A.outerIndexPtr();
+    const int* ai = A.innerIndexPtr();
+    if (!std::equal(outer_.begin(), outer_.end(), ao)) return false;
+    const size_t ne = ccol_.size();
+    const size_t bad = parallel::first_flagged(ne, 1 << 16, [&](size_t e0, size_t e1) {
+        for (size_t e = e0; e < e1; ++e)
+            if (ai[csrc_[e]] != ccol_[e]) return e;
+        return e1;
+    });
+    if (bad != ne) return false;
+    const size_t nd = deep_row_.size();
+    const size_t bad_deep = parallel::first_flagged(nd, 4096, [&](size_t d0, size_t d1) {
+        for (size_t d = d0; d < d1; ++d) {
+            const int r = deep_row_[d];
+            const long len = deep_len_[d];
+            const long off[kSlots] = {0, 2, -2, 2 * len, -2 * (len + 1), -2 * len, 2 * len - 2};
+            for (int q = 0; q < kSlots; ++q) {
+                const long c = r + off[deep_slots_[d * kSlots + static_cast<size_t>(q)]];
+                if (ai[ao[r] + 2 * q] != c || ai[ao[r] + 2 * q + 1] != c + 1 ||
+                    ai[ao[r + 1] + 2 * q] != c || ai[ao[r + 1] + 2 * q + 1] != c + 1)
+                    return d;
+            }
+        }
+        return d1;
+    });
+    return bad_deep == nd;
+}
+
+void LatticeGS::load_rows(const SparseMatrix& A) {
+    A_ = &A;
+    const double* av = A.valuePtr();
+    const size_t ne = ccol_.size();
+    parallel::for_rows(ne, 1 << 16, [&](size_t e0, size_t e1) {
+        for (size_t e = e0; e < e1; ++e)
+            cval_[e] = av[csrc_[e]];
+    });
+    const double omega = params_.omega, tol = params_.singular_tol;
+    parallel::for_rows(cb_row_.size(), 4096, [&](size_t c0, size_t c1) {
+        Eigen::MatrixXd D;
+        for (size_t c = c0; c < c1; ++c) {
+            const int s0 = cb_row_[c];
+            const int s = cb_size_[c];
+            D.setZero(s, s);
+            for (int k = 0; k < s; ++k) {
+                const size_t cr = static_cast<size_t>(cb_crow_[c] + k);
+                for (int e = crow_ptr_[cr]; e < crow_own_end_[cr]; ++e) {
+                    const int col = ccol_[static_cast<size_t>(e)];
+                    if (col >= s0 && col < s0 + s) D(k, col - s0) = cval_[static_cast<size_t>(e)];
+                }
+            }
+            invert_block_unrolled(D, cb_block_[c], s0, omega, tol,
+                                  BlockInverseMap(cinv_.data() + cb_inv_[c], s, s));
+        }
+    });
+}
+
+bool LatticeGS::deep_rows_match(const SparseMatrix& A) const {
+    const int* ao = A.outerIndexPtr();
+    const double* av = A.valuePtr();
+    const size_t nd = deep_row_.size();
+    std::vector<double> tol(stencils_.size() / kStencil);
+    for (size_t m = 0; m < tol.size(); ++m) {
+        double mx = 0.0;
+        for (int e = 0; e < 28; ++e)
+            mx = std::max(mx, std::abs(stencils_[m * kStencil + static_cast<size_t>(e)]));
+        tol[m] = params_.stencil_tol * mx;
+    }
+    const size_t bad = parallel::first_flagged(nd, 4096, [&](size_t d0, size_t d1) {
+        for (size_t d = d0; d < d1; ++d) {
+            const int r = deep_row_[d];
+            const size_t m = static_cast<size_t>(deep_macro_[d]);
+            const double* S = stencils_.data() + m * kStencil;
+            const double t = tol[m];
+            const double* v0 = av + ao[r];
+            const double* v1 = av + ao[r + 1];
+            for (int q = 0; q < kSlots; ++q) {
+                const double* B = S + 4 * deep_slots_[d * kSlots + static_cast<size_t>(q)];
+                if (!(std::abs(v0[2 * q] - B[0]) <= t && std::abs(v0[2 * q + 1] - B[1]) <= t &&
+                      std::abs(v1[2 * q] - B[2]) <= t && std::abs(v1[2 * q + 1] - B[3]) <= t))
+                    return d;
+            }
+        }
+        return d1;
+    });
+    return bad == nd;
+}
+
+template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, double* x) const {
+    const double* snap = snap_.data();
+    const double* val = cval_.data();
+    const int* col = ccol_.data();
+    auto block = [&](int c) {
+        const int s0 = cb_row_[static_cast<size_t>(c)];
+        const int cr = cb_crow_[static_cast<size_t>(c)];
+        const double* D = cinv_.data() + cb_inv_[static_cast<size_t>(c)];
+        if (cb_twin_[static_cast<size_t>(c)]) {
+            const int e0 = crow_ptr_[static_cast<size_t>(cr)];
+            const int len = crow_ptr_[static_cast<size_t>(cr) + 1] - e0;
+            const int oe = crow_own_end_[static_cast<size_t>(cr)];
+            double a0, a1;
+            twin_row_dot(col, val, len, x, e0, oe, a0, a1);
+            for (int e = oe; e < e0 + len; ++e) {
+                a0 += val[e] * snap[col[e]];
+                a1 += val[e + len] * snap[col[e]];
+            }
+            const double r0 = b[s0] - a0, r1 = b[s0 + 1] - a1;
+            x[s0] += D[0] * r0 + D[1] * r1;
+            x[s0 + 1] += D[2] * r0 + D[3] * r1;
+            return;
+        }
+        const int s = cb_size_[static_cast<size_t>(c)];
+        double res[4];
+        for (int k = 0; k < s; ++k) {
+            const size_t r = static_cast<size_t>(cr + k);
+            const int e0 = crow_ptr_[r], e1 = crow_ptr_[r + 1], oe = crow_own_end_[r];
+            double a = row_dot(col, val, x, e0, oe);
+            for (int e = oe; e < e1; ++e)
+                a += val[e] * snap[col[e]];
+            res[k] = b[s0 + k] - a;
+        }
+        for (int k = 0; k < s; ++k) {
+            double d = 0.0;
+            for (int l = 0; l < s; ++l)
+                d += D[k * s + l] * res[l];
+            x[s0 + k] += d;
+        }
+    };
+    auto visit = [&](int i) {
+        const int code = visit_code_[static_cast<size_t>(i)];
+        if (code < 0) {
+            block(-1 - code);
+            return;
+        }
+        const int r = visit_row_[static_cast<size_t>(i)];
+        deep_update(stencils_.data() + static_cast<size_t>(code / kLenCodes) * kStencil, b + r,
+                    x + r, code % kLenCodes);
+    };
+    const int i0 = part_visit_[static_cast<size_t>(p)],
+              i1 = part_visit_[static_cast<size_t>(p) + 1];
+    if constexpr (Forward) {
+        for (int i = i0; i < i1; ++i)
+            visit(i);
+    } else {
+        for (int i = i1; i-- > i0;)
+            visit(i);
+    }
+}
+
+void LatticeGS::half_sweep(const double* b, double* x, bool forward) const {
+    // Compulsory bytes: the row-swept blocks' values, columns, positions and inverses, the visit
+    // entries, b read and x read and written.
+    const double bytes =
+        12.0 * static_cast<double>(ccol_.size()) + 8.0 * static_cast<double>(cinv_.size()) +
+        8.0 * static_cast<double>(visit_row_.size()) + 24.0 * static_cast<double>(n_);
+    const traffic::Pass pass(traffic::Kind::smoother, bytes);
+    for (int c : interface_)
+        snap_[c] = x[c];
+    parallel::for_chunks(static_cast<size_t>(parts()), [&](size_t p) {
+        if (forward)
+            sweep_part<true>(static_cast<int>(p), b, x);
+        else
+            sweep_part<false>(static_cast<int>(p), b, x);
+    });
+}
+
+void LatticeGS::smooth(const Vector& b, Vector& x, Sweep direction, int count) const {
+    MLC_CHECK(A_ != nullptr, "lattice smoother: call setup first");
+    check_size(b, n_, "LatticeGS::smooth", "b");
+    check_size(x, n_, "LatticeGS::smooth", "x");
+    MLC_CHECK(direction != Sweep::symmetric, "lattice smoother: sweeps are forward or backward");
+    for (int s = 0; s < count; ++s)
+        half_sweep(b.data(), x.data(), direction == Sweep::forward);
+}
+
+void LatticeGS::forward_from_zero(const Vector& b, Vector& x, Vector& res) const {
+    parallel::set_zero(x, n_);
+    smooth(b, x, Sweep::forward, 1);
+    csr_residual(csr_arrays(*A_, A_->valuePtr()), b, x, res, traffic::Kind::smoother);
+}
+
+std::vector<Index> LatticeGS::sweep_order_blocks(int part) const {
+    std::vector<Index> out;
+    for (int i = part_visit_[static_cast<size_t>(part)];
+         i < part_visit_[static_cast<size_t>(part) + 1]; ++i)
+        out.push_back(visit_row_[static_cast<size_t>(i)]);
+    return out;
+}
+
+} // namespace mlc::smoothers

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: MIT
+/// @file Vertex-block Gauss–Seidel with structured kernels on the macro triangles' interiors
+/// (mg:smoother=lattice): the multigrid smoother of a uniformly refined level.
+///
+/// On a level refined `depth` times from level 0, the vertices inside each level-0 ("macro")
+/// triangle form a triangular lattice (mesh/lattice.hpp) on which every element has the same
+/// stiffness, so each vertex whose six neighbours are inside the macro has the same 2x2-block
+/// stencil. The assembled sweep (BlockSOR) reads 14 column indices and 28 values per such vertex
+/// and gathers x through them. When the level's unknowns are numbered macro by macro, each
+/// interior row by row (levels::Problem::Numbering::lattice), a vertex's neighbours sit at fixed
+/// offsets from it, and the stencil and its inverted centre block are read once per macro:
+///  - "deep" points: interior lattice points whose six neighbours are interior too, in the same
+///    threaded part, and whose rows hold exactly the macro's stencil (to stencil_tol of its
+///    largest entry), by the stencil;
+///  - every other block (the points next to a macro edge, the macro edges and corners, contact
+///    vertices with their multipliers, fixed components, macros not numbered as a lattice) by
+///    its own rows, as BlockSOR does.
+/// The blocks are visited in a given order (LatticeRows::visit: the Hilbert order of the
+/// vertices, the order BlockSOR visits them in with the default numbering) and cut into threaded
+/// parts as BlockSOR cuts them (runs of that order of about equal nonzeros, Jacobi across the
+/// cuts), so the sweep is BlockSOR's map of the same matrix in the same order, its deep rows
+/// summed differently (round-off).
+///
+/// `update_values` re-reads the rows that are not deep, re-inverts their blocks and checks the
+/// deep rows against their stencils (a full setup when one no longer matches). Every half-sweep
+/// counts one smoother pass (core/traffic).
+#pragma once
+
+#include "core/csr.hpp"
+#include "core/first_touch.hpp"
+#include "smoothers/block_sor.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mlc::smoothers {
+
+/// The rows of the interior lattice points of every macro triangle, and the visiting order.
+struct LatticeRows {
+    /// Subdivisions per macro edge (2^depth); below 6 there are no deep points.
+    int n = 0;
+    /// first_row[m * (n-1)(n-2)/2 + p]: the first of the two rows of the vertex at interior point
+    /// p of macro m (mesh::MacroLattice's numbering), or -1 when that vertex is not a plain 2x2
+    /// vertex block (a fixed component, contact multipliers). A macro whose points are not
+    /// rows first_row[m * np] + 2p (a lattice numbering) is swept by rows.
+    std::vector<Index> first_row;
+    /// The first row of every block in the order the sweep visits them (a permutation of the
+    /// blocks); empty: row order.
+    std::vector<Index> visit;
+};
+
+/// Parameters of `LatticeGS`.
+struct LatticeGSParams {
+    double omega = 1.0; ///< relaxation, in (0, 2), folded into the block inverses
+    /// Threaded parts, >= 0 (0: kHybridParts), at most one per kMinRowsPerThread rows, as
+    /// BlockSORParams::parts.
+    int parts = 0;
+    double singular_tol = 1e-14; ///< pivot threshold of the block inversions (BlockSORParams)
+    /// A deep row matches its macro's stencil when every entry is within stencil_tol times the
+    /// stencil's largest entry (rounding of the element stiffness of congruent triangles).
+    double stencil_tol = 1e-12;
+};
+
+class LatticeGS {
+public:
+    /// block_starts: the vertex blocks (first row of each, as BlockSORParams::block_starts).
+    LatticeGS(std::vector<Index> block_starts, LatticeRows lattice, LatticeGSParams params = {});
+
+    /// Parts, stencils, deep points, rows and block inverses from A (square, compressed CSR).
+    void setup(const SparseMatrix& A);
+    /// New values of A with the same pattern (a different pattern or size: setup).
+    void update_values(const SparseMatrix& A);
+    /// `count` sweeps on A x = b in the given direction (forward or backward), x updated.
+    void smooth(const Vector& b, Vector& x, Sweep direction, int count) const;
+    /// x = one forward sweep from zero, res = b - A x.
+    void forward_from_zero(const Vector& b, Vector& x, Vector& res) const;
+
+    /// Interior lattice points swept by their macro's stencil after the last setup.
+    Index deep_points() const { return n_deep_; }
+    /// Rows of the matrix.
+    Index rows() const { return n_; }
+    /// Parts of the last setup.
+    int parts() const { return static_cast<int>(part_visit_.size()) - 1; }
+    /// The first rows of the blocks of a part in forward sweep order.
+    std::vector<Index> sweep_order_blocks(int part) const;
+    /// "lattice-gs(omega=W,parts=P)".
+    std::string name() const;
+
+private:
+    void derive(const SparseMatrix& A);
+    void load_rows(const SparseMatrix& A); // values of the row-swept blocks and their inverses
+    bool deep_rows_match(const SparseMatrix& A) const;
+    bool same_pattern(const SparseMatrix& A) const;
+    template <bool Forward> void sweep_part(int p, const double* b, double* x) const;
+    void half_sweep(const double* b, double* x, bool forward) const;
+
+    std::vector<Index> block_starts_in_;
+    LatticeRows lattice_;
+    LatticeGSParams params_;
+    Index n_ = 0;
+    const SparseMatrix* A_ = nullptr;
+    std::vector<int> outer_; // A's row pointers at the last setup
+    Index nnz_ = 0;
+    std::vector<Index> starts_;    // block starts, then n
+    std::vector<double> stencils_; // per macro: 7 slots x 2x2 (row-major), then omega D^-1
+    // The visit: per part a run of entries; entry i is a deep point (code >= 0: macro * 4096 +
+    // its row's length, the neighbour offsets) at first row visit_row_[i], or a row-swept block
+    // (code = -1 - its index into cb_*).
+    std::vector<int> part_visit_;
+    std::vector<int> visit_row_, visit_code_;
+    Index n_deep_ = 0;
+    // Deep points: first row, macro, and their neighbours' slots in A's column order, to check
+    // them at update_values.
+    std::vector<int> deep_row_, deep_len_, deep_macro_;
+    std::vector<std::uint8_t> deep_slots_; // 7 per deep point
+    // Row-swept blocks: first row, size, block index, their rows (entries of the own part
+    // first, then those read across a cut), twin flag and inverse.
+    std::vector<int> cb_row_, cb_size_, cb_block_, cb_crow_;
+    std::vector<char> cb_twin_;
+    std::vector<Index> cb_inv_;
+    std::vector<int> crow_ptr_, crow_own_end_;
+    std::vector<int> ccol_, csrc_;
+    parallel::UninitializedVector<double> cval_, cinv_;
+    std::vector<int> interface_; // columns read across the cuts
+    mutable Vector snap_;
+};
+
+} // namespace mlc::smoothers

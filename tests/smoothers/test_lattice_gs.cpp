@@ -1,0 +1,249 @@
+// SPDX-License-Identifier: MIT
+#include "smoothers/lattice_gs.hpp"
+
+#include "fem/assembly.hpp"
+#include "fem/dof_map.hpp"
+#include "mesh/lattice.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <random>
+
+using namespace mlc;
+using namespace mlc::smoothers;
+
+namespace {
+
+// One level: the elastic stiffness of a 2 x 1 rectangle (four macro triangles) refined `depth`
+// times, the bottom edge fixed in y (vertex blocks of one row there), numbered along the Hilbert
+// curve (`lattice` false) or macro by macro (mesh::lattice_vertex_order).
+struct Case {
+    SparseMatrix A;
+    std::vector<Index> starts;
+    LatticeRows lattice;
+    std::vector<int> row_of_hilbert_row; // the lattice-numbered row of each Hilbert-numbered row
+};
+
+Case elastic_case(int depth, bool lattice) {
+    mesh::Mesh m =
+        mesh::structured_rectangle({0.0, 0.0}, {2.0, 1.0}, 2, 1, mesh::Diagonal::alternate);
+    for (int k = 0; k < depth; ++k)
+        m = mesh::refine(m);
+    const size_t nv = static_cast<size_t>(m.n_vertices());
+    std::vector<std::array<bool, 2>> fixed(nv, {false, false});
+    for (size_t v = 0; v < nv; ++v)
+        if (m.vertices[v].y() == 0.0) fixed[v] = {false, true};
+    const auto L = mesh::macro_lattice(m, depth);
+    const std::vector<int> hilbert = mesh::hilbert_order(m.vertices);
+    const fem::DofMap hdofs(fixed, std::vector<int>(nv, 0), hilbert);
+    const fem::DofMap dofs(fixed, std::vector<int>(nv, 0),
+                           lattice ? mesh::lattice_vertex_order(m, *L) : hilbert);
+    const Vector zero = Vector::Zero(2 * m.n_vertices());
+    Case c;
+    c.A = fem::assemble_elastic(m, {fem::Material{}}, dofs, zero, zero).K;
+    for (Index i = 0; i < dofs.n_dofs(); ++i)
+        if (i == 0 || dofs.vertex_of(i) != dofs.vertex_of(i - 1)) c.starts.push_back(i);
+    c.lattice.n = L->n;
+    for (int v : L->vertex) {
+        const int d0 = dofs.u_dof(v, 0), d1 = dofs.u_dof(v, 1);
+        c.lattice.first_row.push_back(d0 >= 0 && d1 == d0 + 1 ? d0 : -1);
+    }
+    for (int v : hilbert) {
+        const int d0 = dofs.u_dof(v, 0), d1 = dofs.u_dof(v, 1);
+        c.lattice.visit.push_back(d0 >= 0 ? d0 : d1);
+    }
+    c.row_of_hilbert_row.resize(static_cast<size_t>(dofs.n_dofs()));
+    for (size_t v = 0; v < nv; ++v)
+        for (int k = 0; k < 2; ++k)
+            if (hdofs.u_dof(static_cast<int>(v), k) >= 0)
+                c.row_of_hilbert_row[static_cast<size_t>(hdofs.u_dof(static_cast<int>(v), k))] =
+                    dofs.u_dof(static_cast<int>(v), k);
+    return c;
+}
+
+// The reference: block Gauss–Seidel in the smoother's order, part by part, each part reading
+// the other parts' unknowns as they were before the sweep, on A's own rows (no stencil).
+Vector reference_sweep(const LatticeGS& S, const SparseMatrix& A, const std::vector<Index>& starts,
+                       const Vector& b, const Vector& x0, bool forward, double omega) {
+    const Index n = A.rows();
+    std::vector<Index> size_of(static_cast<size_t>(n), 0);
+    for (size_t k = 0; k < starts.size(); ++k)
+        size_of[static_cast<size_t>(starts[k])] =
+            (k + 1 < starts.size() ? starts[k + 1] : n) - starts[k];
+    std::vector<int> part_of(static_cast<size_t>(n), -1);
+    std::vector<std::vector<Index>> orders;
+    for (int p = 0; p < S.parts(); ++p) {
+        orders.push_back(S.sweep_order_blocks(p));
+        for (Index r : orders.back())
+            for (Index k = 0; k < size_of[static_cast<size_t>(r)]; ++k)
+                part_of[static_cast<size_t>(r + k)] = p;
+    }
+    Vector x = x0;
+    for (int p = 0; p < S.parts(); ++p) {
+        std::vector<Index> order = orders[static_cast<size_t>(p)];
+        if (!forward) std::reverse(order.begin(), order.end());
+        for (Index r : order) {
+            const Index s = size_of[static_cast<size_t>(r)];
+            Eigen::VectorXd res(s);
+            Eigen::MatrixXd D = Eigen::MatrixXd::Zero(s, s);
+            for (Index k = 0; k < s; ++k) {
+                double a = b[r + k];
+                for (SparseMatrix::InnerIterator it(A, r + k); it; ++it) {
+                    const bool own = part_of[static_cast<size_t>(it.col())] == p;
+                    a -= it.value() * (own ? x[it.col()] : x0[it.col()]);
+                    if (it.col() >= r && it.col() < r + s) D(k, it.col() - r) = it.value();
+                }
+                res[k] = a;
+            }
+            const Eigen::VectorXd d = omega * D.fullPivLu().solve(res);
+            for (Index k = 0; k < s; ++k)
+                x[r + k] += d[k];
+        }
+    }
+    return x;
+}
+
+Vector random_vector(Index n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Vector v(n);
+    for (Index i = 0; i < n; ++i)
+        v[i] = u(rng);
+    return v;
+}
+
+} // namespace
+
+// The lattice sweep is block Gauss–Seidel of A in its visit order (Jacobi across the parts), to
+// round-off: forward and backward, omega 1 and 1.3, one part (level 4) and two (level 6).
+TEST(LatticeGS, SweepIsBlockGaussSeidelInItsVisitOrder) {
+    for (int depth : {4, 6}) {
+        const Case c = elastic_case(depth, true);
+        const Index n = c.A.rows();
+        const Vector b = random_vector(n, 1), x0 = random_vector(n, 2);
+        for (double omega : {1.0, 1.3})
+            for (bool forward : {true, false}) {
+                LatticeGS S(c.starts, c.lattice, {.omega = omega});
+                S.setup(c.A);
+                EXPECT_EQ(S.parts(), depth == 4 ? 1 : 2);
+                if (depth == 4) {
+                    // (16-1)(16-2)/2 = 105 interior points per macro, of which i, j >= 2,
+                    // i + j <= 14: 66 deep; four macros.
+                    EXPECT_EQ(S.deep_points(), 4 * 66);
+                } else {
+                    EXPECT_GT(S.deep_points(), 4 * 1500); // of 4 * 1830 (i, j >= 2, i + j <= 62)
+                    EXPECT_LT(S.deep_points(), 4 * 1830); // the parts' cut takes some
+                }
+                Vector x = x0;
+                S.smooth(b, x, forward ? Sweep::forward : Sweep::backward, 1);
+                const Vector ref = reference_sweep(S, c.A, c.starts, b, x0, forward, omega);
+                EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm())
+                    << depth << " " << omega << " " << forward;
+            }
+    }
+}
+
+// With the Hilbert visit order the lattice-numbered sweep is BlockSOR's sweep of the
+// Hilbert-numbered matrix (the multigrid smoother: unrolled kernel, hybrid parts), to round-off.
+TEST(LatticeGS, IsTheBlockSmootherOfTheDefaultNumbering) {
+    const Case lat = elastic_case(6, true), hil = elastic_case(6, false);
+    const Index n = lat.A.rows();
+    const Vector bh = random_vector(n, 7), xh = random_vector(n, 8);
+    Vector bl(n), xl(n);
+    for (Index i = 0; i < n; ++i) {
+        bl[lat.row_of_hilbert_row[static_cast<size_t>(i)]] = bh[i];
+        xl[lat.row_of_hilbert_row[static_cast<size_t>(i)]] = xh[i];
+    }
+    BlockSOR B({.omega = 1.0,
+                .block_size = 2,
+                .block_starts = hil.starts,
+                .parts = 0,
+                .kernel = Kernel::unrolled});
+    B.setup(hil.A);
+    LatticeGS S(lat.starts, lat.lattice, {});
+    S.setup(lat.A);
+    EXPECT_EQ(S.parts(), B.parts());
+    Vector xb = xh;
+    for (int sweep = 0; sweep < 2; ++sweep) {
+        B.sweep(bh, xb, Sweep::backward);
+        S.smooth(bl, xl, Sweep::backward, 1);
+        double diff = 0.0;
+        for (Index i = 0; i < n; ++i)
+            diff = std::max(diff,
+                            std::abs(xl[lat.row_of_hilbert_row[static_cast<size_t>(i)]] - xb[i]));
+        EXPECT_LT(diff, 1e-12 * xb.cwiseAbs().maxCoeff()) << sweep;
+    }
+}
+
+// A deep row that differs from its macro's stencil is swept by its own rows: still Gauss–Seidel
+// of A; and update_values sees a changed deep row.
+TEST(LatticeGS, ARowOffItsStencilIsSweptByItsRows) {
+    Case c = elastic_case(4, true);
+    const Index n = c.A.rows();
+    const Vector b = random_vector(n, 3), x0 = random_vector(n, 4);
+    LatticeGS S(c.starts, c.lattice, {});
+    S.setup(c.A);
+    const Index deep = S.deep_points();
+    // A point of macro 1 with i, j >= 2 (point 40 of 105: row 4, deep).
+    const Index r = c.lattice.first_row[static_cast<size_t>(105 + 40)];
+    c.A.coeffRef(r, r) *= 1.5;
+    S.update_values(c.A);
+    EXPECT_EQ(S.deep_points(), deep - 1);
+    Vector x = x0;
+    S.smooth(b, x, Sweep::backward, 1);
+    const Vector ref = reference_sweep(S, c.A, c.starts, b, x0, false, 1.0);
+    EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm());
+}
+
+// Two sweeps in one call are two calls; forward_from_zero returns the residual.
+TEST(LatticeGS, RepeatedSweepsAndTheSweepFromZero) {
+    const Case c = elastic_case(4, true);
+    const Index n = c.A.rows();
+    const Vector b = random_vector(n, 5), x0 = random_vector(n, 6);
+    LatticeGS S(c.starts, c.lattice, {});
+    S.setup(c.A);
+    Vector x1 = x0, x2 = x0;
+    S.smooth(b, x1, Sweep::backward, 2);
+    S.smooth(b, x2, Sweep::backward, 1);
+    S.smooth(b, x2, Sweep::backward, 1);
+    EXPECT_EQ(x1, x2);
+    Vector z, res;
+    S.forward_from_zero(b, z, res);
+    Vector z2 = Vector::Zero(n);
+    S.smooth(b, z2, Sweep::forward, 1);
+    EXPECT_EQ(z, z2);
+    EXPECT_LT((res - (b - c.A * z)).norm(), 1e-13 * b.norm());
+}
+
+// A new entry in a deep row or in a row-swept row is a new pattern: update_values sets up again
+// (the deep point becomes row-swept) and the sweep stays Gauss–Seidel of the new matrix.
+TEST(LatticeGS, ANewPatternIsSetUpAgain) {
+    for (bool in_deep_row : {true, false}) {
+        Case c = elastic_case(4, true);
+        const Index n = c.A.rows();
+        LatticeGS S(c.starts, c.lattice, {});
+        S.setup(c.A);
+        const Index deep = S.deep_points();
+        // Row of a deep point of macro 2 (point 40), or of a point next to its edge (point 0),
+        // coupled to a far row (the last one): an entry that was not there.
+        const Index r = c.lattice.first_row[static_cast<size_t>(2 * 105 + (in_deep_row ? 40 : 0))];
+        std::vector<Triplet> t;
+        for (Index i = 0; i < n; ++i)
+            for (SparseMatrix::InnerIterator it(c.A, i); it; ++it)
+                t.emplace_back(i, it.col(), it.value());
+        t.emplace_back(r, n - 1, 1e-3);
+        t.emplace_back(n - 1, r, 1e-3);
+        SparseMatrix B(n, n);
+        B.setFromTriplets(t.begin(), t.end());
+        B.makeCompressed();
+        S.update_values(B);
+        EXPECT_EQ(S.deep_points(), in_deep_row ? deep - 1 : deep);
+        const Vector b = random_vector(n, 9), x0 = random_vector(n, 10);
+        Vector x = x0;
+        S.smooth(b, x, Sweep::forward, 1);
+        const Vector ref = reference_sweep(S, B, c.starts, b, x0, true, 1.0);
+        EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm()) << in_deep_row;
+    }
+}
