@@ -4,6 +4,7 @@
 #include "fem/assembly.hpp"
 #include "fem/dof_map.hpp"
 #include "mesh/lattice.hpp"
+#include "tests/common/random.hpp"
 
 #include <gtest/gtest.h>
 
@@ -105,14 +106,7 @@ Vector reference_sweep(const LatticeGS& S, const SparseMatrix& A, const std::vec
     return x;
 }
 
-Vector random_vector(Index n, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    Vector v(n);
-    for (Index i = 0; i < n; ++i)
-        v[i] = u(rng);
-    return v;
-}
+using mlc::testutil::random_vector;
 
 } // namespace
 

@@ -7,6 +7,7 @@
 #include "levels/level.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
+#include "tests/common/random.hpp"
 #include "transfer/transfer.hpp"
 
 #include <gtest/gtest.h>
@@ -98,12 +99,7 @@ Vector pressure_field(const levels::Level& L, const std::string& tag, double p, 
 
 /// Random coarse field on every unknown.
 Vector random_field(Index n, unsigned seed) {
-    std::mt19937 gen(seed);
-    std::uniform_real_distribution<double> U(-1.0, 1.0);
-    Vector x(n);
-    for (Index i = 0; i < n; ++i)
-        x[i] = U(gen);
-    return x;
+    return mlc::testutil::random_vector(n, seed);
 }
 
 } // namespace
