@@ -326,6 +326,44 @@ smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& la
         const int d0 = L.dofs.u_dof(v, 0), d1 = L.dofs.u_dof(v, 1);
         rows.first_row[k] = d0 >= 0 && d1 == d0 + 1 && L.dofs.extra_dof(v) < 0 ? d0 : -1;
     }
+    // The visit: the blocks in the numbering's order, each macro's interior in serpentine rows
+    // (row j = 1, 3, ... left to right, j = 2, 4, ... right to left): as cheap to sweep as the
+    // numbering's row-by-row order (the rows still stream) and a better Gauss-Seidel order on
+    // the square (level 6: 5.3 BiCGStab iterations per Newton step against 6.0; README,
+    // "Structured sweeps on the macro triangles").
+    const int N = rows.n;
+    const long np = mesh::MacroLattice::interior_points(N);
+    const long n_macros = np > 0 ? static_cast<long>(rows.first_row.size()) / np : 0;
+    std::vector<int> macro_at(static_cast<size_t>(L.n_unknowns()), -1);
+    std::vector<char> interior(static_cast<size_t>(L.n_unknowns()), 0);
+    for (long m = 0; m < n_macros; ++m) { // the macro is visited at its smallest row
+        Index first = -1;
+        for (long q = 0; q < np; ++q) {
+            const Index r = rows.first_row[static_cast<size_t>(m * np + q)];
+            if (r < 0) continue;
+            interior[static_cast<size_t>(r)] = 1;
+            if (first < 0 || r < first) first = r;
+        }
+        if (first >= 0) macro_at[static_cast<size_t>(first)] = static_cast<int>(m);
+    }
+    rows.visit.reserve(static_cast<size_t>(L.n_unknowns()) / 2 + 1);
+    for (Index d = 0; d < L.n_unknowns(); ++d) {
+        if (d > 0 && L.dofs.vertex_of(d) == L.dofs.vertex_of(d - 1)) continue; // not a block start
+        const int m = macro_at[static_cast<size_t>(d)];
+        if (m >= 0) {
+            for (int j = 1; j <= N - 2; ++j) {
+                const int len = N - 1 - j;
+                for (int t = 0; t < len; ++t) {
+                    const int i = j % 2 == 1 ? 1 + t : len - t;
+                    const Index r = rows.first_row[static_cast<size_t>(
+                        m * np + mesh::MacroLattice::point_index(N, i, j))];
+                    if (r >= 0) rows.visit.push_back(r);
+                }
+            }
+        } else if (!interior[static_cast<size_t>(d)]) {
+            rows.visit.push_back(d);
+        }
+    }
     return rows;
 }
 

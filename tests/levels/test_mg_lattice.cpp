@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // `mg:smoother=lattice` with `--numbering lattice`: on levels 4 and finer the smoother sweeps the
-// macro triangles' interiors by their stencils. With the lattice numbering the block smoother
-// visits the blocks in the same order and cuts the same parts, so both are the same linear map
-// up to round-off: the same Newton history, the same Krylov iteration counts (within one) and
-// the same solution to 1e-8 relative, on the dyadic square (stencils equal bit for bit) and on
-// hertz (curved, stencils equal to round-off).
+// macro triangles' interiors by their stencils, visiting each macro's rows in serpentine order.
+// Against the block smoother on the same numbering (the same blocks, visited row by row): the
+// same Newton history, Krylov iterations within one on every Newton system and the same
+// solution to 1e-8 relative, on the dyadic square (stencils equal bit for bit) and on hertz
+// (curved, stencils equal to round-off). (tests/smoothers/test_lattice_gs.cpp checks the sweep
+// itself: against a dense reference, and against BlockSOR in BlockSOR's order.)
 #include "core/check.hpp"
 #include "levels/resources.hpp"
 #include "levels/solve.hpp"
@@ -38,7 +39,7 @@ void expect_like_block(const std::string& scene, int levels, int load_steps) {
     ASSERT_TRUE(l.converged) << l.failure;
     EXPECT_LT((l.x - b.x).norm(), 1e-8 * b.x.norm()) << scene;
     ASSERT_EQ(l.level_steps.size(), b.level_steps.size());
-    int systems = 0, equal = 0;
+    int systems = 0;
     for (size_t lv = 0; lv < b.level_steps.size(); ++lv) {
         ASSERT_EQ(l.level_steps[lv].size(), b.level_steps[lv].size()) << lv;
         for (size_t k = 0; k < b.level_steps[lv].size(); ++k) {
@@ -48,13 +49,11 @@ void expect_like_block(const std::string& scene, int levels, int load_steps) {
             for (size_t i = 0; i < its_b.size(); ++i) {
                 EXPECT_LE(std::abs(its_l[i] - its_b[i]), 1)
                     << scene << " level " << lv << " step " << k << " Newton " << i;
-                equal += its_l[i] == its_b[i];
                 ++systems;
             }
         }
     }
     EXPECT_GT(systems, 0);
-    EXPECT_GE(equal, systems - 1) << scene;
     // The finest level's smoother is the lattice one, with deep points; the block run's is not.
     ASSERT_TRUE(l.multigrid.has_value());
     EXPECT_NE(l.multigrid->levels.back().solve.find("lattice"), std::string::npos);
