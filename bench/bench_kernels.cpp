@@ -18,8 +18,7 @@
 //   two sweeps        two backward sweeps of that smoother (what the default cycle does);
 //   two sweeps lattice, sweep lattice, lattice refresh, lattice setup: the same for
 //                     smoothers::LatticeGS (mg:smoother=lattice) on the finest level's lattice;
-//                     with --numbering lattice its structured kernels apply (without it, the
-//                     macros are not numbered as lattices and every block is swept by rows).
+//                     only with --numbering lattice (the level's Level::lattice).
 // The variants alternate in one process, so that a slow phase of the machine hits them alike:
 // compare them with each other, not with another run's. Output: one JSON object on stdout
 // (times in ms: median and minimum over --reps).
@@ -87,11 +86,10 @@ template <size_t K, class Fn> std::array<double, K> chunk_sums(Index n, Fn&& fn)
 
 class Probe final : public levels::ForwardingSystemSolver {
 public:
-    Probe(std::unique_ptr<levels::NewtonSystemSolver> inner, const levels::Level& level, int depth,
-          int reps, std::map<std::string, Stat>& out)
+    Probe(std::unique_ptr<levels::NewtonSystemSolver> inner, const levels::Level& level, int reps,
+          std::map<std::string, Stat>& out)
         : ForwardingSystemSolver(std::move(inner)), reps_(reps), out_(out),
-          lattice_(level.lattice ? std::optional<smoothers::LatticeRows>(*level.lattice)
-                                 : levels::lattice_rows(level, depth)) {
+          lattice_(level.lattice) {
         std::vector<int> owner(static_cast<size_t>(level.n_unknowns()));
         for (Index i = 0; i < level.n_unknowns(); ++i)
             owner[static_cast<size_t>(i)] = level.dofs.vertex_of(i);
@@ -211,7 +209,7 @@ private:
     int reps_;
     std::map<std::string, Stat>& out_;
     std::vector<Index> block_starts_;
-    std::optional<smoothers::LatticeRows> lattice_;
+    std::shared_ptr<const smoothers::LatticeRows> lattice_; // with --numbering lattice
     bool done_ = false;
 };
 
@@ -252,7 +250,7 @@ int main(int argc, char** argv) {
                                 std::unique_ptr<levels::NewtonSystemSolver> s)
         -> std::unique_ptr<levels::NewtonSystemSolver> {
         if (level != levels) return s;
-        return std::make_unique<Probe>(std::move(s), L, level, reps, out);
+        return std::make_unique<Probe>(std::move(s), L, reps, out);
     };
     const levels::RunResult r = levels::solve(pr, so);
     n = r.finest().n_unknowns();

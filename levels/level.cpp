@@ -310,19 +310,12 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
     return L;
 }
 
-std::optional<smoothers::LatticeRows> lattice_rows(const Level& L, int depth) {
-    const auto lat = mesh::macro_lattice(L.mesh, depth);
-    if (!lat) return std::nullopt;
-    return lattice_rows(L, *lat);
-}
-
 smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& lattice) {
-    const mesh::MacroLattice* lat = &lattice;
     smoothers::LatticeRows rows;
-    rows.n = lat->n;
-    rows.first_row.resize(lat->vertex.size());
-    for (size_t k = 0; k < lat->vertex.size(); ++k) {
-        const int v = lat->vertex[k];
+    rows.n = lattice.n;
+    rows.first_row.resize(lattice.vertex.size());
+    for (size_t k = 0; k < lattice.vertex.size(); ++k) {
+        const int v = lattice.vertex[k];
         const int d0 = L.dofs.u_dof(v, 0), d1 = L.dofs.u_dof(v, 1);
         rows.first_row[k] = d0 >= 0 && d1 == d0 + 1 && L.dofs.extra_dof(v) < 0 ? d0 : -1;
     }

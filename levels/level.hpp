@@ -103,11 +103,9 @@ struct LevelPart {
 /// vertex. Null `part`: build_level(problem, m).
 Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part);
 
-/// The rows of the macro triangles' interior points (smoothers::LatticeGS) when L's mesh is
-/// `depth` refinements of a level-0 mesh in refine's order (mesh::macro_lattice), else nullopt.
-/// A vertex whose unknowns are not its two displacements, in a row, gets -1.
-std::optional<smoothers::LatticeRows> lattice_rows(const Level& L, int depth);
-/// The same for a lattice of L's mesh already found.
+/// The rows of the macro triangles' interior points of L's mesh (smoothers::LatticeGS; a vertex
+/// whose unknowns are not its two displacements, in a row, gets -1) and the serpentine visit
+/// order; build_level fills Level::lattice with it under Problem::Numbering::lattice.
 smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& lattice);
 
 } // namespace mlc::levels

@@ -68,6 +68,12 @@ std::ostream& operator<<(std::ostream& os, const BlockSORParams& p) {
               << "}";
 }
 
+Index hybrid_part_count(int requested, Index rows, Index blocks) {
+    const Index want = requested > 0 ? requested : kHybridParts;
+    return std::clamp<Index>(std::min(want, rows / kMinRowsPerThread), 1,
+                             std::max<Index>(blocks, 1));
+}
+
 std::vector<Index> uniform_block_starts(Index n, Index block_size) {
     MLC_CHECK(n >= 0 && block_size >= 1,
               "uniform_block_starts: need n >= 0 and block_size >= 1, found n = "
@@ -153,9 +159,7 @@ void BlockSOR::derive_structure() {
     const SparseMatrix& A = *A_;
     const Index n = A.rows();
     const Index nb = n_blocks();
-    const Index want = params_.parts > 0 ? params_.parts : kHybridParts;
-    const Index P =
-        std::clamp<Index>(std::min(want, n / kMinRowsPerThread), 1, std::max<Index>(nb, 1));
+    const Index P = hybrid_part_count(params_.parts, n, nb);
     part_block_.assign(1, 0);
     const int* outer = A.outerIndexPtr();
     const int* inner = A.innerIndexPtr();

@@ -115,6 +115,10 @@ void invert_block_unrolled(const Eigen::MatrixXd& D, Index b, Index s0, double o
 /// Prints every field of `p` on one line (block_starts as a count and the largest block).
 std::ostream& operator<<(std::ostream& os, const BlockSORParams& p);
 
+/// Parts of a hybrid sweep: `requested` (0: kHybridParts), at most one per kMinRowsPerThread
+/// rows and one per block, at least one (BlockSOR's and LatticeGS's cut).
+Index hybrid_part_count(int requested, Index rows, Index blocks);
+
 /// Block starts 0, b, 2b, ... for n rows in blocks of size b (the last block may be shorter).
 std::vector<Index> uniform_block_starts(Index n, Index block_size);
 

@@ -94,7 +94,8 @@ void LatticeGS::derive(const SparseMatrix& A) {
     const int* ai = A.innerIndexPtr();
     const double* av = A.valuePtr();
     // Blocks.
-    starts_ = block_starts_in_.empty() ? uniform_block_starts(n_, 2) : block_starts_in_;
+    std::vector<Index> starts_ =
+        block_starts_in_.empty() ? uniform_block_starts(n_, 2) : block_starts_in_;
     if (starts_.back() != n_) starts_.push_back(n_);
     MLC_CHECK(starts_.front() == 0, "lattice smoother: the blocks must start at row 0");
     const Index nb = static_cast<Index>(starts_.size()) - 1;
@@ -125,9 +126,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
             seen[static_cast<size_t>(order[i])] = 1;
         }
     }
-    const Index want = params_.parts > 0 ? params_.parts : kHybridParts;
-    const Index P =
-        std::clamp<Index>(std::min(want, n_ / kMinRowsPerThread), 1, std::max<Index>(nb, 1));
+    const Index P = hybrid_part_count(params_.parts, n_, nb);
     std::vector<int> part_of_block(static_cast<size_t>(nb), 0);
     std::vector<int> cut{0};
     {
