@@ -91,10 +91,14 @@ public:
         // so their published iteration counts stay bit-for-bit reproducible.
         solvers::KrylovParams params = params_;
         params.rel_tol = std::max(params_.rel_tol, forcing);
+        // mg:smoother=lattice: the product by the finest level's stencils (LatticeGS::multiply).
+        const smoothers::LatticeGS* lattice = mg_ ? mg_->finest_lattice() : nullptr;
         SolveResult r =
-            mg_ ? solvers::solve(method_, MatrixOperator(jac_.matrix(), MatVec::unrolled), *pc_, b,
-                                 dx, params)
-                : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params);
+            lattice
+                ? solvers::solve(method_, smoothers::LatticeOperator(*lattice), *pc_, b, dx, params)
+            : mg_ ? solvers::solve(method_, MatrixOperator(jac_.matrix(), MatVec::unrolled), *pc_,
+                                   b, dx, params)
+                  : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params);
         r.setup_seconds = t1 - t0;
         r.assembly_seconds = assembly_seconds_;
         return r;

@@ -11,12 +11,20 @@
 #include <cmath>
 #include <sstream>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace mlc::smoothers {
 
 namespace {
 
-constexpr int kSlots = 7;    // centre, then (1,0), (-1,0), (0,1), (0,-1), (1,-1), (-1,1)
-constexpr int kStencil = 32; // 7 slots x 4 entries, then omega D^{-1} of the centre
+constexpr int kSlots = 7; // centre, then (1,0), (-1,0), (0,1), (0,-1), (1,-1), (-1,1)
+// 7 slots x 4 entries (row-major 2x2), then omega D^{-1} of the centre, then G_east = omega D^{-1}
+// S_(1,0) and G_west = omega D^{-1} S_(-1,0) (deep_run); then the same ten 2x2 blocks packed for
+// two-lane arithmetic, each as its diagonal (B00, B11) and its off-diagonal (B01, B10).
+constexpr int kStencil = 80;
+constexpr int kPacked = 40;
 constexpr int kDi[kSlots] = {0, 1, -1, 0, 0, 1, -1};
 constexpr int kDj[kSlots] = {0, 0, 0, 1, -1, -1, 1};
 constexpr int kLenCodes = 4096; // visit code = macro * kLenCodes + row length
@@ -28,26 +36,121 @@ long point_index(int n, int i, int j) {
     return static_cast<long>(j - 1) * (2 * n - 2 - j) / 2 + (i - 1);
 }
 
-// One deep point: r = b - sum_s S_s x_s over the seven 2x2 blocks, x += omega D^{-1} r, its
-// neighbours `len` (the length of its lattice row) points up and down.
-inline void deep_update(const double* S, const double* b, double* x, long len) {
-    const long nn = 2 * len, nw = 2 * len - 2, so = -2 * (len + 1), se = -2 * len;
-    double a0 = b[0], a1 = b[1];
-    auto acc = [&](const double* B, const double* y) {
-        a0 -= B[0] * y[0] + B[1] * y[1];
-        a1 -= B[2] * y[0] + B[3] * y[1];
-    };
-    acc(S + 0, x);
-    acc(S + 4, x + 2);
-    acc(S + 8, x - 2);
-    acc(S + 12, x + nn);
-    acc(S + 16, x + so);
-    acc(S + 20, x + se);
-    acc(S + 24, x + nw);
-    const double* D = S + 28;
-    x[0] += D[0] * a0 + D[1] * a1;
-    x[1] += D[2] * a0 + D[3] * a1;
+// A run of deep points of one lattice row, visited `count` points from first row r in steps of
+// `step` rows (+2 eastwards, -2 westwards), each neighbour `len` (the row's length) points up and
+// down. Per point x += omega D^{-1} (b - sum_s S_s x_s) over the seven 2x2 blocks, written as
+//   x_new = c - G x_behind,  c = x + omega D^{-1} (b - sum over the six other blocks),
+// with G = omega D^{-1} S_behind: the point visited just before (behind) enters last, so the
+// chain from one point to the next is one 2x2 product and a subtraction, the rest of each point
+// independent of it (the sweep is latency-bound otherwise). x_behind is kept in registers.
+#if defined(__SSE2__)
+// Two lanes (the point's two rows): a 2x2 block B times y is diag(B) y + offdiag(B) swap(y).
+inline __m128d swap(__m128d y) {
+    return _mm_shuffle_pd(y, y, 1);
 }
+inline __m128d block(__m128d d, __m128d o, __m128d y) {
+    return _mm_add_pd(_mm_mul_pd(d, y), _mm_mul_pd(o, swap(y)));
+}
+void deep_run(const double* __restrict S, const double* __restrict b, double* x, long r, long step,
+              int count, long len) {
+    const long nn = 2 * len, nw = 2 * len - 2, so = -2 * (len + 1), se = -2 * len;
+    const double* Q = S + kPacked;
+    const double* Qa = step > 0 ? Q + 4 : Q + 8;   // ahead: east or west
+    const double* Qg = step > 0 ? Q + 36 : Q + 32; // behind: west or east
+    const __m128d c0d = _mm_loadu_pd(Q), c0o = _mm_loadu_pd(Q + 2);
+    const __m128d cad = _mm_loadu_pd(Qa), cao = _mm_loadu_pd(Qa + 2);
+    const __m128d cnd = _mm_loadu_pd(Q + 12), cno = _mm_loadu_pd(Q + 14);
+    const __m128d csd = _mm_loadu_pd(Q + 16), cso = _mm_loadu_pd(Q + 18);
+    const __m128d ced = _mm_loadu_pd(Q + 20), ceo = _mm_loadu_pd(Q + 22);
+    const __m128d cwd = _mm_loadu_pd(Q + 24), cwo = _mm_loadu_pd(Q + 26);
+    const __m128d dd = _mm_loadu_pd(Q + 28), dof = _mm_loadu_pd(Q + 30);
+    const __m128d gd = _mm_loadu_pd(Qg), go = _mm_loadu_pd(Qg + 2);
+    __m128d p = _mm_loadu_pd(x + r - step);
+    for (int k = 0; k < count; ++k, r += step) {
+        const double* y = x + r;
+        const __m128d y0 = _mm_loadu_pd(y);
+        const __m128d t = _mm_add_pd(block(c0d, c0o, y0), block(cad, cao, _mm_loadu_pd(y + step)));
+        const __m128d u = _mm_add_pd(block(cnd, cno, _mm_loadu_pd(y + nn)),
+                                     block(csd, cso, _mm_loadu_pd(y + so)));
+        const __m128d v = _mm_add_pd(block(ced, ceo, _mm_loadu_pd(y + se)),
+                                     block(cwd, cwo, _mm_loadu_pd(y + nw)));
+        const __m128d a = _mm_sub_pd(_mm_loadu_pd(b + r), _mm_add_pd(_mm_add_pd(t, u), v));
+        const __m128d c = _mm_add_pd(y0, block(dd, dof, a));
+        p = _mm_sub_pd(c, block(gd, go, p));
+        _mm_storeu_pd(x + r, p);
+    }
+}
+// y = A x on a run of deep points (as deep_run's): the seven blocks, no dependency between points.
+void deep_product(const double* __restrict S, const double* __restrict x, double* __restrict y,
+                  long r, long step, int count, long len) {
+    const long nn = 2 * len, nw = 2 * len - 2, so = -2 * (len + 1), se = -2 * len;
+    const double* Q = S + kPacked;
+    const __m128d c0d = _mm_loadu_pd(Q), c0o = _mm_loadu_pd(Q + 2);
+    const __m128d ced_ = _mm_loadu_pd(Q + 4), ceo_ = _mm_loadu_pd(Q + 6);
+    const __m128d cwd_ = _mm_loadu_pd(Q + 8), cwo_ = _mm_loadu_pd(Q + 10);
+    const __m128d cnd = _mm_loadu_pd(Q + 12), cno = _mm_loadu_pd(Q + 14);
+    const __m128d csd = _mm_loadu_pd(Q + 16), cso = _mm_loadu_pd(Q + 18);
+    const __m128d ced = _mm_loadu_pd(Q + 20), ceo = _mm_loadu_pd(Q + 22);
+    const __m128d cwd = _mm_loadu_pd(Q + 24), cwo = _mm_loadu_pd(Q + 26);
+    for (int k = 0; k < count; ++k, r += step) {
+        const double* z = x + r;
+        const __m128d t = _mm_add_pd(block(c0d, c0o, _mm_loadu_pd(z)),
+                                     _mm_add_pd(block(ced_, ceo_, _mm_loadu_pd(z + 2)),
+                                                block(cwd_, cwo_, _mm_loadu_pd(z - 2))));
+        const __m128d u = _mm_add_pd(block(cnd, cno, _mm_loadu_pd(z + nn)),
+                                     block(csd, cso, _mm_loadu_pd(z + so)));
+        const __m128d v = _mm_add_pd(block(ced, ceo, _mm_loadu_pd(z + se)),
+                                     block(cwd, cwo, _mm_loadu_pd(z + nw)));
+        _mm_storeu_pd(y + r, _mm_add_pd(_mm_add_pd(t, u), v));
+    }
+}
+#else
+void deep_run(const double* __restrict S, const double* __restrict b, double* x, long r, long step,
+              int count, long len) {
+    const long nn = 2 * len, nw = 2 * len - 2, so = -2 * (len + 1), se = -2 * len;
+    const double* __restrict Sa = step > 0 ? S + 4 : S + 8;  // ahead: east or west
+    const double* __restrict G = step > 0 ? S + 36 : S + 32; // behind: west or east
+    const double* __restrict D = S + 28;
+    double p0 = x[r - step], p1 = x[r - step + 1];
+    for (int k = 0; k < count; ++k, r += step) {
+        const double* y = x + r;
+        const double y0 = y[0], y1 = y[1];
+        const double* ya = y + step;
+        const double* yn = y + nn;
+        const double* ys = y + so;
+        const double* ye = y + se;
+        const double* yw = y + nw;
+        const double t0 = (S[0] * y0 + S[1] * y1) + (Sa[0] * ya[0] + Sa[1] * ya[1]);
+        const double t1 = (S[2] * y0 + S[3] * y1) + (Sa[2] * ya[0] + Sa[3] * ya[1]);
+        const double u0 = (S[12] * yn[0] + S[13] * yn[1]) + (S[16] * ys[0] + S[17] * ys[1]);
+        const double u1 = (S[14] * yn[0] + S[15] * yn[1]) + (S[18] * ys[0] + S[19] * ys[1]);
+        const double v0 = (S[20] * ye[0] + S[21] * ye[1]) + (S[24] * yw[0] + S[25] * yw[1]);
+        const double v1 = (S[22] * ye[0] + S[23] * ye[1]) + (S[26] * yw[0] + S[27] * yw[1]);
+        const double a0 = b[r] - ((t0 + u0) + v0), a1 = b[r + 1] - ((t1 + u1) + v1);
+        const double c0 = y0 + (D[0] * a0 + D[1] * a1), c1 = y1 + (D[2] * a0 + D[3] * a1);
+        const double n0 = c0 - (G[0] * p0 + G[1] * p1), n1 = c1 - (G[2] * p0 + G[3] * p1);
+        x[r] = n0;
+        x[r + 1] = n1;
+        p0 = n0;
+        p1 = n1;
+    }
+}
+void deep_product(const double* __restrict S, const double* __restrict x, double* __restrict y,
+                  long r, long step, int count, long len) {
+    const long off[kSlots] = {0, 2, -2, 2 * len, -2 * (len + 1), -2 * len, 2 * len - 2};
+    for (int k = 0; k < count; ++k, r += step) {
+        double a0 = 0.0, a1 = 0.0;
+        for (int q = 0; q < kSlots; ++q) {
+            const double* B = S + 4 * q;
+            const double* z = x + r + off[q];
+            a0 += B[0] * z[0] + B[1] * z[1];
+            a1 += B[2] * z[0] + B[3] * z[1];
+        }
+        y[r] = a0;
+        y[r + 1] = a1;
+    }
+}
+#endif
 
 } // namespace
 
@@ -217,6 +320,22 @@ void LatticeGS::derive(const SparseMatrix& A) {
                     S[29] = -f * v[1];
                     S[30] = -f * v[2];
                     S[31] = f * v[0];
+                    for (int g = 0; g < 2; ++g) { // G_east (slot 1) at 32, G_west (slot 2) at 36
+                        const double* B = S + 4 + 4 * g;
+                        double* G = S + 32 + 4 * g;
+                        G[0] = S[28] * B[0] + S[29] * B[2];
+                        G[1] = S[28] * B[1] + S[29] * B[3];
+                        G[2] = S[30] * B[0] + S[31] * B[2];
+                        G[3] = S[30] * B[1] + S[31] * B[3];
+                    }
+                    for (int q = 0; q < 10; ++q) {
+                        const double* B = S + 4 * q;
+                        double* Q = S + kPacked + 4 * q;
+                        Q[0] = B[0];
+                        Q[1] = B[3];
+                        Q[2] = B[1];
+                        Q[3] = B[2];
+                    }
                     double mx = 0.0;
                     for (double x : v)
                         mx = std::max(mx, std::abs(x));
@@ -269,6 +388,34 @@ void LatticeGS::derive(const SparseMatrix& A) {
             cb_block_.push_back(b);
         }
     }
+    // Items of each part: runs of deep points along one lattice row (the same macro and row,
+    // consecutive visits two rows apart, all in one direction), and runs of row-swept blocks.
+    item_begin_.clear();
+    part_item_.assign(1, 0);
+    for (size_t p = 0; p + 1 < part_visit_.size(); ++p) {
+        const int e = part_visit_[p + 1];
+        for (int i = part_visit_[p]; i < e;) {
+            item_begin_.push_back(i);
+            const int code = visit_code_[static_cast<size_t>(i)];
+            int j = i + 1;
+            if (code < 0) {
+                while (j < e && visit_code_[static_cast<size_t>(j)] < 0)
+                    ++j;
+            } else if (j < e && visit_code_[static_cast<size_t>(j)] == code) {
+                const int step =
+                    visit_row_[static_cast<size_t>(j)] - visit_row_[static_cast<size_t>(i)];
+                if (step == 2 || step == -2)
+                    while (j < e && visit_code_[static_cast<size_t>(j)] == code &&
+                           visit_row_[static_cast<size_t>(j)] -
+                                   visit_row_[static_cast<size_t>(j) - 1] ==
+                               step)
+                        ++j;
+            }
+            i = j;
+        }
+        part_item_.push_back(static_cast<int>(item_begin_.size()));
+    }
+    item_begin_.push_back(part_visit_.back());
     // Rows of the row-swept blocks: the own part's entries first (column order), then the
     // entries read across a cut; sizes first, then the rows over the threads.
     const size_t ncb = cb_row_.size();
@@ -468,24 +615,38 @@ template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, doubl
             x[s0 + k] += d;
         }
     };
-    auto visit = [&](int i) {
-        const int code = visit_code_[static_cast<size_t>(i)];
-        if (code < 0) {
-            block(-1 - code);
+    const int k0 = part_item_[static_cast<size_t>(p)], k1 = part_item_[static_cast<size_t>(p) + 1];
+    auto item = [&](int k) {
+        const int i0 = item_begin_[static_cast<size_t>(k)];
+        const int i1 = item_begin_[static_cast<size_t>(k) + 1];
+        const int code = visit_code_[static_cast<size_t>(i0)];
+        if (code < 0) { // blocks swept by their rows
+            if constexpr (Forward) {
+                for (int i = i0; i < i1; ++i)
+                    block(-1 - visit_code_[static_cast<size_t>(i)]);
+            } else {
+                for (int i = i1; i-- > i0;)
+                    block(-1 - visit_code_[static_cast<size_t>(i)]);
+            }
             return;
         }
-        const int r = visit_row_[static_cast<size_t>(i)];
-        deep_update(stencils_.data() + static_cast<size_t>(code / kLenCodes) * kStencil, b + r,
-                    x + r, code % kLenCodes);
+        // A run of deep points along one lattice row.
+        const long step = i1 - i0 > 1 ? visit_row_[static_cast<size_t>(i0) + 1] -
+                                            visit_row_[static_cast<size_t>(i0)]
+                                      : 2;
+        const double* S = stencils_.data() + static_cast<size_t>(code / kLenCodes) * kStencil;
+        if constexpr (Forward)
+            deep_run(S, b, x, visit_row_[static_cast<size_t>(i0)], step, i1 - i0, code % kLenCodes);
+        else
+            deep_run(S, b, x, visit_row_[static_cast<size_t>(i1) - 1], -step, i1 - i0,
+                     code % kLenCodes);
     };
-    const int i0 = part_visit_[static_cast<size_t>(p)],
-              i1 = part_visit_[static_cast<size_t>(p) + 1];
     if constexpr (Forward) {
-        for (int i = i0; i < i1; ++i)
-            visit(i);
+        for (int k = k0; k < k1; ++k)
+            item(k);
     } else {
-        for (int i = i1; i-- > i0;)
-            visit(i);
+        for (int k = k1; k-- > k0;)
+            item(k);
     }
 }
 
@@ -519,6 +680,45 @@ void LatticeGS::forward_from_zero(const Vector& b, Vector& x, Vector& res) const
     parallel::set_zero(x, n_);
     smooth(b, x, Sweep::forward, 1);
     csr_residual(csr_arrays(*A_, A_->valuePtr()), b, x, res, traffic::Kind::smoother);
+}
+
+void LatticeGS::multiply(const Vector& x, Vector& y) const {
+    MLC_CHECK(A_ != nullptr, "lattice smoother: call setup first");
+    check_size(x, n_, "LatticeGS::multiply", "x");
+    if (y.size() != n_) y.resize(n_);
+    // Compulsory bytes: the row-swept rows' values and columns and row offsets, the visit
+    // entries, x read and y written.
+    const traffic::Pass pass(
+        traffic::Kind::matvec,
+        12.0 * static_cast<double>(ccol_.size()) + 4.0 * static_cast<double>(crow_ptr_.size()) +
+            8.0 * static_cast<double>(visit_row_.size()) + 16.0 * static_cast<double>(n_));
+    const double* xv = x.data();
+    double* yv = y.data();
+    const double* val = cval_.data();
+    const int* col = ccol_.data();
+    parallel::for_chunks(static_cast<size_t>(parts()), [&](size_t p) {
+        for (int k = part_item_[p]; k < part_item_[p + 1]; ++k) {
+            const int i0 = item_begin_[static_cast<size_t>(k)];
+            const int i1 = item_begin_[static_cast<size_t>(k) + 1];
+            const int code = visit_code_[static_cast<size_t>(i0)];
+            if (code < 0) {
+                for (int i = i0; i < i1; ++i) {
+                    const size_t c = static_cast<size_t>(-1 - visit_code_[static_cast<size_t>(i)]);
+                    for (int q = 0; q < cb_size_[c]; ++q) {
+                        const size_t cr = static_cast<size_t>(cb_crow_[c] + q);
+                        yv[cb_row_[c] + q] =
+                            row_dot(col, val, xv, crow_ptr_[cr], crow_ptr_[cr + 1]);
+                    }
+                }
+                continue;
+            }
+            const long step = i1 - i0 > 1 ? visit_row_[static_cast<size_t>(i0) + 1] -
+                                                visit_row_[static_cast<size_t>(i0)]
+                                          : 2;
+            deep_product(stencils_.data() + static_cast<size_t>(code / kLenCodes) * kStencil, xv,
+                         yv, visit_row_[static_cast<size_t>(i0)], step, i1 - i0, code % kLenCodes);
+        }
+    });
 }
 
 std::vector<Index> LatticeGS::sweep_order_blocks(int part) const {

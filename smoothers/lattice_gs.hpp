@@ -28,6 +28,7 @@
 
 #include "core/csr.hpp"
 #include "core/first_touch.hpp"
+#include "core/linear_operator.hpp"
 #include "smoothers/block_sor.hpp"
 
 #include <cstdint>
@@ -76,6 +77,11 @@ public:
     /// x = one forward sweep from zero, res = b - A x.
     void forward_from_zero(const Vector& b, Vector& x, Vector& res) const;
 
+    /// y = A x for the matrix of the last setup or update_values: deep rows by their macro's
+    /// stencil (equal to A's rows to stencil_tol), every other row by its entries; rows over
+    /// the parts' threads. Counts one mat-vec pass (core/traffic) with the bytes it reads.
+    void multiply(const Vector& x, Vector& y) const;
+
     /// Interior lattice points swept by their macro's stencil after the last setup.
     Index deep_points() const { return n_deep_; }
     /// Rows of the matrix.
@@ -102,13 +108,16 @@ private:
     const SparseMatrix* A_ = nullptr;
     std::vector<int> outer_; // A's row pointers at the last setup
     Index nnz_ = 0;
-    std::vector<Index> starts_;    // block starts, then n
     std::vector<double> stencils_; // per macro: 7 slots x 2x2 (row-major), then omega D^-1
     // The visit: per part a run of entries; entry i is a deep point (code >= 0: macro * 4096 +
     // its row's length, the neighbour offsets) at first row visit_row_[i], or a row-swept block
     // (code = -1 - its index into cb_*).
     std::vector<int> part_visit_;
     std::vector<int> visit_row_, visit_code_;
+    // The visit cut into items (item k: entries item_begin_[k] to item_begin_[k + 1]), those of
+    // part p from part_item_[p]: a run of deep points along one lattice row (swept by deep_run),
+    // or a run of row-swept blocks.
+    std::vector<int> item_begin_, part_item_;
     Index n_deep_ = 0;
     // Deep points: first row, macro, and their neighbours' slots in A's column order, to check
     // them at update_values.
@@ -124,6 +133,19 @@ private:
     parallel::UninitializedVector<double> cval_, cinv_;
     std::vector<int> interface_; // columns read across the cuts
     mutable Vector snap_;
+};
+
+/// A LatticeGS's matrix as a LinearOperator (LatticeGS::multiply): the Krylov product of a level
+/// whose multigrid smoother is mg:smoother=lattice. The smoother must outlive it.
+class LatticeOperator final : public LinearOperator {
+public:
+    explicit LatticeOperator(const LatticeGS& gs) : gs_(gs) {}
+    Index rows() const override { return gs_.rows(); }
+    Index cols() const override { return gs_.rows(); }
+    void apply(const Vector& x, Vector& y) const override { gs_.multiply(x, y); }
+
+private:
+    const LatticeGS& gs_;
 };
 
 } // namespace mlc::smoothers

@@ -342,6 +342,11 @@ const SparseMatrix* Multigrid::finest_operator() const {
     return levels_.back()->A;
 }
 
+const smoothers::LatticeGS* Multigrid::finest_lattice() const {
+    const Level& top = *levels_.back();
+    return top.A != nullptr ? top.lattice.get() : nullptr;
+}
+
 std::string Multigrid::name() const {
     const MultigridParams& p = levels_.back()->params;
     std::ostringstream os;

@@ -135,9 +135,12 @@ public:
     /// How the coarse operators are filled.
     CoarseOperators coarse_operators() const { return coarse_operators_; }
 
-    /// The finest level's operator as last set up (borrowed), or null before `setup`: the matrix
-    /// a MatrixOperator must wrap for `apply_then_multiply` to fuse its product.
+    /// The finest level's operator as last set up (borrowed), or null before `setup`.
     const SparseMatrix* finest_operator() const;
+
+    /// The finest level's lattice smoother (mg:smoother=lattice on a lattice level), or null:
+    /// its `multiply` is the finest operator's product by the macros' stencils, after setup.
+    const smoothers::LatticeGS* finest_lattice() const;
 
     /// Number of levels (the finest is n_levels() - 1).
     int n_levels() const { return static_cast<int>(levels_.size()); }

@@ -241,3 +241,79 @@ TEST(LatticeGS, ANewPatternIsSetUpAgain) {
         EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm()) << in_deep_row;
     }
 }
+
+namespace {
+// A visit of each macro's interior in serpentine rows (row j eastwards when j is odd, westwards
+// when even: runs of deep points stepping +2 and -2 rows), then every other block in row order.
+std::vector<Index> serpentine_visit(const Case& c, const std::vector<Index>& starts) {
+    const int N = c.lattice.n;
+    const size_t np = static_cast<size_t>(N - 1) * static_cast<size_t>(N - 2) / 2;
+    std::vector<Index> visit;
+    std::vector<char> seen(static_cast<size_t>(c.A.rows()), 0);
+    for (size_t m = 0; m * np < c.lattice.first_row.size(); ++m) {
+        size_t base = m * np;
+        for (int j = 1; j <= N - 2; ++j) {
+            const int len = N - 1 - j;
+            for (int k = 0; k < len; ++k) {
+                const Index r =
+                    c.lattice.first_row[base + static_cast<size_t>(j % 2 ? k : len - 1 - k)];
+                if (r >= 0 && !seen[static_cast<size_t>(r)]) {
+                    visit.push_back(r);
+                    seen[static_cast<size_t>(r)] = 1;
+                }
+            }
+            base += static_cast<size_t>(len);
+        }
+    }
+    for (Index s : starts)
+        if (!seen[static_cast<size_t>(s)]) visit.push_back(s);
+    return visit;
+}
+} // namespace
+
+// Visited in serpentine rows (the multigrid's visit), the deep points go by runs along each row in
+// both directions, each point's update taking its predecessor last (x = c - G x_behind): still
+// block Gauss–Seidel in that order to round-off, forward and backward, omega 1 and 1.3.
+TEST(LatticeGS, SerpentineRowsAreBlockGaussSeidelInThatOrder) {
+    Case c = elastic_case(6, true);
+    c.lattice.visit = serpentine_visit(c, c.starts);
+    // An east coupling that is not the west one's transpose (a convection-like term): the
+    // predecessor's block differs with the direction of the run.
+    const double d = 0.2 * c.A.diagonal().mean();
+    for (Index i = 0; i < c.A.rows(); ++i)
+        for (SparseMatrix::InnerIterator it(c.A, i); it; ++it)
+            if (it.col() == i + 2) it.valueRef() += d;
+    const Index n = c.A.rows();
+    const Vector b = random_vector(n, 11), x0 = random_vector(n, 12);
+    for (double omega : {1.0, 1.3})
+        for (bool forward : {true, false}) {
+            LatticeGS S(c.starts, c.lattice, {.omega = omega});
+            S.setup(c.A);
+            EXPECT_GT(S.deep_points(), 4 * 1500);
+            Vector x = x0;
+            S.smooth(b, x, forward ? Sweep::forward : Sweep::backward, 1);
+            const Vector ref = reference_sweep(S, c.A, c.starts, b, x0, forward, omega);
+            EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm()) << omega << " " << forward;
+        }
+}
+
+// multiply is A x (deep rows by the macro's stencil, the others by their rows), with the Hilbert
+// and the serpentine visits, one part (level 4) and two (level 6); so is LatticeOperator.
+TEST(LatticeGS, MultiplyIsTheMatrixProduct) {
+    for (int depth : {4, 6})
+        for (bool serpentine : {false, true}) {
+            Case c = elastic_case(depth, true);
+            if (serpentine) c.lattice.visit = serpentine_visit(c, c.starts);
+            LatticeGS S(c.starts, c.lattice, {});
+            S.setup(c.A);
+            ASSERT_GT(S.deep_points(), 0);
+            const Vector x = random_vector(c.A.rows(), 13);
+            const Vector ref = c.A * x;
+            Vector y;
+            S.multiply(x, y);
+            EXPECT_LT((y - ref).norm(), 1e-13 * c.A.norm() * x.norm()) << depth << serpentine;
+            Vector z = Vector::Constant(c.A.rows(), 7.0);
+            LatticeOperator(S).apply(x, z);
+            EXPECT_EQ(y, z);
+        }
+}
