@@ -478,7 +478,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
         if (across[static_cast<size_t>(col)]) interface_.push_back(static_cast<int>(col));
     cval_.resize(ccol_.size());
     cinv_.resize(static_cast<size_t>(cb_inv_.back()));
-    parallel::set_zero(snap_, n_);
+    snap_.resize(n_); // read at the interface columns only, each written before a sweep reads it
     outer_.assign(ao, ao + n_ + 1);
     nnz_ = A.nonZeros();
 }
