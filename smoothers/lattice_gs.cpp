@@ -28,6 +28,9 @@ constexpr int kPacked = 40;
 constexpr int kDi[kSlots] = {0, 1, -1, 0, 0, 1, -1};
 constexpr int kDj[kSlots] = {0, 0, 0, 1, -1, -1, 1};
 constexpr int kLenCodes = 4096; // visit code = macro * kLenCodes + row length
+// Visit codes of semi-deep points: kSemi + their index (row-swept blocks: -1 - their index).
+constexpr int kSemi = -(1 << 30);
+constexpr int kSemiMax = kSemi + (1 << 29);
 
 long interior_points(int n) {
     return n < 3 ? 0 : static_cast<long>(n - 1) * (n - 2) / 2;
@@ -152,6 +155,30 @@ void deep_product(const double* __restrict S, const double* __restrict x, double
 }
 #endif
 
+// One semi-deep point (its macro's stencil, its neighbours' first rows nb[s] by slot, nb[0] its
+// own): x += omega D^{-1} (b - sum_s S_s x_nb[s]) with `Sweep`, y = sum_s S_s x_nb[s] without.
+template <bool Sweep>
+inline void semi_point(const double* __restrict S, const int* __restrict nb, const double* b,
+                       const double* x_in, double* x_out) {
+    const int r = nb[0];
+    double a0 = 0.0, a1 = 0.0;
+    for (int q = 0; q < kSlots; ++q) {
+        const double* B = S + 4 * q;
+        const double* z = x_in + nb[q];
+        a0 += B[0] * z[0] + B[1] * z[1];
+        a1 += B[2] * z[0] + B[3] * z[1];
+    }
+    if constexpr (Sweep) {
+        const double* D = S + 28;
+        const double r0 = b[r] - a0, r1 = b[r + 1] - a1;
+        x_out[r] += D[0] * r0 + D[1] * r1;
+        x_out[r + 1] += D[2] * r0 + D[3] * r1;
+    } else {
+        x_out[r] = a0;
+        x_out[r + 1] = a1;
+    }
+}
+
 } // namespace
 
 LatticeGS::LatticeGS(std::vector<Index> block_starts, LatticeRows lattice, LatticeGSParams params)
@@ -260,6 +287,10 @@ void LatticeGS::derive(const SparseMatrix& A) {
     std::vector<std::vector<int>> macro_rows(static_cast<size_t>(n_macros));
     std::vector<std::vector<std::uint8_t>> macro_slots(static_cast<size_t>(n_macros));
     std::vector<std::vector<int>> macro_lens(static_cast<size_t>(n_macros));
+    // Semi-deep points: interior points whose rows hold the macro's stencil but some of whose
+    // neighbours lie on the macro's edges (no fixed offset): their neighbours' rows by slot.
+    std::vector<std::vector<int>> macro_semi_nbr(static_cast<size_t>(n_macros));
+    std::vector<std::vector<std::uint8_t>> macro_semi_slots(static_cast<size_t>(n_macros));
     parallel::for_chunks(static_cast<size_t>(n_macros), [&](size_t m) {
         const Index* fr = lattice_.first_row.data() + static_cast<long>(m) * np;
         const Index row0 = fr[0];
@@ -353,6 +384,64 @@ void LatticeGS::derive(const SparseMatrix& A) {
                 macro_lens[m].push_back(N - 1 - j);
                 macro_slots[m].insert(macro_slots[m].end(), slots.begin(), slots.end());
             }
+        if (!have) return;
+        // Semi-deep points: every other interior point whose seven column pairs are plain 2x2
+        // blocks of its part, matched to the slots: the interior neighbours by their rows, the
+        // others (on the macro's edges) by their values among the slots left.
+        for (int j = 1; j <= N - 2; ++j)
+            for (int i = 1; i + j <= N - 1; ++i) {
+                const Index r = fr[point_index(N, i, j)];
+                const int b = block_of_row[static_cast<size_t>(r)];
+                if (deep_len[static_cast<size_t>(b)] >= 0) continue;
+                if (ao[r + 1] - ao[r] != 2 * kSlots || ao[r + 2] - ao[r + 1] != 2 * kSlots)
+                    continue;
+                const int part = part_of_block[static_cast<size_t>(b)];
+                std::array<Index, kSlots> known{};
+                for (int t = 0; t < kSlots; ++t) {
+                    const int ii = i + kDi[t], jj = j + kDj[t];
+                    known[static_cast<size_t>(t)] =
+                        ii >= 1 && jj >= 1 && ii + jj <= N - 1 ? fr[point_index(N, ii, jj)] : -1;
+                }
+                std::array<std::uint8_t, kSlots> slots{};
+                std::array<int, kSlots> nbr{};
+                unsigned used = 0;
+                bool fits = true;
+                for (int q = 0; q < kSlots && fits; ++q) {
+                    const int c0 = ai[ao[r] + 2 * q], c1 = ai[ao[r] + 2 * q + 1];
+                    const int d0 = ai[ao[r + 1] + 2 * q], d1 = ai[ao[r + 1] + 2 * q + 1];
+                    const int cb = block_of_row[static_cast<size_t>(c0)];
+                    fits = c1 == c0 + 1 && d0 == c0 && d1 == c1 && starts_[cb] == c0 &&
+                           starts_[cb + 1] == c0 + 2 &&
+                           part_of_block[static_cast<size_t>(cb)] == part;
+                    if (!fits) break;
+                    const double w[4] = {av[ao[r] + 2 * q], av[ao[r] + 2 * q + 1],
+                                         av[ao[r + 1] + 2 * q], av[ao[r + 1] + 2 * q + 1]};
+                    auto matches = [&](int t) {
+                        for (int e = 0; e < 4; ++e)
+                            if (!(std::abs(w[e] - S[4 * t + e]) <= tol)) return false;
+                        return true;
+                    };
+                    int t = 0;
+                    while (t < kSlots && known[static_cast<size_t>(t)] != c0)
+                        ++t;
+                    if (t == kSlots) { // on an edge: the first free edge slot with its values
+                        t = 0;
+                        while (t < kSlots && (known[static_cast<size_t>(t)] >= 0 ||
+                                              (used >> t & 1u) || !matches(t)))
+                            ++t;
+                    }
+                    fits = t < kSlots && !(used >> t & 1u) && matches(t);
+                    if (!fits) break;
+                    used |= 1u << t;
+                    slots[static_cast<size_t>(q)] = static_cast<std::uint8_t>(t);
+                    nbr[static_cast<size_t>(t)] = c0;
+                }
+                if (!fits || used != (1u << kSlots) - 1) continue;
+                deep_len[static_cast<size_t>(b)] = 0; // semi-deep
+                deep_mac[static_cast<size_t>(b)] = static_cast<int>(m);
+                macro_semi_nbr[m].insert(macro_semi_nbr[m].end(), nbr.begin(), nbr.end());
+                macro_semi_slots[m].insert(macro_semi_slots[m].end(), slots.begin(), slots.end());
+            }
     });
     deep_row_.clear();
     deep_len_.clear();
@@ -368,6 +457,23 @@ void LatticeGS::derive(const SparseMatrix& A) {
                            macro_slots[static_cast<size_t>(m)].end());
     }
     n_deep_ = static_cast<Index>(deep_row_.size());
+    semi_nbr_.clear();
+    semi_slots_.clear();
+    semi_macro_.clear();
+    std::vector<int> semi_of_block(static_cast<size_t>(nb), -1);
+    for (long m = 0; m < n_macros; ++m) {
+        const auto& nbr = macro_semi_nbr[static_cast<size_t>(m)];
+        for (size_t k = 0; k < nbr.size(); k += kSlots) {
+            semi_of_block[static_cast<size_t>(block_of_row[static_cast<size_t>(nbr[k])])] =
+                static_cast<int>(semi_macro_.size());
+            semi_macro_.push_back(static_cast<int>(m));
+        }
+        semi_nbr_.insert(semi_nbr_.end(), nbr.begin(), nbr.end());
+        semi_slots_.insert(semi_slots_.end(), macro_semi_slots[static_cast<size_t>(m)].begin(),
+                           macro_semi_slots[static_cast<size_t>(m)].end());
+    }
+    MLC_CHECK(semi_macro_.size() < (size_t{1} << 29) && nb < (Index{1} << 29),
+              "lattice smoother: too many blocks (" << nb << ")");
     // The visit entries and the row-swept blocks, in visit order.
     part_visit_ = cut;
     visit_row_.resize(static_cast<size_t>(nb));
@@ -378,9 +484,11 @@ void LatticeGS::derive(const SparseMatrix& A) {
     for (Index i = 0; i < nb; ++i) {
         const int b = order[static_cast<size_t>(i)];
         visit_row_[static_cast<size_t>(i)] = static_cast<int>(starts_[b]);
-        if (deep_len[static_cast<size_t>(b)] >= 0) {
+        if (deep_len[static_cast<size_t>(b)] > 0) {
             visit_code_[static_cast<size_t>(i)] =
                 deep_mac[static_cast<size_t>(b)] * kLenCodes + deep_len[static_cast<size_t>(b)];
+        } else if (deep_len[static_cast<size_t>(b)] == 0) {
+            visit_code_[static_cast<size_t>(i)] = kSemi + semi_of_block[static_cast<size_t>(b)];
         } else {
             visit_code_[static_cast<size_t>(i)] = -1 - static_cast<int>(cb_row_.size());
             cb_row_.push_back(static_cast<int>(starts_[b]));
@@ -398,8 +506,10 @@ void LatticeGS::derive(const SparseMatrix& A) {
             item_begin_.push_back(i);
             const int code = visit_code_[static_cast<size_t>(i)];
             int j = i + 1;
-            if (code < 0) {
-                while (j < e && visit_code_[static_cast<size_t>(j)] < 0)
+            if (code < 0) { // a run of semi-deep points, or of row-swept blocks
+                const bool semi = code <= kSemiMax;
+                while (j < e && visit_code_[static_cast<size_t>(j)] < 0 &&
+                       (visit_code_[static_cast<size_t>(j)] <= kSemiMax) == semi)
                     ++j;
             } else if (j < e && visit_code_[static_cast<size_t>(j)] == code) {
                 const int step =
@@ -513,7 +623,23 @@ bool LatticeGS::same_pattern(const SparseMatrix& A) const {
         }
         return d1;
     });
-    return bad_deep == nd;
+    if (bad_deep != nd) return false;
+    const size_t ns = semi_macro_.size();
+    const size_t bad_semi = parallel::first_flagged(ns, 4096, [&](size_t k0, size_t k1) {
+        for (size_t k = k0; k < k1; ++k) {
+            const int* nbr = semi_nbr_.data() + k * kSlots;
+            const int r = nbr[0];
+            if (ao[r + 1] - ao[r] != 2 * kSlots || ao[r + 2] - ao[r + 1] != 2 * kSlots) return k;
+            for (int q = 0; q < kSlots; ++q) {
+                const int c = nbr[semi_slots_[k * kSlots + static_cast<size_t>(q)]];
+                if (ai[ao[r] + 2 * q] != c || ai[ao[r] + 2 * q + 1] != c + 1 ||
+                    ai[ao[r + 1] + 2 * q] != c || ai[ao[r + 1] + 2 * q + 1] != c + 1)
+                    return k;
+            }
+        }
+        return k1;
+    });
+    return bad_semi == ns;
 }
 
 void LatticeGS::load_rows(const SparseMatrix& A) {
@@ -572,7 +698,26 @@ bool LatticeGS::deep_rows_match(const SparseMatrix& A) const {
         }
         return d1;
     });
-    return bad == nd;
+    if (bad != nd) return false;
+    const size_t ns = semi_macro_.size();
+    const size_t bad_semi = parallel::first_flagged(ns, 4096, [&](size_t k0, size_t k1) {
+        for (size_t k = k0; k < k1; ++k) {
+            const size_t m = static_cast<size_t>(semi_macro_[k]);
+            const double* S = stencils_.data() + m * kStencil;
+            const double t = tol[m];
+            const int r = semi_nbr_[k * kSlots];
+            const double* v0 = av + ao[r];
+            const double* v1 = av + ao[r + 1];
+            for (int q = 0; q < kSlots; ++q) {
+                const double* B = S + 4 * semi_slots_[k * kSlots + static_cast<size_t>(q)];
+                if (!(std::abs(v0[2 * q] - B[0]) <= t && std::abs(v0[2 * q + 1] - B[1]) <= t &&
+                      std::abs(v1[2 * q] - B[2]) <= t && std::abs(v1[2 * q + 1] - B[3]) <= t))
+                    return k;
+            }
+        }
+        return k1;
+    });
+    return bad_semi == ns;
 }
 
 template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, double* x) const {
@@ -620,6 +765,21 @@ template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, doubl
         const int i0 = item_begin_[static_cast<size_t>(k)];
         const int i1 = item_begin_[static_cast<size_t>(k) + 1];
         const int code = visit_code_[static_cast<size_t>(i0)];
+        if (code <= kSemiMax) { // semi-deep points
+            auto semi = [&](int i) {
+                const size_t e = static_cast<size_t>(visit_code_[static_cast<size_t>(i)] - kSemi);
+                semi_point<true>(stencils_.data() + static_cast<size_t>(semi_macro_[e]) * kStencil,
+                                 semi_nbr_.data() + e * kSlots, b, x, x);
+            };
+            if constexpr (Forward) {
+                for (int i = i0; i < i1; ++i)
+                    semi(i);
+            } else {
+                for (int i = i1; i-- > i0;)
+                    semi(i);
+            }
+            return;
+        }
         if (code < 0) { // blocks swept by their rows
             if constexpr (Forward) {
                 for (int i = i0; i < i1; ++i)
@@ -655,7 +815,8 @@ void LatticeGS::half_sweep(const double* b, double* x, bool forward) const {
     // entries, b read and x read and written.
     const double bytes =
         12.0 * static_cast<double>(ccol_.size()) + 8.0 * static_cast<double>(cinv_.size()) +
-        8.0 * static_cast<double>(visit_row_.size()) + 24.0 * static_cast<double>(n_);
+        8.0 * static_cast<double>(visit_row_.size()) + 4.0 * static_cast<double>(semi_nbr_.size()) +
+        24.0 * static_cast<double>(n_);
     const traffic::Pass pass(traffic::Kind::smoother, bytes);
     for (int c : interface_)
         snap_[c] = x[c];
@@ -691,7 +852,8 @@ void LatticeGS::multiply(const Vector& x, Vector& y) const {
     const traffic::Pass pass(
         traffic::Kind::matvec,
         12.0 * static_cast<double>(ccol_.size()) + 4.0 * static_cast<double>(crow_ptr_.size()) +
-            8.0 * static_cast<double>(visit_row_.size()) + 16.0 * static_cast<double>(n_));
+            8.0 * static_cast<double>(visit_row_.size()) +
+            4.0 * static_cast<double>(semi_nbr_.size()) + 16.0 * static_cast<double>(n_));
     const double* xv = x.data();
     double* yv = y.data();
     const double* val = cval_.data();
@@ -701,6 +863,16 @@ void LatticeGS::multiply(const Vector& x, Vector& y) const {
             const int i0 = item_begin_[static_cast<size_t>(k)];
             const int i1 = item_begin_[static_cast<size_t>(k) + 1];
             const int code = visit_code_[static_cast<size_t>(i0)];
+            if (code <= kSemiMax) {
+                for (int i = i0; i < i1; ++i) {
+                    const size_t s =
+                        static_cast<size_t>(visit_code_[static_cast<size_t>(i)] - kSemi);
+                    semi_point<false>(stencils_.data() +
+                                          static_cast<size_t>(semi_macro_[s]) * kStencil,
+                                      semi_nbr_.data() + s * kSlots, nullptr, xv, yv);
+                }
+                continue;
+            }
             if (code < 0) {
                 for (int i = i0; i < i1; ++i) {
                     const size_t c = static_cast<size_t>(-1 - visit_code_[static_cast<size_t>(i)]);

@@ -84,6 +84,9 @@ public:
 
     /// Interior lattice points swept by their macro's stencil after the last setup.
     Index deep_points() const { return n_deep_; }
+    /// Interior lattice points next to a macro edge (or a part's cut) whose rows hold the
+    /// macro's stencil: swept by it, their neighbours through a list of rows.
+    Index semi_deep_points() const { return static_cast<Index>(semi_macro_.size()); }
     /// Rows of the matrix.
     Index rows() const { return n_; }
     /// Parts of the last setup.
@@ -123,6 +126,11 @@ private:
     // them at update_values.
     std::vector<int> deep_row_, deep_len_, deep_macro_;
     std::vector<std::uint8_t> deep_slots_; // 7 per deep point
+    // Semi-deep points (visit code kSemi + index): interior points whose rows hold their macro's
+    // stencil, some neighbours on the macro's edges: macro, the neighbours' first rows by slot
+    // (7 per point, slot 0 the point's own), and the slot of each column pair of its rows.
+    std::vector<int> semi_macro_, semi_nbr_;
+    std::vector<std::uint8_t> semi_slots_;
     // Row-swept blocks: first row, size, block index, their rows (entries of the own part
     // first, then those read across a cut), twin flag and inverse.
     std::vector<int> cb_row_, cb_size_, cb_block_, cb_crow_;

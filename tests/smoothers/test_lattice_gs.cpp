@@ -122,6 +122,7 @@ TEST(LatticeGS, SweepIsBlockGaussSeidelInItsVisitOrder) {
                 LatticeGS S(c.starts, c.lattice, {.omega = omega});
                 S.setup(c.A);
                 EXPECT_EQ(S.parts(), depth == 4 ? 1 : 2);
+                EXPECT_GT(S.semi_deep_points(), 0);
                 if (depth == 4) {
                     // (16-1)(16-2)/2 = 105 interior points per macro, of which i, j >= 2,
                     // i + j <= 14: 66 deep; four macros.
