@@ -124,7 +124,8 @@ public:
             lat = std::make_unique<smoothers::LatticeGS>(block_starts_, *lattice_);
             lat->setup(*mg->finest_operator());
             std::cerr << "bench_kernels: lattice smoother " << lat->name() << ", "
-                      << lat->deep_points() << " deep points of " << n / 2 << " vertices\n";
+                      << lat->deep_points() << " deep and " << lat->semi_deep_points()
+                      << " semi-deep points of " << n / 2 << " vertices\n";
         }
         Vector xl = parallel::zeros(n);
         for (int k = 0; k < reps_; ++k) {

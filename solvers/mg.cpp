@@ -368,7 +368,8 @@ MultigridReport Multigrid::report() const {
         row.nonzeros = L.A ? L.A->nonZeros() : 0;
         row.solve = k == 0      ? L.coarse->name()
                     : L.lattice ? "smoother (lattice, " + std::to_string(L.lattice->deep_points()) +
-                                      " deep points)"
+                                      " deep and " + std::to_string(L.lattice->semi_deep_points()) +
+                                      " semi-deep points)"
                                 : "smoother";
         nnz += static_cast<double>(row.nonzeros);
         rows += static_cast<double>(row.rows);
