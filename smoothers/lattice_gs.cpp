@@ -608,18 +608,21 @@ bool LatticeGS::same_pattern(const SparseMatrix& A) const {
         return e1;
     });
     if (bad != ne) return false;
+    // Column pair q of rows r and r + 1 is (c, c + 1) in both (their lengths are the setup's:
+    // outer_ matched).
+    auto pair_at = [&](int r, int q, long c) {
+        return ai[ao[r] + 2 * q] == c && ai[ao[r] + 2 * q + 1] == c + 1 &&
+               ai[ao[r + 1] + 2 * q] == c && ai[ao[r + 1] + 2 * q + 1] == c + 1;
+    };
     const size_t nd = deep_row_.size();
     const size_t bad_deep = parallel::first_flagged(nd, 4096, [&](size_t d0, size_t d1) {
         for (size_t d = d0; d < d1; ++d) {
             const int r = deep_row_[d];
             const long len = deep_len_[d];
             const long off[kSlots] = {0, 2, -2, 2 * len, -2 * (len + 1), -2 * len, 2 * len - 2};
-            for (int q = 0; q < kSlots; ++q) {
-                const long c = r + off[deep_slots_[d * kSlots + static_cast<size_t>(q)]];
-                if (ai[ao[r] + 2 * q] != c || ai[ao[r] + 2 * q + 1] != c + 1 ||
-                    ai[ao[r + 1] + 2 * q] != c || ai[ao[r + 1] + 2 * q + 1] != c + 1)
+            for (int q = 0; q < kSlots; ++q)
+                if (!pair_at(r, q, r + off[deep_slots_[d * kSlots + static_cast<size_t>(q)]]))
                     return d;
-            }
         }
         return d1;
     });
@@ -628,14 +631,9 @@ bool LatticeGS::same_pattern(const SparseMatrix& A) const {
     const size_t bad_semi = parallel::first_flagged(ns, 4096, [&](size_t k0, size_t k1) {
         for (size_t k = k0; k < k1; ++k) {
             const int* nbr = semi_nbr_.data() + k * kSlots;
-            const int r = nbr[0];
-            if (ao[r + 1] - ao[r] != 2 * kSlots || ao[r + 2] - ao[r + 1] != 2 * kSlots) return k;
-            for (int q = 0; q < kSlots; ++q) {
-                const int c = nbr[semi_slots_[k * kSlots + static_cast<size_t>(q)]];
-                if (ai[ao[r] + 2 * q] != c || ai[ao[r] + 2 * q + 1] != c + 1 ||
-                    ai[ao[r + 1] + 2 * q] != c || ai[ao[r + 1] + 2 * q + 1] != c + 1)
+            for (int q = 0; q < kSlots; ++q)
+                if (!pair_at(nbr[0], q, nbr[semi_slots_[k * kSlots + static_cast<size_t>(q)]]))
                     return k;
-            }
         }
         return k1;
     });
@@ -681,40 +679,34 @@ bool LatticeGS::deep_rows_match(const SparseMatrix& A) const {
             mx = std::max(mx, std::abs(stencils_[m * kStencil + static_cast<size_t>(e)]));
         tol[m] = params_.stencil_tol * mx;
     }
-    const size_t bad = parallel::first_flagged(nd, 4096, [&](size_t d0, size_t d1) {
-        for (size_t d = d0; d < d1; ++d) {
-            const int r = deep_row_[d];
-            const size_t m = static_cast<size_t>(deep_macro_[d]);
-            const double* S = stencils_.data() + m * kStencil;
-            const double t = tol[m];
-            const double* v0 = av + ao[r];
-            const double* v1 = av + ao[r + 1];
-            for (int q = 0; q < kSlots; ++q) {
-                const double* B = S + 4 * deep_slots_[d * kSlots + static_cast<size_t>(q)];
-                if (!(std::abs(v0[2 * q] - B[0]) <= t && std::abs(v0[2 * q + 1] - B[1]) <= t &&
-                      std::abs(v1[2 * q] - B[2]) <= t && std::abs(v1[2 * q + 1] - B[3]) <= t))
-                    return d;
-            }
+    // Rows r and r + 1 hold macro m's stencil, their column pairs in the given slots.
+    auto holds_stencil = [&](int r, size_t m, const std::uint8_t* slots) {
+        const double* S = stencils_.data() + m * kStencil;
+        const double t = tol[m];
+        const double* v0 = av + ao[r];
+        const double* v1 = av + ao[r + 1];
+        for (int q = 0; q < kSlots; ++q) {
+            const double* B = S + 4 * slots[q];
+            if (!(std::abs(v0[2 * q] - B[0]) <= t && std::abs(v0[2 * q + 1] - B[1]) <= t &&
+                  std::abs(v1[2 * q] - B[2]) <= t && std::abs(v1[2 * q + 1] - B[3]) <= t))
+                return false;
         }
+        return true;
+    };
+    const size_t bad = parallel::first_flagged(nd, 4096, [&](size_t d0, size_t d1) {
+        for (size_t d = d0; d < d1; ++d)
+            if (!holds_stencil(deep_row_[d], static_cast<size_t>(deep_macro_[d]),
+                               deep_slots_.data() + d * kSlots))
+                return d;
         return d1;
     });
     if (bad != nd) return false;
     const size_t ns = semi_macro_.size();
     const size_t bad_semi = parallel::first_flagged(ns, 4096, [&](size_t k0, size_t k1) {
-        for (size_t k = k0; k < k1; ++k) {
-            const size_t m = static_cast<size_t>(semi_macro_[k]);
-            const double* S = stencils_.data() + m * kStencil;
-            const double t = tol[m];
-            const int r = semi_nbr_[k * kSlots];
-            const double* v0 = av + ao[r];
-            const double* v1 = av + ao[r + 1];
-            for (int q = 0; q < kSlots; ++q) {
-                const double* B = S + 4 * semi_slots_[k * kSlots + static_cast<size_t>(q)];
-                if (!(std::abs(v0[2 * q] - B[0]) <= t && std::abs(v0[2 * q + 1] - B[1]) <= t &&
-                      std::abs(v1[2 * q] - B[2]) <= t && std::abs(v1[2 * q + 1] - B[3]) <= t))
-                    return k;
-            }
-        }
+        for (size_t k = k0; k < k1; ++k)
+            if (!holds_stencil(semi_nbr_[k * kSlots], static_cast<size_t>(semi_macro_[k]),
+                               semi_slots_.data() + k * kSlots))
+                return k;
         return k1;
     });
     return bad_semi == ns;

@@ -108,35 +108,42 @@ Vector reference_sweep(const LatticeGS& S, const SparseMatrix& A, const std::vec
 
 using mlc::testutil::random_vector;
 
+// One sweep of the lattice smoother is block Gauss–Seidel of c.A in its visit order (Jacobi
+// across the parts), to round-off: forward and backward, omega 1 and 1.3.
+void expect_gauss_seidel(const Case& c, unsigned seed) {
+    const Index n = c.A.rows();
+    const Vector b = random_vector(n, seed), x0 = random_vector(n, seed + 1);
+    for (double omega : {1.0, 1.3})
+        for (bool forward : {true, false}) {
+            LatticeGS S(c.starts, c.lattice, {.omega = omega});
+            S.setup(c.A);
+            Vector x = x0;
+            S.smooth(b, x, forward ? Sweep::forward : Sweep::backward, 1);
+            const Vector ref = reference_sweep(S, c.A, c.starts, b, x0, forward, omega);
+            EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm()) << omega << " " << forward;
+        }
+}
+
 } // namespace
 
-// The lattice sweep is block Gauss–Seidel of A in its visit order (Jacobi across the parts), to
-// round-off: forward and backward, omega 1 and 1.3, one part (level 4) and two (level 6).
+// In the Hilbert visit, one part (level 4) and two (level 6).
 TEST(LatticeGS, SweepIsBlockGaussSeidelInItsVisitOrder) {
     for (int depth : {4, 6}) {
         const Case c = elastic_case(depth, true);
-        const Index n = c.A.rows();
-        const Vector b = random_vector(n, 1), x0 = random_vector(n, 2);
-        for (double omega : {1.0, 1.3})
-            for (bool forward : {true, false}) {
-                LatticeGS S(c.starts, c.lattice, {.omega = omega});
-                S.setup(c.A);
-                EXPECT_EQ(S.parts(), depth == 4 ? 1 : 2);
-                EXPECT_GT(S.semi_deep_points(), 0);
-                if (depth == 4) {
-                    // (16-1)(16-2)/2 = 105 interior points per macro, of which i, j >= 2,
-                    // i + j <= 14: 66 deep; four macros.
-                    EXPECT_EQ(S.deep_points(), 4 * 66);
-                } else {
-                    EXPECT_GT(S.deep_points(), 4 * 1500); // of 4 * 1830 (i, j >= 2, i + j <= 62)
-                    EXPECT_LT(S.deep_points(), 4 * 1830); // the parts' cut takes some
-                }
-                Vector x = x0;
-                S.smooth(b, x, forward ? Sweep::forward : Sweep::backward, 1);
-                const Vector ref = reference_sweep(S, c.A, c.starts, b, x0, forward, omega);
-                EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm())
-                    << depth << " " << omega << " " << forward;
-            }
+        LatticeGS S(c.starts, c.lattice, {});
+        S.setup(c.A);
+        EXPECT_EQ(S.parts(), depth == 4 ? 1 : 2);
+        EXPECT_GT(S.semi_deep_points(), 0);
+        if (depth == 4) {
+            // (16-1)(16-2)/2 = 105 interior points per macro, of which i, j >= 2,
+            // i + j <= 14: 66 deep; four macros.
+            EXPECT_EQ(S.deep_points(), 4 * 66);
+        } else {
+            EXPECT_GT(S.deep_points(), 4 * 1500); // of 4 * 1830 (i, j >= 2, i + j <= 62)
+            EXPECT_LT(S.deep_points(), 4 * 1830); // the parts' cut takes some
+        }
+        SCOPED_TRACE(depth);
+        expect_gauss_seidel(c, 1);
     }
 }
 
@@ -212,34 +219,48 @@ TEST(LatticeGS, RepeatedSweepsAndTheSweepFromZero) {
     EXPECT_LT((res - (b - c.A * z)).norm(), 1e-13 * b.norm());
 }
 
-// A new entry in a deep row or in a row-swept row is a new pattern: update_values sets up again
-// (the deep point becomes row-swept) and the sweep stays Gauss–Seidel of the new matrix.
+// A new entry in a deep, a semi-deep or a row-swept row is a new pattern: update_values sets up
+// again (the point becomes row-swept) and the sweep stays Gauss–Seidel of the new matrix.
 TEST(LatticeGS, ANewPatternIsSetUpAgain) {
-    for (bool in_deep_row : {true, false}) {
+    // semi_moved: a semi-deep point's first column pair moved to the last two columns (the
+    // same row lengths: only the semi-deep pattern check sees it).
+    enum Kind { deep_row, semi_row, swept_row, semi_moved };
+    for (Kind kind : {deep_row, semi_row, swept_row, semi_moved}) {
         Case c = elastic_case(4, true);
         const Index n = c.A.rows();
         LatticeGS S(c.starts, c.lattice, {});
         S.setup(c.A);
-        const Index deep = S.deep_points();
-        // Row of a deep point of macro 2 (point 40), or of a point next to its edge (point 0),
-        // coupled to a far row (the last one): an entry that was not there.
-        const Index r = c.lattice.first_row[static_cast<size_t>(2 * 105 + (in_deep_row ? 40 : 0))];
+        const Index deep = S.deep_points(), semi = S.semi_deep_points();
+        // Row of a deep point of macro 2 (point 40), of a semi-deep one (point 60, next to an
+        // edge), or of a row-swept one (point 0, next to the fixed bottom edge), coupled to a far
+        // row (the last one): an entry that was not there.
+        const int point = kind == deep_row ? 40 : kind == swept_row ? 0 : 60;
+        const Index r = c.lattice.first_row[static_cast<size_t>(2 * 105 + point)];
         std::vector<Triplet> t;
+        const Index moved = SparseMatrix::InnerIterator(c.A, r).col(); // first column pair
         for (Index i = 0; i < n; ++i)
-            for (SparseMatrix::InnerIterator it(c.A, i); it; ++it)
-                t.emplace_back(i, it.col(), it.value());
-        t.emplace_back(r, n - 1, 1e-3);
-        t.emplace_back(n - 1, r, 1e-3);
+            for (SparseMatrix::InnerIterator it(c.A, i); it; ++it) {
+                const bool move = kind == semi_moved && (i == r || i == r + 1) &&
+                                  (it.col() == moved || it.col() == moved + 1);
+                t.emplace_back(i, move ? it.col() - moved + n - 2 : it.col(), it.value());
+            }
+        if (kind != semi_moved) {
+            t.emplace_back(r, n - 1, 1e-3);
+            t.emplace_back(n - 1, r, 1e-3);
+        }
         SparseMatrix B(n, n);
         B.setFromTriplets(t.begin(), t.end());
         B.makeCompressed();
         S.update_values(B);
-        EXPECT_EQ(S.deep_points(), in_deep_row ? deep - 1 : deep);
+        EXPECT_EQ(S.deep_points(), kind == deep_row ? deep - 1 : deep);
+        // (The moved pair, on the macro's edge, is matched to its slot by value again: the point
+        // stays semi-deep, now reading the moved column; the sweep below tells.)
+        EXPECT_EQ(S.semi_deep_points(), kind == semi_row ? semi - 1 : semi);
         const Vector b = random_vector(n, 9), x0 = random_vector(n, 10);
         Vector x = x0;
         S.smooth(b, x, Sweep::forward, 1);
         const Vector ref = reference_sweep(S, B, c.starts, b, x0, true, 1.0);
-        EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm()) << in_deep_row;
+        EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm()) << kind;
     }
 }
 
@@ -284,18 +305,10 @@ TEST(LatticeGS, SerpentineRowsAreBlockGaussSeidelInThatOrder) {
     for (Index i = 0; i < c.A.rows(); ++i)
         for (SparseMatrix::InnerIterator it(c.A, i); it; ++it)
             if (it.col() == i + 2) it.valueRef() += d;
-    const Index n = c.A.rows();
-    const Vector b = random_vector(n, 11), x0 = random_vector(n, 12);
-    for (double omega : {1.0, 1.3})
-        for (bool forward : {true, false}) {
-            LatticeGS S(c.starts, c.lattice, {.omega = omega});
-            S.setup(c.A);
-            EXPECT_GT(S.deep_points(), 4 * 1500);
-            Vector x = x0;
-            S.smooth(b, x, forward ? Sweep::forward : Sweep::backward, 1);
-            const Vector ref = reference_sweep(S, c.A, c.starts, b, x0, forward, omega);
-            EXPECT_LT((x - ref).norm(), 1e-12 * ref.norm()) << omega << " " << forward;
-        }
+    LatticeGS S(c.starts, c.lattice, {});
+    S.setup(c.A);
+    EXPECT_GT(S.deep_points(), 4 * 1500);
+    expect_gauss_seidel(c, 11);
 }
 
 // multiply is A x (deep rows by the macro's stencil, the others by their rows), with the Hilbert
