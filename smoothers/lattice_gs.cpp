@@ -54,32 +54,35 @@ inline __m128d swap(__m128d y) {
 inline __m128d block(__m128d d, __m128d o, __m128d y) {
     return _mm_add_pd(_mm_mul_pd(d, y), _mm_mul_pd(o, swap(y)));
 }
+// The ten packed blocks of a macro's stencil (kPacked on): slots 0-6, omega D^{-1} (7), G_east
+// (8), G_west (9), each as its diagonal and off-diagonal pairs.
+struct PackedStencil {
+    __m128d d[10], o[10];
+    explicit PackedStencil(const double* S) {
+        for (int q = 0; q < 10; ++q) {
+            d[q] = _mm_loadu_pd(S + kPacked + 4 * q);
+            o[q] = _mm_loadu_pd(S + kPacked + 4 * q + 2);
+        }
+    }
+    __m128d times(int q, __m128d y) const { return block(d[q], o[q], y); }
+};
 void deep_run(const double* __restrict S, const double* __restrict b, double* x, long r, long step,
               int count, long len) {
     const long nn = 2 * len, nw = 2 * len - 2, so = -2 * (len + 1), se = -2 * len;
-    const double* Q = S + kPacked;
-    const double* Qa = step > 0 ? Q + 4 : Q + 8;   // ahead: east or west
-    const double* Qg = step > 0 ? Q + 36 : Q + 32; // behind: west or east
-    const __m128d c0d = _mm_loadu_pd(Q), c0o = _mm_loadu_pd(Q + 2);
-    const __m128d cad = _mm_loadu_pd(Qa), cao = _mm_loadu_pd(Qa + 2);
-    const __m128d cnd = _mm_loadu_pd(Q + 12), cno = _mm_loadu_pd(Q + 14);
-    const __m128d csd = _mm_loadu_pd(Q + 16), cso = _mm_loadu_pd(Q + 18);
-    const __m128d ced = _mm_loadu_pd(Q + 20), ceo = _mm_loadu_pd(Q + 22);
-    const __m128d cwd = _mm_loadu_pd(Q + 24), cwo = _mm_loadu_pd(Q + 26);
-    const __m128d dd = _mm_loadu_pd(Q + 28), dof = _mm_loadu_pd(Q + 30);
-    const __m128d gd = _mm_loadu_pd(Qg), go = _mm_loadu_pd(Qg + 2);
+    const PackedStencil P(S);
+    const int ahead = step > 0 ? 1 : 2, behind = step > 0 ? 9 : 8; // east or west; G_west or G_east
     __m128d p = _mm_loadu_pd(x + r - step);
     for (int k = 0; k < count; ++k, r += step) {
         const double* y = x + r;
         const __m128d y0 = _mm_loadu_pd(y);
-        const __m128d t = _mm_add_pd(block(c0d, c0o, y0), block(cad, cao, _mm_loadu_pd(y + step)));
-        const __m128d u = _mm_add_pd(block(cnd, cno, _mm_loadu_pd(y + nn)),
-                                     block(csd, cso, _mm_loadu_pd(y + so)));
-        const __m128d v = _mm_add_pd(block(ced, ceo, _mm_loadu_pd(y + se)),
-                                     block(cwd, cwo, _mm_loadu_pd(y + nw)));
+        const __m128d t = _mm_add_pd(P.times(0, y0), P.times(ahead, _mm_loadu_pd(y + step)));
+        const __m128d u =
+            _mm_add_pd(P.times(3, _mm_loadu_pd(y + nn)), P.times(4, _mm_loadu_pd(y + so)));
+        const __m128d v =
+            _mm_add_pd(P.times(5, _mm_loadu_pd(y + se)), P.times(6, _mm_loadu_pd(y + nw)));
         const __m128d a = _mm_sub_pd(_mm_loadu_pd(b + r), _mm_add_pd(_mm_add_pd(t, u), v));
-        const __m128d c = _mm_add_pd(y0, block(dd, dof, a));
-        p = _mm_sub_pd(c, block(gd, go, p));
+        const __m128d c = _mm_add_pd(y0, P.times(7, a));
+        p = _mm_sub_pd(c, P.times(behind, p));
         _mm_storeu_pd(x + r, p);
     }
 }
@@ -87,23 +90,16 @@ void deep_run(const double* __restrict S, const double* __restrict b, double* x,
 void deep_product(const double* __restrict S, const double* __restrict x, double* __restrict y,
                   long r, long step, int count, long len) {
     const long nn = 2 * len, nw = 2 * len - 2, so = -2 * (len + 1), se = -2 * len;
-    const double* Q = S + kPacked;
-    const __m128d c0d = _mm_loadu_pd(Q), c0o = _mm_loadu_pd(Q + 2);
-    const __m128d ced_ = _mm_loadu_pd(Q + 4), ceo_ = _mm_loadu_pd(Q + 6);
-    const __m128d cwd_ = _mm_loadu_pd(Q + 8), cwo_ = _mm_loadu_pd(Q + 10);
-    const __m128d cnd = _mm_loadu_pd(Q + 12), cno = _mm_loadu_pd(Q + 14);
-    const __m128d csd = _mm_loadu_pd(Q + 16), cso = _mm_loadu_pd(Q + 18);
-    const __m128d ced = _mm_loadu_pd(Q + 20), ceo = _mm_loadu_pd(Q + 22);
-    const __m128d cwd = _mm_loadu_pd(Q + 24), cwo = _mm_loadu_pd(Q + 26);
+    const PackedStencil P(S);
     for (int k = 0; k < count; ++k, r += step) {
         const double* z = x + r;
-        const __m128d t = _mm_add_pd(block(c0d, c0o, _mm_loadu_pd(z)),
-                                     _mm_add_pd(block(ced_, ceo_, _mm_loadu_pd(z + 2)),
-                                                block(cwd_, cwo_, _mm_loadu_pd(z - 2))));
-        const __m128d u = _mm_add_pd(block(cnd, cno, _mm_loadu_pd(z + nn)),
-                                     block(csd, cso, _mm_loadu_pd(z + so)));
-        const __m128d v = _mm_add_pd(block(ced, ceo, _mm_loadu_pd(z + se)),
-                                     block(cwd, cwo, _mm_loadu_pd(z + nw)));
+        const __m128d t =
+            _mm_add_pd(P.times(0, _mm_loadu_pd(z)), _mm_add_pd(P.times(1, _mm_loadu_pd(z + 2)),
+                                                               P.times(2, _mm_loadu_pd(z - 2))));
+        const __m128d u =
+            _mm_add_pd(P.times(3, _mm_loadu_pd(z + nn)), P.times(4, _mm_loadu_pd(z + so)));
+        const __m128d v =
+            _mm_add_pd(P.times(5, _mm_loadu_pd(z + se)), P.times(6, _mm_loadu_pd(z + nw)));
         _mm_storeu_pd(y + r, _mm_add_pd(_mm_add_pd(t, u), v));
     }
 }
