@@ -175,6 +175,17 @@ inline void semi_point(const double* __restrict S, const int* __restrict nb, con
     }
 }
 
+// fn(i) for i in [i0, i1): ascending when Forward, else descending.
+template <bool Forward, class Fn> inline void in_order(int i0, int i1, Fn&& fn) {
+    if constexpr (Forward) {
+        for (int i = i0; i < i1; ++i)
+            fn(i);
+    } else {
+        for (int i = i1; i-- > i0;)
+            fn(i);
+    }
+}
+
 } // namespace
 
 LatticeGS::LatticeGS(std::vector<Index> block_starts, LatticeRows lattice, LatticeGSParams params)
@@ -754,28 +765,16 @@ template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, doubl
         const int i1 = item_begin_[static_cast<size_t>(k) + 1];
         const int code = visit_code_[static_cast<size_t>(i0)];
         if (code <= kSemiMax) { // semi-deep points
-            auto semi = [&](int i) {
+            in_order<Forward>(i0, i1, [&](int i) {
                 const size_t e = static_cast<size_t>(visit_code_[static_cast<size_t>(i)] - kSemi);
                 semi_point<true>(stencils_.data() + static_cast<size_t>(semi_macro_[e]) * kStencil,
                                  semi_nbr_.data() + e * kSlots, b, x, x);
-            };
-            if constexpr (Forward) {
-                for (int i = i0; i < i1; ++i)
-                    semi(i);
-            } else {
-                for (int i = i1; i-- > i0;)
-                    semi(i);
-            }
+            });
             return;
         }
         if (code < 0) { // blocks swept by their rows
-            if constexpr (Forward) {
-                for (int i = i0; i < i1; ++i)
-                    block(-1 - visit_code_[static_cast<size_t>(i)]);
-            } else {
-                for (int i = i1; i-- > i0;)
-                    block(-1 - visit_code_[static_cast<size_t>(i)]);
-            }
+            in_order<Forward>(i0, i1,
+                              [&](int i) { block(-1 - visit_code_[static_cast<size_t>(i)]); });
             return;
         }
         // A run of deep points along one lattice row.
@@ -789,13 +788,7 @@ template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, doubl
             deep_run(S, b, x, visit_row_[static_cast<size_t>(i1) - 1], -step, i1 - i0,
                      code % kLenCodes);
     };
-    if constexpr (Forward) {
-        for (int k = k0; k < k1; ++k)
-            item(k);
-    } else {
-        for (int k = k1; k-- > k0;)
-            item(k);
-    }
+    in_order<Forward>(k0, k1, item);
 }
 
 void LatticeGS::half_sweep(const double* b, double* x, bool forward) const {
