@@ -231,15 +231,15 @@ void LatticeGS::derive(const SparseMatrix& A) {
     const int* ai = A.innerIndexPtr();
     const double* av = A.valuePtr();
     // Blocks.
-    std::vector<Index> starts_ =
+    std::vector<Index> starts =
         block_starts_in_.empty() ? uniform_block_starts(n_, 2) : block_starts_in_;
-    if (starts_.back() != n_) starts_.push_back(n_);
-    MLC_CHECK(starts_.front() == 0, "lattice smoother: the blocks must start at row 0");
-    const Index nb = static_cast<Index>(starts_.size()) - 1;
+    if (starts.back() != n_) starts.push_back(n_);
+    MLC_CHECK(starts.front() == 0, "lattice smoother: the blocks must start at row 0");
+    const Index nb = static_cast<Index>(starts.size()) - 1;
     std::vector<int> block_of_row(static_cast<size_t>(n_));
     for (Index b = 0; b < nb; ++b) {
-        MLC_CHECK(starts_[b] < starts_[b + 1], "lattice smoother: block starts must increase");
-        for (Index r = starts_[b]; r < starts_[b + 1]; ++r)
+        MLC_CHECK(starts[b] < starts[b + 1], "lattice smoother: block starts must increase");
+        for (Index r = starts[b]; r < starts[b + 1]; ++r)
             block_of_row[static_cast<size_t>(r)] = static_cast<int>(b);
     }
     // The visit order and its parts: runs of about equal nonzeros (BlockSOR's cut).
@@ -254,7 +254,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
         std::vector<char> seen(static_cast<size_t>(nb), 0);
         for (size_t i = 0; i < lattice_.visit.size(); ++i) {
             const Index r = lattice_.visit[i];
-            MLC_CHECK(r >= 0 && r < n_ && starts_[block_of_row[static_cast<size_t>(r)]] == r &&
+            MLC_CHECK(r >= 0 && r < n_ && starts[block_of_row[static_cast<size_t>(r)]] == r &&
                           !seen[static_cast<size_t>(block_of_row[static_cast<size_t>(r)])],
                       "lattice smoother: visit entry " << i << " (row " << r
                                                        << ") is not a block's first row, or "
@@ -273,7 +273,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
         for (Index i = 0; i < nb; ++i) {
             const int b = order[static_cast<size_t>(i)];
             part_of_block[static_cast<size_t>(b)] = p;
-            cum += static_cast<double>(ao[starts_[b + 1]] - ao[starts_[b]]);
+            cum += static_cast<double>(ao[starts[b + 1]] - ao[starts[b]]);
             if (p + 1 < P && cum >= per_part * (p + 1)) {
                 cut.push_back(static_cast<int>(i + 1));
                 ++p;
@@ -305,7 +305,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
             const Index r = fr[q];
             if (r != row0 + 2 * q || r < 0 || r + 2 > n_) return;
             const int b = block_of_row[static_cast<size_t>(r)];
-            if (starts_[b] != r || starts_[b + 1] != r + 2) return;
+            if (starts[b] != r || starts[b + 1] != r + 2) return;
         }
         double* S = stencils_.data() + m * kStencil;
         bool have = false;
@@ -417,8 +417,8 @@ void LatticeGS::derive(const SparseMatrix& A) {
                     const int c0 = ai[ao[r] + 2 * q], c1 = ai[ao[r] + 2 * q + 1];
                     const int d0 = ai[ao[r + 1] + 2 * q], d1 = ai[ao[r + 1] + 2 * q + 1];
                     const int cb = block_of_row[static_cast<size_t>(c0)];
-                    fits = c1 == c0 + 1 && d0 == c0 && d1 == c1 && starts_[cb] == c0 &&
-                           starts_[cb + 1] == c0 + 2 &&
+                    fits = c1 == c0 + 1 && d0 == c0 && d1 == c1 && starts[cb] == c0 &&
+                           starts[cb + 1] == c0 + 2 &&
                            part_of_block[static_cast<size_t>(cb)] == part;
                     if (!fits) break;
                     const double w[4] = {av[ao[r] + 2 * q], av[ao[r] + 2 * q + 1],
@@ -490,7 +490,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
     cb_block_.clear();
     for (Index i = 0; i < nb; ++i) {
         const int b = order[static_cast<size_t>(i)];
-        visit_row_[static_cast<size_t>(i)] = static_cast<int>(starts_[b]);
+        visit_row_[static_cast<size_t>(i)] = static_cast<int>(starts[b]);
         if (deep_len[static_cast<size_t>(b)] > 0) {
             visit_code_[static_cast<size_t>(i)] =
                 deep_mac[static_cast<size_t>(b)] * kLenCodes + deep_len[static_cast<size_t>(b)];
@@ -498,8 +498,8 @@ void LatticeGS::derive(const SparseMatrix& A) {
             visit_code_[static_cast<size_t>(i)] = kSemi + semi_of_block[static_cast<size_t>(b)];
         } else {
             visit_code_[static_cast<size_t>(i)] = -1 - static_cast<int>(cb_row_.size());
-            cb_row_.push_back(static_cast<int>(starts_[b]));
-            cb_size_.push_back(static_cast<int>(starts_[b + 1] - starts_[b]));
+            cb_row_.push_back(static_cast<int>(starts[b]));
+            cb_size_.push_back(static_cast<int>(starts[b + 1] - starts[b]));
             cb_block_.push_back(b);
         }
     }
@@ -719,6 +719,12 @@ bool LatticeGS::deep_rows_match(const SparseMatrix& A) const {
     return bad_semi == ns;
 }
 
+long LatticeGS::run_step(int i0, int i1) const {
+    return i1 - i0 > 1
+               ? visit_row_[static_cast<size_t>(i0) + 1] - visit_row_[static_cast<size_t>(i0)]
+               : 2;
+}
+
 template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, double* x) const {
     const double* snap = snap_.data();
     const double* val = cval_.data();
@@ -778,9 +784,7 @@ template <bool Forward> void LatticeGS::sweep_part(int p, const double* b, doubl
             return;
         }
         // A run of deep points along one lattice row.
-        const long step = i1 - i0 > 1 ? visit_row_[static_cast<size_t>(i0) + 1] -
-                                            visit_row_[static_cast<size_t>(i0)]
-                                      : 2;
+        const long step = run_step(i0, i1);
         const double* S = stencils_.data() + static_cast<size_t>(code / kLenCodes) * kStencil;
         if constexpr (Forward)
             deep_run(S, b, x, visit_row_[static_cast<size_t>(i0)], step, i1 - i0, code % kLenCodes);
@@ -865,9 +869,7 @@ void LatticeGS::multiply(const Vector& x, Vector& y) const {
                 }
                 continue;
             }
-            const long step = i1 - i0 > 1 ? visit_row_[static_cast<size_t>(i0) + 1] -
-                                                visit_row_[static_cast<size_t>(i0)]
-                                          : 2;
+            const long step = run_step(i0, i1);
             deep_product(stencils_.data() + static_cast<size_t>(code / kLenCodes) * kStencil, xv,
                          yv, visit_row_[static_cast<size_t>(i0)], step, i1 - i0, code % kLenCodes);
         }

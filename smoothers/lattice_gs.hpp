@@ -11,19 +11,23 @@
 /// offsets from it, and the stencil and its inverted centre block are read once per macro:
 ///  - "deep" points: interior lattice points whose six neighbours are interior too, in the same
 ///    threaded part, and whose rows hold exactly the macro's stencil (to stencil_tol of its
-///    largest entry), by the stencil;
-///  - every other block (the points next to a macro edge, the macro edges and corners, contact
-///    vertices with their multipliers, fixed components, macros not numbered as a lattice) by
-///    its own rows, as BlockSOR does.
-/// The blocks are visited in a given order (LatticeRows::visit: the Hilbert order of the
-/// vertices, the order BlockSOR visits them in with the default numbering) and cut into threaded
-/// parts as BlockSOR cuts them (runs of that order of about equal nonzeros, Jacobi across the
-/// cuts), so the sweep is BlockSOR's map of the same matrix in the same order, its deep rows
-/// summed differently (round-off).
+///    largest entry), by the stencil, in runs along each lattice row (the point visited just
+///    before entering last: x_new = c - G x_behind, see deep_run);
+///  - "semi-deep" points: the other interior points whose seven column pairs are plain 2x2 blocks
+///    of their part and whose rows hold the stencil (the points next to a macro edge, or next to
+///    a cut), by the stencil through a list of their neighbours' rows;
+///  - every other block (the macro edges and corners, contact vertices with their multipliers,
+///    fixed components, macros not numbered as a lattice) by its own rows, as BlockSOR does.
+/// The blocks are visited in a given order (LatticeRows::visit: the multigrid gives each macro's
+/// interior in serpentine rows, levels::lattice_rows; the Hilbert order reproduces BlockSOR's)
+/// and cut into threaded parts as BlockSOR cuts them (runs of that order of about equal
+/// nonzeros, Jacobi across the cuts), so the sweep is block Gauss–Seidel of the matrix in that
+/// order, its stencil rows summed differently (round-off). `multiply` is the matrix's product by
+/// the same data.
 ///
-/// `update_values` re-reads the rows that are not deep, re-inverts their blocks and checks the
-/// deep rows against their stencils (a full setup when one no longer matches). Every half-sweep
-/// counts one smoother pass (core/traffic).
+/// `update_values` re-reads the row-swept rows, re-inverts their blocks and checks the deep and
+/// semi-deep rows against their stencils (a full setup when one no longer matches). Every
+/// half-sweep counts one smoother pass (core/traffic).
 #pragma once
 
 #include "core/csr.hpp"
@@ -77,9 +81,10 @@ public:
     /// x = one forward sweep from zero, res = b - A x.
     void forward_from_zero(const Vector& b, Vector& x, Vector& res) const;
 
-    /// y = A x for the matrix of the last setup or update_values: deep rows by their macro's
-    /// stencil (equal to A's rows to stencil_tol), every other row by its entries; rows over
-    /// the parts' threads. Counts one mat-vec pass (core/traffic) with the bytes it reads.
+    /// y = A x for the matrix of the last setup or update_values: deep and semi-deep rows by
+    /// their macro's stencil (equal to A's rows to stencil_tol), every other row by its
+    /// entries; rows over the parts' threads. Counts one mat-vec pass (core/traffic) with the bytes
+    /// it reads.
     void multiply(const Vector& x, Vector& y) const;
 
     /// Interior lattice points swept by their macro's stencil after the last setup.
@@ -102,6 +107,8 @@ private:
     bool deep_rows_match(const SparseMatrix& A) const;
     bool same_pattern(const SparseMatrix& A) const;
     template <bool Forward> void sweep_part(int p, const double* b, double* x) const;
+    // The row step (+2 or -2) of the deep run of visit entries [i0, i1) (+2 for one point).
+    long run_step(int i0, int i1) const;
     void half_sweep(const double* b, double* x, bool forward) const;
 
     std::vector<Index> block_starts_in_;
@@ -111,15 +118,18 @@ private:
     const SparseMatrix* A_ = nullptr;
     std::vector<int> outer_; // A's row pointers at the last setup
     Index nnz_ = 0;
-    std::vector<double> stencils_; // per macro: 7 slots x 2x2 (row-major), then omega D^-1
+    // Per macro (kStencil doubles): 7 slots x 2x2 (row-major), omega D^-1, G_east, G_west, then
+    // the same ten blocks packed for two-lane arithmetic.
+    std::vector<double> stencils_;
     // The visit: per part a run of entries; entry i is a deep point (code >= 0: macro * 4096 +
-    // its row's length, the neighbour offsets) at first row visit_row_[i], or a row-swept block
-    // (code = -1 - its index into cb_*).
+    // its row's length, the neighbour offsets) at first row visit_row_[i], a semi-deep point
+    // (code kSemi + its index into semi_*), or a row-swept block (code = -1 - its index into
+    // cb_*).
     std::vector<int> part_visit_;
     std::vector<int> visit_row_, visit_code_;
     // The visit cut into items (item k: entries item_begin_[k] to item_begin_[k + 1]), those of
     // part p from part_item_[p]: a run of deep points along one lattice row (swept by deep_run),
-    // or a run of row-swept blocks.
+    // a run of semi-deep points, or a run of row-swept blocks.
     std::vector<int> item_begin_, part_item_;
     Index n_deep_ = 0;
     // Deep points: first row, macro, and their neighbours' slots in A's column order, to check
