@@ -42,6 +42,17 @@ bool bad(double v) {
     return v == 0.0 || !std::isfinite(v);
 }
 
+// An elementwise vector statement over the threads: fn(begin, size) on the chunks of [0, n)
+// (one chunk on the caller below 2^15 entries). Each entry is computed by the operations of the
+// whole-vector expression, so the values are the same whichever thread writes them; reductions
+// (inner products, norms) stay whole-vector Eigen ones, bit for bit as before.
+template <class Fn> void elementwise(Index n, Fn&& fn) {
+    parallel::for_rows(static_cast<std::size_t>(n), parallel::kTouchRowsPerChunk,
+                       [&](std::size_t b, std::size_t e) {
+                           fn(static_cast<Index>(b), static_cast<Index>(e - b));
+                       });
+}
+
 // Entry checks, tolerances, history and the final report shared by the four methods.
 class Run {
 public:
@@ -127,7 +138,9 @@ public:
     double true_residual(Vector& t) const {
         A_.apply(x_, t);
         traffic::vectors(b_.size(), 4); // t = b - t, ||t||
-        t = b_ - t;
+        elementwise(b_.size(), [&](Index i, Index m) {
+            t.segment(i, m) = b_.segment(i, m) - t.segment(i, m);
+        });
         return norm(t);
     }
 
@@ -376,7 +389,7 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
            t = parallel::zeros(n);
 
     double rn = run.true_residual(t);
-    r = t;
+    parallel::copy(t.data(), static_cast<std::size_t>(n), r.data());
     traffic::vectors(n, 2);
     run.initial(rn);
     if (run.ok(rn)) return run.finish(StopReason::converged, 0, rn);
@@ -392,16 +405,16 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
             done = true;
             return;
         }
-        r = t;
+        parallel::copy(t.data(), static_cast<std::size_t>(n), r.data());
         traffic::vectors(t.size(), 2);
         restart = true;
     };
     while (true) {
         if (restart) {
-            rh = r;
+            parallel::copy(r.data(), static_cast<std::size_t>(n), rh.data());
             rho_old = alpha = omega = 1.0;
-            v.setZero();
-            p.setZero();
+            parallel::fill(v.data(), static_cast<std::size_t>(n), 0.0);
+            parallel::fill(p.data(), static_cast<std::size_t>(n), 0.0);
             restart = false;
             traffic::vectors(n, 4);
         }
@@ -412,7 +425,9 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("rho = (r^, r)", it, rho));
         const double beta = (rho / rho_old) * (alpha / omega);
-        p = r + beta * (p - omega * v);
+        elementwise(n, [&](Index i, Index m) {
+            p.segment(i, m) = r.segment(i, m) + beta * (p.segment(i, m) - omega * v.segment(i, m));
+        });
         M.apply(p, ph);
         A.apply(ph, v);
         const double d = run.dot(rh, v);
@@ -420,14 +435,14 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
             return run.finish(StopReason::breakdown, it, run.true_residual(t),
                               at("(r^, A C^{-1} p)", it, d));
         alpha = rho / d;
-        r -= alpha * v; // r now holds s
+        elementwise(n, [&](Index i, Index m) { r.segment(i, m) -= alpha * v.segment(i, m); }); // s
         const double sn = run.norm(r);
         traffic::vectors(n, 12); // (r^, r), p, (r^, v), s, ||s||
         if (!std::isfinite(sn) || !std::isfinite(alpha))
             return run.finish(StopReason::breakdown, it + 1, run.true_residual(t),
                               at("half-step residual norm", it + 1, sn));
         if (run.ok(sn)) { // converged at the half step: x += alpha p^
-            x += alpha * ph;
+            elementwise(n, [&](Index i, Index m) { x.segment(i, m) += alpha * ph.segment(i, m); });
             traffic::vectors(n, 3);
             ++it;
             run.record(sn);
@@ -443,12 +458,16 @@ SolveResult bicgstab(const LinearOperator& A, const Preconditioner& M, const Vec
         const double ts = run.dot(t, r);
         omega = ts / tt;
         if (bad(tt) || bad(omega)) {
-            x += alpha * ph; // the half step is still a valid update
+            elementwise(n, [&](Index i, Index m) {
+                x.segment(i, m) += alpha * ph.segment(i, m);
+            }); // the half step is still a valid update
             return run.finish(StopReason::breakdown, it + 1, run.true_residual(t),
                               at("omega = (t, s) / (t, t)", it + 1, omega));
         }
-        x += alpha * ph + omega * sh;
-        r -= omega * t;
+        elementwise(n, [&](Index i, Index m) {
+            x.segment(i, m) += alpha * ph.segment(i, m) + omega * sh.segment(i, m);
+            r.segment(i, m) -= omega * t.segment(i, m);
+        });
         rho_old = rho;
         ++it;
         rn = run.norm(r);

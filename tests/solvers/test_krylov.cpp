@@ -2,6 +2,7 @@
 // Krylov methods x preconditioners on manufactured problems (x* = 1), plus the failure paths:
 // NaN input, breakdown, max_iter, b = 0, history and true residuals.
 #include "core/check.hpp"
+#include "core/parallel.hpp"
 #include "smoothers/block_sor.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
@@ -389,4 +390,56 @@ TEST(Krylov, ASlowSolveIsGivenUpOnlyWhenItsRateMissesTheBudget) {
     KrylovParams bad;
     bad.give_up_budget = -1;
     EXPECT_THROW(bad.validate(), InvalidInput);
+}
+
+namespace {
+// Textbook right-preconditioned BiCGStab with the identity preconditioner in whole-vector Eigen
+// statements (the form of bicgstab before its elementwise statements ran over the threads),
+// without the half-step exit: the iterates of `iterations` full steps from x = 0.
+Vector reference_bicgstab(const SparseMatrix& A, const Vector& b, int iterations) {
+    const Index n = b.size();
+    Vector x = Vector::Zero(n), r = b - A * x, rh = r, p = Vector::Zero(n), v = Vector::Zero(n),
+           t(n);
+    double rho_old = 1.0, alpha = 1.0, omega = 1.0;
+    for (int it = 0; it < iterations; ++it) {
+        const double rho = rh.dot(r);
+        const double beta = (rho / rho_old) * (alpha / omega);
+        p = r + beta * (p - omega * v);
+        v = A * p;
+        alpha = rho / rh.dot(v);
+        r -= alpha * v;
+        t = A * r;
+        omega = t.dot(r) / t.squaredNorm();
+        x += alpha * p + omega * r;
+        r -= omega * t;
+        rho_old = rho;
+    }
+    return x;
+}
+} // namespace
+
+TEST(Krylov, BicgstabOverTheThreadsIsTheWholeVectorIterationBitForBit) {
+    // 90 000 unknowns: the elementwise statements run as three chunks over two threads. Each
+    // entry is computed as the whole-vector expression computes it, so after 60 iterations
+    // (stopped by max_iter, far from the tolerance) x is the reference's to the last bit (a
+    // wrong chunk offset, a missed chunk or a statement moved across a reduction changes it),
+    // at two threads and at one. The same solve run to its tolerance meets it.
+    const SparseMatrix A = testmat::laplace_2d(300, 1.5);
+    const MatrixOperator op(A);
+    IdentityPreconditioner I;
+    const Vector b = A * testmat::pseudo_random(A.rows());
+    const Vector ref = reference_bicgstab(A, b, 60);
+    for (int threads : {2, 1}) {
+        parallel::set_num_threads(threads);
+        Vector x;
+        const SolveResult r = bicgstab(op, I, b, x, {.rel_tol = 1e-14, .max_iter = 60});
+        EXPECT_EQ(r.reason, StopReason::max_iter) << r;
+        EXPECT_EQ(r.iterations, 60);
+        EXPECT_EQ((x - ref).cwiseAbs().maxCoeff(), 0.0) << "threads " << threads;
+        Vector y;
+        const SolveResult full = bicgstab(op, I, b, y, {.rel_tol = 1e-6, .max_iter = 4000});
+        ASSERT_TRUE(full.converged) << full;
+        EXPECT_LE((b - A * y).norm(), 1e-6 * b.norm());
+    }
+    parallel::set_num_threads(0);
 }
