@@ -195,9 +195,20 @@ double matrix_seconds(const traffic::Account& a) {
 
 } // namespace
 
-BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body) {
+BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
+                         bool lattice) {
     if (pc != "default") return {opt.krylov.value_or("cgs"), pc};
-    return {opt.krylov.value_or(levels::kMgDefaultKrylov), levels::default_mg_spec(two_body)};
+    std::string spec = levels::default_mg_spec(two_body);
+    if (lattice && opt.levels >= levels::kMgDefaultLatticeLevel)
+        spec += levels::kMgDefaultLatticeOption;
+    return {opt.krylov.value_or(levels::kMgDefaultKrylov), spec};
+}
+
+std::string bench_numbering(const BenchSquareOptions& opt) {
+    if (opt.numbering) return *opt.numbering;
+    const bool all_default = std::all_of(opt.pcs.begin(), opt.pcs.end(),
+                                         [](const std::string& pc) { return pc == "default"; });
+    return all_default && opt.levels >= levels::kMgDefaultLatticeLevel ? "lattice" : "hilbert";
 }
 
 int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
@@ -211,13 +222,14 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     check_preconditioner_names(named, true);
     levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
-    MLC_CHECK(opt.numbering == "hilbert" || opt.numbering == "lattice",
-              "bench square: --numbering must be hilbert or lattice, found '" << opt.numbering
-                                                                              << "'");
-    base.numbering = opt.numbering == "lattice" ? levels::Problem::Numbering::lattice
-                                                : levels::Problem::Numbering::hilbert;
+    const std::string numbering = bench_numbering(opt);
+    MLC_CHECK(numbering == "hilbert" || numbering == "lattice",
+              "bench square: --numbering must be hilbert or lattice, found '" << numbering << "'");
+    base.numbering = numbering == "lattice" ? levels::Problem::Numbering::lattice
+                                            : levels::Problem::Numbering::hilbert;
+    const bool lattice = numbering == "lattice";
     const bool two_body = levels::has_two_body_pair(base);
-    const BenchSolver def = bench_solver(opt, "default", two_body);
+    const BenchSolver def = bench_solver(opt, "default", two_body, lattice);
     const std::string named_krylov = opt.krylov.value_or("cgs");
     std::string krylov_label = named_krylov;
     if (named.size() != opt.pcs.size())
@@ -226,7 +238,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
        << ",\n  \"krylov\": " << json_string(krylov_label) << ",\n  \"rel_tol\": " << opt.rel_tol
-       << ",\n  \"repeat\": " << opt.repeat << ",\n  \"numbering\": " << json_string(opt.numbering)
+       << ",\n  \"repeat\": " << opt.repeat << ",\n  \"numbering\": " << json_string(numbering)
        << ",\n  \"extrapolate\": " << (opt.extrapolate ? "true" : "false") << ",\n  \"runs\": [";
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
        << base.load_steps << " load steps, Krylov " << krylov_label << " rel_tol " << opt.rel_tol
@@ -255,7 +267,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         levels::SolveOptions so;
         so.coarse_to_fine = true;
         so.extrapolate = opt.extrapolate;
-        const BenchSolver solver = bench_solver(opt, pc, two_body);
+        const BenchSolver solver = bench_solver(opt, pc, two_body, lattice);
         if (pc == "schur" || pc == "lu")
             so.linear.method = pc;
         else

@@ -45,8 +45,9 @@ struct BenchSquareOptions {
     std::vector<std::string> pcs = {"default"};
     /// Krylov method for the preconditioner specs; unset: CGS, and for "default" the run's.
     std::optional<std::string> krylov;
-    /// Order of the unknowns, "hilbert" or "lattice" (levels::Problem::numbering).
-    std::string numbering = "hilbert";
+    /// Order of the unknowns, "hilbert" or "lattice" (levels::Problem::numbering); unset:
+    /// bench_numbering.
+    std::optional<std::string> numbering;
     double rel_tol = 1e-8; ///< Krylov relative tolerance
     int max_iter = 5000;   ///< Krylov iterations per Newton step
     int repeat = 1;        ///< runs per solver; times are medians over them
@@ -61,11 +62,20 @@ struct BenchSquareOptions {
 
 /// The Krylov method and preconditioner spec `bench square` runs for the entry `pc` of
 /// opt.pcs on a problem with (`two_body`) or without a two-body pair: "default" is the run's
-/// default above the crossover, anything else `pc` itself with opt.krylov (CGS if unset).
+/// default above the crossover (with the lattice sweep, levels::kMgDefaultLatticeOption, when
+/// `lattice`: the levels numbered by lattices and the finest at least
+/// levels::kMgDefaultLatticeLevel), anything else `pc` itself with opt.krylov (CGS if unset).
 struct BenchSolver {
     std::string krylov, pc;
 };
-BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body);
+BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
+                         bool lattice = false);
+
+/// The numbering of a single-process `bench square`: opt.numbering if set, else "lattice" when
+/// every solver is the default one and the finest level is at least
+/// levels::kMgDefaultLatticeLevel (the numbering the run's default takes there), else "hilbert"
+/// (the named preconditioners keep the numbering they always had).
+std::string bench_numbering(const BenchSquareOptions& opt);
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every run converged).
 int bench_square(const BenchSquareOptions& opt, std::ostream& os);

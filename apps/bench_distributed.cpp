@@ -41,6 +41,10 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
                   (opt.pcs.front() == "default" || opt.pcs.front().rfind("mg", 0) == 0),
               "bench square on several processes runs mg alone (--pc default or "
               "mg[:options]); the other preconditioners have no distributed form");
+    MLC_CHECK(!opt.numbering || *opt.numbering == "hilbert",
+              "bench square on several processes numbers each process's unknowns along a Hilbert "
+              "curve; the lattice numbering has no distributed form (drop --numbering "
+                  << *opt.numbering << ")");
     levels::Problem p = scene::load_scene(opt.scene);
     p.levels = opt.levels;
     p.validate();

@@ -39,9 +39,12 @@ int main(int argc, char** argv) {
     run->add_option("scene", ro.scene, "scene file (.toml) or built-in scene name");
     run->add_option("--levels,-l", ro.levels, "number of 1->4 refinements of the level-0 mesh");
     run->add_option("--numbering", ro.numbering,
-                    "order of each level's unknowns: hilbert (default, along a Hilbert curve) or "
-                    "lattice (macro triangle by macro triangle, the order mg:smoother=lattice "
-                    "sweeps in without copies; levels that are not refinements keep hilbert)")
+                    "order of each level's unknowns: hilbert (along a Hilbert curve) or lattice "
+                    "(macro triangle by macro triangle, the order mg:smoother=lattice sweeps in "
+                    "without copies; levels that are not refinements keep hilbert). Default: "
+                    "lattice when the default solver sweeps by lattices (mg above the crossover, "
+                    "--levels >= 4), else hilbert; hilbert with the default solver keeps its block "
+                    "sweep")
         ->check(CLI::IsMember({"hilbert", "lattice"}));
     run->add_option("--mu", ro.mu, "friction coefficient for every contact pair");
     run->add_option("--r", ro.r, "augmentation parameter r for every contact pair");
@@ -191,8 +194,11 @@ int main(int argc, char** argv) {
     bsq->add_option("--krylov", bso.krylov,
                     "Krylov method for the preconditioners (default cgs; for `default` the run's, "
                     "bicgstab)");
-    bsq->add_option("--numbering", bso.numbering,
-                    "order of each level's unknowns: hilbert (default) or lattice (as run's)")
+    bsq->add_option(
+           "--numbering", bso.numbering,
+           "order of each level's unknowns: hilbert or lattice (as run's); default: lattice "
+           "when every solver is the default one and --levels >= 4 (the run's default "
+           "there), else hilbert")
         ->check(CLI::IsMember({"hilbert", "lattice"}));
     bsq->add_option("--tol", bso.rel_tol, "Krylov relative tolerance (default 1e-8)");
     bsq->add_option("--max-iter", bso.max_iter, "Krylov iterations per Newton step (default 5000)");

@@ -56,12 +56,15 @@ void apply_overrides(levels::Problem& p, const RunOptions& opt) {
     p.validate();
 }
 
-levels::SolveOptions run_solve_options(const levels::Problem& p, const RunOptions& opt,
+levels::SolveOptions run_solve_options(levels::Problem& p, const RunOptions& opt,
                                        levels::SolverChoice& choice) {
     levels::SolveOptions so;
     so.predicted_sizes = levels::predict_level_sizes(p); // level 0 built once for both
-    choice = levels::choose_solver(p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol},
-                                   &so.predicted_sizes);
+    choice = levels::choose_solver(
+        p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol, opt.numbering},
+        &so.predicted_sizes);
+    // The default mg's lattice sweep needs its levels numbered by macro triangle.
+    if (choice.lattice_numbering) p.numbering = levels::Problem::Numbering::lattice;
     so.coarse_to_fine = !opt.cold;
     so.extrapolate = !opt.no_extrapolation;
     so.linear = choice.spec;

@@ -17,7 +17,9 @@ namespace mlc::apps {
 struct RunOptions {
     std::string scene = "square"; ///< file path or built-in scene name
     std::optional<int> levels;    ///< overrides [scene].levels
-    /// "hilbert" or "lattice" (levels::Problem::numbering); unset: hilbert.
+    /// "hilbert" or "lattice" (levels::Problem::numbering); unset: lattice where the default
+    /// solver sweeps by lattices (levels 4 and finer, levels::SolverChoice::lattice_numbering),
+    /// else hilbert.
     std::optional<std::string> numbering;
     std::optional<double> mu;      ///< overrides mu of every contact pair
     std::optional<double> r;       ///< overrides r of every contact pair
@@ -59,9 +61,10 @@ void apply_overrides(levels::Problem& p, const RunOptions& opt);
 
 /// The solve options of `mlcontact run` for `p` (after apply_overrides): the Newton-system solver
 /// chosen as the driver chooses it (levels::choose_solver, returned in `choice`), coarse-to-fine
-/// unless opt.cold, no progress stream. The Python module solves with these, so that its numbers
-/// are the driver's.
-levels::SolveOptions run_solve_options(const levels::Problem& p, const RunOptions& opt,
+/// unless opt.cold, no progress stream; when the default solver sweeps by lattices
+/// (SolverChoice::lattice_numbering), p's levels are numbered for it. The Python module solves
+/// with these, so that its numbers are the driver's.
+levels::SolveOptions run_solve_options(levels::Problem& p, const RunOptions& opt,
                                        levels::SolverChoice& choice);
 
 /// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not

@@ -42,10 +42,27 @@ std::string num(double v, int digits = 3) {
     return os.str();
 }
 
+/// mg:smoother=lattice (the default's sweep from level 4 on) on p (its levels set): the levels
+/// numbered by lattices, or below level 4 (the slender case's level 1) the block sweep, as the
+/// default takes there; returns whether the lattice option was dropped.
+bool sweep_for(levels::Problem& p, levels::LinearSolverSpec& solver) {
+    const std::string option = levels::kMgDefaultLatticeOption;
+    const auto at = solver.pc.find(option);
+    if (at == std::string::npos) return false;
+    if (p.levels >= levels::kMgDefaultLatticeLevel) {
+        p.numbering = levels::Problem::Numbering::lattice;
+        return false;
+    }
+    solver.pc.erase(at, option.size());
+    return true;
+}
+
 /// Solves a problem and summarizes it.
-Fields solve_case(levels::Problem p, int levels, const levels::LinearSolverSpec& solver) {
+Fields solve_case(levels::Problem p, int levels, levels::LinearSolverSpec solver) {
     p.levels = levels;
+    const bool block_sweep = sweep_for(p, solver);
     Fields f;
+    if (block_sweep) f["block_sweep"] = std::to_string(levels);
     const double t0 = wall_seconds();
     levels::SolveOptions so;
     so.linear = solver;
@@ -246,8 +263,11 @@ mu = 0.3
                           if (s.point) *s.point *= L;
                       si.contacts[0].r *= P; // r = 0.1 E in both
                       mm.levels = si.levels = l;
+                      levels::LinearSolverSpec spec = solver;
+                      sweep_for(mm, spec);
+                      sweep_for(si, spec);
                       levels::SolveOptions so;
-                      so.linear = solver;
+                      so.linear = spec;
                       so.exact_fallback = true;
                       so.r_continuation = true;
                       const auto a = levels::solve(mm, so);
@@ -374,18 +394,25 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     levels::Problem sq = square();
     sq.levels = opt.levels;
     if (opt.linear || opt.krylov || opt.pc || opt.linear_rel_tol) {
+        // A lattice sweep asked for is run on levels numbered for it (every case is).
+        if (opt.pc && opt.pc->find("smoother=lattice") != std::string::npos)
+            sq.numbering = levels::Problem::Numbering::lattice;
         solvers.push_back(
             levels::choose_solver(sq, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}));
     } else {
         solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}}));
         if (opt.levels >= 1) {
             // What the default takes above its crossover: BiCGStab + mg's V(0,2) cycle (one
-            // body) and the same damped (with a two-body pair, as in the contrast cases).
+            // body) and the same damped (with a two-body pair, as in the contrast cases); from
+            // level 4 on both with the lattice sweep, on levels numbered for it.
             const std::string krylov = levels::kMgDefaultKrylov;
+            const bool lattice = opt.levels >= levels::kMgDefaultLatticeLevel;
+            if (lattice) sq.numbering = levels::Problem::Numbering::lattice;
+            const std::string sweep = lattice ? levels::kMgDefaultLatticeOption : "";
             solvers.push_back(levels::choose_solver(
-                sq, {{}, krylov, std::string(levels::kMgDefaultOneBody), {}}));
+                sq, {{}, krylov, std::string(levels::kMgDefaultOneBody) + sweep, {}}));
             solvers.push_back(levels::choose_solver(
-                sq, {{}, krylov, std::string(levels::kMgDefaultTwoBody), {}}));
+                sq, {{}, krylov, std::string(levels::kMgDefaultTwoBody) + sweep, {}}));
         }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "
@@ -420,6 +447,9 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
             if (f.count("continuations"))
                 notes += (notes.empty() ? "" : "; ") + f["continuations"] +
                          " level step(s) recovered by r continuation";
+            if (f.count("block_sweep"))
+                notes += (notes.empty() ? "" : "; ") + std::string("level ") + f["block_sweep"] +
+                         ": the block sweep (lattices need level 4)";
             if (f.count("unit_diff_u"))
                 notes += "rel. diff u " + f["unit_diff_u"] + ", lambda " + f["unit_diff_lambda"];
             os << std::left << std::setw(26) << c.name << std::setw(11) << get("status")

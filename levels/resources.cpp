@@ -153,9 +153,18 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             const bool two_body = has_two_body_pair(problem);
             s.pc = default_mg_spec(two_body);
             if (!req.krylov) s.krylov = kMgDefaultKrylov;
+            // Levels 4 and finer swept by lattices, numbered for it (not when the request keeps
+            // the Hilbert numbering).
+            c.lattice_numbering = problem.levels >= kMgDefaultLatticeLevel &&
+                                  (!req.numbering || *req.numbering == "lattice");
+            if (c.lattice_numbering) s.pc += kMgDefaultLatticeOption;
             os << "default: " << n << " unknowns on the finest level exceed the crossover "
                << crossover << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
-               << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles)" : ")");
+               << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles" : "")
+               << (c.lattice_numbering ? "; levels 4 and finer numbered and swept macro triangle "
+                                         "by macro triangle, --numbering hilbert for the block "
+                                         "sweep)"
+                                       : ")");
         } else {
             s.method = "schur";
             if (!has_levels && n > crossover)

@@ -193,10 +193,12 @@ std::shared_ptr<Result> solve(const Scene& scene, std::optional<int> levels,
                               std::optional<double> mu, std::optional<double> r,
                               std::optional<int> load_steps, std::optional<std::string> linear,
                               std::optional<std::string> krylov, std::optional<std::string> pc,
-                              std::optional<double> linear_tol, bool cold, bool keep_steps,
+                              std::optional<double> linear_tol,
+                              std::optional<std::string> numbering, bool cold, bool keep_steps,
                               bool progress, bool extrapolate) {
     apps::RunOptions opt;
     opt.levels = levels;
+    opt.numbering = numbering;
     opt.mu = mu;
     opt.r = r;
     opt.load_steps = load_steps;
@@ -728,6 +730,10 @@ PYBIND11_MODULE(_core, m) {
                                    d["pc"] = sp.pc;
                                    d["rel_tol"] = sp.rel_tol;
                                    d["automatic"] = r.run.solver.automatic;
+                                   d["numbering"] = r.problem.numbering ==
+                                                            levels::Problem::Numbering::lattice
+                                                        ? "lattice"
+                                                        : "hilbert";
                                    d["reason"] = r.run.solver.reason;
                                    return d;
                                })
@@ -803,9 +809,9 @@ PYBIND11_MODULE(_core, m) {
     m.def("solve", &solve, py::arg("scene"), py::arg("levels") = py::none(),
           py::arg("mu") = py::none(), py::arg("r") = py::none(), py::arg("load_steps") = py::none(),
           py::arg("solver") = py::none(), py::arg("krylov") = py::none(),
-          py::arg("pc") = py::none(), py::arg("linear_tol") = py::none(), py::arg("cold") = false,
-          py::arg("keep_steps") = false, py::arg("progress") = false,
-          py::arg("extrapolate") = true);
+          py::arg("pc") = py::none(), py::arg("linear_tol") = py::none(),
+          py::arg("numbering") = py::none(), py::arg("cold") = false, py::arg("keep_steps") = false,
+          py::arg("progress") = false, py::arg("extrapolate") = true);
 
     m.def(
         "study_status_transfer",

@@ -72,13 +72,15 @@ Scene.__setattr__ = _scene_setattr
 
 
 def solve(scene, *, levels=None, mu=None, r=None, load_steps=None, solver=None, krylov=None,
-          pc=None, linear_tol=None, cold=False, keep_steps=False, progress=False,
+          pc=None, linear_tol=None, numbering=None, cold=False, keep_steps=False, progress=False,
           extrapolate=True, raise_on_failure=True):
     """Solves a Scene as `mlcontact run` does, with the same options and the same numbers.
 
     levels, mu, r, load_steps override the scene's (as --levels, --mu, --r, --steps);
     solver ("schur", "lu", "krylov"), krylov, pc, linear_tol choose the Newton-system solver
-    (as --linear, --krylov, --pc, --linear-tol; none: chosen by size); cold=True solves the
+    (as --linear, --krylov, --pc, --linear-tol; none: chosen by size); numbering ("hilbert",
+    "lattice") orders each level's unknowns (as --numbering; none: lattice where the default
+    solver sweeps by lattices, levels 4 and finer, else hilbert); cold=True solves the
     finest level alone (--cold); keep_steps=True keeps every step's state (Result.step_state);
     progress=True prints the per-step progress lines on stdout; extrapolate=False starts every
     load step from the usual guess (--no-extrapolation).
@@ -92,7 +94,8 @@ def solve(scene, *, levels=None, mu=None, r=None, load_steps=None, solver=None, 
     options = {}
     for name, value, kind in (("levels", levels, int), ("load_steps", load_steps, int),
                               ("mu", mu, float), ("r", r, float), ("linear_tol", linear_tol, float),
-                              ("solver", solver, str), ("krylov", krylov, str), ("pc", pc, str)):
+                              ("solver", solver, str), ("krylov", krylov, str), ("pc", pc, str),
+                              ("numbering", numbering, str)):
         if value is not None:  # numpy scalars too (a sweep over np.arange)
             abc = {int: _numbers.Integral, float: _numbers.Real, str: str}[kind]
             if not isinstance(value, abc) or isinstance(value, bool):

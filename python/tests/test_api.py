@@ -238,6 +238,27 @@ def test_bad_solve_options_raise_value_error():
         mlcontact.solve(s, levels=0, solver="krylov", pc="mg:coarse=galerkin")
     with pytest.raises(TypeError):
         mlcontact.solve("square")
+    with pytest.raises(ValueError, match="--numbering must be hilbert or lattice, found 'spiral'"):
+        mlcontact.solve(s, numbering="spiral")
+
+
+def test_default_solver_sweeps_by_lattices_from_level_4_and_numbering_hilbert_keeps_blocks():
+    # The default at level 4: mg with the lattice sweep on levels numbered by macro triangle;
+    # numbering="hilbert" keeps the block sweep. Same contact solution to 1e-8 (the Newton
+    # statuses and the discrete solution do not depend on the numbering or the smoother).
+    s = square()
+    a = mlcontact.solve(s, levels=4)
+    b = mlcontact.solve(s, levels=4, numbering="hilbert")
+    assert a.solver["automatic"] and b.solver["automatic"]
+    assert a.solver["numbering"] == "lattice" and a.solver["pc"] == "mg:pre=0,post=2,smoother=lattice"
+    assert b.solver["numbering"] == "hilbert" and b.solver["pc"] == "mg:pre=0,post=2"
+    assert (a.vertices == b.vertices).all()  # the mesh's vertex order, whatever the numbering
+    umax = abs(b.displacement).max()
+    assert abs(a.displacement - b.displacement).max() < 1e-8 * umax
+    assert abs(a.lambda_n - b.lambda_n).max() < 1e-8 * abs(b.lambda_n).max()
+    # Level 3: no lattice levels, the Hilbert numbering and the block sweep.
+    c = mlcontact.solve(s, levels=3)
+    assert c.solver["numbering"] == "hilbert" and c.solver["pc"] == "mg:pre=0,post=2"
 
 
 def test_not_converged_carries_the_report():

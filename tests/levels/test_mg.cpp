@@ -399,8 +399,11 @@ TEST(RecoveredLevels, TheExportedSquareSolvesAsTheRefinedSquareDoes) {
         worst = std::max(worst, (u_of(La, a.x, v) - it->second).norm());
     }
     EXPECT_LT(worst, 1e-8 * umax);
-    // Above the crossover the default is the multigrid over the recovered levels.
-    EXPECT_EQ(choose_solver(p, {}).spec.pc, "mg:pre=0,post=2");
+    // Above the crossover the default is the multigrid over the recovered levels, swept by
+    // lattices on levels 4 to 7 (2 triangles refined 4 to 7 times).
+    const auto c = choose_solver(p, {});
+    EXPECT_EQ(c.spec.pc, "mg:pre=0,post=2,smoother=lattice");
+    EXPECT_TRUE(c.lattice_numbering);
 }
 
 TEST(RecoveredLevels, AnUnstructuredGmshMeshHasNoneAndTheKeyNeedsGmshMeshes) {

@@ -119,9 +119,12 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
             EXPECT_FALSE(c.reason.empty());
             if (L >= 1 && n > crossover) {
                 EXPECT_EQ(c.spec.method, "krylov");
-                EXPECT_EQ(c.spec.pc, crossover == levels::kMgCrossoverTwoBody
-                                         ? "mg:omega=0.8,pre=0,post=2"
-                                         : "mg:pre=0,post=2");
+                // From level 4 on with the lattice sweep (the test below).
+                EXPECT_EQ(c.spec.pc, std::string(crossover == levels::kMgCrossoverTwoBody
+                                                     ? "mg:omega=0.8,pre=0,post=2"
+                                                     : "mg:pre=0,post=2") +
+                                         (L >= 4 ? ",smoother=lattice" : ""));
+                EXPECT_EQ(c.lattice_numbering, L >= 4);
                 EXPECT_EQ(c.spec.krylov, "bicgstab");
             } else {
                 EXPECT_EQ(c.spec.method, "schur");
@@ -237,4 +240,41 @@ TEST(MemoryEstimate, SquareLevel7WithMgFitsIn24GiB) {
     EXPECT_GT(e.bytes, 4.0 * 2487 * 1048576.0 * 0.7) << levels::format_bytes(e.bytes);
     EXPECT_NO_THROW(levels::check_memory_fits(e, {24.0 * 1024 * 1024 * 1024, "24 GiB"}, sizes));
     std::cout << "square level 7, mg: estimated " << levels::format_bytes(e.bytes) << "\n";
+}
+
+TEST(ChooseSolver, TheDefaultSweepsByLatticesFromLevel4UnlessNumberingHilbertIsAsked) {
+    // Above the crossover from level 4 on, the default mg sweeps the levels by lattices and
+    // asks for the lattice numbering; below level 4 (no lattice levels), with numbering hilbert
+    // asked, or with any solver option named, the block sweep on the Hilbert numbering.
+    auto p = scene::load_scene("square");
+    p.levels = 4;
+    const auto d = levels::choose_solver(p, {});
+    EXPECT_TRUE(d.automatic);
+    EXPECT_TRUE(d.lattice_numbering);
+    EXPECT_EQ(d.spec.pc, "mg:pre=0,post=2,smoother=lattice");
+    EXPECT_EQ(d.spec.krylov, "bicgstab");
+    EXPECT_NE(d.reason.find("macro triangle by macro triangle"), std::string::npos) << d.reason;
+    const auto l = levels::choose_solver(p, {{}, {}, {}, {}, std::string("lattice")});
+    EXPECT_TRUE(l.lattice_numbering);
+    EXPECT_EQ(l.spec.pc, d.spec.pc);
+    const auto h = levels::choose_solver(p, {{}, {}, {}, {}, std::string("hilbert")});
+    EXPECT_TRUE(h.automatic);
+    EXPECT_FALSE(h.lattice_numbering);
+    EXPECT_EQ(h.spec.pc, "mg:pre=0,post=2");
+    const auto named = levels::choose_solver(p, {{}, {}, std::string("mg:pre=0,post=2"), {}});
+    EXPECT_FALSE(named.lattice_numbering);
+    const auto krylov = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
+    EXPECT_FALSE(krylov.lattice_numbering);
+    EXPECT_EQ(krylov.spec.pc, "mg:pre=0,post=2");
+    // A two-body pair keeps its damping, with the lattice sweep.
+    auto dt = scene::load_scene("dovetail");
+    dt.levels = 4;
+    const auto t = levels::choose_solver(dt, {});
+    EXPECT_TRUE(t.lattice_numbering);
+    EXPECT_EQ(t.spec.pc, "mg:omega=0.8,pre=0,post=2,smoother=lattice");
+    p.levels = 3;
+    const auto three = levels::choose_solver(p, {});
+    EXPECT_TRUE(three.automatic);
+    EXPECT_FALSE(three.lattice_numbering);
+    EXPECT_EQ(three.spec.pc, "mg:pre=0,post=2");
 }
