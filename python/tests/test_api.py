@@ -256,6 +256,7 @@ def test_default_solver_sweeps_by_lattices_from_level_4_and_numbering_hilbert_ke
     umax = abs(b.displacement).max()
     assert abs(a.displacement - b.displacement).max() < 1e-8 * umax
     assert abs(a.lambda_n - b.lambda_n).max() < 1e-8 * abs(b.lambda_n).max()
+    assert (a.status == b.status).all()
     # Level 3: no lattice levels, the Hilbert numbering and the block sweep.
     c = mlcontact.solve(s, levels=3)
     assert c.solver["numbering"] == "hilbert" and c.solver["pc"] == "mg:pre=0,post=2"
