@@ -398,9 +398,9 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
         if (opt.pc && opt.pc->find("smoother=lattice") != std::string::npos)
             sq.numbering = levels::Problem::Numbering::lattice;
         solvers.push_back(
-            levels::choose_solver(sq, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol}));
+            levels::choose_solver(sq, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol, {}}));
     } else {
-        solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}}));
+        solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}, {}}));
         if (opt.levels >= 1) {
             // What the default takes above its crossover: BiCGStab + mg's V(0,2) cycle (one
             // body) and the same damped (with a two-body pair, as in the contrast cases); from
@@ -410,9 +410,9 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
             if (lattice) sq.numbering = levels::Problem::Numbering::lattice;
             const std::string sweep = lattice ? levels::kMgDefaultLatticeOption : "";
             solvers.push_back(levels::choose_solver(
-                sq, {{}, krylov, std::string(levels::kMgDefaultOneBody) + sweep, {}}));
+                sq, {{}, krylov, std::string(levels::kMgDefaultOneBody) + sweep, {}, {}}));
             solvers.push_back(levels::choose_solver(
-                sq, {{}, krylov, std::string(levels::kMgDefaultTwoBody) + sweep, {}}));
+                sq, {{}, krylov, std::string(levels::kMgDefaultTwoBody) + sweep, {}, {}}));
         }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "

@@ -42,6 +42,8 @@ std::string_view to_string(Kind k) {
         return "coarse";
     case Kind::vector:
         return "vector";
+    case Kind::structured:
+        return "structured";
     }
     return "unknown";
 }

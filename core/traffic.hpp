@@ -30,6 +30,13 @@
 ///   vectors still double): each 12 nnz becomes 8 nnz and each 8 d becomes 4 d.
 /// - The multigrid's coarse solve (level 0, sparse LU): timed, its bytes not counted (0), kind
 ///   `coarse`.
+/// - The structured passes of `mg:smoother=lattice` (smoothers::LatticeGS: a half-sweep, and the
+///   product `multiply` that replaces the Krylov mat-vec): the rows of the blocks swept by rows
+///   (12 bytes an entry, their inverses and offsets), the visit entries, the semi-deep points'
+///   neighbour lists and the vectors (b read and x read and written: 24 n; x read and y written:
+///   16 n); the stencils (one per macro triangle) count nothing. Kind `structured`: these passes
+///   read no assembled matrix for most rows, so their GB/s is not a measure of how well a matrix
+///   streams (bench square's `matrix` figure leaves them out; their cost is read in time).
 ///
 /// Counters are process-wide relaxed atomics, incremented by the calling thread once per call
 /// (a parallel kernel counts once, on the thread that called it). Timing (two steady-clock reads
@@ -48,10 +55,10 @@
 namespace mlc::traffic {
 
 /// What a pass does.
-enum class Kind { matvec, smoother, transfer, coarse, vector };
-inline constexpr int kKinds = 5;
+enum class Kind { matvec, smoother, transfer, coarse, vector, structured };
+inline constexpr int kKinds = 6;
 
-/// "matvec", "smoother", "transfer", "coarse", "vector".
+/// "matvec", "smoother", "transfer", "coarse", "vector", "structured".
 std::string_view to_string(Kind k);
 
 /// The counters at one moment (cumulative since the start of the process); differences of two

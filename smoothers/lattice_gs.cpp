@@ -802,7 +802,7 @@ void LatticeGS::half_sweep(const double* b, double* x, bool forward) const {
         12.0 * static_cast<double>(ccol_.size()) + 8.0 * static_cast<double>(cinv_.size()) +
         8.0 * static_cast<double>(visit_row_.size()) + 4.0 * static_cast<double>(semi_nbr_.size()) +
         24.0 * static_cast<double>(n_);
-    const traffic::Pass pass(traffic::Kind::smoother, bytes);
+    const traffic::Pass pass(traffic::Kind::structured, bytes);
     for (int c : interface_)
         snap_[c] = x[c];
     parallel::for_chunks(static_cast<size_t>(parts()), [&](size_t p) {
@@ -835,7 +835,7 @@ void LatticeGS::multiply(const Vector& x, Vector& y) const {
     // Compulsory bytes: the row-swept rows' values and columns and row offsets, the visit
     // entries, x read and y written.
     const traffic::Pass pass(
-        traffic::Kind::matvec,
+        traffic::Kind::structured,
         12.0 * static_cast<double>(ccol_.size()) + 4.0 * static_cast<double>(crow_ptr_.size()) +
             8.0 * static_cast<double>(visit_row_.size()) +
             4.0 * static_cast<double>(semi_nbr_.size()) + 16.0 * static_cast<double>(n_));

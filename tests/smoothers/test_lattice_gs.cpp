@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "smoothers/lattice_gs.hpp"
 
+#include "core/traffic.hpp"
 #include "fem/assembly.hpp"
 #include "fem/dof_map.hpp"
 #include "mesh/lattice.hpp"
@@ -330,4 +331,34 @@ TEST(LatticeGS, MultiplyIsTheMatrixProduct) {
             LatticeOperator(S).apply(x, z);
             EXPECT_EQ(y, z);
         }
+}
+
+TEST(LatticeGS, ItsPassesAreCountedAsStructured) {
+    // A sweep and a product are one `structured` pass each (bench square's matrix figure leaves
+    // them out), nothing under smoother or matvec; each counts its vectors (b read and x read and
+    // written: 24 n; x read and y written: 16 n) and less than A's 12 bytes per entry for the
+    // rows it still reads (most rows by the stencils).
+    const Case c = elastic_case(6, true);
+    LatticeGS S(c.starts, c.lattice, {});
+    S.setup(c.A);
+    ASSERT_GT(S.deep_points(), 0);
+    const double n = static_cast<double>(c.A.rows());
+    const double matrix = 12.0 * static_cast<double>(c.A.nonZeros());
+    const Vector b = random_vector(c.A.rows(), 5);
+    Vector x = Vector::Zero(c.A.rows()), y;
+    const traffic::Account a0 = traffic::snapshot();
+    S.smooth(b, x, Sweep::backward, 1);
+    const traffic::Account a1 = traffic::snapshot();
+    S.multiply(x, y);
+    const traffic::Account a2 = traffic::snapshot();
+    const traffic::Account sweep = a1 - a0, product = a2 - a1;
+    for (const traffic::Account* d : {&sweep, &product}) {
+        EXPECT_EQ(d->p(traffic::Kind::structured), 1.0);
+        EXPECT_EQ(d->p(traffic::Kind::smoother), 0.0);
+        EXPECT_EQ(d->p(traffic::Kind::matvec), 0.0);
+    }
+    EXPECT_GT(sweep.b(traffic::Kind::structured), 24.0 * n);
+    EXPECT_LT(sweep.b(traffic::Kind::structured), 24.0 * n + 0.5 * matrix);
+    EXPECT_GT(product.b(traffic::Kind::structured), 16.0 * n);
+    EXPECT_LT(product.b(traffic::Kind::structured), 16.0 * n + 0.5 * matrix);
 }
