@@ -209,7 +209,12 @@ std::string bench_numbering(const BenchSquareOptions& opt) {
     if (opt.numbering) return *opt.numbering;
     const bool all_default = std::all_of(opt.pcs.begin(), opt.pcs.end(),
                                          [](const std::string& pc) { return pc == "default"; });
-    return all_default && opt.levels >= levels::kMgDefaultLatticeLevel ? "lattice" : "hilbert";
+    const bool named_lattice =
+        std::any_of(opt.pcs.begin(), opt.pcs.end(),
+                    [](const std::string& pc) { return levels::wants_lattice_sweep(pc); });
+    return named_lattice || (all_default && opt.levels >= levels::kMgDefaultLatticeLevel)
+               ? "lattice"
+               : "hilbert";
 }
 
 int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
@@ -921,6 +926,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     (void)solvers::parse_krylov(opt.krylov);
     levels::Problem problem = scene::load_scene(opt.scene);
     problem.levels = opt.levels;
+    levels::number_for(problem, opt.pc); // a lattice sweep on levels numbered for it
     // Thread counts: 1 first (hypre's runs), then the others as given.
     std::vector<int> threads{1};
     for (int t : opt.threads)

@@ -73,8 +73,9 @@ BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, b
 
 /// The numbering of a single-process `bench square`: opt.numbering if set, else "lattice" when
 /// every solver is the default one and the finest level is at least
-/// levels::kMgDefaultLatticeLevel (the numbering the run's default takes there), else "hilbert"
-/// (the named preconditioners keep the numbering they always had).
+/// levels::kMgDefaultLatticeLevel (the numbering the run's default takes there) or one of them
+/// names the lattice sweep (mg:...,smoother=lattice), else "hilbert" (the named preconditioners
+/// keep the numbering they always had).
 std::string bench_numbering(const BenchSquareOptions& opt);
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every run converged).

@@ -10,9 +10,9 @@
 /// displacements; right-hand side the full load), distributed as a run distributes it, solved
 /// from zero to --tol by hypre's ParCSR PCG with BoomerAMG ("boomeramg-pcg", the one-process
 /// bench's settings) and by the distributed V-cycle (levels/distributed_solve.hpp) inside GMRES,
-/// CGS and CG ("mg-gmres", "mg-cgs", "mg-cg"). Per solver: setup and solve seconds (medians over --repeat of
-/// the slowest process), iterations, the true relative residual ||b - K x|| / ||b|| and the
-/// 2-norm and max-norm of x (all over the processes). The JSON
+/// CGS and CG ("mg-gmres", "mg-cgs", "mg-cg"). Per solver: setup and solve seconds (medians over
+/// --repeat of the slowest process), iterations, the true relative residual ||b - K x|| / ||b|| and
+/// the 2-norm and max-norm of x (all over the processes). The JSON
 /// (out/bench/elastic_<scene>_L<L>_np<N>.json unless --out) is written by rank 0.
 #pragma once
 

@@ -210,6 +210,7 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
             levels::SolveOptions so;
             so.coarse_to_fine = c.coarse_to_fine;
             so.linear = c.linear;
+            levels::number_for(p, so.linear.pc); // a lattice sweep on levels numbered for it
             const double t0 = wall_seconds();
             levels::RunResult r;
             try {

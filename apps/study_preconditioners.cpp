@@ -42,6 +42,7 @@ std::string run_combination(const levels::Problem& base, const PreconditionerStu
                             int finest) {
     levels::Problem p = base;
     p.levels = finest;
+    levels::number_for(p, pc); // a lattice sweep on levels numbered for it
     if (opt.load_steps > 0) p.load_steps = opt.load_steps;
     for (auto& c : p.contacts) {
         c.mu = mu;

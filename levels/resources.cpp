@@ -73,17 +73,27 @@ double mg_crossover_unknowns(const Problem& problem) {
     return has_two_body_pair(problem) ? kMgCrossoverTwoBody : kMgCrossoverOneBody;
 }
 
-void check_lattice_smoother(const Problem& problem, const std::string& pc) {
-    if (pc.find("smoother=lattice") == std::string::npos) return;
+bool wants_lattice_sweep(const std::string& pc) {
+    return pc.find("smoother=lattice") != std::string::npos;
+}
+
+void number_for(Problem& problem, const std::string& pc) {
+    if (wants_lattice_sweep(pc)) problem.numbering = Problem::Numbering::lattice;
+}
+
+void check_lattice_smoother(const Problem& problem, const std::string& pc, bool numbered_for_it) {
+    if (!wants_lattice_sweep(pc)) return;
     MLC_CHECK(problem.levels >= 4,
               "--pc " << pc
                       << ": smoother=lattice sweeps levels 4 and finer of a refined hierarchy (16 "
                          "subdivisions of every level-0 edge), and the finest level here is level "
                       << problem.levels << ": use --levels >= 4");
-    MLC_CHECK(problem.numbering == Problem::Numbering::lattice,
+    MLC_CHECK(numbered_for_it || problem.numbering == Problem::Numbering::lattice,
               "--pc " << pc
                       << ": smoother=lattice needs the levels' unknowns numbered macro triangle "
-                         "by macro triangle: add --numbering lattice");
+                         "by macro triangle (--numbering lattice, which the option takes when "
+                         "no numbering is given; Problem::numbering = lattice in the library): "
+                         "drop --numbering hilbert");
 }
 
 SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
@@ -123,7 +133,9 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
                           << " (`mlcontact preconditioners` lists their options)");
             MLC_CHECK(has_levels || !entry->needs_level_below || entry->single_level_too,
                       "--pc " << s.pc << " needs the level below: use --levels >= 1");
-            check_lattice_smoother(problem, s.pc);
+            // A lattice sweep named without a numbering numbers the levels for it.
+            c.lattice_numbering = wants_lattice_sweep(s.pc) && !req.numbering;
+            check_lattice_smoother(problem, s.pc, c.lattice_numbering);
         } else {
             // mg over the levels, or over an aggregation hierarchy on a single level (there it
             // is faster than ILU(0), which falls back to schur from the square's level-3 export

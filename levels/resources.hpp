@@ -102,9 +102,18 @@ inline constexpr const char* kMgDefaultLatticeOption = ",smoother=lattice";
 inline constexpr int kMgDefaultLatticeLevel = 4;
 
 /// Refuses mg:smoother=lattice (InvalidInput naming the fix) where it cannot take effect: a
-/// finest level below 4, or the levels not numbered as lattices (Problem::Numbering::lattice).
-/// Called by choose_solver and solve.
-void check_lattice_smoother(const Problem& problem, const std::string& pc);
+/// finest level below 4, or the levels not numbered as lattices (Problem::Numbering::lattice;
+/// `numbered_for_it`: the caller will number them so). Called by choose_solver and solve.
+void check_lattice_smoother(const Problem& problem, const std::string& pc,
+                            bool numbered_for_it = false);
+
+/// Whether a preconditioner spec asks for the lattice sweep (mg:...,smoother=lattice).
+bool wants_lattice_sweep(const std::string& pc);
+
+/// Numbers `problem`'s levels by lattices when `pc` asks for the lattice sweep (what `run` does
+/// when no --numbering is given): for the studies and benchmarks that take a --pc and solve with
+/// it directly.
+void number_for(Problem& problem, const std::string& pc);
 
 /// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
 /// without `pc` uses the default mg (damped, kMgDefaultTwoBody, with a two-body pair; over an
@@ -112,7 +121,8 @@ void check_lattice_smoother(const Problem& problem, const std::string& pc);
 /// by size: `schur` up to mg_crossover_unknowns(problem) unknowns on the finest level, Krylov +
 /// `mg` above it when levels exist (BiCGStab + mg's V(0,2) cycle, damped with a two-body pair;
 /// from level kMgDefaultLatticeLevel on with the lattice sweep, kMgDefaultLatticeOption, and
-/// SolverChoice::lattice_numbering set, unless the request names numbering hilbert).
+/// SolverChoice::lattice_numbering set, unless the request names numbering hilbert). A `pc`
+/// that names smoother=lattice sets lattice_numbering too when the request names no numbering.
 /// `pc` alone without `krylov` takes CGS; when the driver picks mg itself (no `pc`), BiCGStab
 /// (kMgDefaultKrylov). A Krylov option next to `linear schur` or `linear lu`
 /// contradicts it and throws InvalidInput saying so. `sizes`: predict_level_sizes(problem) when the

@@ -314,7 +314,8 @@ const std::vector<PreconditionerEntry>& preconditioner_registry() {
          "to at most N = 3000 unknowns, prolongation smoothing S = 4/3; precision=single stores "
          "the smoother's matrices, block inverses and transfers as float, vectors stay double; "
          "smoother=lattice sweeps the interiors of the level-0 triangles of levels 4 and finer "
-         "with structured kernels; it needs --numbering lattice)",
+         "with structured kernels on levels numbered by lattices, --numbering lattice, which it "
+         "takes when no numbering is given; the default from level 4 on)",
          "",
          {"pre", "post", "omega", "coarse", "csize", "smooth", "precision", "smoother"},
          true,

@@ -76,13 +76,24 @@ TEST(LatticeMultigrid, RefusesWhatCannotTakeEffect) {
     auto p = scene::load_scene("square");
     p.levels = 4;
     const SolverRequest req{.pc = std::string("mg:pre=0,post=2,smoother=lattice")};
+    // Named without a numbering, the option numbers the levels for itself; named beside
+    // numbering hilbert it is refused.
+    EXPECT_TRUE(choose_solver(p, req).lattice_numbering);
+    SolverRequest hilbert = req;
+    hilbert.numbering = "hilbert";
     try {
-        (void)choose_solver(p, req);
-        ADD_FAILURE() << "no error without the lattice numbering";
+        (void)choose_solver(p, hilbert);
+        ADD_FAILURE() << "no error with the Hilbert numbering";
     } catch (const InvalidInput& e) {
-        EXPECT_NE(std::string(e.what()).find("--numbering lattice"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("drop --numbering hilbert"), std::string::npos)
+            << e.what();
     }
-    p.numbering = Problem::Numbering::lattice;
+    // The library's solve needs the levels numbered (number_for does it from the spec).
+    SolveOptions direct;
+    direct.linear = {.method = "krylov", .krylov = "bicgstab", .pc = *req.pc, .rel_tol = 1e-8};
+    EXPECT_THROW((void)solve(p, direct), InvalidInput);
+    number_for(p, *req.pc);
+    EXPECT_EQ(p.numbering, Problem::Numbering::lattice);
     EXPECT_NO_THROW((void)choose_solver(p, req));
     p.levels = 3;
     try {

@@ -45,18 +45,18 @@ TEST(PredictLevelSizes, RefinementCountsAreExactAndUnknownsClose) {
 TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
     auto p = scene::load_scene("square");
     p.levels = 2;
-    const auto c = levels::choose_solver(p, {{}, {}, std::string("mg"), {}});
+    const auto c = levels::choose_solver(p, {{}, {}, std::string("mg"), {}, {}});
     EXPECT_EQ(c.spec.method, "krylov");
     EXPECT_EQ(c.spec.pc, "mg");
     EXPECT_EQ(c.spec.krylov, "cgs");
     EXPECT_FALSE(c.automatic);
     // A Krylov method or tolerance alone too, with mg where there is a level below.
-    const auto k = levels::choose_solver(p, {{}, std::string("gmres"), {}, {}});
+    const auto k = levels::choose_solver(p, {{}, std::string("gmres"), {}, {}, {}});
     EXPECT_EQ(k.spec.method, "krylov");
     EXPECT_EQ(k.spec.krylov, "gmres");
     EXPECT_EQ(k.spec.pc, "mg:pre=0,post=2");
     // The tolerance alone: the driver's own mg pair, BiCGStab + V(0,2).
-    const auto t = levels::choose_solver(p, {{}, {}, {}, 1e-6});
+    const auto t = levels::choose_solver(p, {{}, {}, {}, 1e-6, {}});
     EXPECT_EQ(t.spec.method, "krylov");
     EXPECT_EQ(t.spec.rel_tol, 1e-6);
     EXPECT_EQ(t.spec.krylov, "bicgstab");
@@ -66,23 +66,23 @@ TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
 TEST(ChooseSolver, LinearKrylovUsesTheDefaultMgOnEveryMesh) {
     auto p = scene::load_scene("square");
     p.levels = 1;
-    const auto mg = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
+    const auto mg = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}, {}});
     EXPECT_EQ(mg.spec.pc, "mg:pre=0,post=2");
     EXPECT_EQ(mg.spec.krylov, "bicgstab");
     // A Krylov method named beside it is kept.
-    EXPECT_EQ(
-        levels::choose_solver(p, {std::string("krylov"), std::string("cgs"), {}, {}}).spec.krylov,
-        "cgs");
+    EXPECT_EQ(levels::choose_solver(p, {std::string("krylov"), std::string("cgs"), {}, {}, {}})
+                  .spec.krylov,
+              "cgs");
     // On a single level the same pair over an aggregation hierarchy (not ILU(0)), damped with a
     // two-body pair.
     p.levels = 0;
-    const auto one = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
+    const auto one = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}, {}});
     EXPECT_EQ(one.spec.pc, "mg:pre=0,post=2");
     EXPECT_EQ(one.spec.krylov, "bicgstab");
     EXPECT_NE(one.reason.find("aggregation hierarchy"), std::string::npos) << one.reason;
     auto dt = scene::load_scene("dovetail");
     dt.levels = 0;
-    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.pc,
+    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}, {}}).spec.pc,
               "mg:omega=0.8,pre=0,post=2");
 }
 
@@ -91,17 +91,20 @@ TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
     p.levels = 2;
     for (const char* direct : {"schur", "lu"}) {
         try {
-            levels::choose_solver(p, {std::string(direct), {}, std::string("mg"), {}});
+            levels::choose_solver(p, {std::string(direct), {}, std::string("mg"), {}, {}});
             ADD_FAILURE() << "no error for --linear " << direct << " --pc mg";
         } catch (const InvalidInput& e) {
             EXPECT_NE(std::string(e.what()).find("--pc mg applies to Krylov solves only"),
                       std::string::npos)
                 << e.what();
         }
-        EXPECT_THROW(levels::choose_solver(p, {std::string(direct), std::string("cgs"), {}, {}}),
+        EXPECT_THROW(
+            levels::choose_solver(p, {std::string(direct), std::string("cgs"), {}, {}, {}}),
+            InvalidInput);
+        EXPECT_THROW(levels::choose_solver(p, {std::string(direct), {}, {}, 1e-8, {}}),
                      InvalidInput);
-        EXPECT_THROW(levels::choose_solver(p, {std::string(direct), {}, {}, 1e-8}), InvalidInput);
-        EXPECT_EQ(levels::choose_solver(p, {std::string(direct), {}, {}, {}}).spec.method, direct);
+        EXPECT_EQ(levels::choose_solver(p, {std::string(direct), {}, {}, {}, {}}).spec.method,
+                  direct);
     }
 }
 
@@ -166,13 +169,13 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
     EXPECT_EQ(levels::choose_solver(dt, {}).spec.krylov, "bicgstab");
     EXPECT_NE(levels::choose_solver(dt, {}).reason.find("BiCGStab + mg:omega=0.8,pre=0,post=2"),
               std::string::npos);
-    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.pc,
+    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}, {}}).spec.pc,
               "mg:omega=0.8,pre=0,post=2");
-    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}}).spec.krylov,
+    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}, {}}).spec.krylov,
               "bicgstab");
     // A named preconditioner is taken as given, with CGS unless a method is named.
-    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}}).spec.pc, "mg");
-    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}}).spec.krylov, "cgs");
+    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}, {}}).spec.pc, "mg");
+    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}, {}}).spec.krylov, "cgs");
     sq.levels = 3;
     EXPECT_EQ(levels::choose_solver(sq, {}).spec.krylov, "bicgstab");
     EXPECT_NE(levels::choose_solver(sq, {}).reason.find("BiCGStab + mg:pre=0,post=2"),
@@ -261,9 +264,9 @@ TEST(ChooseSolver, TheDefaultSweepsByLatticesFromLevel4UnlessNumberingHilbertIsA
     EXPECT_TRUE(h.automatic);
     EXPECT_FALSE(h.lattice_numbering);
     EXPECT_EQ(h.spec.pc, "mg:pre=0,post=2");
-    const auto named = levels::choose_solver(p, {{}, {}, std::string("mg:pre=0,post=2"), {}});
+    const auto named = levels::choose_solver(p, {{}, {}, std::string("mg:pre=0,post=2"), {}, {}});
     EXPECT_FALSE(named.lattice_numbering);
-    const auto krylov = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}});
+    const auto krylov = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}, {}});
     EXPECT_FALSE(krylov.lattice_numbering);
     EXPECT_EQ(krylov.spec.pc, "mg:pre=0,post=2");
     // A two-body pair keeps its damping, with the lattice sweep.
