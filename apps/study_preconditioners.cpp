@@ -205,9 +205,16 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
             for (double mu : opt.mu)
                 for (double rf : opt.r_over_E) {
                     // Levels 1..L, each its own run; after a level fails, the finer ones are not
-                    // run (they repeat the failing level first).
+                    // run (they repeat the failing level first). The lattice sweep runs from
+                    // level 4 (below it the option is refused: those levels are not run).
                     bool stop = false;
-                    for (int finest = 1; finest <= opt.levels && !stop; ++finest) {
+                    const int first = levels::wants_lattice_sweep(pc)
+                                          ? std::min(opt.levels, levels::kMgDefaultLatticeLevel)
+                                          : 1;
+                    if (first > 1)
+                        os << pc << ": levels 1-" << first - 1
+                           << " not run (smoother=lattice sweeps levels 4 and finer)\n";
+                    for (int finest = first; finest <= opt.levels && !stop; ++finest) {
                         const std::string text = run_bounded(
                             [&] { return run_combination(problem, opt, kr, pc, mu, rf, finest); },
                             opt.seconds_per_run);
