@@ -199,10 +199,9 @@ double matrix_seconds(const traffic::Account& a) {
 BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
                          bool lattice) {
     if (pc != "default") return {opt.krylov.value_or("cgs"), pc};
-    std::string spec = levels::default_mg_spec(two_body);
-    if (lattice && opt.levels >= levels::kMgDefaultLatticeLevel)
-        spec += levels::kMgDefaultLatticeOption;
-    return {opt.krylov.value_or(levels::kMgDefaultKrylov), spec};
+    return {
+        opt.krylov.value_or(levels::kMgDefaultKrylov),
+        levels::default_mg_spec(two_body, lattice && opt.levels >= levels::kMgDefaultLatticeLevel)};
 }
 
 std::string bench_numbering(const BenchSquareOptions& opt) {
@@ -229,11 +228,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     levels::Problem base = scene::load_scene(opt.scene);
     base.levels = opt.levels;
     const std::string numbering = bench_numbering(opt);
-    MLC_CHECK(numbering == "hilbert" || numbering == "lattice",
-              "bench square: --numbering must be hilbert or lattice, found '" << numbering << "'");
-    base.numbering = numbering == "lattice" ? levels::Problem::Numbering::lattice
-                                            : levels::Problem::Numbering::hilbert;
-    const bool lattice = numbering == "lattice";
+    base.numbering = levels::parse_numbering(numbering, "bench square: --numbering");
+    const bool lattice = base.numbering == levels::Problem::Numbering::lattice;
     const bool two_body = levels::has_two_body_pair(base);
     const BenchSolver def = bench_solver(opt, "default", two_body, lattice);
     const std::string named_krylov = opt.krylov.value_or("cgs");

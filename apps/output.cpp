@@ -489,8 +489,7 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
                 sv.insert("rel_tol", sp.rel_tol);
             }
             sv.insert("automatic", r.solver.automatic);
-            sv.insert("numbering",
-                      p.numbering == levels::Problem::Numbering::lattice ? "lattice" : "hilbert");
+            sv.insert("numbering", std::string(levels::to_string(p.numbering)));
             sv.insert("reason", r.solver.reason);
             int fallbacks = 0;
             for (const auto& ls : r.level_steps)

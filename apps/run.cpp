@@ -32,12 +32,7 @@ void apply_overrides(levels::Problem& p, const RunOptions& opt) {
                                 : std::string()));
         p.levels = k + *opt.levels;
     }
-    if (opt.numbering) {
-        MLC_CHECK(*opt.numbering == "hilbert" || *opt.numbering == "lattice",
-                  "--numbering must be hilbert or lattice, found '" << *opt.numbering << "'");
-        p.numbering = *opt.numbering == "lattice" ? levels::Problem::Numbering::lattice
-                                                  : levels::Problem::Numbering::hilbert;
-    }
+    if (opt.numbering) p.numbering = levels::parse_numbering(*opt.numbering, "--numbering");
     if (opt.load_steps) {
         MLC_CHECK(*opt.load_steps >= 1, "--steps must be at least 1, found " << *opt.load_steps);
         p.load_steps = *opt.load_steps;

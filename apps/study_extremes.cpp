@@ -43,17 +43,16 @@ std::string num(double v, int digits = 3) {
 }
 
 /// mg:smoother=lattice (the default's sweep from level 4 on) on p (its levels set): the levels
-/// numbered by lattices, or below level 4 (the slender case's level 1) the block sweep, as the
-/// default takes there; returns whether the lattice option was dropped.
+/// numbered by lattices (levels::number_for), or below level 4 (the slender case's level 1)
+/// smoother=block, as the default takes there; returns whether the block sweep replaced it.
 bool sweep_for(levels::Problem& p, levels::LinearSolverSpec& solver) {
-    const std::string option = levels::kMgDefaultLatticeOption;
-    const auto at = solver.pc.find(option);
-    if (at == std::string::npos) return false;
+    if (!levels::wants_lattice_sweep(solver.pc)) return false;
     if (p.levels >= levels::kMgDefaultLatticeLevel) {
-        p.numbering = levels::Problem::Numbering::lattice;
+        levels::number_for(p, solver.pc);
         return false;
     }
-    solver.pc.erase(at, option.size());
+    const std::string lattice = "smoother=lattice";
+    solver.pc.replace(solver.pc.find(lattice), lattice.size(), "smoother=block");
     return true;
 }
 
@@ -395,8 +394,7 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     sq.levels = opt.levels;
     if (opt.linear || opt.krylov || opt.pc || opt.linear_rel_tol) {
         // A lattice sweep asked for is run on levels numbered for it (every case is).
-        if (opt.pc && opt.pc->find("smoother=lattice") != std::string::npos)
-            sq.numbering = levels::Problem::Numbering::lattice;
+        if (opt.pc) levels::number_for(sq, *opt.pc);
         solvers.push_back(
             levels::choose_solver(sq, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol, {}}));
     } else {
@@ -407,12 +405,11 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
             // level 4 on both with the lattice sweep, on levels numbered for it.
             const std::string krylov = levels::kMgDefaultKrylov;
             const bool lattice = opt.levels >= levels::kMgDefaultLatticeLevel;
-            if (lattice) sq.numbering = levels::Problem::Numbering::lattice;
-            const std::string sweep = lattice ? levels::kMgDefaultLatticeOption : "";
-            solvers.push_back(levels::choose_solver(
-                sq, {{}, krylov, std::string(levels::kMgDefaultOneBody) + sweep, {}, {}}));
-            solvers.push_back(levels::choose_solver(
-                sq, {{}, krylov, std::string(levels::kMgDefaultTwoBody) + sweep, {}, {}}));
+            for (const bool two_body : {false, true}) {
+                const std::string pc = levels::default_mg_spec(two_body, lattice);
+                levels::number_for(sq, pc);
+                solvers.push_back(levels::choose_solver(sq, {{}, krylov, pc, {}, {}}));
+            }
         }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "

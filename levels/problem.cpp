@@ -133,6 +133,16 @@ double Problem::path_value(const std::vector<double>& path, double full, int k, 
     return path[static_cast<size_t>(k - 1)];
 }
 
+std::string_view to_string(Problem::Numbering n) {
+    return n == Problem::Numbering::lattice ? "lattice" : "hilbert";
+}
+
+Problem::Numbering parse_numbering(std::string_view name, std::string_view what) {
+    MLC_CHECK(name == "hilbert" || name == "lattice",
+              what << " must be hilbert or lattice, found '" << name << "'");
+    return name == "lattice" ? Problem::Numbering::lattice : Problem::Numbering::hilbert;
+}
+
 std::string_view to_string(ContactElementKind k) {
     switch (k) {
     case ContactElementKind::node_on_rigid:

@@ -181,4 +181,10 @@ struct Problem {
     static double path_value(const std::vector<double>& path, double full, int k, int K);
 };
 
+/// "hilbert" or "lattice".
+std::string_view to_string(Problem::Numbering n);
+/// The numbering named "hilbert" or "lattice"; anything else throws InvalidInput naming `what`
+/// (the option, e.g. "--numbering") and the value.
+Problem::Numbering parse_numbering(std::string_view name, std::string_view what);
+
 } // namespace mlc::levels

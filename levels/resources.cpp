@@ -163,13 +163,12 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             // BiCGStab with a V(0,2) cycle; two-body pairs also damp the sweeps (README
             // "Choosing the Newton-system solver", "The default cycle: V(0,2) with BiCGStab").
             const bool two_body = has_two_body_pair(problem);
-            s.pc = default_mg_spec(two_body);
             if (!req.krylov) s.krylov = kMgDefaultKrylov;
             // Levels 4 and finer swept by lattices, numbered for it (not when the request keeps
             // the Hilbert numbering).
             c.lattice_numbering = problem.levels >= kMgDefaultLatticeLevel &&
                                   (!req.numbering || *req.numbering == "lattice");
-            if (c.lattice_numbering) s.pc += kMgDefaultLatticeOption;
+            s.pc = default_mg_spec(two_body, c.lattice_numbering);
             os << "default: " << n << " unknowns on the finest level exceed the crossover "
                << crossover << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
                << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles" : "")

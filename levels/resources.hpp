@@ -101,6 +101,11 @@ inline constexpr const char* kMgDefaultLatticeOption = ",smoother=lattice";
 /// level-0 edge: solvers::kMinLatticeSubdivisions).
 inline constexpr int kMgDefaultLatticeLevel = 4;
 
+/// default_mg_spec(two_body), with kMgDefaultLatticeOption when `lattice`.
+inline std::string default_mg_spec(bool two_body, bool lattice) {
+    return std::string(default_mg_spec(two_body)) + (lattice ? kMgDefaultLatticeOption : "");
+}
+
 /// Refuses mg:smoother=lattice (InvalidInput naming the fix) where it cannot take effect: a
 /// finest level below 4, or the levels not numbered as lattices (Problem::Numbering::lattice;
 /// `numbered_for_it`: the caller will number them so). Called by choose_solver and solve.

@@ -730,10 +730,8 @@ PYBIND11_MODULE(_core, m) {
                                    d["pc"] = sp.pc;
                                    d["rel_tol"] = sp.rel_tol;
                                    d["automatic"] = r.run.solver.automatic;
-                                   d["numbering"] = r.problem.numbering ==
-                                                            levels::Problem::Numbering::lattice
-                                                        ? "lattice"
-                                                        : "hilbert";
+                                   d["numbering"] =
+                                       std::string(levels::to_string(r.problem.numbering));
                                    d["reason"] = r.run.solver.reason;
                                    return d;
                                })
