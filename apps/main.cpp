@@ -189,7 +189,8 @@ int main(int argc, char** argv) {
         "--pc", bso.pcs,
         mlc::apps::pc_option_help(
             "solvers (space-separated list): schur, lu, default (the run's default above the "
-            "crossover: BiCGStab + mg:pre=0,post=2, damped with a two-body pair), or "
+            "crossover: BiCGStab + mg:pre=0,post=2, damped with a two-body pair, with "
+            "smoother=lattice from level 4 on levels numbered by lattices), or "
             "preconditioner specs (default: default)"));
     bsq->add_option("--krylov", bso.krylov,
                     "Krylov method for the preconditioners (default cgs; for `default` the run's, "

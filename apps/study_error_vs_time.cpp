@@ -27,22 +27,26 @@ struct Config {
     /// What bounds the levels it runs on: none (0..L), ILU(0) (0..min(L, ilu_max_level)) or the
     /// multigrid (1..L: it needs a level below).
     enum class Family { exact, ilu, mg } family = Family::exact;
+    /// The run's default: from this level on its pc gains kMgDefaultLatticeOption (the lattice
+    /// sweep, on levels numbered for it), as choose_solver's default does; 0 = never.
+    int lattice_from = 0;
 };
 
 std::vector<Config> configurations(const levels::Problem& problem) {
     std::vector<Config> c;
     using F = Config::Family;
-    // The multilevel solvers: the run's default above the crossover up to 2026-11-27 (BiCGStab +
-    // mg's V(0,2) cycle with the block sweep, damped with a two-body pair; from level 4 the
-    // default now adds the lattice sweep, which this study does not run yet), `--pc mg` (CGS +
-    // V(1,1), the default before 2026-11-26) and hypre's MGR with `--pc mgr`, to the run's
-    // default linear tolerance.
+    // The multilevel solvers: the run's default above the crossover (BiCGStab + mg's V(0,2)
+    // cycle, damped with a two-body pair; from level kMgDefaultLatticeLevel on with the lattice
+    // sweep on levels numbered by lattices: `lattice_from`), `--pc mg` (CGS + V(1,1), the
+    // default before 2026-11-26) and hypre's MGR with `--pc mgr`, to the run's default linear
+    // tolerance.
     const levels::LinearSolverSpec def{
         .method = "krylov",
         .krylov = levels::kMgDefaultKrylov,
         .pc = levels::default_mg_spec(levels::has_two_body_pair(problem)),
         .rel_tol = 1e-10};
-    c.push_back({"c2f default bicgstab+mg", true, def, 1e-10, F::mg});
+    c.push_back(
+        {"c2f default bicgstab+mg", true, def, 1e-10, F::mg, levels::kMgDefaultLatticeLevel});
     const levels::LinearSolverSpec mg{
         .method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-10};
     c.push_back({"c2f cgs+mg", true, mg, 1e-10, F::mg});
@@ -73,6 +77,13 @@ std::vector<Config> configurations(const levels::Problem& problem) {
                  1e-6,
                  F::ilu});
     return c;
+}
+
+/// The linear solver a configuration runs on level `level`.
+levels::LinearSolverSpec linear_for(const Config& c, int level) {
+    levels::LinearSolverSpec s = c.linear;
+    if (c.lattice_from > 0 && level >= c.lattice_from) s.pc += levels::kMgDefaultLatticeOption;
+    return s;
 }
 
 /// Prolongates a full nodal vector from level l to level L of a hierarchy (P_nodal chain).
@@ -161,6 +172,13 @@ Errors errors_against(const levels::RunResult& ref, int l, const levels::RunResu
 
 } // namespace
 
+std::string error_vs_time_pc(const levels::Problem& problem, const std::string& configuration,
+                             int level) {
+    for (const auto& c : configurations(problem))
+        if (c.name == configuration) return linear_for(c, level).pc;
+    throw InvalidInput("study error-vs-time has no configuration named '" + configuration + "'");
+}
+
 int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOptions& opt,
                         std::ostream& os) {
     MLC_CHECK(opt.max_level >= 0 && opt.max_level <= 6, "--levels must lie in [0, 6]");
@@ -214,7 +232,7 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
             p.newton.rel_tol = c.newton_tol;
             levels::SolveOptions so;
             so.coarse_to_fine = c.coarse_to_fine;
-            so.linear = c.linear;
+            so.linear = linear_for(c, l);
             levels::number_for(p, so.linear.pc); // a lattice sweep on levels numbered for it
             const double t0 = wall_seconds();
             levels::RunResult r;

@@ -27,7 +27,14 @@ struct ErrorVsTimeOptions {
     std::filesystem::path out; ///< default out/studies/<scene>_error_vs_time
 };
 
-/// Configurations: coarse-to-fine and cold CGS + `mg` (levels 1..max_level: mg needs a level
+/// The preconditioner spec the configuration named `configuration` runs on level `level` of
+/// `problem` ("c2f default bicgstab+mg": the run's default above the crossover, with the lattice
+/// sweep from level 4). Throws InvalidInput for an unknown name.
+std::string error_vs_time_pc(const levels::Problem& problem, const std::string& configuration,
+                             int level);
+
+/// Configurations: the run's default above the crossover (coarse-to-fine BiCGStab + `mg`,
+/// levels 1..max_level), coarse-to-fine and cold CGS + `mg` (levels 1..max_level: mg needs a level
 /// below), coarse-to-fine CGS + hypre MGR (`mgr`, in builds with hypre), coarse-to-fine and cold
 /// `schur`, `schur` with Newton tolerance 1e-6, coarse-to-fine and cold `lu`, and GMRES / CGS +
 /// ILU(0) (up to ilu_max_level). A run that throws is recorded as not converged.

@@ -3,6 +3,8 @@
 // mg from level 1, mgr where hypre is built in), converge, and their error against the level-3
 // reference falls with the level; the other configurations are left out by --only.
 #include "apps/study_error_vs_time.hpp"
+#include "core/check.hpp"
+#include "levels/resources.hpp"
 #include "scene/scene.hpp"
 #include "solvers/hypre/boomeramg.hpp"
 
@@ -68,7 +70,34 @@ TEST(ErrorVsTime, MultilevelRowsConvergeAndTheirErrorFallsWithTheLevel) {
         EXPECT_NEAR(r.at(1).second, 0.0167, 0.0005) << name;
         EXPECT_NEAR(r.at(2).second, 0.00757, 0.0002) << name;
         EXPECT_LT(r.at(2).second, 0.6 * r.at(1).second) << name;
-        if (r.count(0)) EXPECT_LT(r.at(1).second, 0.6 * r.at(0).second) << name;
+        if (r.count(0)) {
+            EXPECT_LT(r.at(1).second, 0.6 * r.at(0).second) << name;
+        }
     }
     std::filesystem::remove_all(dir);
+}
+
+// The grid's default row is the run's default above the crossover on every level: the block
+// sweep up to level 3, the lattice sweep from level 4 (what choose_solver picks with no solver
+// flag), with a one-body and a two-body scene.
+TEST(ErrorVsTime, TheDefaultRowRunsTheRunsDefaultOnEveryLevel) {
+    // patch (two bodies, crossover 10 000 unknowns) is below it up to level 3.
+    for (const char* name : {"square", "patch"}) {
+        const auto scene = scene::load_scene(name);
+        for (int level : {3, 4, 5}) {
+            if (std::string(name) == "patch" && level == 3) continue;
+            levels::Problem p = scene;
+            p.levels = level;
+            const levels::SolverChoice choice = levels::choose_solver(p, {});
+            ASSERT_TRUE(choice.spec.method == "krylov")
+                << name << " level " << level << ": " << choice.reason;
+            EXPECT_EQ(apps::error_vs_time_pc(scene, "c2f default bicgstab+mg", level),
+                      choice.spec.pc)
+                << name << " level " << level;
+            EXPECT_EQ(choice.lattice_numbering, level >= 4) << name << " level " << level;
+        }
+    }
+    EXPECT_EQ(apps::error_vs_time_pc(scene::load_scene("square"), "c2f cgs+mg", 5), "mg");
+    EXPECT_THROW(apps::error_vs_time_pc(scene::load_scene("square"), "no such row", 1),
+                 InvalidInput);
 }
