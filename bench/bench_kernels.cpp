@@ -19,6 +19,9 @@
 //   two sweeps lattice, sweep lattice, lattice refresh, lattice setup: the same for
 //                     smoothers::LatticeGS (mg:smoother=lattice) on the finest level's lattice;
 //                     only with --numbering lattice (the level's Level::lattice).
+//   restriction csr, prolongation csr, restriction lattice, prolongation lattice: R r and T e
+//                     between level L-1 and level L (csr_multiply against solvers::LatticeTransfer,
+//                     the same values bit for bit); only with --numbering lattice and L >= 5.
 // The variants alternate in one process, so that a slow phase of the machine hits them alike:
 // compare them with each other, not with another run's. Output: one JSON object on stdout
 // (times in ms: median and minimum over --reps).
@@ -29,11 +32,13 @@
 #include "core/first_touch.hpp"
 #include "core/parallel.hpp"
 #include "core/timer.hpp"
+#include "levels/hierarchy.hpp"
 #include "levels/level.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 #include "smoothers/block_sor.hpp"
 #include "smoothers/lattice_gs.hpp"
+#include "solvers/lattice_transfer.hpp"
 #include "solvers/mg.hpp"
 
 #include <algorithm>
@@ -255,6 +260,25 @@ int main(int argc, char** argv) {
     };
     const levels::RunResult r = levels::solve(pr, so);
     n = r.finest().n_unknowns();
+    if (lattice_numbering && levels >= 5) {
+        const levels::Hierarchy& h = r.hierarchy;
+        const auto& tr = h.transfers[static_cast<size_t>(levels - 1)];
+        const auto& fine_rows = *h.levels[static_cast<size_t>(levels)].lattice;
+        const auto& coarse_rows = *h.levels[static_cast<size_t>(levels - 1)].lattice;
+        for (int k = 0; k < 3; ++k)
+            out["lattice transfer setup"].ms.push_back(time_ms(
+                [&] { const solvers::LatticeTransfer t(tr.T, tr.R, fine_rows, coarse_rows); }));
+        const solvers::LatticeTransfer lt(tr.T, tr.R, fine_rows, coarse_rows);
+        Vector f = parallel::zeros(tr.T.rows()), c = parallel::zeros(tr.T.cols());
+        for (Index i = 0; i < f.size(); ++i)
+            f[i] = std::sin(0.001 * static_cast<double>(i));
+        for (int k = 0; k < reps; ++k) {
+            out["restriction csr"].ms.push_back(time_ms([&] { csr_multiply(tr.R, f, c); }));
+            out["prolongation csr"].ms.push_back(time_ms([&] { csr_multiply(tr.T, c, f); }));
+            out["restriction lattice"].ms.push_back(time_ms([&] { lt.restrict_residual(f, c); }));
+            out["prolongation lattice"].ms.push_back(time_ms([&] { lt.prolongate(c, f, false); }));
+        }
+    }
     std::cout << "{\"levels\": " << levels << ", \"unknowns\": " << n
               << ", \"threads\": " << parallel::num_threads() << ", \"reps\": " << reps;
     for (const auto& [k, s] : out)

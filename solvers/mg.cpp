@@ -7,6 +7,7 @@
 #include "core/timer.hpp"
 #include "smoothers/matrix_checks.hpp"
 #include "solvers/direct.hpp"
+#include "solvers/lattice_transfer.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -50,8 +51,8 @@ smoothers::BlockSORParams smoother_params(const MultigridParams& params,
 // smoother and the work vectors of the cycle.
 struct Multigrid::Level {
     Level(const MultigridLevelData& d, const MultigridParams& p)
-        : T(d.T), R(d.R), T_storage(d.T_storage), R_storage(d.R_storage), params(p),
-          smoother(smoother_params(p, d.block_starts)) {
+        : T(d.T), R(d.R), T_storage(d.T_storage), R_storage(d.R_storage), lattice_rows(d.lattice),
+          params(p), smoother(smoother_params(p, d.block_starts)) {
         if (T && p.smoother == MultigridParams::Smoother::lattice && d.lattice &&
             d.lattice->n >= kMinLatticeSubdivisions)
             lattice = std::make_unique<smoothers::LatticeGS>(
@@ -63,16 +64,26 @@ struct Multigrid::Level {
     }
     const SparseMatrix* T = nullptr;
     const SparseMatrix* R = nullptr;
-    std::shared_ptr<const SparseMatrix> T_storage, R_storage; // owned transfers, or null
+    std::shared_ptr<const SparseMatrix> T_storage, R_storage;   // owned transfers, or null
+    std::shared_ptr<const smoothers::LatticeRows> lattice_rows; // the level's lattice, or null
     parallel::UninitializedVector<float> T32, R32; // float32: T's and R's values, rounded
     MultigridParams params;
     smoothers::BlockSOR smoother;                  // levels >= 1
     std::unique_ptr<smoothers::LatticeGS> lattice; // mg:smoother=lattice: used instead
-    std::unique_ptr<Preconditioner> coarse;        // level 0
-    bool coarse_replaced = false;                  // level 0: set_coarse_solver was called
-    const SparseMatrix* A = nullptr;               // the operator (borrowed, or `owned`)
-    SparseMatrix owned;                            // Galerkin operator
-    mutable Vector res, rc, ec;                    // levels >= 1
+    // mg:smoother=lattice with the level below numbered by lattices too: T and R through the
+    // lattice (the same values as csr_multiply).
+    std::unique_ptr<LatticeTransfer> lattice_transfer;
+    void link_lattice_transfer(const Level& below) {
+        if (lattice && below.lattice_rows && lattice_rows &&
+            lattice_rows->n == 2 * below.lattice_rows->n && lattice_rows->first_row.size() > 0)
+            lattice_transfer =
+                std::make_unique<LatticeTransfer>(*T, *R, *lattice_rows, *below.lattice_rows);
+    }
+    std::unique_ptr<Preconditioner> coarse; // level 0
+    bool coarse_replaced = false;           // level 0: set_coarse_solver was called
+    const SparseMatrix* A = nullptr;        // the operator (borrowed, or `owned`)
+    SparseMatrix owned;                     // Galerkin operator
+    mutable Vector res, rc, ec;             // levels >= 1
 
     // Full setup (`full`) or a refresh reusing the structure; the first call is always full.
     void set(const SparseMatrix& M, bool full) {
@@ -134,6 +145,7 @@ Multigrid::Multigrid(std::vector<MultigridLevelData> levels, MultigridParams par
         }
         auto L = std::make_shared<Level>(d, params);
         if (k == 0) L->coarse = std::make_unique<SparseLUPreconditioner>();
+        if (k > 0) L->link_lattice_transfer(*levels_.back());
         levels_.push_back(std::move(L));
     }
 }
@@ -154,7 +166,9 @@ std::unique_ptr<Multigrid> Multigrid::above(const Multigrid& below, MultigridLev
               "Multigrid::above: only rediscretized multigrids share their levels");
     std::unique_ptr<Multigrid> mg(new Multigrid());
     mg->levels_ = below.levels_;
-    mg->levels_.push_back(std::make_shared<Level>(top, params));
+    auto L = std::make_shared<Level>(top, params);
+    L->link_lattice_transfer(under);
+    mg->levels_.push_back(std::move(L));
     return mg;
 }
 
@@ -318,6 +332,10 @@ void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
         csr_multiply(csr_arrays(*L.R, L.R32.data()), res, L.rc, false, traffic::Kind::transfer);
         cycle(k - 1, L.rc, L.ec);
         csr_multiply(csr_arrays(*L.T, L.T32.data()), L.ec, z, !from_zero, traffic::Kind::transfer);
+    } else if (L.lattice_transfer) {
+        L.lattice_transfer->restrict_residual(res, L.rc);
+        cycle(k - 1, L.rc, L.ec);
+        L.lattice_transfer->prolongate(L.ec, z, !from_zero);
     } else {
         csr_multiply(*L.R, res, L.rc, false, traffic::Kind::transfer);
         cycle(k - 1, L.rc, L.ec);
@@ -390,6 +408,9 @@ MultigridReport Multigrid::report() const {
     if (p.smoother == MultigridParams::Smoother::lattice)
         sm << "; structured kernels on the macro triangles' interiors (smoother=lattice) on the "
               "levels marked lattice";
+    if (std::any_of(levels_.begin(), levels_.end(),
+                    [](const auto& L) { return L->lattice_transfer != nullptr; }))
+        sm << "; between two such levels the transfers through the lattice too";
     r.smoother = sm.str();
     const Level& L0 = *levels_.front();
     r.coarse_solver =
