@@ -8,7 +8,9 @@
 #include "core/traffic.hpp"
 
 #include <algorithm>
+#if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
 
 namespace mlc::solvers {
 
@@ -66,21 +68,58 @@ template <class Fn> void for_structured_fine(int nf, Fn&& fn) {
             fn(i, j);
 }
 
-// The two components of a point in one register, each lane summed as row_dot (core/csr.hpp)
-// sums the row: a0 = 0 + v x0 (+ v x1), then (a0 + a1) + (a2 + a3) with a1 = a2 = a3 = 0, which
-// leaves a0 as it is (a0 = 0 + p is never -0.0), so it is left out.
-inline __m128d dot1(__m128d x) {
-    return _mm_add_pd(_mm_setzero_pd(), _mm_mul_pd(_mm_set1_pd(1.0), x));
-}
-inline __m128d dot2(__m128d x0, __m128d x1) {
-    const __m128d h = _mm_set1_pd(0.5);
-    return _mm_add_pd(_mm_add_pd(_mm_setzero_pd(), _mm_mul_pd(h, x0)), _mm_mul_pd(h, x1));
-}
-inline __m128d ld(const double* p) {
+// The two components of a point as one pair of lanes (SSE2, or two doubles elsewhere: the same
+// operations lane by lane, the same bits).
+#if defined(__SSE2__)
+using Pair = __m128d;
+inline Pair ld(const double* p) {
     return _mm_loadu_pd(p);
 }
-template <bool Add> inline void put(double* y, __m128d v) {
-    _mm_storeu_pd(y, Add ? _mm_add_pd(_mm_loadu_pd(y), v) : v);
+inline void st(double* p, Pair v) {
+    _mm_storeu_pd(p, v);
+}
+inline Pair add(Pair a, Pair b) {
+    return _mm_add_pd(a, b);
+}
+inline Pair mul(double v, Pair a) {
+    return _mm_mul_pd(_mm_set1_pd(v), a);
+}
+inline Pair zero() {
+    return _mm_setzero_pd();
+}
+#else
+struct Pair {
+    double a, b;
+};
+inline Pair ld(const double* p) {
+    return {p[0], p[1]};
+}
+inline void st(double* p, Pair v) {
+    p[0] = v.a;
+    p[1] = v.b;
+}
+inline Pair add(Pair x, Pair y) {
+    return {x.a + y.a, x.b + y.b};
+}
+inline Pair mul(double v, Pair x) {
+    return {v * x.a, v * x.b};
+}
+inline Pair zero() {
+    return {0.0, 0.0};
+}
+#endif
+
+// Each lane summed as row_dot (core/csr.hpp) sums the row: a0 = 0 + v x0 (+ v x1), then
+// (a0 + a1) + (a2 + a3) with a1 = a2 = a3 = 0, which leaves a0 as it is (a0 = 0 + p is never
+// -0.0), so it is left out.
+inline Pair dot1(Pair x) {
+    return add(zero(), mul(1.0, x));
+}
+inline Pair dot2(Pair x0, Pair x1) {
+    return add(add(zero(), mul(0.5, x0)), mul(0.5, x1));
+}
+template <bool Add> inline void put(double* y, Pair v) {
+    st(y, Add ? add(ld(y), v) : v);
 }
 
 // T on the structured points of one macro: fine interior from row f, coarse from row c.
@@ -119,7 +158,6 @@ template <bool Add> void prolongate_macro(const double* xp, double* yp, Index f,
 // row_dot sums seven entries.
 void restrict_macro(const double* xp, double* yp, Index f, Index c, int nc) {
     const int nf = 2 * nc;
-    const __m128d h = _mm_set1_pd(0.5), one = _mm_set1_pd(1.0), z = _mm_setzero_pd();
     for (int J = 1; J <= nc - 2; ++J) {
         double* yr = yp + (c + 2 * point(nc, 1, J));
         // Fine rows 2J - 1, 2J and 2J + 1 around coarse row J (point (p, row) at 2 (p - 1)).
@@ -128,14 +166,14 @@ void restrict_macro(const double* xp, double* yp, Index f, Index c, int nc) {
         const double* above = xp + (f + 2 * point(nf, 1, 2 * J + 1));
         for (int I = 1; I <= nc - 1 - J; ++I) {
             const int i = 2 * I;
-            __m128d a0 = _mm_add_pd(z, _mm_mul_pd(h, ld(below + 2 * i - 2)));
-            const __m128d a1 = _mm_add_pd(z, _mm_mul_pd(h, ld(below + 2 * i)));
-            const __m128d a2 = _mm_add_pd(z, _mm_mul_pd(h, ld(on + 2 * i - 4)));
-            const __m128d a3 = _mm_add_pd(z, _mm_mul_pd(one, ld(on + 2 * i - 2)));
-            a0 = _mm_add_pd(a0, _mm_mul_pd(h, ld(on + 2 * i)));
-            a0 = _mm_add_pd(a0, _mm_mul_pd(h, ld(above + 2 * i - 4)));
-            a0 = _mm_add_pd(a0, _mm_mul_pd(h, ld(above + 2 * i - 2)));
-            _mm_storeu_pd(yr + 2 * I - 2, _mm_add_pd(_mm_add_pd(a0, a1), _mm_add_pd(a2, a3)));
+            Pair a0 = add(zero(), mul(0.5, ld(below + 2 * i - 2)));
+            const Pair a1 = add(zero(), mul(0.5, ld(below + 2 * i)));
+            const Pair a2 = add(zero(), mul(0.5, ld(on + 2 * i - 4)));
+            const Pair a3 = add(zero(), mul(1.0, ld(on + 2 * i - 2)));
+            a0 = add(a0, mul(0.5, ld(on + 2 * i)));
+            a0 = add(a0, mul(0.5, ld(above + 2 * i - 4)));
+            a0 = add(a0, mul(0.5, ld(above + 2 * i - 2)));
+            st(yr + 2 * I - 2, add(add(a0, a1), add(a2, a3)));
         }
     }
 }
@@ -144,6 +182,17 @@ constexpr double kHalf = 0.5;
 constexpr double kOne = 1.0;
 
 } // namespace
+
+bool LatticeTransfer::applies(const smoothers::LatticeRows& fine,
+                              const smoothers::LatticeRows& coarse) {
+    if (fine.n != 2 * coarse.n || coarse.n < 1) return false;
+    const long npf = static_cast<long>(fine.n - 1) * (fine.n - 2) / 2;
+    const long npc = static_cast<long>(coarse.n - 1) * (coarse.n - 2) / 2;
+    if (npf == 0) return fine.first_row.empty() && coarse.first_row.empty();
+    const long macros = static_cast<long>(fine.first_row.size()) / npf;
+    return static_cast<long>(fine.first_row.size()) == macros * npf &&
+           static_cast<long>(coarse.first_row.size()) == macros * npc;
+}
 
 LatticeTransfer::LatticeTransfer(const SparseMatrix& T, const SparseMatrix& R,
                                  const smoothers::LatticeRows& fine,
@@ -204,20 +253,41 @@ LatticeTransfer::LatticeTransfer(const SparseMatrix& T, const SparseMatrix& R,
                 if (!ok) continue;
                 fb[m] = f;
                 cb[m] = c;
-                for_structured_fine(nf_, [&](int i, int j) {
-                    const Index r = f + 2 * point(nf_, i, j);
-                    t_done[static_cast<size_t>(r)] = t_done[static_cast<size_t>(r + 1)] = 1;
-                });
-                for (Index r = c; r < c + 2 * npc; ++r)
-                    r_done[static_cast<size_t>(r)] = 1;
             }
         });
     }
-    for (long m = 0; m < macros; ++m)
-        if (fb[static_cast<size_t>(m)] >= 0) {
-            fine_base_.push_back(fb[static_cast<size_t>(m)]);
-            coarse_base_.push_back(cb[static_cast<size_t>(m)]);
+    // Keep the macros whose rows no other kept macro holds (a lattice from levels::lattice_rows
+    // never overlaps; two that did would write the same rows twice), in macro order.
+    std::vector<char> f_taken(static_cast<size_t>(T.rows()), 0);
+    std::vector<char> c_taken(static_cast<size_t>(R.rows()), 0);
+    for (long m = 0; m < macros; ++m) {
+        const Index f = fb[static_cast<size_t>(m)], c = cb[static_cast<size_t>(m)];
+        if (f < 0) continue;
+        if (f_taken[static_cast<size_t>(f)] || f_taken[static_cast<size_t>(f + 2 * npf - 1)] ||
+            c_taken[static_cast<size_t>(c)] || c_taken[static_cast<size_t>(c + 2 * npc - 1)])
+            continue;
+        bool free_rows = true;
+        for (Index r = f; r < f + 2 * npf && free_rows; ++r)
+            free_rows = !f_taken[static_cast<size_t>(r)];
+        for (Index r = c; r < c + 2 * npc && free_rows; ++r)
+            free_rows = !c_taken[static_cast<size_t>(r)];
+        if (!free_rows) continue;
+        std::fill(f_taken.begin() + f, f_taken.begin() + f + 2 * npf, 1);
+        std::fill(c_taken.begin() + c, c_taken.begin() + c + 2 * npc, 1);
+        fine_base_.push_back(f);
+        coarse_base_.push_back(c);
+    }
+    parallel::for_rows(fine_base_.size(), 1, [&](size_t m0, size_t m1) {
+        for (size_t m = m0; m < m1; ++m) {
+            const Index f = fine_base_[m], c = coarse_base_[m];
+            for_structured_fine(nf_, [&](int i, int j) {
+                const Index r = f + 2 * point(nf_, i, j);
+                t_done[static_cast<size_t>(r)] = t_done[static_cast<size_t>(r + 1)] = 1;
+            });
+            for (Index r = c; r < c + 2 * npc; ++r)
+                r_done[static_cast<size_t>(r)] = 1;
         }
+    });
     rest_t_.take(T, t_done);
     rest_r_.take(R, r_done);
     structured_t_ = T.rows() - static_cast<Index>(rest_t_.row.size());

@@ -27,11 +27,14 @@ namespace mlc::solvers {
 
 class LatticeTransfer {
 public:
-    /// T: fine x coarse, R: coarse x fine (compressed CSR, borrowed: they must outlive this);
-    /// fine.n == 2 coarse.n, and the two lattices have the same macros. Throws InvalidInput
-    /// otherwise.
+    /// T: fine x coarse, R: coarse x fine (compressed CSR, borrowed: they must outlive this and
+    /// keep their values, which are checked and partly copied here); `applies(fine, coarse)`.
+    /// Throws InvalidInput otherwise.
     LatticeTransfer(const SparseMatrix& T, const SparseMatrix& R,
                     const smoothers::LatticeRows& fine, const smoothers::LatticeRows& coarse);
+
+    /// Whether two lattices fit: fine.n == 2 coarse.n and the same number of macros.
+    static bool applies(const smoothers::LatticeRows& fine, const smoothers::LatticeRows& coarse);
 
     /// y = T x (or y += T x with `add`; y must then have T.rows() entries): csr_multiply(T, x, y,
     /// add, Kind::transfer) bit for bit. Counts one `structured` pass.

@@ -74,8 +74,8 @@ struct Multigrid::Level {
     // lattice (the same values as csr_multiply).
     std::unique_ptr<LatticeTransfer> lattice_transfer;
     void link_lattice_transfer(const Level& below) {
-        if (lattice && below.lattice_rows && lattice_rows &&
-            lattice_rows->n == 2 * below.lattice_rows->n && lattice_rows->first_row.size() > 0)
+        if (lattice && below.lattice_rows && lattice_rows && !lattice_rows->first_row.empty() &&
+            LatticeTransfer::applies(*lattice_rows, *below.lattice_rows))
             lattice_transfer =
                 std::make_unique<LatticeTransfer>(*T, *R, *lattice_rows, *below.lattice_rows);
     }

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 #include <string>
@@ -109,7 +110,7 @@ TEST(LatticeTransfer, ARowThatIsNotTheInterpolationIsAppliedByItsEntries) {
     SparseMatrix T = h.transfers[4].T, R = h.transfers[4].R;
     const auto& fine = *h.levels[5].lattice;
     const auto& coarse = *h.levels[4].lattice;
-    const solvers::LatticeTransfer all(T, R, fine, coarse);
+    const solvers::LatticeTransfer all(h.transfers[4].T, h.transfers[4].R, fine, coarse);
     // Point (8, 8) of macro 0's fine lattice (32 subdivisions), point (4, 4) of its coarse one.
     const Index rt = fine.first_row[static_cast<size_t>(mesh::MacroLattice::point_index(32, 8, 8))];
     const Index rr =
@@ -130,7 +131,43 @@ TEST(LatticeTransfer, ARowThatIsNotTheInterpolationIsAppliedByItsEntries) {
     csr_multiply(T, xc, ref);
     changed.prolongate(xc, got, false);
     EXPECT_TRUE(same_bits(ref, got));
+    ref = xf;
+    got = xf;
+    csr_multiply(T, xc, ref, true);
+    changed.prolongate(xc, got, true);
+    EXPECT_TRUE(same_bits(ref, got));
     csr_multiply(R, xf, ref);
     changed.restrict_residual(xf, got);
+    EXPECT_TRUE(same_bits(ref, got));
+}
+
+// Two macros that claim the same rows (a malformed lattice): only the first is applied through
+// the lattice, so no row is written twice and y += T x stays csr_multiply's.
+TEST(LatticeTransfer, MacrosThatShareRowsAreAppliedOnce) {
+    auto p = scene::load_scene("square");
+    p.levels = 5;
+    p.numbering = levels::Problem::Numbering::lattice;
+    const levels::Hierarchy h = levels::build_hierarchy(p);
+    const auto& T = h.transfers[4].T;
+    const auto& R = h.transfers[4].R;
+    smoothers::LatticeRows fine = *h.levels[5].lattice, coarse = *h.levels[4].lattice;
+    const long npf = static_cast<long>(fine.n - 1) * (fine.n - 2) / 2;
+    const long npc = static_cast<long>(coarse.n - 1) * (coarse.n - 2) / 2;
+    ASSERT_GE(fine.first_row.size(), static_cast<size_t>(2 * npf));
+    // Macro 1 repeats macro 0's rows on both levels.
+    std::copy(fine.first_row.begin(), fine.first_row.begin() + npf, fine.first_row.begin() + npf);
+    std::copy(coarse.first_row.begin(), coarse.first_row.begin() + npc,
+              coarse.first_row.begin() + npc);
+    const solvers::LatticeTransfer all(T, R, *h.levels[5].lattice, *h.levels[4].lattice);
+    const solvers::LatticeTransfer shared(T, R, fine, coarse);
+    EXPECT_LT(shared.structured_rows_T(), all.structured_rows_T());
+    EXPECT_GT(shared.structured_rows_T(), 0);
+    const Vector xc = sample(T.cols(), 5), xf = sample(T.rows(), 6);
+    Vector ref = xf, got = xf;
+    csr_multiply(T, xc, ref, true);
+    shared.prolongate(xc, got, true);
+    EXPECT_TRUE(same_bits(ref, got));
+    csr_multiply(R, xf, ref);
+    shared.restrict_residual(xf, got);
     EXPECT_TRUE(same_bits(ref, got));
 }
