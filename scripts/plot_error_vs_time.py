@@ -7,6 +7,7 @@ next to each point, the Pareto front as a black step line.
 Usage: plot_error_vs_time.py DIR
 """
 import csv
+import json
 import os
 import sys
 from collections import defaultdict
@@ -40,7 +41,11 @@ if front:
 ax.set_xscale("log")
 ax.set_yscale("log")
 ax.set_xlabel("wall time of the solve [s]")
-scene = d.rstrip("/").split("/")[-1].replace("_error_vs_time", "")
+# The scene as the study names it (error_vs_time.json), not the folder's name (-o may be any).
+try:
+    scene = json.load(open(f"{d}/error_vs_time.json"))["scene"]
+except (OSError, ValueError, KeyError):
+    scene = d.rstrip("/").split("/")[-1].replace("_error_vs_time", "")
 ylabel = "relative L2 pressure error vs closed form" if scene == "hertz" else \
     "relative energy-norm displacement error (vs finer reference)"
 ax.set_ylabel(ylabel)
