@@ -39,13 +39,10 @@ bool same_bits(const Vector& a, const Vector& b) {
            std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<size_t>(a.size())) == 0;
 }
 
-void expect_like_csr(const SparseMatrix& T, const SparseMatrix& R,
-                     const smoothers::LatticeRows& fine, const smoothers::LatticeRows& coarse,
-                     const std::string& what, double min_structured) {
-    const solvers::LatticeTransfer lt(T, R, fine, coarse);
-    EXPECT_GE(static_cast<double>(lt.structured_rows_T()), min_structured * T.rows()) << what;
-    EXPECT_GE(static_cast<double>(lt.structured_rows_R()), min_structured * R.rows()) << what;
-    const Vector xc = sample(T.cols(), 1), xf = sample(T.rows(), 2);
+// T x, y += T x and R x through `lt` against csr_multiply, bit for bit.
+void expect_products(const solvers::LatticeTransfer& lt, const SparseMatrix& T,
+                     const SparseMatrix& R, unsigned seed, const std::string& what) {
+    const Vector xc = sample(T.cols(), seed), xf = sample(T.rows(), seed + 1);
     Vector ref, got;
     csr_multiply(T, xc, ref);
     lt.prolongate(xc, got, false);
@@ -57,11 +54,31 @@ void expect_like_csr(const SparseMatrix& T, const SparseMatrix& R,
     lt.prolongate(xc, got, true);
     EXPECT_TRUE(same_bits(ref, got)) << what << ": y += T x";
     csr_multiply(R, xf, ref);
+    lt.restrict_residual(xf, got);
+    EXPECT_TRUE(same_bits(ref, got))
+        << what << ": R x, largest difference " << (ref - got).cwiseAbs().maxCoeff();
+}
+
+// The square's levels 0-5 numbered by lattices (levels 4 and 5 have lattices).
+levels::Hierarchy square_level5() {
+    auto p = scene::load_scene("square");
+    p.levels = 5;
+    p.numbering = levels::Problem::Numbering::lattice;
+    return levels::build_hierarchy(p);
+}
+
+void expect_like_csr(const SparseMatrix& T, const SparseMatrix& R,
+                     const smoothers::LatticeRows& fine, const smoothers::LatticeRows& coarse,
+                     const std::string& what, double min_structured) {
+    const solvers::LatticeTransfer lt(T, R, fine, coarse);
+    EXPECT_GE(static_cast<double>(lt.structured_rows_T()), min_structured * T.rows()) << what;
+    EXPECT_GE(static_cast<double>(lt.structured_rows_R()), min_structured * R.rows()) << what;
+    expect_products(lt, T, R, 1, what);
+    const Vector xf = sample(T.rows(), 2);
+    Vector got;
     const traffic::Account before = traffic::snapshot();
     lt.restrict_residual(xf, got);
     const traffic::Account d = traffic::snapshot() - before;
-    EXPECT_TRUE(same_bits(ref, got))
-        << what << ": R x, largest difference " << (ref - got).cwiseAbs().maxCoeff();
     // One structured pass; fewer bytes than the CSR product's.
     EXPECT_EQ(d.p(traffic::Kind::structured), 1.0) << what;
     EXPECT_LT(d.b(traffic::Kind::structured),
@@ -90,23 +107,17 @@ void expect_scene(const std::string& scene, int levels, double min_structured) {
 } // namespace
 
 TEST(LatticeTransfer, TAndRThroughTheLatticeAreTheirCsrProductsBitForBit) {
-    // Square levels 4 -> 5: 16 and 32 subdivisions per macro edge. The structured fine points
-    // are those of lattice rows 2 .. 29 from column 2 on (378 of a macro's 512 vertices: 74 %;
-    // 86 % at 64 subdivisions).
-    expect_scene("square", 5, 0.7);
-}
-
-TEST(LatticeTransfer, TwoBodiesAreTheirCsrProductsBitForBit) {
-    expect_scene("patch", 5, 0.7);
+    // Levels 4 -> 5: 16 and 32 subdivisions per macro edge. The structured fine points are those
+    // of lattice rows 2 .. 29 from column 2 on (378 of a macro's 512 vertices: 74 %; 86 % at 64
+    // subdivisions). The square has one body, patch two (node on facet).
+    for (const char* scene : {"square", "patch"})
+        expect_scene(scene, 5, 0.7);
 }
 
 // A row of T or R that is not the lattice's interpolation (here: one value changed in a
 // structured row of each) is applied by its entries: the products stay csr_multiply's.
 TEST(LatticeTransfer, ARowThatIsNotTheInterpolationIsAppliedByItsEntries) {
-    auto p = scene::load_scene("square");
-    p.levels = 5;
-    p.numbering = levels::Problem::Numbering::lattice;
-    const levels::Hierarchy h = levels::build_hierarchy(p);
+    const levels::Hierarchy h = square_level5();
     SparseMatrix T = h.transfers[4].T, R = h.transfers[4].R;
     const auto& fine = *h.levels[5].lattice;
     const auto& coarse = *h.levels[4].lattice;
@@ -126,28 +137,13 @@ TEST(LatticeTransfer, ARowThatIsNotTheInterpolationIsAppliedByItsEntries) {
     EXPECT_LT(changed.structured_rows_T(), all.structured_rows_T());
     EXPECT_LT(changed.structured_rows_R(), all.structured_rows_R());
     EXPECT_GT(changed.structured_rows_T(), 0);
-    const Vector xc = sample(T.cols(), 3), xf = sample(T.rows(), 4);
-    Vector ref, got;
-    csr_multiply(T, xc, ref);
-    changed.prolongate(xc, got, false);
-    EXPECT_TRUE(same_bits(ref, got));
-    ref = xf;
-    got = xf;
-    csr_multiply(T, xc, ref, true);
-    changed.prolongate(xc, got, true);
-    EXPECT_TRUE(same_bits(ref, got));
-    csr_multiply(R, xf, ref);
-    changed.restrict_residual(xf, got);
-    EXPECT_TRUE(same_bits(ref, got));
+    expect_products(changed, T, R, 3, "a changed row");
 }
 
 // Two macros that claim the same rows (a malformed lattice): only the first is applied through
 // the lattice, so no row is written twice and y += T x stays csr_multiply's.
 TEST(LatticeTransfer, MacrosThatShareRowsAreAppliedOnce) {
-    auto p = scene::load_scene("square");
-    p.levels = 5;
-    p.numbering = levels::Problem::Numbering::lattice;
-    const levels::Hierarchy h = levels::build_hierarchy(p);
+    const levels::Hierarchy h = square_level5();
     const auto& T = h.transfers[4].T;
     const auto& R = h.transfers[4].R;
     smoothers::LatticeRows fine = *h.levels[5].lattice, coarse = *h.levels[4].lattice;
@@ -162,12 +158,5 @@ TEST(LatticeTransfer, MacrosThatShareRowsAreAppliedOnce) {
     const solvers::LatticeTransfer shared(T, R, fine, coarse);
     EXPECT_LT(shared.structured_rows_T(), all.structured_rows_T());
     EXPECT_GT(shared.structured_rows_T(), 0);
-    const Vector xc = sample(T.cols(), 5), xf = sample(T.rows(), 6);
-    Vector ref = xf, got = xf;
-    csr_multiply(T, xc, ref, true);
-    shared.prolongate(xc, got, true);
-    EXPECT_TRUE(same_bits(ref, got));
-    csr_multiply(R, xf, ref);
-    shared.restrict_residual(xf, got);
-    EXPECT_TRUE(same_bits(ref, got));
+    expect_products(shared, T, R, 5, "a repeated macro");
 }
