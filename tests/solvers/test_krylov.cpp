@@ -423,7 +423,8 @@ TEST(Krylov, BicgstabOverTheThreadsIsTheWholeVectorIterationBitForBit) {
     // entry is computed as the whole-vector expression computes it, so after 60 iterations
     // (stopped by max_iter, far from the tolerance) x is the reference's to the last bit (a
     // wrong chunk offset, a missed chunk or a statement moved across a reduction changes it),
-    // at two threads and at one. The same solve run to its tolerance meets it.
+    // at two threads and at one. The same solve run to its tolerance meets it (at two threads
+    // only: its thousand iterations are most of this test's time under the sanitizers).
     const SparseMatrix A = testmat::laplace_2d(300, 1.5);
     const MatrixOperator op(A);
     IdentityPreconditioner I;
@@ -436,6 +437,7 @@ TEST(Krylov, BicgstabOverTheThreadsIsTheWholeVectorIterationBitForBit) {
         EXPECT_EQ(r.reason, StopReason::max_iter) << r;
         EXPECT_EQ(r.iterations, 60);
         EXPECT_EQ((x - ref).cwiseAbs().maxCoeff(), 0.0) << "threads " << threads;
+        if (threads != 2) continue;
         Vector y;
         const SolveResult full = bicgstab(op, I, b, y, {.rel_tol = 1e-6, .max_iter = 4000});
         ASSERT_TRUE(full.converged) << full;
