@@ -269,6 +269,9 @@ int main(int argc, char** argv) {
             out["lattice transfer setup"].ms.push_back(time_ms(
                 [&] { const solvers::LatticeTransfer t(tr.T, tr.R, fine_rows, coarse_rows); }));
         const solvers::LatticeTransfer lt(tr.T, tr.R, fine_rows, coarse_rows);
+        std::cerr << "bench_kernels: lattice transfer, " << lt.structured_rows_T() << " of "
+                  << tr.T.rows() << " rows of T and " << lt.structured_rows_R() << " of "
+                  << tr.R.rows() << " rows of R structured\n";
         Vector f = parallel::zeros(tr.T.rows()), c = parallel::zeros(tr.T.cols());
         for (Index i = 0; i < f.size(); ++i)
             f[i] = std::sin(0.001 * static_cast<double>(i));
