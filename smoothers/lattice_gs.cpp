@@ -32,13 +32,6 @@ constexpr int kLenCodes = 4096; // visit code = macro * kLenCodes + row length
 constexpr int kSemi = -(1 << 30);
 constexpr int kSemiMax = kSemi + (1 << 29);
 
-long interior_points(int n) {
-    return n < 3 ? 0 : static_cast<long>(n - 1) * (n - 2) / 2;
-}
-long point_index(int n, int i, int j) {
-    return static_cast<long>(j - 1) * (2 * n - 2 - j) / 2 + (i - 1);
-}
-
 // A run of deep points of one lattice row, visited `count` points from first row r in steps of
 // `step` rows (+2 eastwards, -2 westwards), each neighbour `len` (the row's length) points up and
 // down. Per point x += omega D^{-1} (b - sum_s S_s x_s) over the seven 2x2 blocks, written as
@@ -195,7 +188,7 @@ LatticeGS::LatticeGS(std::vector<Index> block_starts, LatticeRows lattice, Latti
     MLC_CHECK(params_.parts >= 0, "lattice smoother: parts must be >= 0, found " << params_.parts);
     MLC_CHECK(lattice_.n >= 1 && lattice_.n < kLenCodes,
               "lattice smoother: n must be in [1, " << kLenCodes << "), found " << lattice_.n);
-    const long np = interior_points(lattice_.n);
+    const long np = LatticeRows::interior_points(lattice_.n);
     MLC_CHECK(np == 0 ? lattice_.first_row.empty()
                       : lattice_.first_row.size() % static_cast<size_t>(np) == 0,
               "lattice smoother: " << lattice_.first_row.size()
@@ -285,7 +278,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
     }
     // Macros numbered as a lattice: every interior point a plain 2x2 block at row0 + 2p.
     const int N = lattice_.n;
-    const long np = interior_points(N);
+    const long np = LatticeRows::interior_points(N);
     const long n_macros = np == 0 ? 0 : static_cast<long>(lattice_.first_row.size()) / np;
     // Deep points, macro by macro over the threads (each writes its own stencil and lists).
     std::vector<int> deep_len(static_cast<size_t>(nb), -1); // per block: row length if deep
@@ -314,7 +307,8 @@ void LatticeGS::derive(const SparseMatrix& A) {
             for (int i = 2; i + j <= N - 2; ++i) {
                 std::array<Index, kSlots> nbr{};
                 for (int s = 0; s < kSlots; ++s)
-                    nbr[static_cast<size_t>(s)] = fr[point_index(N, i + kDi[s], j + kDj[s])];
+                    nbr[static_cast<size_t>(s)] =
+                        fr[LatticeRows::point_index(N, i + kDi[s], j + kDj[s])];
                 const Index r = nbr[0];
                 const int part =
                     part_of_block[static_cast<size_t>(block_of_row[static_cast<size_t>(r)])];
@@ -397,7 +391,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
         // others (on the macro's edges) by their values among the slots left.
         for (int j = 1; j <= N - 2; ++j)
             for (int i = 1; i + j <= N - 1; ++i) {
-                const Index r = fr[point_index(N, i, j)];
+                const Index r = fr[LatticeRows::point_index(N, i, j)];
                 const int b = block_of_row[static_cast<size_t>(r)];
                 if (deep_len[static_cast<size_t>(b)] >= 0) continue;
                 if (ao[r + 1] - ao[r] != 2 * kSlots || ao[r + 2] - ao[r + 1] != 2 * kSlots)
@@ -406,8 +400,9 @@ void LatticeGS::derive(const SparseMatrix& A) {
                 std::array<Index, kSlots> known{};
                 for (int t = 0; t < kSlots; ++t) {
                     const int ii = i + kDi[t], jj = j + kDj[t];
-                    known[static_cast<size_t>(t)] =
-                        ii >= 1 && jj >= 1 && ii + jj <= N - 1 ? fr[point_index(N, ii, jj)] : -1;
+                    known[static_cast<size_t>(t)] = ii >= 1 && jj >= 1 && ii + jj <= N - 1
+                                                        ? fr[LatticeRows::point_index(N, ii, jj)]
+                                                        : -1;
                 }
                 std::array<std::uint8_t, kSlots> slots{};
                 std::array<int, kSlots> nbr{};

@@ -53,6 +53,32 @@ struct LatticeRows {
     /// The first row of every block in the order the sweep visits them (a permutation of the
     /// blocks); empty: row order.
     std::vector<Index> visit;
+
+    /// Interior points of one macro, (n-1)(n-2)/2 (mesh::MacroLattice::interior_points; this
+    /// folder does not depend on mesh/).
+    static long interior_points(int n) {
+        return n < 3 ? 0 : static_cast<long>(n - 1) * (n - 2) / 2;
+    }
+    /// Index of interior point (i, j) in its macro's row-by-row numbering
+    /// (mesh::MacroLattice::point_index).
+    static long point_index(int n, int i, int j) {
+        return static_cast<long>(j - 1) * (2 * n - 2 - j) / 2 + (i - 1);
+    }
+    /// Macros: first_row.size() / interior_points(n) (0 without interior points).
+    long macros() const {
+        const long np = interior_points(n);
+        return np == 0 ? 0 : static_cast<long>(first_row.size()) / np;
+    }
+    /// The first row of macro m's interior when its points are rows first_row[m np] + 2p (a
+    /// lattice numbering of the macro), else -1.
+    Index lattice_base(long m) const {
+        const long np = interior_points(n);
+        const Index* f = first_row.data() + m * np;
+        if (np == 0 || f[0] < 0) return -1;
+        for (long p = 1; p < np; ++p)
+            if (f[p] != f[0] + 2 * p) return -1;
+        return f[0];
+    }
 };
 
 /// Parameters of `LatticeGS`.

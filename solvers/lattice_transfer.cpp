@@ -16,19 +16,9 @@ namespace mlc::solvers {
 
 namespace {
 
-// Index of interior point (i, j) of a lattice of n subdivisions (mesh::MacroLattice::point_index).
+// Index of interior point (i, j) of a lattice of n subdivisions.
 inline Index point(int n, int i, int j) {
-    return static_cast<Index>(j - 1) * (2 * n - 2 - j) / 2 + (i - 1);
-}
-
-// The first row of macro m's interior when its points are rows first + 2p (a lattice numbering
-// of the macro), else -1.
-Index lattice_base(const smoothers::LatticeRows& L, long np, long m) {
-    const Index* f = L.first_row.data() + m * np;
-    if (np == 0 || f[0] < 0) return -1;
-    for (long p = 1; p < np; ++p)
-        if (f[p] != f[0] + 2 * p) return -1;
-    return f[0];
+    return smoothers::LatticeRows::point_index(n, i, j);
 }
 
 // Whether row r of A holds exactly `count` entries at columns cols[0..count) (increasing) with
@@ -186,10 +176,10 @@ constexpr double kOne = 1.0;
 bool LatticeTransfer::applies(const smoothers::LatticeRows& fine,
                               const smoothers::LatticeRows& coarse) {
     if (fine.n != 2 * coarse.n || coarse.n < 1) return false;
-    const long npf = static_cast<long>(fine.n - 1) * (fine.n - 2) / 2;
-    const long npc = static_cast<long>(coarse.n - 1) * (coarse.n - 2) / 2;
+    const long npf = smoothers::LatticeRows::interior_points(fine.n);
+    const long npc = smoothers::LatticeRows::interior_points(coarse.n);
     if (npf == 0) return fine.first_row.empty() && coarse.first_row.empty();
-    const long macros = static_cast<long>(fine.first_row.size()) / npf;
+    const long macros = fine.macros();
     return static_cast<long>(fine.first_row.size()) == macros * npf &&
            static_cast<long>(coarse.first_row.size()) == macros * npc;
 }
@@ -202,25 +192,22 @@ LatticeTransfer::LatticeTransfer(const SparseMatrix& T, const SparseMatrix& R,
     MLC_CHECK(R.rows() == T.cols() && R.cols() == T.rows(),
               "LatticeTransfer: T is " << T.rows() << " x " << T.cols() << ", R " << R.rows()
                                        << " x " << R.cols());
-    MLC_CHECK(nf_ == 2 * nc_ && nc_ >= 1, "LatticeTransfer: the fine lattice has "
-                                              << nf_ << " subdivisions, the coarse one " << nc_
-                                              << " (expected twice as many)");
-    const long npf = static_cast<long>(nf_ - 1) * (nf_ - 2) / 2;
-    const long npc = static_cast<long>(nc_ - 1) * (nc_ - 2) / 2;
-    const long macros = npf > 0 ? static_cast<long>(fine.first_row.size()) / npf : 0;
-    MLC_CHECK(npf == 0 || (static_cast<long>(fine.first_row.size()) == macros * npf &&
-                           static_cast<long>(coarse.first_row.size()) == macros * npc),
-              "LatticeTransfer: the lattices' macros differ (" << fine.first_row.size() << " and "
-                                                               << coarse.first_row.size()
-                                                               << " interior points)");
+    MLC_CHECK(applies(fine, coarse), "LatticeTransfer: the fine lattice has "
+                                         << nf_ << " subdivisions and " << fine.first_row.size()
+                                         << " interior points, the coarse one " << nc_ << " and "
+                                         << coarse.first_row.size()
+                                         << " (expected twice the subdivisions, the same macros)");
+    const long npf = smoothers::LatticeRows::interior_points(nf_);
+    const long npc = smoothers::LatticeRows::interior_points(nc_);
+    const long macros = fine.macros();
     std::vector<char> t_done(static_cast<size_t>(T.rows()), 0);
     std::vector<char> r_done(static_cast<size_t>(R.rows()), 0);
     std::vector<Index> fb(static_cast<size_t>(macros), -1), cb(static_cast<size_t>(macros), -1);
     if (npc > 0) {
         parallel::for_rows(static_cast<size_t>(macros), 1, [&](size_t m0, size_t m1) {
             for (size_t m = m0; m < m1; ++m) {
-                const Index f = lattice_base(fine, npf, static_cast<long>(m));
-                const Index c = lattice_base(coarse, npc, static_cast<long>(m));
+                const Index f = fine.lattice_base(static_cast<long>(m));
+                const Index c = coarse.lattice_base(static_cast<long>(m));
                 if (f < 0 || c < 0 || f + 2 * npf > T.rows() || c + 2 * npc > R.rows()) continue;
                 bool ok = true;
                 for_structured_fine(nf_, [&](int i, int j) {
@@ -263,9 +250,6 @@ LatticeTransfer::LatticeTransfer(const SparseMatrix& T, const SparseMatrix& R,
     for (long m = 0; m < macros; ++m) {
         const Index f = fb[static_cast<size_t>(m)], c = cb[static_cast<size_t>(m)];
         if (f < 0) continue;
-        if (f_taken[static_cast<size_t>(f)] || f_taken[static_cast<size_t>(f + 2 * npf - 1)] ||
-            c_taken[static_cast<size_t>(c)] || c_taken[static_cast<size_t>(c + 2 * npc - 1)])
-            continue;
         bool free_rows = true;
         for (Index r = f; r < f + 2 * npf && free_rows; ++r)
             free_rows = !f_taken[static_cast<size_t>(r)];

@@ -148,8 +148,8 @@ TEST(LatticeTransfer, MacrosThatShareRowsAreAppliedOnce) {
     const auto& T = h.transfers[4].T;
     const auto& R = h.transfers[4].R;
     smoothers::LatticeRows fine = *h.levels[5].lattice, coarse = *h.levels[4].lattice;
-    const long npf = static_cast<long>(fine.n - 1) * (fine.n - 2) / 2;
-    const long npc = static_cast<long>(coarse.n - 1) * (coarse.n - 2) / 2;
+    const long npf = smoothers::LatticeRows::interior_points(fine.n);
+    const long npc = smoothers::LatticeRows::interior_points(coarse.n);
     ASSERT_GE(fine.first_row.size(), static_cast<size_t>(2 * npf));
     // Macro 1 repeats macro 0's rows on both levels.
     std::copy(fine.first_row.begin(), fine.first_row.begin() + npf, fine.first_row.begin() + npf);
