@@ -239,9 +239,10 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
             for_vertex_dofs(dofs, v, d.n_extra[static_cast<size_t>(v)], [&](int) { ++d.n_owned; });
     for (int v = 0; v < nv; ++v)
         if (lp.owned[static_cast<size_t>(v)])
-            for_vertex_dofs(dofs, v, d.n_extra[static_cast<size_t>(v)], [&](int dof) {
-                MLC_ASSERT(dof < d.n_owned, "an owned unknown is numbered after a ghost one");
-            });
+            for_vertex_dofs(
+                dofs, v, d.n_extra[static_cast<size_t>(v)], [&]([[maybe_unused]] int dof) {
+                    MLC_ASSERT(dof < d.n_owned, "an owned unknown is numbered after a ghost one");
+                });
     d.first_dof = comm.exclusive_sum(static_cast<std::int64_t>(d.n_owned));
     d.n_global_dofs = comm.sum(static_cast<std::int64_t>(d.n_owned));
     Vector g = Vector::Constant(dofs.n_dofs(), -1.0);

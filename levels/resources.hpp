@@ -74,12 +74,12 @@ inline const char* default_mg_spec(bool two_body) {
 
 /// What the user asked for; unset fields take the driver's defaults.
 struct SolverRequest {
-    std::optional<std::string> linear; ///< schur | lu | krylov
-    std::optional<std::string> krylov; ///< cgs | bicg | bicgstab | gmres
-    std::optional<std::string> pc;     ///< preconditioner spec
-    std::optional<double> rel_tol;     ///< Krylov relative tolerance
+    std::optional<std::string> linear{}; ///< schur | lu | krylov
+    std::optional<std::string> krylov{}; ///< cgs | bicg | bicgstab | gmres
+    std::optional<std::string> pc{};     ///< preconditioner spec
+    std::optional<double> rel_tol{};     ///< Krylov relative tolerance
     /// hilbert | lattice as requested (Problem::numbering); unset: the default solver's choice.
-    std::optional<std::string> numbering;
+    std::optional<std::string> numbering{};
 };
 
 /// The Newton-system solver of a run and why it was chosen.

@@ -266,16 +266,16 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
         int* ti = tr.T.innerIndexPtr();
         double* tv = tr.T.valuePtr();
         for (Index d = 0; d < n_f; ++d) {
-            const int k = to[d];
+            const int at = to[d];
             if (fine_dofs.is_displacement(d)) {
                 const int m = u_cols(d, cols);
                 for (int j = 0; j < m; ++j) {
-                    ti[k + j] = cols[j];
-                    tv[k + j] = m == 1 && fine_dofs.vertex_of(d) < nc ? 1.0 : 0.5;
+                    ti[at + j] = cols[j];
+                    tv[at + j] = m == 1 && fine_dofs.vertex_of(d) < nc ? 1.0 : 0.5;
                 }
             } else {
-                std::copy(Q.innerIndexPtr() + qo[d], Q.innerIndexPtr() + qo[d + 1], ti + k);
-                std::copy(Q.valuePtr() + qo[d], Q.valuePtr() + qo[d + 1], tv + k);
+                std::copy(Q.innerIndexPtr() + qo[d], Q.innerIndexPtr() + qo[d + 1], ti + at);
+                std::copy(Q.valuePtr() + qo[d], Q.valuePtr() + qo[d + 1], tv + at);
             }
         }
     }

@@ -319,7 +319,7 @@ void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
             xyz[3 * v] = m.vertices[v].x();
             xyz[3 * v + 1] = m.vertices[v].y();
         }
-        attributes.push_back("type=\"Float64\" NumberOfComponents=\"3\"");
+        attributes.emplace_back("type=\"Float64\" NumberOfComponents=\"3\"");
         raws.push_back({raw_bytes(xyz)});
     }
     {
@@ -330,11 +330,11 @@ void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
                 conn[3 * t + k] = m.triangles[t][k];
             offsets[t] = static_cast<std::int64_t>(3 * (t + 1));
         }
-        attributes.push_back("type=\"Int32\" Name=\"connectivity\"");
+        attributes.emplace_back("type=\"Int32\" Name=\"connectivity\"");
         raws.push_back({raw_bytes(conn)});
-        attributes.push_back("type=\"Int64\" Name=\"offsets\"");
+        attributes.emplace_back("type=\"Int64\" Name=\"offsets\"");
         raws.push_back({raw_bytes(offsets)});
-        attributes.push_back("type=\"UInt8\" Name=\"types\"");
+        attributes.emplace_back("type=\"UInt8\" Name=\"types\"");
         raws.push_back({std::vector<unsigned char>(nt, 5)});
     }
     std::vector<AppendedArray> arrays(raws.size());

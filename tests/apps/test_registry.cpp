@@ -19,10 +19,6 @@ using namespace mlc;
 
 namespace {
 
-std::string name_of(const std::string& spec) {
-    return spec.substr(0, spec.find(':'));
-}
-
 // Level data whose callables return empty inputs: enough for a builder to read its options.
 solvers::LevelData stub_level_data() {
     solvers::LevelData d;
@@ -42,10 +38,11 @@ TEST(Registry, NamesAreUniqueAndEveryEntryIsComplete) {
         EXPECT_EQ(e.usage.rfind(e.name, 0), 0u) << "usage of " << e.name << ": " << e.usage;
         EXPECT_NE(e.build, nullptr) << e.name;
         EXPECT_TRUE(!e.needs_level_below || e.level_aware) << e.name;
-        if (!e.positional_key.empty())
+        if (!e.positional_key.empty()) {
             EXPECT_NE(std::find(e.options.begin(), e.options.end(), e.positional_key),
                       e.options.end())
                 << e.name;
+        }
         for (const auto& key : e.options)
             EXPECT_NE(e.usage.find(key), std::string::npos)
                 << e.name << "'s usage does not mention its option " << key;
@@ -93,8 +90,9 @@ TEST(Registry, DeclaredOptionsAreExactlyTheOnesTheBuilderReads) {
 TEST(Registry, LevelAwareEntriesRefuseToBeBuiltFromAMatrixAlone) {
     for (const auto& e : solvers::preconditioner_registry()) {
         if (!e.level_aware) {
-            if (e.name != "amg" || solvers::have_hypre())
+            if (e.name != "amg" || solvers::have_hypre()) {
                 EXPECT_NO_THROW(solvers::make_preconditioner(e.name)) << e.name;
+            }
             continue;
         }
         try {

@@ -408,7 +408,9 @@ TEST(AxisRelease, AxisHeldThenReleasedWithBalanceAndCoulomb) {
         EXPECT_LE(r.cylinder.first, 1e-10);
         EXPECT_LE(r.block.second, 1e-10);
         EXPECT_LE(r.cylinder.second, 1e-10);
-        if (k == 1) EXPECT_GT(r.slipping, 0); // partial slip under Q = 0.5 mu P
+        if (k == 1) {
+            EXPECT_GT(r.slipping, 0); // partial slip under Q = 0.5 mu P
+        }
         EXPECT_LE(r.coulomb, 1e-10);
         EXPECT_LE(r.cone_excess, 1e-10);
     }
@@ -488,7 +490,9 @@ TEST(Incline, SticksBelowTheFrictionAngleAndIsHeldAboveIt) {
             closed += n.status != contact::Status::gap;
             slipping += n.status == contact::Status::slip_forward;
             sticking += n.status == contact::Status::stick;
-            if (!sticks) EXPECT_NE(n.status, contact::Status::slip_backward);
+            if (!sticks) {
+                EXPECT_NE(n.status, contact::Status::slip_backward);
+            }
         }
         std::cout << "incline theta = " << deg << ": contact resultant (" << f.x() << ", " << f.y()
                   << "), " << closed << " closed, " << sticking << " stick, " << slipping

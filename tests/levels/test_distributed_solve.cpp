@@ -149,7 +149,9 @@ void expect_same_elements(const levels::Problem& prob, int p) {
         reaching += static_cast<std::int64_t>(others.size());
     }
     EXPECT_EQ(comm.sum(reaching), comm.sum(static_cast<std::int64_t>(L.ghost_contacts.size())));
-    if (comm.size() > 1) EXPECT_GT(comm.sum(reaching), 0) << "the interface is not cut";
+    if (comm.size() > 1) {
+        EXPECT_GT(comm.sum(reaching), 0) << "the interface is not cut";
+    }
 }
 
 } // namespace

@@ -146,7 +146,9 @@ TEST(Extrapolation, StepsWhoseStatusesChangeStartFromTheUsualGuess) {
     for (int l = 0; l <= 1; ++l)
         for (int k = 0; k < 4; ++k) {
             // Level 0 starts from the previous step: its statuses change over every step.
-            if (l == 0) EXPECT_GE(plain.level_steps[l][k].report.iterations, 2);
+            if (l == 0) {
+                EXPECT_GE(plain.level_steps[l][k].report.iterations, 2);
+            }
             EXPECT_EQ(extra.level_steps[l][k].report.iterations,
                       plain.level_steps[l][k].report.iterations)
                 << "level " << l << " step " << k + 1;
