@@ -279,7 +279,7 @@ void LatticeGS::derive(const SparseMatrix& A) {
     // Macros numbered as a lattice: every interior point a plain 2x2 block at row0 + 2p.
     const int N = lattice_.n;
     const long np = LatticeRows::interior_points(N);
-    const long n_macros = np == 0 ? 0 : static_cast<long>(lattice_.first_row.size()) / np;
+    const long n_macros = lattice_.macros();
     // Deep points, macro by macro over the threads (each writes its own stencil and lists).
     std::vector<int> deep_len(static_cast<size_t>(nb), -1); // per block: row length if deep
     std::vector<int> deep_mac(static_cast<size_t>(nb), -1);
@@ -293,10 +293,10 @@ void LatticeGS::derive(const SparseMatrix& A) {
     std::vector<std::vector<std::uint8_t>> macro_semi_slots(static_cast<size_t>(n_macros));
     parallel::for_chunks(static_cast<size_t>(n_macros), [&](size_t m) {
         const Index* fr = lattice_.first_row.data() + static_cast<long>(m) * np;
-        const Index row0 = fr[0];
+        const Index row0 = lattice_.lattice_base(static_cast<long>(m));
+        if (row0 < 0 || row0 + 2 * np > n_) return;
         for (long q = 0; q < np; ++q) {
-            const Index r = fr[q];
-            if (r != row0 + 2 * q || r < 0 || r + 2 > n_) return;
+            const Index r = row0 + 2 * q;
             const int b = block_of_row[static_cast<size_t>(r)];
             if (starts[b] != r || starts[b + 1] != r + 2) return;
         }
