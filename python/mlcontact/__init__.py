@@ -11,7 +11,7 @@
 Errors: a bad scene key or value raises ValueError naming it (with file and line for scene
 files); a load step that does not converge raises NotConverged (its .result holds the reports);
 a numerical breakdown raises SolverBreakdown; Ctrl-C during solve() raises KeyboardInterrupt.
-See README.md, section "Python".
+See docs/guide/python.md#python (the guide) and docs/api/python.md#api-python (the reference).
 """
 
 import csv as _csv

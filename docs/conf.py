@@ -1,0 +1,60 @@
+# SPDX-License-Identifier: MIT
+# Sphinx configuration of the mlcontact documentation site (built by scripts/docs.sh).
+# Pages are MyST Markdown; the Python API is autodoc of the built module (build/python), the C++
+# API is Doxygen XML read by Breathe (see docs/api/cpp.md for why).
+import os
+import re
+import sys
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
+BUILD = os.environ.get("MLC_BUILD_DIR", os.path.join(ROOT, "build"))
+sys.path.insert(0, os.path.join(BUILD, "python"))
+
+project = "mlcontact"
+author = "the mlcontact authors"
+copyright = "the mlcontact authors, MIT licence"
+with open(os.path.join(ROOT, "CMakeLists.txt")) as f:
+    version = release = re.search(r"project\(mlcontact VERSION ([0-9.]+)", f.read()).group(1)
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.mathjax",
+    "breathe",
+]
+source_suffix = {".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+
+# MyST: explicit labels `(label)=`, {ref}/{doc} roles, $..$ and $$..$$ math.
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+myst_heading_anchors = 0
+myst_dmath_double_inline = True
+
+# Math renders offline: MathJax 2 from Debian's libjs-mathjax, copied into the built site by
+# scripts/docs.sh (no CDN).
+mathjax_path = "mathjax/MathJax.js?config=TeX-AMS_CHTML"
+
+# Python API: the built extension module; signatures come from pybind11's docstrings.
+autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}
+autodoc_member_order = "bysource"
+autodoc_docstring_signature = True
+
+# C++ API: Doxygen XML of the installed headers (scripts/docs.sh runs doxygen first).
+breathe_projects = {"mlcontact": os.environ.get("MLC_DOXYGEN_XML",
+                                                os.path.join(BUILD, "docs", "doxygen", "xml"))}
+breathe_default_project = "mlcontact"
+breathe_default_members = ("members",)
+# Ignore list for the C++ domain: types from Eigen, the standard library and our dependencies
+# that the headers use but this site does not document.
+cpp_id_attributes = ["MLC_EXPORT"]
+nitpicky = False
+suppress_warnings = [
+    "duplicate_declaration.cpp",  # one declaration seen in a header and its Doxygen group
+]
+
+html_theme = "sphinx_rtd_theme"
+html_static_path = ["_static"]
+html_title = f"mlcontact {release}"
+html_theme_options = {"navigation_depth": 3, "collapse_navigation": False}
+html_show_sourcelink = False
