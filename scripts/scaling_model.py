@@ -19,7 +19,7 @@
                          load step.
 `model` combines them with stated network assumptions (--latency, --bandwidth) and writes
 out/model/scaling_model.json and docs/results/scaling_model.png, and prints the tables of
-docs/results/parallel.md.
+docs/results/parallel.md#results-parallel.
 
 The model, per V-cycle on P processes from level L with partition level p (the run's rule):
   compute    sum over l = p+1..L of c * n_l / P * imbalance   (c: seconds per unknown and level

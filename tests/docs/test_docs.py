@@ -178,7 +178,7 @@ def test_readme_is_short_and_narrow():
     assert not wide, "\n".join(wide)
 
 
-LINK = re.compile(r"\]\(([^)\s]+)\)")
+LINK = re.compile(r"\]\(\s*([^)\s]+)\s*\)")
 URL = re.compile(r"\b(?:https?|ftp|file)://[^\s)>`\"']+")
 
 
