@@ -26,6 +26,8 @@ from . import _core
 from ._core import Result, Scene, SolverBreakdown
 
 __version__ = _core.__version__
+SolverBreakdown.__doc__ = """A numerical breakdown during solve(): a NaN or Inf, or a singular Newton
+system (a RuntimeError; the driver exits 3 for the same condition)."""
 
 #: Status codes of Result.status: STATUS_NAMES[code].
 STATUS_NAMES = tuple(_core.status_names)
