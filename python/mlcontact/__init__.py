@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: MIT
 """mlcontact: multilevel frictional contact in 2D linear elasticity, from Python.
 
+Example::
+
     import mlcontact
     scene = mlcontact.Scene.builtin("square")
     scene.mu = 0.3
