@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
 """A model of the distributed mg's time per V-cycle and per load step on 64 and 1024 processes
-(issue 13 item 4; README "Running on a cluster"):
+(docs/parallel.md#cluster-model):
 
     /usr/bin/python3 scripts/scaling_model.py measure   # the benches below (idle machine: timings)
     /usr/bin/python3 scripts/scaling_model.py model     # the model from their JSON files
