@@ -386,6 +386,23 @@ def test_cli_help_has_no_dates_no_readme_and_valid_citations(tmp_path):
     assert sum(len(CITATION.findall(t)) for t in texts.values()) >= 3
 
 
+def test_builtin_scenes_as_the_driver_shows_them(tmp_path):
+    """`mlcontact show NAME` prints the compiled-in scene: no date, no file outside the
+    repository, citations that resolve."""
+    names = run_cli(["scenes"], tmp_path, timeout=60).stdout.split()
+    shown = [n for n in names if os.path.isfile(os.path.join(SRC, "scenes", n + ".toml"))]
+    assert len(shown) >= 10, names
+    bad = []
+    for name in shown:
+        text = run_cli(["show", name], tmp_path, timeout=60).stdout
+        assert text.startswith("#"), name
+        bad += dated_lines(text, f"show {name}") + check_citations(text, f"show {name}")
+        for needle in ("shared/spec", "benchmarks.md#", "formulation.md"):
+            if needle in text.replace("scenes-benchmarks.md#", ""):
+                bad.append(f"show {name}: names {needle}")
+    assert not bad, "\n".join(bad)
+
+
 # ---------------------------------------------------------------------------------------------
 # Docstrings of the Python API.
 
