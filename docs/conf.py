@@ -83,7 +83,7 @@ def setup(app):
     logging.getLogger("sphinx.sphinx.domains.cpp").addFilter(_CppDomainNoise())
 
 html_theme = "sphinx_rtd_theme"
-html_static_path = ["_static"]
+html_static_path = []  # our only static files (MathJax) are copied in by scripts/docs.sh
 html_title = f"mlcontact {release}"
 html_theme_options = {"navigation_depth": 3, "collapse_navigation": False}
 html_show_sourcelink = False
