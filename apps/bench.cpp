@@ -491,7 +491,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
            << ", \"triad_gbs\": " << stream->triad_gbs << ", \"doubles\": " << stream->n
            << ", \"repeats\": " << stream->repeats << ", \"threads\": " << stream->threads << "}";
     js << "\n}\n";
-    os << "\nbandwidth account per Newton step (compulsory bytes, README: Bandwidth account); "
+    os << "\nbandwidth account per Newton step (compulsory bytes, docs/studies.md#bench-bandwidth); "
           "MB / Newton step by kind, GB/s = bytes / seconds\n"
        << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "MB/newt"
        << std::setw(9) << "matvec" << std::setw(9) << "smooth" << std::setw(9) << "transf"

@@ -30,6 +30,7 @@
 
 namespace mlc::apps {
 
+/// Options of `mlcontact bench comm`: the scene, levels and repetitions of the measured operations.
 struct BenchCommOptions {
     std::string scene = "square";
     int levels = 5;           ///< the finest level L (1..8)

@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
     run->add_option("--partition-level", ro.partition_level,
                     "under mpirun with several processes: the level whose mesh is partitioned "
                     "(default: the coarsest with 2000 triangles per process, at most --levels - 1; "
-                    "README, \"Running on several processes\")")
+                    "see docs/parallel.md#parallel-partition-level)")
         ->check(CLI::NonNegativeNumber);
     run->add_option("--linear-tol", ro.linear_rel_tol,
                     "relative tolerance of each Krylov solve (implies a Krylov solve; default "
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
                   "coarser level solved");
     run->add_flag("--plot", ro.plot,
                   "draw contact.png: pressure and tangential traction along each contact pair");
-    auto* study = app.add_subcommand("study", "run a study (see README: Studies)");
+    auto* study = app.add_subcommand("study", "run a study (see docs/studies.md#studies)");
     study->require_subcommand(1);
     mlc::apps::StatusTransferOptions sto;
     std::string sto_scene = "square", sto_out, sto_q = "paper";
@@ -177,7 +177,7 @@ int main(int argc, char** argv) {
     ac->add_flag("!--no-compare", aco.compare_integration,
                  "node-on-facet scenes: do not also solve with the other integration variants");
     auto* bench =
-        app.add_subcommand("bench", "scaling benchmarks (see README: Multilevel preconditioner)");
+        app.add_subcommand("bench", "scaling benchmarks (see docs/studies.md#bench)");
     bench->require_subcommand(1);
     mlc::apps::BenchSquareOptions bso;
     std::string bso_out;
@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
     auto* bcm = bench->add_subcommand(
         "comm", "messages, bytes, reductions and seconds per V-cycle, mat-vec and Krylov "
                 "iteration of the distributed mg (under mpirun with the PMPI library preloaded; "
-                "see README: Running on a cluster)");
+                "see docs/parallel.md#cluster-communication)");
     bcm->add_option("scene", bco.scene, "scene file or built-in name (default square)");
     bcm->add_option("--levels,-l", bco.levels, "finest level, 1..8 (default 5)");
     bcm->add_option("--partition-level", bco.partition_level,

@@ -56,6 +56,7 @@ inline void set_zero(Vector& v, Index n) {
 /// doubles or floats then writes nothing, and the (parallel) loop that first writes the elements
 /// decides which threads touch the pages (a std::vector<T> writes zeros from one thread).
 template <class T> struct DefaultInitAllocator : std::allocator<T> {
+    /// The same allocator for another value type (what std::allocator_traits asks for).
     template <class U> struct rebind { using other = DefaultInitAllocator<U>; };
     DefaultInitAllocator() noexcept = default;
     template <class U> DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}

@@ -27,6 +27,7 @@ public:
         auto it = table_.find(section);
         return it == table_.end() ? 0.0 : it->second.seconds;
     }
+    /// One section of the table: its accumulated seconds and how often it was timed.
     struct Entry {
         double seconds = 0.0;
         long calls = 0;

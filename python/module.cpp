@@ -313,14 +313,24 @@ PYBIND11_MODULE(_core, m) {
             },
             py::arg("text"), py::arg("origin") = "<string>", py::arg("base_dir") = "",
             "A scene from TOML text; relative mesh files resolve against base_dir")
-        .def_static("builtin_names", &scene::builtin_scene_names)
-        .def("copy", [](const Scene& s) { return std::make_shared<Scene>(s); })
+        .def_static("builtin_names", &scene::builtin_scene_names,
+                    "The names of the built-in scenes (as `mlcontact scenes` lists them)")
+        .def(
+            "copy", [](const Scene& s) { return std::make_shared<Scene>(s); },
+            "An independent copy of the scene (copy.copy and copy.deepcopy give the same)")
         .def("__copy__", [](const Scene& s) { return std::make_shared<Scene>(s); })
         .def("__deepcopy__", [](const Scene& s, py::dict) { return std::make_shared<Scene>(s); })
-        .def_property_readonly("origin", [](const Scene& s) { return s.origin; })
-        .def_property_readonly("name", [](const Scene& s) { return s.problem.name; })
-        .def_property_readonly("description", [](const Scene& s) { return s.problem.description; })
-        .def_property_readonly("units", [](const Scene& s) { return s.problem.units; })
+        .def_property_readonly(
+            "origin", [](const Scene& s) { return s.origin; },
+            "where the scene came from: builtin:NAME, a file path or the from_toml origin")
+        .def_property_readonly(
+            "name", [](const Scene& s) { return s.problem.name; }, "[scene].name")
+        .def_property_readonly(
+            "description", [](const Scene& s) { return s.problem.description; },
+            "[scene].description (empty if not given)")
+        .def_property_readonly(
+            "units", [](const Scene& s) { return s.problem.units; },
+            "[scene].units, free text (the code is unit-free)")
         .def_property_readonly(
             "n_vertices", [](const Scene& s) { return s.problem.mesh0.n_vertices(); },
             "vertices of the level-0 mesh")
@@ -531,14 +541,22 @@ PYBIND11_MODULE(_core, m) {
         });
 
     py::class_<Result, std::shared_ptr<Result>>(m, "Result", "A solved scene")
-        .def_property_readonly("converged", [](const Result& r) { return r.run.converged; })
-        .def_property_readonly("failure", [](const Result& r) { return r.run.failure; })
-        .def_property_readonly("scene_name", [](const Result& r) { return r.problem.name; })
         .def_property_readonly(
-            "level", [](const Result& r) { return static_cast<int>(r.run.levels().size()) - 1; })
+            "converged", [](const Result& r) { return r.run.converged; },
+            "whether every load step converged on every level")
+        .def_property_readonly(
+            "failure", [](const Result& r) { return r.run.failure; },
+            "the diagnosis of the step that did not converge (empty when converged)")
+        .def_property_readonly(
+            "scene_name", [](const Result& r) { return r.problem.name; },
+            "the solved scene's [scene].name")
+        .def_property_readonly(
+            "level", [](const Result& r) { return static_cast<int>(r.run.levels().size()) - 1; },
+            "the finest level solved (0 for the level-0 mesh)")
         .def_property_readonly(
             "unknowns",
-            [](const Result& r) { return static_cast<long>(r.run.finest().n_unknowns()); })
+            [](const Result& r) { return static_cast<long>(r.run.finest().n_unknowns()); },
+            "unknowns of the finest level (free displacement components and multipliers)")
         .def_property_readonly(
             "vertices",
             [](py::object self) {
@@ -669,7 +687,8 @@ PYBIND11_MODULE(_core, m) {
                                    for (const auto& c : r.problem.contacts)
                                        v.push_back(c.name);
                                    return v;
-                               })
+                               },
+                               "the contact pairs' names; contact_pair[i] indexes this list")
         .def_property_readonly(
             "resultants",
             [](const Result& r) {
@@ -720,7 +739,8 @@ PYBIND11_MODULE(_core, m) {
                                    for (const auto& [name, e] : r.run.timings.table())
                                        d[py::str(name)] = e.seconds;
                                    return d;
-                               })
+                               },
+                               "seconds per timed section of the run (as the report's table)")
         .def_property_readonly("solver",
                                [](const Result& r) {
                                    const auto& sp = r.run.solver.spec;
@@ -734,7 +754,9 @@ PYBIND11_MODULE(_core, m) {
                                        std::string(levels::to_string(r.problem.numbering));
                                    d["reason"] = r.run.solver.reason;
                                    return d;
-                               })
+                               },
+                               "the Newton-system solver: method, krylov, pc, rel_tol, "
+                               "automatic (chosen by the default), numbering, reason")
         .def(
             "step_state",
             [](const Result& r, int k) {

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Threads on a shared machine (issue 11): `mlcontact bench square --levels L --pc mg` four ways,
+# Threads on a shared machine (docs/results/mg.md#results-mg): `mlcontact bench square --levels L --pc mg` four ways,
 # each the median of 3 runs (bench --repeat 3):
 #   idle      both cores free, default threads
 #   1 thread  OMP_NUM_THREADS=1

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
-"""One process against N processes, back to back, on the same commit (issue 12's judged case):
+"""One process against N processes, back to back, on the same commit (docs/results/parallel.md#results-parallel):
 
     /usr/bin/python3 scripts/bench_distributed.py --levels 6 --repeat 3 --np 2
 

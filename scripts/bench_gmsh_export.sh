@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The square exported from level L as a Gmsh file against the refined square (README "`mg` on a
-# mesh without levels" and "Levels recovered from a Gmsh mesh"). The export is a uniform
+# The square exported from level L as a Gmsh file against the refined square (docs/results/mg.md#results-mg
+# and docs/guide/scenes.md#scenes-recovered-levels). The export is a uniform
 # refinement, so by default the scene recovers its levels ([scene].recover_levels): the default
 # solver (coarse-to-fine, mg) and `--linear schur` on it; then the same file read flat
 # (`recover_levels = false`: one level, no hierarchy) with its default (schur there),

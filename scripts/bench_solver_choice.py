@@ -1,16 +1,15 @@
 #!/usr/bin/python3
-"""The default Newton-system solver against both candidates (issue 11, "a fast default at every
-size"): for each scene and level, `mlcontact run SCENE --levels L --quiet` with no solver flag,
+"""The default Newton-system solver against both candidates (a fast default at every
+size; docs/results/solver-choice.md#results-solver-choice): for each scene and level, `mlcontact run SCENE --levels L --quiet` with no solver flag,
 with `--linear schur` and with the Krylov + mg candidate (`--linear krylov`, the driver's own
-pair: BiCGStab + mg:pre=0,post=2, damped with a two-body pair; until 2026-11-26 this was
-`--pc mg`, CGS + mg; --mg sets other flags; none on level 0, where the default is schur
+pair: BiCGStab + mg:pre=0,post=2, damped with a two-body pair; --mg sets other flags; none on level 0, where the default is schur
 whatever the size), REPEAT times each in turn. Wall time (perf_counter, ms resolution) and the peak
 RSS of each process (wait4). Prints the medians, the solver the default chose and its ratios to
 the faster and to the smaller candidate (the bar: both at most 1.15), and writes
 out/bench/solver_choice.csv and .json. Run it on an idle machine: it measures wall time.
 
 usage: scripts/bench_solver_choice.py [--repeat N] [--mg "FLAGS"] [SCENE:L1,L2 ...]
-  default cases (the README's table): square:1,2,3,4 hertz:1,2,3 calumet:1,2 incline:1,2 patch:1,2
+  default cases (the table of docs/results/solver-choice.md#results-solver-choice): square:1,2,3,4 hertz:1,2,3 calumet:1,2 incline:1,2 patch:1,2
   patch_matching:2 dovetail:1,2,3,4 axis_release:1,2 mindlin:1,2
 """
 import argparse

@@ -13,6 +13,11 @@ packages=(
   python3-vtk9                  # tests: VTK's own reader opens our VTU/PVD files
   pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (python/) and the Python tests
   clang-14 libclang-rt-14-dev   # sanitizer build and libFuzzer (scripts/sanitize.sh, fuzz.sh)
+  python3-sphinx python3-myst-parser python3-sphinx-rtd-theme   # the docs site (scripts/docs.sh)
+  doxygen python3-breathe       # the C++ API pages (docs/api/cpp.md#api-cpp)
+  libjs-mathjax fonts-mathjax   # math rendered offline, from the built site
+  chromium                      # tests: the built site opened in a headless browser
+  xvfb xauth                    # offscreen VTK rendering under xvfb-run (docs/viewing.md#viewing-vtk)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: MIT
 """A model of the distributed mg's time per V-cycle and per load step on 64 and 1024 processes
-(issue 13 item 4; README "Running on a cluster"):
+(docs/parallel.md#cluster-model):
 
     /usr/bin/python3 scripts/scaling_model.py measure   # the benches below (idle machine: timings)
     /usr/bin/python3 scripts/scaling_model.py model     # the model from their JSON files
@@ -18,7 +18,8 @@
                          steps per load step, Krylov iterations per Newton step, wall time per
                          load step.
 `model` combines them with stated network assumptions (--latency, --bandwidth) and writes
-out/model/scaling_model.json and docs/scaling_model.png, and prints the README's tables.
+out/model/scaling_model.json and docs/results/scaling_model.png, and prints the tables of
+docs/results/parallel.md#results-parallel.
 
 The model, per V-cycle on P processes from level L with partition level p (the run's rule):
   compute    sum over l = p+1..L of c * n_l / P * imbalance   (c: seconds per unknown and level
@@ -306,8 +307,8 @@ def model(a):
                      f"beta {a.bandwidth:g} B/s)")
         ax.legend()
         fig.tight_layout()
-        fig.savefig(ROOT / "docs" / "scaling_model.png", dpi=110)
-        print("\nwrote docs/scaling_model.png")
+        fig.savefig(ROOT / "docs" / "results" / "scaling_model.png", dpi=110)
+        print("\nwrote docs/results/scaling_model.png")
     except ImportError:
         print("matplotlib missing: no plot")
     print(f"wrote {OUT / 'scaling_model.json'}")

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# First README command: install what is missing, build, and solve the built-in default scene.
+# First of the two commands (docs/guide/install.md#install-two-commands): install what is missing, build, and solve the built-in default scene.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh

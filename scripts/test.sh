@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Second README command: build (installing what is missing) and run the whole test suite.
+# Second of the two commands (docs/guide/install.md#install-two-commands): build (installing what is missing) and run the whole test suite.
 # `ctest --test-dir build -LE slow` runs the fast subset only.
-# Then, hostile input (README): the fast unit tests again under address+undefined sanitizers
+# Then, hostile input (docs/testing.md#testing-hostile): the fast unit tests again under address+undefined sanitizers
 # (scripts/sanitize.sh, build-asan/) and both fuzz targets for 60 s each (scripts/fuzz.sh).
 # These are skipped when ctest arguments are given or MLC_HOSTILE=0; MLC_FUZZ_SECONDS sets the
 # fuzzing time.

@@ -93,6 +93,8 @@ struct LatticeGSParams {
     double stencil_tol = 1e-12;
 };
 
+/// The vertex-block Gauss–Seidel smoother with structured kernels on the macro triangles'
+/// interiors (mg:smoother=lattice); see the file comment.
 class LatticeGS {
 public:
     /// block_starts: the vertex blocks (first row of each, as BlockSORParams::block_starts).

@@ -25,6 +25,8 @@
 
 namespace mlc::solvers {
 
+/// The multigrid's prolongation T and restriction R between two lattice-numbered levels, applied
+/// through the lattice where the rows allow it; see the file comment.
 class LatticeTransfer {
 public:
     /// T: fine x coarse, R: coarse x fine (compressed CSR, borrowed: they must outlive this and

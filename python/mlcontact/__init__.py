@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: MIT
 """mlcontact: multilevel frictional contact in 2D linear elasticity, from Python.
 
+Example::
+
     import mlcontact
     scene = mlcontact.Scene.builtin("square")
     scene.mu = 0.3
@@ -11,7 +13,7 @@
 Errors: a bad scene key or value raises ValueError naming it (with file and line for scene
 files); a load step that does not converge raises NotConverged (its .result holds the reports);
 a numerical breakdown raises SolverBreakdown; Ctrl-C during solve() raises KeyboardInterrupt.
-See README.md, section "Python".
+See docs/guide/python.md#python (the guide) and docs/api/python.md#api-python (the reference).
 """
 
 import csv as _csv
@@ -26,6 +28,8 @@ from . import _core
 from ._core import Result, Scene, SolverBreakdown
 
 __version__ = _core.__version__
+SolverBreakdown.__doc__ = """A numerical breakdown during solve(): a NaN or Inf, or a singular Newton
+system (a RuntimeError; the driver exits 3 for the same condition)."""
 
 #: Status codes of Result.status: STATUS_NAMES[code].
 STATUS_NAMES = tuple(_core.status_names)
