@@ -344,7 +344,9 @@ int main(int argc, char** argv) {
                 mlc::apps::install_stop_handlers(true, rank == 0 ? 0 : 500);
                 return mlc::apps::run_scene_distributed(ro, mlc::comm::world(), std::cout);
             }
-            mlc::apps::install_stop_handlers();
+            // Under mpirun -np 1 too, a signal ends the run at once: mpirun follows it with
+            // SIGKILL after a second, too soon for a stop after the current Newton iteration.
+            mlc::apps::install_stop_handlers(mlc::comm::launched_by_mpirun());
             ro.stop = &mlc::apps::stop_flag();
             ro.progress_eta = ::isatty(STDOUT_FILENO) == 1;
             if (ro.partition_level)
@@ -437,8 +439,8 @@ int main(int argc, char** argv) {
         // A stop request seen outside the solve (e.g. while meshing): nothing was written.
         const int sig = mlc::apps::stop_signal();
         if (rank == 0)
-            std::cerr << "mlcontact: stopped by " << mlc::apps::signal_name(sig) << ": "
-                      << e.what() << "\n";
+            std::cerr << "mlcontact: stopped by " << mlc::apps::signal_name(sig) << ": " << e.what()
+                      << "\n";
         return 128 + (sig > 0 ? sig : 2);
     } catch (const mlc::SolverBreakdown& e) {
         std::cerr << "mlcontact: numerical breakdown"

@@ -17,13 +17,13 @@
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <iomanip>
 #include <map>
 #include <sstream>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <toml++/toml.h>
+#include <unistd.h>
 
 namespace mlc::apps {
 
@@ -699,13 +699,13 @@ std::string killed_summary(const std::string& scene, int sig, int processes) {
     return "{\n    \"complete\": false,\n    \"scene\": " + json_string(scene) +
            ",\n    \"converged\": false,\n    \"stopped\": true,\n    \"stopped_at\": " +
            json_string(std::string("ended at once by ") + name +
-                       (processes > 1 ? " under mpirun (" + std::to_string(processes) +
-                                            " processes)"
-                                      : std::string()) +
+                       (processes > 1
+                            ? " under mpirun (" + std::to_string(processes) + " processes)"
+                            : std::string()) +
                        "; the other files in this folder may be incomplete or from an earlier "
                        "run") +
-           ",\n    \"signal\": " + json_string(name) + ",\n    \"processes\": " +
-           std::to_string(processes) + "\n}\n";
+           ",\n    \"signal\": " + json_string(name) +
+           ",\n    \"processes\": " + std::to_string(processes) + "\n}\n";
 }
 
 OutputFolder::OutputFolder(std::filesystem::path dir, bool lock) : dir_(std::move(dir)) {
@@ -736,15 +736,17 @@ OutputFolder::OutputFolder(std::filesystem::path dir, bool lock) : dir_(std::mov
                 ::usleep(10000);
             ::close(fd);
             if (err == EWOULDBLOCK)
-                folder_error(dir_, "is in use by another mlcontact run (process " +
-                                       (pid > 0 ? std::to_string(pid) : std::string("unknown")) +
-                                       ", lock file " + lf.string() +
-                                       "); wait for it to end, or choose another folder with --out");
+                folder_error(dir_,
+                             "is in use by another mlcontact run (process " +
+                                 (pid > 0 ? std::to_string(pid) : std::string("unknown")) +
+                                 ", lock file " + lf.string() +
+                                 "); wait for it to end, or choose another folder with --out");
             folder_error(dir_, std::string("cannot be locked (") + std::strerror(err) + ")");
         }
         // Locked; but the file may have been removed (its holder ended) between open and flock:
         // then lock the new one.
-        struct stat a {}, b {};
+        struct stat a {
+        }, b{};
         if (::fstat(fd, &a) != 0 || ::stat(lf.c_str(), &b) != 0 || a.st_ino != b.st_ino ||
             a.st_dev != b.st_dev) {
             ::close(fd);

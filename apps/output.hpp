@@ -4,10 +4,10 @@
 /// Every number is checked finite before a file is written; a NaN/Inf aborts with a diagnosis.
 #pragma once
 
+#include "core/atomic_file.hpp"
 #include "levels/checks.hpp"
 #include "levels/problem.hpp"
 #include "levels/solve.hpp"
-#include "core/atomic_file.hpp"
 #include "mesh/io/vtu.hpp"
 
 #include <cstdint>

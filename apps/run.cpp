@@ -7,16 +7,16 @@
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
-#include "core/stop.hpp"
 #include "core/parallel.hpp"
+#include "core/stop.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
-#include <iostream>
 #include <filesystem>
+#include <iostream>
 #include <optional>
 
 namespace mlc::apps {
@@ -245,8 +245,9 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
                                          : std::string("no load step"))
                << "\n";
         else
-            os << "\nstopped by " << signal_name(sig) << " while the files were written: "
-               << st.stopped_at << "; summary.json lists the files written\n";
+            os << "\nstopped by " << signal_name(sig)
+               << " while the files were written: " << st.stopped_at
+               << "; summary.json lists the files written\n";
         return 128 + (sig > 0 ? sig : 2);
     }
     if (plot_failed) {

@@ -22,10 +22,10 @@
 #include <array>
 #include <cmath>
 #include <csignal>
-#include <optional>
 #include <iomanip>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <tuple>
 
@@ -229,8 +229,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         if (refused)
             throw InvalidInput(root ? why : "the output folder was refused (process 0 says why)");
         if (folder && folder->took_over_from() > 0)
-            os << "note: the output folder's lock was left by process "
-               << folder->took_over_from() << ", which has ended; taken over\n";
+            os << "note: the output folder's lock was left by process " << folder->took_over_from()
+               << ", which has ended; taken over\n";
     }
 
     levels::SolveOptions so;

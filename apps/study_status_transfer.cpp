@@ -9,12 +9,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
-#include <sys/wait.h>
 #include <deque>
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <sstream>
+#include <sys/wait.h>
 #include <toml++/toml.h>
 
 namespace mlc::apps {
@@ -104,7 +104,7 @@ bool run_plot_script(const std::string& script, const std::filesystem::path& dir
     }
     const std::string why =
         "'" + cmd + "' failed (" +
-        (rc == -1 ? std::string("could not be started")
+        (rc == -1        ? std::string("could not be started")
          : WIFEXITED(rc) ? "exit " + std::to_string(WEXITSTATUS(rc))
                          : "signal " + std::to_string(WTERMSIG(rc))) +
         ")" + (last.empty() ? std::string() : ": " + last.substr(last.find_first_not_of(" \t")));

@@ -127,8 +127,8 @@ AtomicOfstream::AtomicOfstream(const std::filesystem::path& file, std::filesyste
       uncaught_(std::uncaught_exceptions()), pending_(is_open()) {}
 
 AtomicOfstream::AtomicOfstream(AtomicOfstream&& other) noexcept
-    : std::ofstream(std::move(other)), file_(std::move(other.file_)),
-      tmp_(std::move(other.tmp_)), uncaught_(other.uncaught_), pending_(other.pending_) {
+    : std::ofstream(std::move(other)), file_(std::move(other.file_)), tmp_(std::move(other.tmp_)),
+      uncaught_(other.uncaught_), pending_(other.pending_) {
     other.pending_ = false;
 }
 

@@ -747,8 +747,7 @@ PYBIND11_MODULE(_core, m) {
                                        "mlcontact.solve(scene, ..., keep_steps=True)");
                 if (k < 1 || k > static_cast<int>(st.size()))
                     throw InvalidInput("step must lie in [1, " + std::to_string(st.size()) +
-                                       "] (the load steps completed), found " +
-                                       std::to_string(k));
+                                       "] (the load steps completed), found " + std::to_string(k));
                 const auto& n = st[static_cast<size_t>(k - 1)];
                 const Vector& u = r.run.step_u_full[static_cast<size_t>(k - 1)];
                 py::array_t<double> x({static_cast<py::ssize_t>(n.size()), py::ssize_t{2}});
