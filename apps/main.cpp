@@ -4,9 +4,10 @@
 // `mlcontact run` with no argument solves the built-in `square` scene (the 1997 paper's square
 // test); `mlcontact scenes` lists the built-in scenes; `mlcontact show NAME` prints one, as a
 // starting point for your own scene file. Every error is reported as one line on stderr with a
-// non-zero exit code: 1 for bad input, 2 for a solve that did not converge, 3 for a numerical
-// breakdown; a run stopped by SIGINT / SIGTERM exits 130 / 143 after writing the files of its
-// completed load steps.
+// non-zero exit code: 1 for bad input (a bad command line included), 2 for a solve that did not
+// converge, 3 for a numerical breakdown (NaN/Inf included), 4 for a run whose results were
+// written but whose --plot failed; a run stopped by SIGINT / SIGTERM exits 130 / 143 after
+// writing the files of its completed load steps.
 #include "apps/bench.hpp"
 #include "apps/bench_comm.hpp"
 #include "apps/bench_distributed.hpp"
@@ -272,7 +273,48 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // Bad command lines are bad input: exit 1 with the usual prefix, and where to look.
+        if (e.get_exit_code() == 0) return app.exit(e);
+        // The deepest command parsed, e.g. `mlcontact study`.
+        CLI::App* at = &app;
+        std::string where = "mlcontact";
+        for (bool deeper = true; deeper;) {
+            deeper = false;
+            for (auto* sub : at->get_subcommands([](CLI::App*) { return true; }))
+                if (sub->parsed()) {
+                    at = sub;
+                    where += " " + sub->get_name();
+                    deeper = true;
+                    break;
+                }
+        }
+        std::string what = e.what();
+        const auto subs = at->get_subcommands([](CLI::App*) { return true; });
+        if (!subs.empty() && at->get_subcommands().empty()) {
+            // A command that needs a subcommand got none it knows: name the word it got.
+            std::string word;
+            for (int i = 1; i < argc; ++i) {
+                const std::string a = argv[i];
+                if (a.empty() || a[0] == '-' || a == at->get_name()) continue;
+                bool known = false;
+                for (CLI::App* c = &app; c; c = c->get_parent())
+                    known = known || c->get_name() == a;
+                for (const char* n : {"run", "study", "bench", "show", "scenes", "preconditioners"})
+                    known = known || a == n;
+                if (!known) {
+                    word = a;
+                    break;
+                }
+            }
+            std::string names;
+            for (const auto* sub : subs)
+                names += (names.empty() ? "" : ", ") + sub->get_name();
+            what = (word.empty() ? "`" + where + "` needs a command"
+                                 : "unknown command '" + word + "' for `" + where + "`") +
+                   " (one of: " + names + ")";
+        }
+        std::cerr << "mlcontact: error: " << what << " (see `" << where << " --help`)\n";
+        return 1;
     }
     // Started by mpirun with several processes: `run` and `bench square|elastic` are distributed
     // (issue 12); the other commands are one process only and say so (N copies of a one-process
@@ -291,11 +333,20 @@ int main(int argc, char** argv) {
     }
     try {
         if (*run) {
-            // Several processes: Ctrl-C ends them (mpirun forwards it; a stop after the current
-            // Newton iteration would need every process to see it at the same iteration).
-            if (distributed)
+            if (run->count("--out") > 0 && ro.out.empty())
+                throw mlc::InvalidInput("--out needs a folder name, found an empty one; leave "
+                                        "--out out to write to out/<scene name>");
+            // Several processes: a signal ends them at once (mpirun follows its SIGTERM with
+            // SIGKILL after a second; a stop after the current Newton iteration would need every
+            // process to see it at the same iteration): temporaries removed, summary.json
+            // written by process 0 saying so.
+            if (distributed) {
+                mlc::apps::install_stop_handlers(true, rank == 0 ? 0 : 500);
                 return mlc::apps::run_scene_distributed(ro, mlc::comm::world(), std::cout);
-            mlc::apps::install_stop_handlers();
+            }
+            // Under mpirun -np 1 too, a signal ends the run at once: mpirun follows it with
+            // SIGKILL after a second, too soon for a stop after the current Newton iteration.
+            mlc::apps::install_stop_handlers(mlc::comm::launched_by_mpirun());
             ro.stop = &mlc::apps::stop_flag();
             ro.progress_eta = ::isatty(STDOUT_FILENO) == 1;
             if (ro.partition_level)
@@ -384,6 +435,13 @@ int main(int argc, char** argv) {
         // Several processes: input errors are found by every process alike; rank 0 says it.
         if (rank == 0) std::cerr << "mlcontact: error: " << e.what() << "\n";
         return 1;
+    } catch (const mlc::Interrupted& e) {
+        // A stop request seen outside the solve (e.g. while meshing): nothing was written.
+        const int sig = mlc::apps::stop_signal();
+        if (rank == 0)
+            std::cerr << "mlcontact: stopped by " << mlc::apps::signal_name(sig) << ": " << e.what()
+                      << "\n";
+        return 128 + (sig > 0 ? sig : 2);
     } catch (const mlc::SolverBreakdown& e) {
         std::cerr << "mlcontact: numerical breakdown"
                   << (distributed ? " (process " + std::to_string(rank) + ")" : "") << ": "

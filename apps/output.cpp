@@ -10,12 +10,20 @@
 #include "levels/checks.hpp"
 #include "mesh/io/vtu.hpp"
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
 #include <fstream>
 #include <iomanip>
 #include <map>
 #include <sstream>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <toml++/toml.h>
+#include <unistd.h>
 
 namespace mlc::apps {
 
@@ -324,8 +332,12 @@ toml::array steps_json(const std::vector<levels::StepReport>& steps, int* total_
         t.insert("newton_iterations", static_cast<int64_t>(s.iterations));
         t.insert("linear_iterations", static_cast<int64_t>(s.linear_iterations));
         toml::array res;
-        for (double v : s.residuals)
-            res.push_back(v);
+        for (double v : s.residuals) {
+            if (std::isfinite(v))
+                res.push_back(v);
+            else // JSON has no NaN/Inf (a failed run's summary)
+                res.push_back(std::string(v != v ? "NaN" : v > 0 ? "Infinity" : "-Infinity"));
+        }
         t.insert("residuals", res);
         toml::array ch;
         for (int v : s.status_changes)
@@ -404,12 +416,12 @@ void write_iterations_csv(const std::filesystem::path& file,
     });
 }
 
-std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
-                                       const levels::RunResult& r, const OutputOptions& options) {
+void write_result_files(const std::filesystem::path& dir, const levels::Problem& p,
+                        const levels::RunResult& r, const OutputOptions& options,
+                        std::vector<std::string>& written) {
     const auto& L = r.finest();
     std::filesystem::create_directories(dir);
-    std::vector<std::string> written;
-    if (!r.converged && !r.stopped) return written;
+    if (!r.converged && !r.stopped) return;
     // Check everything first so that no partial result set is left behind.
     for (const auto& nodes : r.step_nodes)
         for (const auto& n : nodes) {
@@ -441,8 +453,16 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         write_iterations_csv(dir / "iterations.csv", its);
         written.push_back("iterations.csv");
     }
-    { // summary.json
+}
+
+void write_summary(const std::filesystem::path& dir, const levels::Problem& p,
+                   const levels::RunResult& r, const OutputOptions& options,
+                   const SummaryStatus& status) {
+    const auto& L = r.finest();
+    std::filesystem::create_directories(dir);
+    {
         toml::table root;
+        root.insert("complete", status.complete);
         root.insert("scene", p.name);
         root.insert("units", p.units);
         root.insert("level", static_cast<int64_t>(r.levels().size() - 1));
@@ -452,8 +472,17 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         root.insert("vertices", static_cast<int64_t>(L.mesh.n_vertices()));
         root.insert("triangles", static_cast<int64_t>(L.mesh.n_triangles()));
         root.insert("converged", r.converged);
-        root.insert("stopped", r.stopped);
-        if (r.stopped) root.insert("stopped_at", r.failure);
+        root.insert("stopped", status.stopped);
+        if (status.stopped) root.insert("stopped_at", status.stopped_at);
+        if (!r.converged && !r.stopped) root.insert("failure", r.failure);
+        {
+            toml::array files;
+            for (const auto& f : status.files)
+                files.push_back(f);
+            files.push_back("summary.json");
+            root.insert("files", files);
+        }
+        if (!status.plot.empty()) root.insert("plot", status.plot);
         root.insert("load_steps", static_cast<int64_t>(p.load_steps));
         root.insert("recovered_levels", static_cast<int64_t>(p.recovered_levels));
         root.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
@@ -542,25 +571,27 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         root.insert("blas", parallel::blas_library());
         write_file_atomically(dir / "summary.json",
                               [&](std::ostream& f) { f << toml::json_formatter{root} << "\n"; });
-        written.push_back("summary.json");
     }
+}
+
+std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
+                                       const levels::RunResult& r, const OutputOptions& options) {
+    std::vector<std::string> written;
+    write_result_files(dir, p, r, options, written);
+    SummaryStatus st;
+    st.stopped = r.stopped;
+    if (r.stopped) st.stopped_at = r.failure;
+    st.files = written;
+    write_summary(dir, p, r, options, st);
+    written.push_back("summary.json");
     return written;
 }
 
-StepFiles::StepFiles(std::filesystem::path dir, const levels::Problem& p, bool every_level,
+StepFiles::StepFiles(OutputFolder& folder, const levels::Problem& p, bool every_level,
                      mesh::VtuFormat format)
-    : dir_(std::move(dir)), finest_(p.levels), every_level_(every_level), format_(format),
-      series_(static_cast<size_t>(p.levels) + 1) {
+    : folder_(&folder), dir_(folder.dir()), scene_(p.name), finest_(p.levels),
+      every_level_(every_level), format_(format), series_(static_cast<size_t>(p.levels) + 1) {
     digits_ = std::max(4, static_cast<int>(std::to_string(p.load_steps).size()));
-    std::filesystem::create_directories(dir_);
-    // Step files of an earlier run (a longer one would leave steps this run does not list).
-    for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
-        const std::string name = entry.path().filename().string();
-        const bool ours =
-            (name.rfind("solution_step_", 0) == 0 || name.rfind("solution_level_", 0) == 0) &&
-            (name.ends_with(".vtu") || name.ends_with(".pvd"));
-        if (ours) std::filesystem::remove(entry.path());
-    }
 }
 
 void StepFiles::operator()(const levels::LevelStepState& s) {
@@ -570,10 +601,13 @@ void StepFiles::operator()(const levels::LevelStepState& s) {
     const std::string prefix =
         s.level == finest_ ? "solution" : "solution_level_" + std::to_string(s.level);
     const std::string name = prefix + "_step_" + step.str() + ".vtu";
+    folder_->begin_writing(scene_);
     write_solution_vtu(dir_ / name, *s.L, *s.u_full, *s.nodes, format_);
+    folder_->add(name);
     auto& series = series_[static_cast<size_t>(s.level)];
     series.emplace_back(s.s, name);
     mesh::write_pvd(dir_ / (prefix + ".pvd"), series);
+    folder_->add(prefix + ".pvd");
 }
 
 int StepFiles::finest_steps() const {
@@ -588,6 +622,179 @@ std::vector<std::string> StepFiles::collections() const {
                               ? std::string("solution.pvd")
                               : "solution_level_" + std::to_string(l) + ".pvd");
     return out;
+}
+
+namespace {
+
+/// A name the driver writes into an output folder (the only names begin_writing removes).
+bool driver_file_name(const std::string& n) {
+    if (n.empty() || n.find('/') != std::string::npos || n[0] == '.') return false;
+    const bool ours_prefix = n.rfind("solution", 0) == 0 || n.rfind("contact", 0) == 0 ||
+                             n == "iterations.csv" || n == "summary.json";
+    const bool ours_suffix = n.ends_with(".vtu") || n.ends_with(".pvtu") || n.ends_with(".pvd") ||
+                             n.ends_with(".csv") || n.ends_with(".png") || n.ends_with(".json");
+    return ours_prefix && ours_suffix;
+}
+
+std::string json_string(const std::string& s) {
+    std::string out = "\"";
+    for (char c : s) {
+        if (c == '"' || c == '\\') out += '\\';
+        if (static_cast<unsigned char>(c) < 0x20) {
+            out += ' ';
+            continue;
+        }
+        out += c;
+    }
+    return out + "\"";
+}
+
+/// The earlier run's summary.json: whether it says "complete": true, and its "files" (read as
+/// write_summary formats it; anything else reads as not complete).
+bool read_complete_summary(const std::filesystem::path& file, std::vector<std::string>& files) {
+    std::ifstream in(file);
+    if (!in) return false;
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string t = ss.str();
+    auto value_at = [&](const std::string& key) -> size_t {
+        const size_t k = t.find("\"" + key + "\"");
+        if (k == std::string::npos) return std::string::npos;
+        size_t i = k + key.size() + 2;
+        while (i < t.size() && (t[i] == ' ' || t[i] == ':' || t[i] == '\n' || t[i] == '\t'))
+            ++i;
+        return i;
+    };
+    const size_t c = value_at("complete");
+    if (c == std::string::npos || t.compare(c, 4, "true") != 0) return false;
+    const size_t f = value_at("files");
+    if (f == std::string::npos || f >= t.size() || t[f] != '[') return false;
+    const size_t end = t.find(']', f);
+    if (end == std::string::npos) return false;
+    for (size_t i = f; i < end; ++i) {
+        if (t[i] != '"') continue;
+        const size_t q = t.find('"', i + 1);
+        if (q == std::string::npos || q > end) break;
+        files.push_back(t.substr(i + 1, q - i - 1));
+        i = q;
+    }
+    return true;
+}
+
+[[noreturn]] void folder_error(const std::filesystem::path& dir, const std::string& what) {
+    throw InvalidInput("the output folder '" + dir.string() + "' " + what);
+}
+
+} // namespace
+
+std::string in_progress_summary(const std::string& scene) {
+    return "{\n    \"complete\": false,\n    \"scene\": " + json_string(scene) +
+           ",\n    \"stopped\": false,\n    \"pid\": " + std::to_string(::getpid()) +
+           ",\n    \"note\": \"being written by process " + std::to_string(::getpid()) +
+           "; a run that ended without completing this folder leaves it so\"\n}\n";
+}
+
+std::string killed_summary(const std::string& scene, int sig, int processes) {
+    const char* name = sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "a signal";
+    return "{\n    \"complete\": false,\n    \"scene\": " + json_string(scene) +
+           ",\n    \"converged\": false,\n    \"stopped\": true,\n    \"stopped_at\": " +
+           json_string(std::string("ended at once by ") + name +
+                       (processes > 1
+                            ? " under mpirun (" + std::to_string(processes) + " processes)"
+                            : std::string()) +
+                       "; the other files in this folder may be incomplete or from an earlier "
+                       "run") +
+           ",\n    \"signal\": " + json_string(name) +
+           ",\n    \"processes\": " + std::to_string(processes) + "\n}\n";
+}
+
+OutputFolder::OutputFolder(std::filesystem::path dir, bool lock) : dir_(std::move(dir)) {
+    std::error_code ec;
+    if (std::filesystem::exists(dir_, ec) && !std::filesystem::is_directory(dir_, ec))
+        folder_error(dir_, "is not a folder (a file of that name exists); choose another --out");
+    std::filesystem::create_directories(dir_, ec);
+    if (ec)
+        folder_error(dir_, "cannot be created: " + ec.message() +
+                               "; choose a writable folder with --out");
+    if (!lock) return;
+    const std::filesystem::path lf = dir_ / lock_name;
+    for (int attempt = 0;; ++attempt) {
+        const int fd = ::open(lf.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        if (fd < 0)
+            folder_error(dir_, std::string("is not writable: cannot create its lock file (") +
+                                   std::strerror(errno) + "); choose a writable folder with --out");
+        auto read_pid = [&] {
+            char buf[32] = {};
+            const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
+            return n > 0 ? std::strtol(buf, nullptr, 10) : 0L;
+        };
+        if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+            const int err = errno;
+            long pid = 0;
+            // The holder writes its id right after locking: give it a moment.
+            for (int i = 0; i < 100 && (pid = read_pid()) == 0; ++i)
+                ::usleep(10000);
+            ::close(fd);
+            if (err == EWOULDBLOCK)
+                folder_error(dir_,
+                             "is in use by another mlcontact run (process " +
+                                 (pid > 0 ? std::to_string(pid) : std::string("unknown")) +
+                                 ", lock file " + lf.string() +
+                                 "); wait for it to end, or choose another folder with --out");
+            folder_error(dir_, std::string("cannot be locked (") + std::strerror(err) + ")");
+        }
+        // Locked; but the file may have been removed (its holder ended) between open and flock:
+        // then lock the new one.
+        struct stat a {
+        }, b{};
+        if (::fstat(fd, &a) != 0 || ::stat(lf.c_str(), &b) != 0 || a.st_ino != b.st_ino ||
+            a.st_dev != b.st_dev) {
+            ::close(fd);
+            if (attempt < 100) continue;
+            folder_error(dir_, "cannot be locked (its lock file keeps changing)");
+        }
+        took_over_from_ = read_pid();
+        const std::string id = std::to_string(::getpid()) + "\n";
+        const bool ok = ::ftruncate(fd, 0) == 0 &&
+                        ::pwrite(fd, id.data(), id.size(), 0) == static_cast<ssize_t>(id.size()) &&
+                        ::fsync(fd) == 0;
+        if (!ok) {
+            const int err = errno;
+            ::unlink(lf.c_str());
+            ::close(fd);
+            folder_error(dir_, std::string("is not writable (") + std::strerror(err) +
+                                   "); choose another folder with --out");
+        }
+        lock_fd_ = fd;
+        lock_registered_.emplace(lf);
+        return;
+    }
+}
+
+OutputFolder::~OutputFolder() {
+    if (lock_fd_ < 0) return;
+    lock_registered_.reset();
+    ::unlink((dir_ / lock_name).c_str()); // while still holding it (see the constructor)
+    ::close(lock_fd_);
+}
+
+void OutputFolder::begin_writing(const std::string& scene) {
+    if (begun_) return;
+    begun_ = true;
+    std::vector<std::string> earlier;
+    if (read_complete_summary(dir_ / "summary.json", earlier))
+        for (const auto& n : earlier) {
+            std::error_code ec;
+            const auto f = dir_ / n;
+            if (!driver_file_name(n) || !std::filesystem::is_regular_file(f, ec)) continue;
+            if (std::filesystem::remove(f, ec)) removed_.push_back(n);
+        }
+    const std::string text = in_progress_summary(scene);
+    write_file_atomically(dir_ / "summary.json", [&](std::ostream& f) { f << text; });
+}
+
+void OutputFolder::add(const std::string& name) {
+    if (std::find(files_.begin(), files_.end(), name) == files_.end()) files_.push_back(name);
 }
 
 } // namespace mlc::apps

@@ -4,6 +4,7 @@
 /// Every number is checked finite before a file is written; a NaN/Inf aborts with a diagnosis.
 #pragma once
 
+#include "core/atomic_file.hpp"
 #include "levels/checks.hpp"
 #include "levels/problem.hpp"
 #include "levels/solve.hpp"
@@ -11,6 +12,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -93,23 +95,99 @@ struct LevelIterations {
 void write_iterations_csv(const std::filesystem::path& file,
                           const std::vector<LevelIterations>& levels);
 
-/// Writes the files of a run into dir (created if needed), each under a temporary name renamed
-/// when complete: when converged, solution.vtu, contact.csv, contact_steps.csv, iterations.csv
-/// and summary.json; when stopped on request, contact_steps.csv (the completed steps),
-/// iterations.csv and summary.json; nothing else. Returns the names of the files written.
+/// The output folder of one run of the driver, from before its solve to its exit.
+///
+/// Constructed before the solve, it checks the folder and locks it: creates it if needed, refuses
+/// a path that is not a folder, and creates the lock file `.mlcontact.lock` in it holding this
+/// process's id (flock, so a lock whose process is gone is free: it is taken over). Creating the
+/// lock and writing the id (with fsync) is also the probe that files can be written there, so a
+/// read-only or full file system is found before the solve. Another live run holding the lock:
+/// refused at once. Every failure throws InvalidInput naming the folder. The lock file is removed
+/// when the object is destroyed.
+///
+/// begin_writing(), before this run's first file: removes the files listed in the folder's
+/// summary.json when that summary is complete (a finished earlier run of this folder; only names
+/// the driver writes, never anything else), then writes summary.json as in progress
+/// ("complete": false), so that a folder left by a run killed while writing tells so.
+class OutputFolder {
+public:
+    static constexpr const char* lock_name = ".mlcontact.lock";
+
+    /// `lock` false (the Python module's Result.write): no lock, no check beyond creating dir.
+    explicit OutputFolder(std::filesystem::path dir, bool lock = true);
+    OutputFolder(const OutputFolder&) = delete;
+    OutputFolder& operator=(const OutputFolder&) = delete;
+    ~OutputFolder();
+
+    const std::filesystem::path& dir() const { return dir_; }
+    /// The process id found in a lock this run took over (its run ended without removing it),
+    /// or 0.
+    long took_over_from() const { return took_over_from_; }
+    /// See the class comment; does its work once.
+    void begin_writing(const std::string& scene);
+    /// Records a file this run wrote (name in the folder).
+    void add(const std::string& name);
+    /// The files this run wrote, in order.
+    const std::vector<std::string>& files() const { return files_; }
+    /// The files of the earlier run that begin_writing removed.
+    const std::vector<std::string>& removed() const { return removed_; }
+
+private:
+    std::filesystem::path dir_;
+    int lock_fd_ = -1;
+    /// The lock file, removed by a signal handler that ends the process at once.
+    std::optional<RegisteredTemporary> lock_registered_;
+    long took_over_from_ = 0;
+    bool begun_ = false;
+    std::vector<std::string> files_, removed_;
+};
+
+/// The state summary.json records besides the result: "complete" (every file the run meant to
+/// write was written, summary.json last), "stopped" (a signal arrived; "stopped_at" says where),
+/// "files" (this run's files in the folder) and the plot's outcome.
+struct SummaryStatus {
+    bool complete = true;
+    bool stopped = false;
+    std::string stopped_at;
+    std::vector<std::string> files; ///< without summary.json, which is added
+    std::string plot;               ///< "written", "failed: <cause>", or empty (not asked)
+};
+
+/// The files of a run but summary.json, into dir (created if needed), each under a temporary name
+/// renamed when complete: when converged, solution.vtu, contact.csv, contact_steps.csv and
+/// iterations.csv; when stopped on request, contact_steps.csv (the completed steps) and
+/// iterations.csv; nothing else. Appends the names written to `written`. A stop requested while
+/// writes are stoppable (core/stop.hpp) ends it with mlc::Interrupted after the files written so
+/// far (the one being written is left as it was).
+void write_result_files(const std::filesystem::path& dir, const levels::Problem& p,
+                        const levels::RunResult& r, const OutputOptions& options,
+                        std::vector<std::string>& written);
+
+/// summary.json of a run (written atomically; never stopped by a signal).
+void write_summary(const std::filesystem::path& dir, const levels::Problem& p,
+                   const levels::RunResult& r, const OutputOptions& options,
+                   const SummaryStatus& status);
+
+/// write_result_files then write_summary (complete, not stopped unless r.stopped). Returns the
+/// names of the files written.
 std::vector<std::string> write_outputs(const std::filesystem::path& dir, const levels::Problem& p,
                                        const levels::RunResult& r,
                                        const OutputOptions& options = {});
+
+/// The summary.json a run writes when it begins writing ("complete": false) and the one a signal
+/// handler writes when it ends the process at once ("stopped": true, "complete": false).
+std::string in_progress_summary(const std::string& scene);
+std::string killed_summary(const std::string& scene, int sig, int processes);
 
 /// --every-step / --every-level: writes each converged load step's VTU as soon as it is done
 /// (solution_step_0001.vtu, ... for the finest level; solution_level_<l>_step_0001.vtu for
 /// level l < finest with every_level) and rewrites the collection of that level after each
 /// (solution.pvd, solution_level_<l>.pvd), with the load parameter s as the time. Use as
-/// SolveOptions::on_level_step. Files of this naming left in dir by an earlier run are removed
-/// when constructed.
+/// SolveOptions::on_level_step. Each file written is recorded in `folder`, whose
+/// begin_writing() is called before the first.
 class StepFiles {
 public:
-    StepFiles(std::filesystem::path dir, const levels::Problem& p, bool every_level,
+    StepFiles(OutputFolder& folder, const levels::Problem& p, bool every_level,
               mesh::VtuFormat format);
     void operator()(const levels::LevelStepState& s);
     /// Load steps written of the finest level.
@@ -118,7 +196,9 @@ public:
     std::vector<std::string> collections() const;
 
 private:
+    OutputFolder* folder_;
     std::filesystem::path dir_;
+    std::string scene_;
     int finest_ = 0;
     int digits_ = 4;
     bool every_level_ = false;

@@ -8,12 +8,15 @@
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/parallel.hpp"
+#include "core/stop.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <iostream>
 #include <optional>
 
 namespace mlc::apps {
@@ -71,6 +74,19 @@ levels::SolveOptions run_solve_options(levels::Problem& p, const RunOptions& opt
     return so;
 }
 
+namespace {
+
+/// A Newton residual that became NaN/Inf in the last load step: a numerical breakdown (exit 3),
+/// not a lack of convergence.
+bool nonfinite_residual(const levels::RunResult& r) {
+    for (const auto& s : r.steps)
+        for (double v : s.residuals)
+            if (!std::isfinite(v)) return true;
+    return false;
+}
+
+} // namespace
+
 int run_scene(const RunOptions& opt, std::ostream& os) {
     levels::Problem p = scene::load_scene(opt.scene);
     apply_overrides(p, opt);
@@ -79,6 +95,11 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     OutputOptions out;
     out.vtu = opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
+    // The folder is checked and locked before the solve: a second run on it is refused at once,
+    // an unwritable one before any time is spent.
+    OutputFolder folder(dir);
+    set_stop_summary(dir / "summary.json", killed_summary(p.name, SIGINT, 1),
+                     killed_summary(p.name, SIGTERM, 1));
     levels::SolverChoice choice;
     levels::SolveOptions so = run_solve_options(p, opt, choice);
     so.progress = opt.quiet ? nullptr : &os;
@@ -86,10 +107,13 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     so.stop = opt.stop;
     std::optional<StepFiles> steps;
     if (opt.every_step || opt.every_level) {
-        steps.emplace(dir, p, opt.every_level, out.vtu);
+        steps.emplace(folder, p, opt.every_level, out.vtu);
         so.on_level_step = [&](const levels::LevelStepState& s) { (*steps)(s); };
     }
     os << "mlcontact: solving '" << p.name << "'\n";
+    if (folder.took_over_from() > 0)
+        os << "note: the output folder's lock was left by process " << folder.took_over_from()
+           << ", which has ended; taken over\n";
     os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
     {
         // The BLAS behind CHOLMOD (README "The BLAS behind schur").
@@ -135,10 +159,70 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     print_header(os, p, r);
     print_summary(os, p, r);
     if (!r.converged && !r.stopped) {
-        os << "\nerror: " << r.failure << "\n";
+        const bool breakdown = nonfinite_residual(r);
+        if (!breakdown) os << "\nerror: " << r.failure << "\n"; // else main says it
+        if (!folder.files().empty()) { // step files were written: say what they are
+            SummaryStatus st;
+            st.files = folder.files();
+            write_summary(dir, p, r, out, st);
+        }
+        set_stop_summary({}, {}, {});
+        if (breakdown) throw SolverBreakdown(r.failure);
         return 2;
     }
-    std::vector<std::string> files = write_outputs(dir, p, r, out);
+    // Writing. A run stopped during its solve writes the files of its completed steps; a signal
+    // that arrives while a finished run writes abandons the file being written and skips the
+    // rest (summary.json then says "stopped": true, "complete": false).
+    set_writes_stoppable(!r.stopped);
+    SummaryStatus st;
+    st.stopped = r.stopped;
+    if (r.stopped) st.stopped_at = r.failure;
+    bool plot_failed = false;
+    std::string plot_cause;
+    try {
+        folder.begin_writing(p.name);
+        std::vector<std::string> written;
+        try {
+            write_result_files(dir, p, r, out, written);
+        } catch (const Interrupted&) {
+            for (const auto& w : written)
+                folder.add(w);
+            throw;
+        }
+        for (const auto& w : written)
+            folder.add(w);
+        if (opt.plot && r.completed_steps > 0) {
+            // A failed plot leaves no plot (an earlier run's would not show these results).
+            std::error_code ec;
+            std::filesystem::remove(dir / "contact.png", ec);
+            if (run_plot_script("plot_contact.py", dir, os, steps ? "--all-steps" : "",
+                                &plot_cause)) {
+                folder.add("contact.png");
+                st.plot = "written";
+            } else {
+                std::filesystem::remove(dir / "contact.png", ec);
+                plot_failed = true;
+                st.plot = "failed: " + plot_cause;
+            }
+        }
+    } catch (const Interrupted& e) {
+        st.stopped = true;
+        st.complete = false;
+        st.stopped_at = e.what();
+    }
+    set_writes_stoppable(false);
+    if (!st.stopped && stop_requested()) { // after the last file: all written
+        st.stopped = true;
+        st.stopped_at = "after the result files were written";
+    }
+    st.files = folder.files();
+    write_summary(dir, p, r, out, st);
+    set_stop_summary({}, {}, {});
+    std::vector<std::string> files;
+    for (const auto& f : st.files)
+        if (f.rfind("solution_step_", 0) != 0 && f.rfind("solution_level_", 0) != 0 &&
+            !f.ends_with(".pvd") && f != "contact.png")
+            files.push_back(f);
     if (steps) {
         for (const auto& c : steps->collections())
             files.push_back(c);
@@ -146,20 +230,30 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
             files.push_back("solution_step_*.vtu (" + std::to_string(steps->finest_steps()) +
                             " load steps)");
     }
-    if (opt.plot && r.completed_steps > 0 &&
-        run_plot_script("plot_contact.py", dir, os, steps ? "--all-steps" : ""))
-        files.push_back("contact.png");
+    if (st.plot == "written") files.push_back("contact.png");
+    files.push_back("summary.json");
     os << "\nwrote";
     for (size_t i = 0; i < files.size(); ++i)
         os << (i ? ", " : " ") << (dir / files[i]).string();
     os << "\n";
-    if (r.stopped) {
+    if (st.stopped) {
         const int sig = stop_signal();
-        os << "\nstopped by " << signal_name(sig) << ": " << r.failure << "; the files above hold "
-           << (r.completed_steps > 0 ? "load steps 1-" + std::to_string(r.completed_steps)
-                                     : std::string("no load step"))
-           << "\n";
+        if (r.stopped)
+            os << "\nstopped by " << signal_name(sig) << ": " << r.failure
+               << "; the files above hold "
+               << (r.completed_steps > 0 ? "load steps 1-" + std::to_string(r.completed_steps)
+                                         : std::string("no load step"))
+               << "\n";
+        else
+            os << "\nstopped by " << signal_name(sig)
+               << " while the files were written: " << st.stopped_at
+               << "; summary.json lists the files written\n";
         return 128 + (sig > 0 ? sig : 2);
+    }
+    if (plot_failed) {
+        std::cerr << "mlcontact: error: the results were written, but the plot failed: "
+                  << plot_cause << "\n";
+        return 4;
     }
     return 0;
 }

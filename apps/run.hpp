@@ -67,9 +67,13 @@ void apply_overrides(levels::Problem& p, const RunOptions& opt);
 levels::SolveOptions run_solve_options(levels::Problem& p, const RunOptions& opt,
                                        levels::SolverChoice& choice);
 
-/// Runs a scene. Returns the process exit code: 0 on success, 2 when a load step did not
-/// converge (the report says which and how), 130 / 143 when stopped by SIGINT / SIGTERM (see
-/// RunOptions::stop). Throws InvalidInput for bad input.
+/// Runs a scene. The output folder is checked and locked before the solve (OutputFolder: a
+/// folder another run is writing is refused). Returns the process exit code: 0 on success, 2 when
+/// a load step did not converge (the report says which and how), 4 when the results were written
+/// but --plot failed (the cause on stderr, no contact.png left), 130 / 143 when stopped by SIGINT
+/// / SIGTERM during the solve (see RunOptions::stop) or while the files were written. Throws
+/// InvalidInput for bad input (the folder included) and SolverBreakdown when the Newton residual
+/// became NaN/Inf. summary.json is written last ("complete", "stopped", "files").
 int run_scene(const RunOptions& opt, std::ostream& os);
 
 } // namespace mlc::apps

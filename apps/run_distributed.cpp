@@ -2,6 +2,7 @@
 // `mlcontact run` under mpirun with several processes (issue 12).
 #include "apps/run_distributed.hpp"
 
+#include "apps/interrupt.hpp"
 #include "apps/output.hpp"
 #include "apps/summary_json.hpp"
 #include "core/atomic_file.hpp"
@@ -20,9 +21,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <csignal>
 #include <iomanip>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <tuple>
 
@@ -208,6 +211,27 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     const mesh::VtuFormat vtu =
         opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
+    // Process 0 checks and locks the output folder before the solve (OutputFolder) and alone
+    // writes in it but for the .vtu pieces; every process learns whether it may go on.
+    std::optional<OutputFolder> folder;
+    {
+        int refused = 0;
+        std::string why;
+        if (root) try {
+                folder.emplace(dir);
+                set_stop_summary(dir / "summary.json", killed_summary(p.name, SIGINT, comm.size()),
+                                 killed_summary(p.name, SIGTERM, comm.size()));
+            } catch (const InvalidInput& e) {
+                refused = 1;
+                why = e.what();
+            }
+        comm.broadcast(std::span<int>(&refused, 1), 0);
+        if (refused)
+            throw InvalidInput(root ? why : "the output folder was refused (process 0 says why)");
+        if (folder && folder->took_over_from() > 0)
+            os << "note: the output folder's lock was left by process " << folder->took_over_from()
+               << ", which has ended; taken over\n";
+    }
 
     levels::SolveOptions so;
     so.predicted_sizes = levels::predict_level_sizes([&] {
@@ -329,11 +353,14 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
        << std::setprecision(6) << "\n";
     if (!r.converged) {
         os << "\nerror: " << r.failure << "\n";
+        for (const auto& st : r.steps)
+            for (double v : st.residuals)
+                if (!std::isfinite(v)) throw SolverBreakdown(r.failure);
         return 2;
     }
 
-    // Files: solution.pvtu and its pieces, contact.csv and summary.json.
-    if (root) std::filesystem::create_directories(dir);
+    // Files: solution.pvtu and its pieces, contact.csv and summary.json (last).
+    if (root) folder->begin_writing(p.name);
     comm.barrier();
     {
         // The contact values of ghost vertices from their owners, so that every piece shows them.
@@ -395,6 +422,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
             files.push_back("iterations.csv");
         }
         toml::table root_t;
+        root_t.insert("complete", true);
         root_t.insert("scene", p.name);
         root_t.insert("units", p.units);
         root_t.insert("level", static_cast<int64_t>(finest));
@@ -404,6 +432,17 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         root_t.insert("vertices", static_cast<int64_t>(totals[2]));
         root_t.insert("triangles", static_cast<int64_t>(totals[0]));
         root_t.insert("converged", r.converged);
+        root_t.insert("stopped", false); // a signal ends the processes (main.cpp)
+        {
+            toml::array fl;
+            fl.push_back("solution.pvtu");
+            for (int q = 0; q < comm.size(); ++q)
+                fl.push_back(mesh::piece_path(dir / "solution.pvtu", q).filename().string());
+            for (const char* f : {"contact.csv", "contact_steps.csv", "iterations.csv"})
+                fl.push_back(f);
+            fl.push_back("summary.json");
+            root_t.insert("files", fl);
+        }
         root_t.insert("load_steps", static_cast<int64_t>(p.load_steps));
         root_t.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
         root_t.insert("vtu_format", mesh::to_string(vtu));
@@ -462,6 +501,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         write_file_atomically(dir / "summary.json",
                               [&](std::ostream& f) { f << toml::json_formatter{root_t} << "\n"; });
         files.push_back("summary.json");
+        set_stop_summary({}, {}, {});
     }
     comm.barrier();
     os << "\nwrote";

@@ -7,11 +7,14 @@
 #include "levels/solve.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <sstream>
+#include <sys/wait.h>
 #include <toml++/toml.h>
 
 namespace mlc::apps {
@@ -58,25 +61,56 @@ std::vector<int> distance_to_zone_boundary(const levels::Level& L,
 } // namespace
 
 bool run_plot_script(const std::string& script, const std::filesystem::path& dir, std::ostream& os,
-                     const std::string& extra) {
+                     const std::string& extra, std::string* cause) {
     const std::filesystem::path path = std::filesystem::path(MLC_SOURCE_DIR) / "scripts" / script;
     if (!std::filesystem::exists(path)) {
-        os << "plot: " << path.string()
-           << " not found (run from a source checkout to draw plots)\n";
+        const std::string why =
+            path.string() + " not found (run from a source checkout to draw plots)";
+        os << "plot: " << why << "\n";
+        if (cause) *cause = why;
         return false;
     }
     // Debian's interpreter has python3-matplotlib; a python3 earlier on PATH may not.
     const std::string py =
         std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    const std::string cmd =
-        py + " '" + path.string() + "' '" + dir.string() + "'" + (extra.empty() ? "" : " " + extra);
-    const int rc = std::system(cmd.c_str());
-    if (rc != 0) {
-        os << "plot: '" << cmd << "' failed (exit " << rc
-           << "); install python3-matplotlib to draw plots\n";
-        return false;
+    auto quoted = [](const std::string& s) {
+        std::string q = "'";
+        for (char c : s)
+            q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        return q + "'";
+    };
+    const std::string cmd = py + " " + quoted(path.string()) + " " + quoted(dir.string()) +
+                            (extra.empty() ? "" : " " + extra);
+    os << std::flush;
+    std::string output;
+    int rc = -1;
+    if (std::FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r")) {
+        char buf[4096];
+        size_t n = 0;
+        while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0)
+            output.append(buf, n);
+        rc = ::pclose(pipe);
     }
-    return true;
+    if (rc == 0) {
+        os << output;
+        return true;
+    }
+    // The script's last line says what went wrong (a Python exception's type and message).
+    std::string last;
+    {
+        std::istringstream in(output);
+        for (std::string line; std::getline(in, line);)
+            if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+    }
+    const std::string why =
+        "'" + cmd + "' failed (" +
+        (rc == -1        ? std::string("could not be started")
+         : WIFEXITED(rc) ? "exit " + std::to_string(WEXITSTATUS(rc))
+                         : "signal " + std::to_string(WTERMSIG(rc))) +
+        ")" + (last.empty() ? std::string() : ": " + last.substr(last.find_first_not_of(" \t")));
+    os << output << "plot: " << why << "\n";
+    if (cause) *cause = why;
+    return false;
 }
 
 int study_status_transfer(const levels::Problem& problem_in, const StatusTransferOptions& opt,

@@ -761,10 +761,15 @@ PYBIND11_MODULE(_core, m) {
             "step_state",
             [](const Result& r, int k) {
                 const auto& st = r.run.step_nodes;
-                if (st.empty())
-                    throw InvalidInput("step states were not kept: solve(..., keep_steps=True)");
+                // The contact states of every step are always kept, the displacements only with
+                // keep_steps: both must hold step k.
+                if (r.run.step_u_full.size() < st.size() || st.empty())
+                    throw InvalidInput("step_state needs the states of every load step, which "
+                                       "this result did not keep: solve it with "
+                                       "mlcontact.solve(scene, ..., keep_steps=True)");
                 if (k < 1 || k > static_cast<int>(st.size()))
-                    throw InvalidInput("step must lie in [1, " + std::to_string(st.size()) + "]");
+                    throw InvalidInput("step must lie in [1, " + std::to_string(st.size()) +
+                                       "] (the load steps completed), found " + std::to_string(k));
                 const auto& n = st[static_cast<size_t>(k - 1)];
                 const Vector& u = r.run.step_u_full[static_cast<size_t>(k - 1)];
                 py::array_t<double> x({static_cast<py::ssize_t>(n.size()), py::ssize_t{2}});

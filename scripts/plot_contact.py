@@ -75,7 +75,12 @@ for j, pair in enumerate(pairs):
     ap.legend(handles=handles, fontsize=7, loc="best")
 fig.suptitle("contact tractions" + (" over the load steps" if all_steps else " at the final step"))
 fig.tight_layout()
-tmp = os.path.join(d, "contact.png.tmp")
-fig.savefig(tmp, dpi=120, format="png")
-os.replace(tmp, os.path.join(d, "contact.png"))
+tmp = os.path.join(d, f"contact.png.{os.getpid()}.tmp")  # this process's own temporary
+try:
+    fig.savefig(tmp, dpi=120, format="png")
+    os.replace(tmp, os.path.join(d, "contact.png"))
+except BaseException:
+    if os.path.exists(tmp):
+        os.remove(tmp)
+    raise
 print(f"wrote {os.path.join(d, 'contact.png')}")

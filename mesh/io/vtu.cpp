@@ -3,7 +3,9 @@
 // buffer with std::to_chars into a temporary file that is renamed into place.
 #include "mesh/io/vtu.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/check.hpp"
+#include "core/stop.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -54,6 +56,13 @@ public:
         n_ = static_cast<std::size_t>(r.ptr - buf_.data());
     }
 
+    /// Closes without writing what is buffered.
+    void abandon() {
+        n_ = 0;
+        if (file_) std::fclose(file_);
+        file_ = nullptr;
+    }
+
     /// Flushes and closes; false if any write failed.
     bool close() {
         flush();
@@ -64,6 +73,9 @@ public:
 
 private:
     void flush() {
+        // A stop requested while writes are stoppable (core/stop.hpp) abandons the file here,
+        // within one buffer.
+        if (write_stop_requested()) throw Interrupted("stopped while writing a VTU file");
         if (n_ > 0) failed_ |= std::fwrite(buf_.data(), 1, n_, file_) != n_;
         n_ = 0;
     }
@@ -155,8 +167,10 @@ void put_fields(BufferedFile& out, const std::vector<Field>& fields, const char*
 /// the temporary is removed and nothing is left at `file`'s path by us.
 template <class Write>
 void write_atomically(const std::filesystem::path& file, const char* who, Write&& write) {
-    std::filesystem::path tmp = file;
-    tmp += ".tmp";
+    if (write_stop_requested())
+        throw Interrupted(std::string(who) + ": stopped before writing '" + file.string() + "'");
+    const std::filesystem::path tmp = temporary_path(file);
+    RegisteredTemporary registered(tmp);
     BufferedFile out(tmp);
     MLC_CHECK(out.is_open(), who << ": cannot open '" << tmp.string()
                                  << "' for writing; does the directory exist and is it writable?");
@@ -170,6 +184,13 @@ void write_atomically(const std::filesystem::path& file, const char* who, Write&
         if (ec)
             throw std::runtime_error(std::string(who) + ": cannot rename '" + tmp.string() +
                                      "' to '" + file.string() + "': " + ec.message());
+        registered.release();
+    } catch (const Interrupted&) {
+        out.abandon();
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw Interrupted(std::string(who) + ": stopped while writing '" + file.string() +
+                          "' (the file was left as it was)");
     } catch (...) {
         std::error_code ec;
         std::filesystem::remove(tmp, ec);

@@ -50,8 +50,11 @@ const char* to_string(VtuFormat f);
 /// (n_vertices * n_components for point fields, n_triangles * n_components for cell fields),
 /// names, and that every value and coordinate is finite. A violation throws InvalidInput naming
 /// the field, entity and component, and no file is created. The file is written to a temporary
-/// next to it ("<file>.tmp") and renamed at the end, so a reader never sees a half-written file;
-/// an I/O failure throws std::runtime_error and removes the temporary.
+/// next to it (core/atomic_file.hpp's temporary_path: unique to the process and the call) and
+/// renamed at the end, so a reader never sees a half-written file; an I/O failure throws
+/// std::runtime_error and removes the temporary. A stop requested while writes are stoppable
+/// (core/stop.hpp) abandons the file within one 1 MiB buffer: mlc::Interrupted, the temporary
+/// removed, the file left as it was.
 void write_vtu(const std::filesystem::path& file, const Mesh& m,
                const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields,
                VtuFormat format = VtuFormat::binary);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Tests of the .vtu/.pvd writers: parse the XML back and compare sizes, connectivity and values.
 #include "core/check.hpp"
+#include "core/stop.hpp"
 #include "mesh/io/vtu.hpp"
 #include "mesh/mesh.hpp"
 
@@ -35,6 +36,15 @@ fs::path scratch_dir() {
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
+}
+
+/// The names in a folder that are temporaries (written by a writer and not renamed).
+std::vector<std::string> temporaries(const fs::path& dir) {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().ends_with(".tmp"))
+            out.push_back(e.path().filename().string());
+    return out;
 }
 
 std::string slurp(const fs::path& p) {
@@ -101,7 +111,7 @@ TEST_F(Vtu, RoundTripsMeshAndFields) {
     const Field s{"stress <xx>", 3, {1, 2, 3, 4, 5, 6}};
     write_vtu(file, m, {u}, {p, s}, VtuFormat::ascii);
     ASSERT_TRUE(fs::exists(file));
-    EXPECT_FALSE(fs::exists(file.string() + ".tmp"));
+    EXPECT_TRUE(temporaries(file.parent_path()).empty());
 
     const std::string xml = slurp(file);
     EXPECT_EQ(xml.rfind("<?xml", 0), 0u);
@@ -200,7 +210,7 @@ TEST_F(Vtu, BinaryHoldsTheSameArraysBitForBit) {
     const Field zero{"zero", 1, std::vector<double>(nt, 0.0)};
     write_vtu(dir / "b.vtu", m, {u}, {s, zero});
     write_vtu(dir / "a.vtu", m, {u}, {s, zero}, VtuFormat::ascii);
-    EXPECT_FALSE(fs::exists(dir / "b.vtu.tmp"));
+    EXPECT_TRUE(temporaries(dir).empty());
     const std::string xml = slurp(dir / "b.vtu");
     EXPECT_NE(xml.find("header_type=\"UInt64\""), std::string::npos);
     EXPECT_NE(xml.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
@@ -333,4 +343,26 @@ TEST_F(Vtu, PvdListsSteps) {
     EXPECT_THROW(write_pvd(dir / "bad.pvd", {{std::nan(""), "a.vtu"}}), InvalidInput);
     EXPECT_THROW(write_pvd(dir / "bad.pvd", {{1.0, ""}}), InvalidInput);
     EXPECT_FALSE(fs::exists(dir / "bad.pvd"));
+}
+
+TEST_F(Vtu, AStopRequestWhileWritesAreStoppableAbandonsTheFile) {
+    const fs::path dir = scratch_dir();
+    const Mesh m = structured_rectangle(Vec2(0, 0), Vec2(1, 1), 200, 200);
+    Field u{"displacement", 2, std::vector<double>(2 * m.vertices.size(), 0.25)};
+    write_vtu(dir / "a.vtu", m, {u}, {}, VtuFormat::ascii);
+    const std::string before = slurp(dir / "a.vtu");
+    request_stop(2);
+    set_writes_stoppable(true);
+    for (const auto format : {VtuFormat::ascii, VtuFormat::binary}) {
+        EXPECT_THROW(write_vtu(dir / "a.vtu", m, {u}, {}, format), Interrupted);
+        EXPECT_THROW(write_vtu(dir / "b.vtu", m, {u}, {}, format), Interrupted);
+    }
+    set_writes_stoppable(false);
+    clear_stop_request();
+    EXPECT_EQ(slurp(dir / "a.vtu"), before); // left as it was
+    EXPECT_FALSE(fs::exists(dir / "b.vtu"));
+    EXPECT_TRUE(temporaries(dir).empty());
+    write_vtu(dir / "b.vtu", m, {u}, {}, VtuFormat::ascii); // no request: written
+    EXPECT_EQ(slurp(dir / "b.vtu"), before);
+    fs::remove_all(dir);
 }
