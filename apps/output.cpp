@@ -101,10 +101,14 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
 
 void print_checks(std::ostream& os, const levels::Problem& p, const levels::StateChecks& c,
                   const std::vector<PairResultant>& resultants) {
-    os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1)
-       << c.force_balance << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| "
-       << c.slip_equality << "  complementarity " << c.complementarity << "  penetration "
-       << c.penetration << std::defaultfloat << "\n";
+    os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1);
+    if (c.force_balance_applicable)
+        os << c.force_balance;
+    else
+        os << "n/a (no force to balance)";
+    os << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| " << c.slip_equality
+       << "  complementarity " << c.complementarity << "  penetration " << c.penetration
+       << std::defaultfloat << "\n";
     // Per pair: the resultant force the target exerts on the contactor nodes (global axes),
     // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
     for (size_t k = 0; k < p.contacts.size() && k < resultants.size(); ++k)
@@ -136,6 +140,8 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
         }
         print_checks(os, p, levels::check_state(p, r), res);
     }
+    for (const auto& w : r.warnings)
+        os << "warning: " << w << "\n";
     os << "\ntimings\n";
     r.timings.print(os);
 }
@@ -383,7 +389,9 @@ toml::array contacts_json(const levels::Problem& p, const std::vector<PairResult
 
 toml::table checks_json(const levels::StateChecks& c) {
     toml::table ct;
-    ct.insert("force_balance", c.force_balance);
+    // Not applicable (no force to balance): left out, and said so.
+    if (c.force_balance_applicable) ct.insert("force_balance", c.force_balance);
+    ct.insert("force_balance_applicable", c.force_balance_applicable);
     ct.insert("coulomb_excess", c.coulomb_excess);
     ct.insert("slip_equality", c.slip_equality);
     ct.insert("complementarity", c.complementarity);
@@ -479,6 +487,12 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
             root.insert("contacts", contacts_json(p, res));
         }
         if (r.converged) root.insert("checks", checks_json(levels::check_state(p, r)));
+        {
+            toml::array w;
+            for (const auto& s : r.warnings)
+                w.push_back(s);
+            root.insert("warnings", std::move(w));
+        }
         {
             const auto& sp = r.solver.spec;
             toml::table sv;
