@@ -16,9 +16,9 @@ namespace mlc::levels {
 
 /// Rotations (radians, the skew part of an element's displacement gradient) and strains (the
 /// largest principal strain in absolute value) above these are outside small-displacement theory:
-/// a warning (RunResult::warnings). Not lower: the benchmark scenes sit below them (hertz's
-/// elements at the contact edge turn by 0.084 rad as the disc's surface, of slope a / R = 0.1
-/// there, flattens; the patch test strains by 5 %).
+/// a warning (RunResult::warnings). Not lower: the benchmark scenes stay below them (hertz's
+/// elements at the contact edge turn by about a / R as the disc's surface flattens there; the
+/// patch test's prescribed strain is half the limit).
 inline constexpr double kSmallRotationLimit = 0.1;
 inline constexpr double kSmallStrainLimit = 0.1;
 

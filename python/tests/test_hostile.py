@@ -106,3 +106,19 @@ def test_fuzz_seed_parses_or_is_a_value_error(path):
     out = parse_in_child(path, "file")
     assert out["outcome"] in ("valid", "ValueError"), out
     assert out["seconds"] < 10
+
+
+def test_warnings_and_not_applicable_checks_reach_summary_json(tmp):
+    import mlcontact
+    rolls = mlcontact.solve(mlcontact.Scene.from_file(os.path.join(DATA, "hostile", "half_cylinder_rolls.toml")))
+    assert len(rolls.warnings) == 1 and rolls.warnings[0].startswith("large rotation: triangle ")
+    rolls.write(str(tmp / "rolls"))
+    summary = json.load(open(tmp / "rolls" / "summary.json"))
+    assert summary["warnings"] == rolls.warnings
+    assert summary["checks"]["force_balance_applicable"] is True
+    apart = mlcontact.solve(mlcontact.Scene.from_file(os.path.join(DATA, "hostile", "bodies_apart.toml")))
+    assert apart.warnings == [] and apart.checks["force_balance"] is None
+    apart.write(str(tmp / "apart"))
+    summary = json.load(open(tmp / "apart" / "summary.json"))
+    assert summary["warnings"] == []
+    assert summary["checks"]["force_balance_applicable"] is False and "force_balance" not in summary["checks"]
