@@ -109,10 +109,14 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
 
 void print_checks(std::ostream& os, const levels::Problem& p, const levels::StateChecks& c,
                   const std::vector<PairResultant>& resultants) {
-    os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1)
-       << c.force_balance << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| "
-       << c.slip_equality << "  complementarity " << c.complementarity << "  penetration "
-       << c.penetration << std::defaultfloat << "\n";
+    os << "\nchecks (relative)  force balance " << std::scientific << std::setprecision(1);
+    if (c.force_balance_applicable)
+        os << c.force_balance;
+    else
+        os << "n/a (no force to balance)";
+    os << "  Coulomb excess " << c.coulomb_excess << "  slip |lt|-mu|ln| " << c.slip_equality
+       << "  complementarity " << c.complementarity << "  penetration " << c.penetration
+       << std::defaultfloat << "\n";
     // Per pair: the resultant force the target exerts on the contactor nodes (global axes),
     // -sum (lambda_t t + lambda_n n), and the number of nodes in contact.
     for (size_t k = 0; k < p.contacts.size() && k < resultants.size(); ++k)
@@ -144,6 +148,8 @@ void print_summary(std::ostream& os, const levels::Problem& p, const levels::Run
         }
         print_checks(os, p, levels::check_state(p, r), res);
     }
+    for (const auto& w : r.warnings)
+        os << "warning: " << w << "\n";
     os << "\ntimings\n";
     r.timings.print(os);
 }
@@ -395,7 +401,9 @@ toml::array contacts_json(const levels::Problem& p, const std::vector<PairResult
 
 toml::table checks_json(const levels::StateChecks& c) {
     toml::table ct;
-    ct.insert("force_balance", c.force_balance);
+    // Not applicable (no force to balance): left out, and said so.
+    if (c.force_balance_applicable) ct.insert("force_balance", c.force_balance);
+    ct.insert("force_balance_applicable", c.force_balance_applicable);
     ct.insert("coulomb_excess", c.coulomb_excess);
     ct.insert("slip_equality", c.slip_equality);
     ct.insert("complementarity", c.complementarity);
@@ -508,6 +516,12 @@ void write_summary(const std::filesystem::path& dir, const levels::Problem& p,
             root.insert("contacts", contacts_json(p, res));
         }
         if (r.converged) root.insert("checks", checks_json(levels::check_state(p, r)));
+        {
+            toml::array w;
+            for (const auto& s : r.warnings)
+                w.push_back(s);
+            root.insert("warnings", std::move(w));
+        }
         {
             const auto& sp = r.solver.spec;
             toml::table sv;

@@ -10,6 +10,7 @@
 #include "core/memory.hpp"
 #include "core/parallel.hpp"
 #include "levels/checks.hpp"
+#include "levels/diagnoses.hpp"
 #include "levels/distributed_solve.hpp"
 #include "levels/resources.hpp"
 #include "mesh/distributed.hpp"
@@ -27,6 +28,7 @@
 #include <numeric>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 namespace mlc::apps {
@@ -347,6 +349,33 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
                              static_cast<int>(std::lround(sums[3 * k + 2]))};
         print_checks(os, p, checks, resultants);
     }
+    // Small-displacement theory on the finest level's final state (one process also names the
+    // element and the load step: levels::RunResult::warnings).
+    std::vector<std::string> warnings;
+    if (r.converged) {
+        const levels::Deformation d = levels::max_deformation(F.local, r.u_full);
+        std::array<double, 2> m{d.rotation, d.strain};
+        comm.allreduce(std::span<double>(m), ReduceOp::max);
+        std::ostringstream w;
+        w << std::setprecision(3);
+        if (m[0] > levels::kSmallRotationLimit) {
+            w << "large rotation: an element of the finest level rotates by " << m[0]
+              << " rad in the final state, above " << levels::kSmallRotationLimit
+              << " rad: small-displacement theory does not hold there and the results are not "
+                 "reliable";
+            warnings.push_back(w.str());
+            w.str("");
+        }
+        if (m[1] > levels::kSmallStrainLimit) {
+            w << "large strain: an element of the finest level has a principal strain of " << m[1]
+              << " in the final state, above " << levels::kSmallStrainLimit
+              << ": small-displacement theory does not hold there and the results are not "
+                 "reliable";
+            warnings.push_back(w.str());
+        }
+        for (const auto& x : warnings)
+            os << "warning: " << x << "\n";
+    }
     os << "\ntimings of process 0 (the distributed levels):\n";
     if (root) r.timings.print(os);
     os << "\ntime: " << std::fixed << std::setprecision(2) << r.seconds << " s" << std::defaultfloat
@@ -477,6 +506,12 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         root_t.insert("recovered_levels", static_cast<int64_t>(p.recovered_levels));
         root_t.insert("contacts", contacts_json(p, resultants));
         root_t.insert("checks", checks_json(checks));
+        {
+            toml::array w;
+            for (const auto& x : warnings)
+                w.push_back(x);
+            root_t.insert("warnings", std::move(w));
+        }
         toml::table sv;
         sv.insert("method", spec.method);
         sv.insert("krylov", spec.krylov);

@@ -8,8 +8,23 @@
 
 namespace mlc::fem {
 
+namespace {
+/// The range of Young's modulus a solve can represent (Material::validate).
+constexpr double kMinYoungModulus = 1e-100, kMaxYoungModulus = 1e100;
+} // namespace
+
 void Material::validate() const {
     MLC_CHECK(std::isfinite(E) && E > 0, "Young's modulus E must be positive, found E = " << E);
+    // The solve forms E times displacements and sums their squares (norms, inner products,
+    // factorizations): outside this range they underflow to 0 or overflow, and the failure
+    // surfaces far from its cause (r = r_over_E E = 0, a singular matrix).
+    MLC_CHECK(E >= kMinYoungModulus && E <= kMaxYoungModulus,
+              "Young's modulus E = " << E << " is " << (E < kMinYoungModulus ? "below " : "above ")
+                                     << (E < kMinYoungModulus ? kMinYoungModulus : kMaxYoungModulus)
+                                     << ": the solve's products of E "
+                                     << (E < kMinYoungModulus ? "underflow to 0" : "overflow")
+                                     << "; state E, the loads and the lengths in other units "
+                                        "(e.g. GPa instead of Pa)");
     MLC_CHECK(std::isfinite(nu) && nu > -1.0 && nu < 0.5,
               "Poisson's ratio nu must lie in (-1, 0.5), found nu = " << nu);
 }

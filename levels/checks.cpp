@@ -3,6 +3,7 @@
 #include "levels/checks.hpp"
 
 #include "fem/assembly.hpp"
+#include "fem/elasticity.hpp"
 
 #include <algorithm>
 #include <array>
@@ -18,7 +19,7 @@ namespace {
 /// `x` (a distributed part's unknowns with their ghost values; null on one process) gives the
 /// multipliers of Level::ghost_contacts, whose forces act on owned vertices too.
 template <class Count>
-std::array<double, 4> balance_sums(const Level& level, double s, const Vector& u_full,
+std::array<double, 5> balance_sums(const Level& level, double s, const Vector& u_full,
                                    const std::vector<ContactNodeState>& nodes, Count&& count,
                                    const Vector* x = nullptr) {
     // External forces on the body: loads F, contact forces -C (C = sum_j w_j (lambda_t t +
@@ -45,7 +46,23 @@ std::array<double, 4> balance_sums(const Level& level, double s, const Vector& u
             C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
                 el.weight[static_cast<size_t>(j)] * f;
     }
-    std::array<double, 4> sums{}; // resultant x, y, magnitude x, y
+    // The internal forces' own scale: sum of |K_e| |u_e| over the rows of counted vertices.
+    double internal = 0.0;
+    for (int t = 0; t < level.mesh.n_triangles(); ++t) {
+        const auto& tri = level.mesh.triangles[static_cast<size_t>(t)];
+        const auto ke = fem::element_stiffness(level.mesh.vertices[static_cast<size_t>(tri[0])],
+                                               level.mesh.vertices[static_cast<size_t>(tri[1])],
+                                               level.mesh.vertices[static_cast<size_t>(tri[2])],
+                                               fem::material_of(level.mesh, level.materials, t));
+        Eigen::Matrix<double, 6, 1> ue;
+        for (int i = 0; i < 3; ++i)
+            ue.segment<2>(2 * i) = u_full.segment<2>(2 * tri[static_cast<size_t>(i)]).cwiseAbs();
+        const Eigen::Matrix<double, 6, 1> fe = ke.cwiseAbs() * ue;
+        for (int i = 0; i < 3; ++i)
+            if (count(tri[static_cast<size_t>(i)])) internal += fe[2 * i] + fe[2 * i + 1];
+    }
+    std::array<double, 5> sums{}; // resultant x, y, magnitude x, y, internal scale
+    sums[4] = internal;
     for (int a = 0; a < 2; ++a)
         for (int v = 0; v < level.mesh.n_vertices(); ++v) {
             if (!count(v)) continue;
@@ -59,10 +76,15 @@ std::array<double, 4> balance_sums(const Level& level, double s, const Vector& u
     return sums;
 }
 
-double balance_error(const std::array<double, 4>& sums) {
+double balance_error(const std::array<double, 5>& sums) {
     const double err = std::max(std::abs(sums[0]), std::abs(sums[1]));
     const double total = std::max(sums[2], sums[3]);
     return total > 0 ? err / total : err;
+}
+
+/// See StateChecks::force_balance_applicable.
+bool balance_applicable(const std::array<double, 5>& sums) {
+    return sums[2] + sums[3] > kNoForceRatio * sums[4];
 }
 
 /// The unnormalised contact figures: max |lambda_n|, max |u|, then the six maxima of StateChecks.
@@ -88,9 +110,10 @@ std::array<double, 8> node_maxima(const Problem& p, const Level& L, const Vector
     return m;
 }
 
-StateChecks normalised(const std::array<double, 8>& m, double force_balance) {
+StateChecks normalised(const std::array<double, 8>& m, const std::array<double, 5>& sums) {
     StateChecks c;
-    c.force_balance = force_balance;
+    c.force_balance = balance_error(sums);
+    c.force_balance_applicable = balance_applicable(sums);
     const double lmax = m[0], umax = m[1];
     c.coulomb_excess = m[2];
     c.slip_equality = m[3];
@@ -117,7 +140,7 @@ double force_balance_error(const Level& level, double s, const Vector& u_full,
 StateChecks check_state(const Problem& p, const RunResult& r) {
     const auto& L = r.finest();
     return normalised(node_maxima(p, L, r.u_full, r.nodes),
-                      force_balance_error(L, 1.0, r.u_full, r.nodes));
+                      balance_sums(L, 1.0, r.u_full, r.nodes, [](int) { return true; }));
 }
 
 StateChecks check_state(const Problem& p, const DistributedRunResult& r, const Communicator& comm) {
@@ -129,7 +152,7 @@ StateChecks check_state(const Problem& p, const DistributedRunResult& r, const C
     comm.allreduce(std::span<double>(sums), ReduceOp::sum);
     auto m = node_maxima(p, F.local, r.u_full, r.nodes);
     comm.allreduce(std::span<double>(m), ReduceOp::max);
-    return normalised(m, balance_error(sums));
+    return normalised(m, sums);
 }
 
 Vec2 contact_resultant(const Level& L, const std::vector<ContactNodeState>& nodes, int pair,

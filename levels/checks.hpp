@@ -29,7 +29,16 @@ struct StateChecks {
     double complementarity = 0.0; ///< max |lambda_n d_n| / (max |lambda_n| * max |u|)
     double penetration = 0.0;     ///< max (-d_n)+ / max |u|
     double tension = 0.0;         ///< max (lambda_n)+ / max |lambda_n|
+    /// False when there is no force to balance: the loads, contact forces and reactions sum (in
+    /// magnitude) to less than kNoForceRatio times the internal forces' own scale (sum over
+    /// the elements of |K_e| |u_e|), i.e. to round-off, as for bodies moved rigidly by their
+    /// supports without touching. force_balance is then round-off over round-off and means
+    /// nothing; it is reported as not applicable.
+    bool force_balance_applicable = true;
 };
+
+/// See StateChecks::force_balance_applicable.
+inline constexpr double kNoForceRatio = 1e-12;
 
 /// The checks of the final state of a run (r.u_full and r.nodes on the finest level, full load):
 /// force balance as force_balance_error; the contact figures over all contact nodes, the Coulomb

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Problem validation.
 #include "levels/problem.hpp"
+#include "levels/diagnoses.hpp"
 
 #include "core/check.hpp"
 
@@ -39,6 +40,8 @@ void Problem::validate() const {
         MLC_CHECK(std::isfinite(c.r) && c.r > 0,
                   "contact '" << c.name << "': augmentation parameter r must be > 0, found "
                               << c.r);
+        MLC_CHECK(r_out_of_scale(c.r, min_young_modulus()).empty(),
+                  "contact '" << c.name << "': " << r_out_of_scale(c.r, min_young_modulus()));
         if (c.element == ContactElementKind::node_on_rigid) {
             MLC_CHECK(c.obstacle.has_value(),
                       "contact '" << c.name << "' has no target: give an obstacle or a target tag");

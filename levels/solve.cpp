@@ -2,6 +2,7 @@
 // Load stepping on the finest level.
 #include "levels/solve.hpp"
 
+#include "levels/diagnoses.hpp"
 #include "levels/resources.hpp"
 
 #include "core/check.hpp"
@@ -306,6 +307,9 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     std::vector<double> continued(static_cast<size_t>(n_levels), 0.0);
     std::vector<std::unique_ptr<NewtonSystemSolver>> continuation_solver(
         static_cast<size_t>(n_levels));
+    Deformation deformation; // the largest of the completed steps, finest level
+    int rotation_step = 0, strain_step = 0;
+    std::string not_unique; // the first completed step whose state is not unique
     for (int step = 1; step <= problem.load_steps && res.converged; ++step) {
         const double s = static_cast<double>(step) / problem.load_steps;
         if (!problem.same_supports(step, phase_step)) {
@@ -518,6 +522,19 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 std::ostringstream os;
                 os << "load step " << step << " (load factor " << s << ")";
                 if (n_levels > 1) os << " on level " << l;
+                // The cause, when it is one of the problem's (a load with no equilibrium, a
+                // rigid motion nothing holds), comes first: how Newton failed on it follows.
+                std::string why = no_equilibrium(problem, L, s);
+                if (why.empty() && rep.counts.stick == 0 &&
+                    rep.counts.slip_forward + rep.counts.slip_backward > 0) {
+                    // Newton's last iterate (the report's statuses): no node sticks. Whether a
+                    // free rigid motion is tangential at every contact node is then all to ask.
+                    std::vector<ContactNodeState> slipping(L.contacts.size());
+                    for (auto& n : slipping)
+                        n.status = contact::Status::slip_forward;
+                    why = unheld_tangential_motion(problem, L, slipping);
+                }
+                if (!why.empty()) os << ": " << why << ". Newton";
                 os << " did not converge: " << rep.message << "; residual history:";
                 for (double r : rep.residuals)
                     os << " " << std::scientific << std::setprecision(2) << r;
@@ -545,10 +562,64 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         if (options.keep_step_states) res.step_u_full.push_back(res.u_full);
         res.step_nodes.push_back(res.nodes);
         res.completed_steps = step;
+        {
+            // Small-displacement theory and uniqueness, on the finest level at this step: the
+            // largest rotation and strain over the steps, the first non-unique state.
+            const Deformation d = max_deformation(levels[static_cast<size_t>(finest)], res.u_full);
+            if (d.rotation > deformation.rotation) {
+                deformation.rotation = d.rotation;
+                deformation.rotation_triangle = d.rotation_triangle;
+                rotation_step = step;
+            }
+            if (d.strain > deformation.strain) {
+                deformation.strain = d.strain;
+                deformation.strain_triangle = d.strain_triangle;
+                strain_step = step;
+            }
+            if (not_unique.empty()) {
+                not_unique = unheld_tangential_motion(problem, levels[static_cast<size_t>(finest)],
+                                                      res.nodes);
+                if (!not_unique.empty())
+                    not_unique = "load step " + std::to_string(step) + ": " + not_unique;
+            }
+        }
         for (int l = first; l < n_levels; ++l)
             u_prev[static_cast<size_t>(l)] = u_now[static_cast<size_t>(l)];
     }
     res.x = x.back();
+    {
+        const Level& F = levels[static_cast<size_t>(finest)];
+        const auto centroid = [&](int t) {
+            const auto& tri = F.mesh.triangles[static_cast<size_t>(t)];
+            Vec2 c = Vec2::Zero();
+            for (int v : tri)
+                c += F.mesh.vertices[static_cast<size_t>(v)] / 3.0;
+            std::ostringstream os;
+            os << "triangle " << t << " at (" << c.x() << ", " << c.y() << ")";
+            return os.str();
+        };
+        std::ostringstream os;
+        os << std::setprecision(3);
+        if (deformation.rotation > kSmallRotationLimit) {
+            os << "large rotation: " << centroid(deformation.rotation_triangle)
+               << " of the finest level rotates by " << deformation.rotation << " rad at load step "
+               << rotation_step << ", above " << kSmallRotationLimit
+               << " rad: small-displacement theory (linear strains, contact normals and gaps of "
+                  "the undeformed shape) does not hold there and the results are not reliable; "
+                  "hold the body so that it cannot roll or turn, or reduce the loads";
+            res.warnings.push_back(os.str());
+            os.str("");
+        }
+        if (deformation.strain > kSmallStrainLimit) {
+            os << "large strain: " << centroid(deformation.strain_triangle)
+               << " of the finest level has a principal strain of " << deformation.strain
+               << " at load step " << strain_step << ", above " << kSmallStrainLimit
+               << ": small-displacement theory (linear elasticity) does not hold there and the "
+                  "results are not reliable; reduce the loads or prescribed displacements";
+            res.warnings.push_back(os.str());
+        }
+        if (!not_unique.empty()) res.warnings.push_back(not_unique);
+    }
     if (const solvers::Multigrid* mg = system[static_cast<size_t>(finest)]->multigrid())
         res.multigrid = mg->report();
     return res;

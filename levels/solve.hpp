@@ -112,7 +112,7 @@ using Confusion = std::array<std::array<int, 4>, 4>;
 struct LevelStep {
     int level = 0;
     StepReport report;
-    bool predicted = false;                          ///< an interpolated initial guess was used
+    bool predicted = false;    ///< an interpolated initial guess was used
     bool extrapolated = false; ///< the extrapolated state was taken (SolveOptions::extrapolate)
     std::vector<contact::Status> predicted_statuses; ///< statuses of the initial guess
     std::vector<contact::Status> final_statuses;     ///< Newton (projection) statuses at the end
@@ -150,6 +150,10 @@ struct RunResult {
     /// says where. converged is false.
     bool stopped = false;
     int completed_steps = 0; ///< load steps completed on every solved level
+    /// What makes the solution doubtful though it converged (levels/diagnoses.hpp): a rotation
+    /// or strain of the finest level too large for small-displacement theory, a solution that
+    /// is not unique. One sentence each, without a "warning:" prefix.
+    std::vector<std::string> warnings;
     const Level& finest() const { return hierarchy.finest(); }
     const std::vector<Level>& levels() const { return hierarchy.levels; }
 };

@@ -8,6 +8,7 @@
 #include "apps/study_accuracy.hpp"
 #include "apps/study_status_transfer.hpp"
 #include "core/check.hpp"
+#include "core/user_message.hpp"
 #include "levels/checks.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
@@ -17,9 +18,11 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <regex>
 #include <sstream>
 
 namespace py = pybind11;
@@ -240,6 +243,55 @@ std::shared_ptr<Result> solve(const Scene& scene, std::optional<int> levels,
     return res;
 }
 
+/// An error message as Python users read it: without the internal check locations
+/// (core/user_message.hpp; returned in `locations`) and with the driver's options named as the
+/// Python parameters that set them (`--levels 13` -> `levels=13`, `--pc mg` -> `pc='mg'`).
+std::string python_message(const std::string& what, std::string* locations) {
+    std::string m = user_message(what, locations);
+    static const std::vector<std::pair<std::regex, std::string>> names = {
+        {std::regex(R"(fewer --levels)"), "a smaller levels="},
+        {std::regex(R"(--levels (>=|<=|>|<))"), "levels $1"},
+        {std::regex(R"(--levels)"), "levels="},
+        {std::regex(R"(--linear-tol)"), "linear_tol="},
+        // A value follows the option, or a word of the sentence ("--numbering must be ...").
+        {std::regex(R"(--linear (?!(?:must|needs|applies|is|and|or)\b)(\w+))"), "solver='$1'"},
+        {std::regex(R"(--linear)"), "solver="},
+        {std::regex(
+             R"(--(pc|krylov|numbering) (?!(?:must|needs|applies|is|and|or)\b)([A-Za-z][^\s,;)]*))"),
+         "$1='$2'"},
+        {std::regex(R"(--(pc|krylov|numbering))"), "$1="},
+        {std::regex(R"(--steps)"), "load_steps="},
+        {std::regex(R"(--mu)"), "mu="},
+        {std::regex(R"(--r(?![\w-]))"), "r="},
+        {std::regex(R"(--cold)"), "cold=True"},
+        {std::regex(R"(--no-extrapolation)"), "extrapolate=False"},
+    };
+    for (const auto& [re, py] : names)
+        m = std::regex_replace(m, re, py);
+    return m;
+}
+
+/// Raises a Python exception of type `type` with python_message(what); the check locations, if
+/// any, go to its attribute `check_location` (and into the message too when the environment
+/// variable MLC_CHECK_LOCATIONS is set, for debugging).
+void raise_python(PyObject* type, const std::string& what) {
+    std::string where;
+    std::string msg = python_message(what, &where);
+    const char* env = std::getenv("MLC_CHECK_LOCATIONS");
+    if (env && *env && !where.empty()) msg += " [" + where + "]";
+    PyObject* exc = PyObject_CallFunction(type, "s", msg.c_str());
+    if (!exc) return; // the call set its own error
+    if (!where.empty()) {
+        PyObject* w = PyUnicode_FromString(where.c_str());
+        if (w) {
+            PyObject_SetAttrString(exc, "check_location", w);
+            Py_DECREF(w);
+        }
+    }
+    PyErr_SetObject(type, exc);
+    Py_DECREF(exc);
+}
+
 /// Runs a study writing into `out` without the plot; returns (exit code, report text).
 template <class F> py::tuple run_study(F&& f) {
     std::ostringstream os;
@@ -264,11 +316,11 @@ PYBIND11_MODULE(_core, m) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const InvalidInput& e) {
-            PyErr_SetString(PyExc_ValueError, e.what());
+            raise_python(PyExc_ValueError, e.what());
         } catch (const SolverBreakdown& e) {
-            breakdown(e.what());
+            raise_python(breakdown.ptr(), e.what());
         } catch (const Interrupted& e) {
-            interrupted(e.what());
+            raise_python(interrupted.ptr(), e.what());
         }
     });
 
@@ -724,7 +776,10 @@ PYBIND11_MODULE(_core, m) {
                 if (!r.run.converged) return py::none();
                 const levels::StateChecks c = levels::check_state(r.problem, r.run);
                 py::dict d;
-                d["force_balance"] = c.force_balance;
+                // None when there is no force to balance (StateChecks::force_balance_applicable).
+                d["force_balance"] = c.force_balance_applicable
+                                         ? py::object(py::float_(c.force_balance))
+                                         : py::none();
                 d["coulomb_excess"] = c.coulomb_excess;
                 d["slip_equality"] = c.slip_equality;
                 d["complementarity"] = c.complementarity;
@@ -732,7 +787,13 @@ PYBIND11_MODULE(_core, m) {
                 d["tension"] = c.tension;
                 return d;
             },
-            "relative physics checks of the final state (None if not converged)")
+            "relative physics checks of the final state (None if not converged; force_balance "
+            "None when there is no force to balance)")
+        .def_property_readonly(
+            "warnings", [](const Result& r) { return r.run.warnings; },
+            "what makes the solution doubtful though it converged: a rotation or strain too "
+            "large for small-displacement theory, a solution that is not unique (the lines "
+            "'warning: ...' of the report)")
         .def_property_readonly("timings",
                                [](const Result& r) {
                                    py::dict d;

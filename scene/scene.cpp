@@ -3,6 +3,7 @@
 #include "scene/scene.hpp"
 
 #include "core/check.hpp"
+#include "levels/diagnoses.hpp"
 #include "levels/level.hpp"
 #include "mesh/mesh.hpp"
 #ifdef MLC_HAVE_CGAL
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <optional>
 #include <set>
@@ -435,6 +437,67 @@ mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::s
 // digits; tol also allows the rounding of coordinates far from the origin); the coarsest one on
 // which the scene's level 0 builds (its support points are vertices, every contact pair finds
 // contactor nodes, matching node pairs match) becomes mesh0. Called on a parsed, valid problem.
+/// Empty, or why obstacle `o` of a pair whose contactor tag is `tag` faces away from the body:
+/// more than half of the area of a body holding a contactor vertex lies on the obstacle's far
+/// side (behind a line, against its normal; inside a circle the body should be outside of, or
+/// the reverse). Its contact would then hold the body from the wrong side.
+std::string obstacle_faces_away(const levels::Problem& p, const std::string& tag,
+                                const contact::Obstacle& o) {
+    const mesh::Mesh& m = p.mesh0;
+    const auto tid = m.find_tag(tag);
+    if (!tid) return {};
+    const auto body_of = [&](int t) {
+        return m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
+    };
+    std::vector<int> vbody(static_cast<size_t>(m.n_vertices()), -1);
+    for (int t = 0; t < m.n_triangles(); ++t)
+        for (int v : m.triangles[static_cast<size_t>(t)])
+            vbody[static_cast<size_t>(v)] = body_of(t);
+    std::set<int> bodies;
+    for (int v : m.vertices_with_tag(*tid))
+        bodies.insert(vbody[static_cast<size_t>(v)]);
+    for (int b : bodies) {
+        double total = 0.0, behind = 0.0;
+        for (int t = 0; t < m.n_triangles(); ++t) {
+            if (body_of(t) != b) continue;
+            const auto& tri = m.triangles[static_cast<size_t>(t)];
+            const Vec2 c =
+                (m.vertices[static_cast<size_t>(tri[0])] + m.vertices[static_cast<size_t>(tri[1])] +
+                 m.vertices[static_cast<size_t>(tri[2])]) /
+                3.0;
+            double gap = 0.0;
+            if (o.kind == contact::Obstacle::Kind::line)
+                gap = o.normal.dot(c - o.point);
+            else
+                gap = o.body_outside ? (c - o.center).norm() - o.radius
+                                     : o.radius - (c - o.center).norm();
+            const double a = std::abs(m.signed_area(t));
+            total += a;
+            if (gap < 0) behind += a;
+        }
+        if (!(total > 0) || behind <= 0.5 * total) continue;
+        const std::string name = b >= 0 && b < static_cast<int>(p.bodies.size())
+                                     ? p.bodies[static_cast<size_t>(b)].name
+                                     : std::to_string(b);
+        std::ostringstream os;
+        os << std::setprecision(3) << 100.0 * behind / total << "% of the area of body '" << name
+           << "' lies ";
+        if (o.kind == contact::Obstacle::Kind::line)
+            os << "behind the line (against its normal [" << o.normal.x() << ", " << o.normal.y()
+               << "]): the normal points away from the body; it must point from the obstacle "
+                  "into the body: normal = ["
+               << -o.normal.x() + 0.0 << ", " << -o.normal.y() + 0.0 << "]";
+        else
+            os << (o.body_outside ? "inside" : "outside") << " the circle, but side = \""
+               << (o.body_outside ? "outside" : "inside")
+               << "\" puts the body there: the obstacle's normal points away from the body; use "
+                  "side = \""
+               << (o.body_outside ? "inside" : "outside") << "\"";
+        return os.str();
+    }
+    return {};
+}
+
 void recover_levels(levels::Problem& p) {
     Vec2 lo = p.mesh0.vertices.front(), hi = lo;
     double far = 0.0;
@@ -696,6 +759,8 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
         if (!(c.r > 0))
             rd.fail(ct->get("r") ? ct->get("r") : ct->get("r_over_E"),
                     w + ": augmentation parameter r must be > 0");
+        if (const std::string why = levels::r_out_of_scale(c.r, Emin); !why.empty())
+            rd.fail(ct->get("r") ? ct->get("r") : ct->get("r_over_E"), w + ": " + why);
         if (const toml::node* rn = ct->get("region")) {
             const toml::table& rt = rd.table(rn, w + ".region");
             rd.check_keys(rt, {"min", "max"}, w + ".region");
@@ -783,6 +848,8 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
             o.validate();
             return 0;
         });
+        if (const std::string why = obstacle_faces_away(p, c.contactor, o); !why.empty())
+            rd.fail(&ot, ow + ": " + why);
         c.obstacle = o;
         p.contacts.push_back(c);
     }

@@ -230,15 +230,15 @@ def test_bad_solve_options_raise_value_error():
     s = square()
     with pytest.raises(ValueError, match="solver must be schur, lu or krylov, found 'cholesky'"):
         mlcontact.solve(s, solver="cholesky")
-    with pytest.raises(ValueError, match="--levels must lie in"):
+    with pytest.raises(ValueError, match="^levels= must lie in"):
         mlcontact.solve(s, levels=-1)
-    with pytest.raises(ValueError, match="--mu must be >= 0"):
+    with pytest.raises(ValueError, match="^mu= must be >= 0"):
         mlcontact.solve(s, mu=-1.0)
     with pytest.raises(ValueError, match="mg needs the level below"):
         mlcontact.solve(s, levels=0, solver="krylov", pc="mg:coarse=galerkin")
     with pytest.raises(TypeError):
         mlcontact.solve("square")
-    with pytest.raises(ValueError, match="--numbering must be hilbert or lattice, found 'spiral'"):
+    with pytest.raises(ValueError, match="numbering= must be hilbert or lattice, found 'spiral'"):
         mlcontact.solve(s, numbering="spiral")
 
 

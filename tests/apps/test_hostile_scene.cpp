@@ -4,7 +4,12 @@
 // tests/data/hostile/ (the Python tests read the same files, python/tests/test_hostile.py) whose
 // comment line "# expect: invalid[: text]" or "# expect: valid: N triangles" says what parsing it
 // must give: an InvalidInput (whose message contains the text), or a scene with N triangles,
-// parsed in under 10 s.
+// parsed in under 10 s. Scenes that parse but whose solve must name a cause say
+// "# expect: not converged: text" (the run fails, exit 2, and its diagnosis contains the text) or
+// "# expect: solves: text" (the run converges and its report contains the text: a warning or a
+// check said not applicable); they are solved as `mlcontact run` solves them.
+#include "apps/output.hpp"
+#include "apps/run.hpp"
 #include "core/check.hpp"
 #include "scene/scene.hpp"
 
@@ -26,7 +31,9 @@ struct Hostile {
     std::filesystem::path path;
     std::string text;
     bool valid = false;
-    std::string message; ///< invalid: a part of the expected message (may be empty)
+    /// Parses, then the solve does not converge ("not converged") or converges ("solves").
+    std::string solve;
+    std::string message; ///< invalid, solve: a part of the expected message (may be empty)
     int triangles = -1;  ///< valid: the expected number of triangles
 };
 
@@ -51,6 +58,10 @@ std::vector<Hostile> hostile_scenes() {
             if (what.rfind("valid: ", 0) == 0) {
                 h.valid = true;
                 h.triangles = std::stoi(what.substr(7));
+            } else if (what.rfind("not converged: ", 0) == 0 || what.rfind("solves: ", 0) == 0) {
+                const size_t colon = what.find(": ");
+                h.solve = what.substr(0, colon);
+                h.message = what.substr(colon + 2);
             } else if (what.rfind("invalid", 0) == 0) {
                 h.message = what.size() > 9 ? what.substr(9) : "";
             } else {
@@ -77,6 +88,30 @@ TEST(HostileScene, EveryDataFileGivesItsExpectedOutcome) {
         if (h.valid) {
             const auto p = scene::parse_scene(h.text, h.path.string());
             EXPECT_EQ(p.mesh0.n_triangles(), h.triangles);
+        } else if (!h.solve.empty()) {
+            // As `mlcontact run` solves it, with its report.
+            auto p = scene::parse_scene(h.text, h.path.string());
+            const apps::RunOptions opt;
+            apps::apply_overrides(p, opt);
+            levels::SolverChoice choice;
+            const levels::SolveOptions so = apps::run_solve_options(p, opt, choice);
+            const levels::RunResult r = levels::solve(p, so);
+            std::ostringstream report;
+            apps::print_summary(report, p, r);
+            if (h.solve == "not converged") {
+                EXPECT_FALSE(r.converged);
+                EXPECT_NE(r.failure.find(h.message), std::string::npos) << r.failure;
+            } else {
+                EXPECT_TRUE(r.converged) << r.failure;
+                EXPECT_NE(report.str().find(h.message), std::string::npos) << report.str();
+                // A warning is in RunResult::warnings too (summary.json's "warnings").
+                if (h.message.rfind("warning: ", 0) == 0) {
+                    const std::string w = h.message.substr(9);
+                    EXPECT_TRUE(std::any_of(r.warnings.begin(), r.warnings.end(), [&](auto& x) {
+                        return x.find(w) != std::string::npos;
+                    })) << w;
+                }
+            }
         } else {
             try {
                 scene::parse_scene(h.text, h.path.string());

@@ -354,3 +354,18 @@ def test_a_run_that_cannot_fit_in_memory_is_refused(tmp_path):
     assert p.stderr.count("mlcontact: error:") == 1, p.stderr
     assert "use fewer --levels (the 2 processes on this machine together" in p.stderr, p.stderr
     assert not (tmp_path / "o").exists()
+
+
+def test_the_rotation_warning_is_the_one_process_runs(tmp_path):
+    """A half-disc that rolls on a rigid floor: two processes warn of the same largest rotation as
+    one process (report and summary.json "warnings")."""
+    scene = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data",
+                         "hostile", "half_cylinder_rolls.toml")
+    rotation = {}
+    for np_ in (1, 2):
+        out, p = run(tmp_path, scene, 2, np_)
+        warnings = json.load(open(out / "summary.json"))["warnings"]
+        assert len(warnings) == 1 and warnings[0].startswith("large rotation: "), warnings
+        assert "warning: " + warnings[0] in p.stdout
+        rotation[np_] = float(re.search(r"rotates by ([0-9.]+) rad", warnings[0]).group(1))
+    assert rotation[1] == rotation[2] and rotation[1] > 0.1
