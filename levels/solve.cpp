@@ -227,7 +227,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         options.predicted_sizes.empty() ? predict_level_sizes(problem) : options.predicted_sizes;
     res.memory = estimate_memory(res.predicted_sizes, options.linear,
                                  options.coarse_to_fine || options.solve_all_levels ||
-                                     needs_coarse_level(options.linear));
+                                     needs_coarse_level(options.linear),
+                                 {problem.load_steps, options.keep_step_states});
     res.memory_limit = process_memory_limit();
     check_memory_fits(res.memory, res.memory_limit, res.predicted_sizes);
     // Supports released or taken up between load steps (Support::active) change which components
