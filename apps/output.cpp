@@ -457,6 +457,10 @@ std::vector<std::string> write_outputs(const std::filesystem::path& dir, const l
         root.insert("load_steps", static_cast<int64_t>(p.load_steps));
         root.insert("recovered_levels", static_cast<int64_t>(p.recovered_levels));
         root.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
+        toml::array warnings; // initial_gap_warnings (levels/initial_gap.hpp), as reported
+        for (const auto& w : r.warnings)
+            warnings.push_back(w);
+        root.insert("warnings", warnings);
         root.insert("vtu_format", mesh::to_string(options.vtu));
         int total_newton = 0;
         root.insert("steps", steps_json(r.steps, &total_newton));

@@ -119,6 +119,8 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     os << "memory: estimated peak " << levels::format_bytes(r.memory.bytes) << " of "
        << levels::format_bytes(r.memory_limit.bytes) << " available (" << r.memory_limit.source
        << "); measured peak " << levels::format_bytes(peak_rss_bytes()) << "\n";
+    for (const auto& w : r.warnings)
+        os << "warning: " << w << "\n";
     if (r.multigrid) os << *r.multigrid;
     {
         int fallbacks = 0;

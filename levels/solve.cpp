@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Load stepping on the finest level.
 #include "levels/solve.hpp"
+#include "levels/initial_gap.hpp"
 
 #include "levels/resources.hpp"
 
@@ -237,6 +238,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     int phase_step = 1; // the load step whose supports the current hierarchy has
     res.hierarchy = build_hierarchy(problem.at_step(1), options.q_rule, &res.timings);
     const auto& levels = res.hierarchy.levels;
+    res.warnings = initial_gap_warnings(problem, levels.front());
     const int n_levels = res.hierarchy.n_levels();
     const int finest = n_levels - 1;
     const bool all_levels =

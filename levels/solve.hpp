@@ -150,6 +150,8 @@ struct RunResult {
     /// says where. converged is false.
     bool stopped = false;
     int completed_steps = 0; ///< load steps completed on every solved level
+    /// Notes on legal but suspicious input, one sentence each (initial_gap_warnings of level 0).
+    std::vector<std::string> warnings;
     const Level& finest() const { return hierarchy.finest(); }
     const std::vector<Level>& levels() const { return hierarchy.levels; }
 };
