@@ -569,9 +569,9 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
             estimate_memory(sizes, options.linear, true, {problem.load_steps, false});
         MemoryEstimate per = one;
         // The per-step data is kept whole on every process.
-        per.bytes = 1.15 * (one.bytes - one.steps_bytes) / comm.size() *
-                        comm::processes_on_this_machine() +
-                    one.steps_bytes * comm::processes_on_this_machine();
+        per.bytes =
+            1.15 * (one.bytes - one.steps_bytes) / comm.size() * comm::processes_on_this_machine() +
+            one.steps_bytes * comm::processes_on_this_machine();
         const MemoryLimit limit = process_memory_limit();
         std::string error;
         try {

@@ -246,9 +246,9 @@ MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const Linear
     const LevelSize& f = sizes.back();
     const double solved_levels = coarse_to_fine ? static_cast<double>(sizes.size()) : 1.0;
     const double n_steps = std::max(1, steps.load_steps);
-    e.steps_bytes = n_steps * (kStepBytesPerLevel * solved_levels +
-                               kStepBytesPerContactNode * f.contact_nodes +
-                               (steps.keep_step_states ? kStepBytesPerKeptVertex * f.vertices : 0));
+    e.steps_bytes =
+        n_steps * (kStepBytesPerLevel * solved_levels + kStepBytesPerContactNode * f.contact_nodes +
+                   (steps.keep_step_states ? kStepBytesPerKeptVertex * f.vertices : 0));
     e.output_bytes = n_steps * (kOutputBytesPerLevel * solved_levels +
                                 kOutputBytesPerContactNode * f.contact_nodes);
     e.bytes = kBaseline + e.hierarchy_bytes + e.solver_bytes + e.steps_bytes;

@@ -9,10 +9,10 @@
 #include <cmath>
 #include <cstdint>
 #include <iomanip>
-#include <sstream>
-#include <tuple>
 #include <limits>
 #include <numeric>
+#include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 namespace mlc::mesh {
@@ -409,15 +409,16 @@ void check_topology(const Mesh& m, const TriangleNamer& name) {
                 const Vec2& q = m.vertices[static_cast<size_t>(e.b)];
                 const Vec2 d = q - p, w = x - p;
                 const double len2 = d.squaredNorm();
-                const double s = w.dot(d) / len2;               // along the edge, 0 .. 1
+                const double s = w.dot(d) / len2; // along the edge, 0 .. 1
                 const double off = std::abs(d.x() * w.y() - d.y() * w.x()) / len2; // across
                 if (s <= tol || s >= 1 - tol || off > tol) continue;
                 // The same body only: bodies of one mesh may touch along non-matching edges.
                 if (!std::binary_search(vertex_body.begin(), vertex_body.end(),
                                         std::pair<int, int>{v, body_of_triangle(e.t)}))
                     continue;
-                fail("hanging node (T-junction): " + vertex_text(v) + " lies inside the edge from " +
-                     vertex_text(e.a) + " to " + vertex_text(e.b) + " of " + tri_name(e.t) +
+                fail("hanging node (T-junction): " + vertex_text(v) +
+                     " lies inside the edge from " + vertex_text(e.a) + " to " + vertex_text(e.b) +
+                     " of " + tri_name(e.t) +
                      " but is not a vertex of it, so the triangles on the two sides of that edge "
                      "do not share their nodes and the body has a slit there; split the edge at "
                      "the vertex (or remesh conformingly)");

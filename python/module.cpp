@@ -321,14 +321,14 @@ PYBIND11_MODULE(_core, m) {
                 if (!f) throw InvalidInput("cannot open scene file '" + path + "'");
                 std::ostringstream text;
                 text << f.rdbuf();
-                return std::make_shared<Scene>(
-                    Scene{parse_honouring_signals([&](const scene::StopPoll& poll) {
-                              return scene::parse_scene(text.str(), fp.string(),
-                                                        fp.parent_path(), poll);
-                          }),
-                          path});
+                return std::make_shared<Scene>(Scene{
+                    parse_honouring_signals([&](const scene::StopPoll& poll) {
+                        return scene::parse_scene(text.str(), fp.string(), fp.parent_path(), poll);
+                    }),
+                    path});
             },
-            py::arg("path"), "A scene file (TOML); errors name the file and line. Ctrl-C while its domains are "
+            py::arg("path"),
+            "A scene file (TOML); errors name the file and line. Ctrl-C while its domains are "
             "meshed raises KeyboardInterrupt")
         .def_static(
             "from_toml",

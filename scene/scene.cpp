@@ -424,8 +424,8 @@ mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::s
         });
         if (const toml::node* mx = t.get("mirror_x")) {
             const double x0 = rd.number(mx, where + ".mirror_x");
-            const mesh::Mesh half = at(rd, where_lines,
-                                       [&] { return mesh::mesh_domain(loops, sf, lines, rd.stop()); });
+            const mesh::Mesh half =
+                at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines, rd.stop()); });
             return at(rd, mx, [&] { return mesh::mirror_about_x(half, x0); });
         }
         return at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines, rd.stop()); });

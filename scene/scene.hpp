@@ -23,8 +23,7 @@ using StopPoll = std::function<bool()>;
 /// as one level in the memory this process may use is refused (levels::check_meshing_fits); the
 /// meshing polls `stop`.
 levels::Problem parse_scene(const std::string& text, const std::string& origin,
-                            const std::filesystem::path& base_dir = {},
-                            const StopPoll& stop = {});
+                            const std::filesystem::path& base_dir = {}, const StopPoll& stop = {});
 
 /// Loads a scene by file path (anything ending in .toml or naming an existing file) or by the
 /// name of a built-in scene. Throws InvalidInput for a missing file or an unknown name. `stop`:

@@ -749,8 +749,8 @@ MeshPrediction predict_mesh_size(const std::vector<std::vector<Segment>>& loops,
         for (const SegmentGeometry& sg : segs) {
             auto& ring = rings[static_cast<std::size_t>(sg.loop)];
             const int pieces =
-                sg.arc ? std::max(2, static_cast<int>(std::ceil(std::abs(sg.sweep) * 90 /
-                                                                 std::numbers::pi)))
+                sg.arc ? std::max(2, static_cast<int>(
+                                         std::ceil(std::abs(sg.sweep) * 90 / std::numbers::pi)))
                        : 1;
             for (int k = 0; k < pieces; ++k)
                 ring.push_back(sg.at(static_cast<double>(k) / pieces));

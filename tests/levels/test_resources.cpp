@@ -224,9 +224,9 @@ TEST(MemoryEstimate, CountsWhatEveryLoadStepKeepsAndTheFiles) {
     p.levels = 1;
     const auto two = levels::predict_level_sizes(p);
     const auto c2f = levels::estimate_memory(two, schur, true, {1000, false});
-    EXPECT_DOUBLE_EQ(c2f.steps_bytes, 1000 * (2 * levels::kStepBytesPerLevel +
-                                              two.back().contact_nodes *
-                                                  levels::kStepBytesPerContactNode));
+    EXPECT_DOUBLE_EQ(c2f.steps_bytes,
+                     1000 * (2 * levels::kStepBytesPerLevel +
+                             two.back().contact_nodes * levels::kStepBytesPerContactNode));
     // Refused when it does not fit, saying it is the load steps.
     try {
         levels::check_memory_fits(many, {0.5 * many.bytes, "a test limit"}, sizes);

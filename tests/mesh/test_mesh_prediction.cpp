@@ -18,8 +18,10 @@ namespace {
 constexpr double pi = std::numbers::pi;
 
 std::vector<std::vector<Segment>> square(double side) {
-    return {{Segment::line({0, 0}, {side, 0}, "bottom"), Segment::line({side, 0}, {side, side}, "right"),
-             Segment::line({side, side}, {0, side}, "top"), Segment::line({0, side}, {0, 0}, "left")}};
+    return {{Segment::line({0, 0}, {side, 0}, "bottom"),
+             Segment::line({side, 0}, {side, side}, "right"),
+             Segment::line({side, side}, {0, side}, "top"),
+             Segment::line({0, side}, {0, 0}, "left")}};
 }
 
 /// The hertz scene's quarter disc: the arc from (0, 0) to (1, 1) about (0, 1), the top, the axis.
@@ -75,7 +77,8 @@ TEST(MeshPrediction, AtOrAboveTheMeshedCountAndWithinOneAndAHalfTimesIt) {
         {square(1), field(0.1, 0.005, {{0.5, 0}}, 0.25)},
         {quarter_disc(), field(0.1, 0.004, {{0, 0}}, 0.12)}, // the hertz scene
         {quarter_disc(), field(0.02, 0, {}, 0.25)},
-        {{{Segment::arc({1, 0}, {1, 0}, {0, 0}, true, "circle")}}, field(0.1, 0.01, {{0, 0}, {0.5, 0}}, 0.3)},
+        {{{Segment::arc({1, 0}, {1, 0}, {0, 0}, true, "circle")}},
+         field(0.1, 0.01, {{0, 0}, {0.5, 0}}, 0.3)},
     };
     for (size_t i = 0; i < cases.size(); ++i) {
         const double predicted = predict_mesh_size(cases[i].loops, cases[i].size).triangles;

@@ -48,13 +48,16 @@ Mesh square_beside_fan(double x0, int left_body, int right_body) {
     Mesh m;
     add_square(m, Vec2(0, 0), left_body);
     const int b = m.n_vertices();
-    for (const Vec2& p : {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1), Vec2(0, 0.5),
-                          Vec2(0.5, 0.5)})
+    for (const Vec2& p :
+         {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1), Vec2(0, 0.5), Vec2(0.5, 0.5)})
         m.vertices.push_back(Vec2(x0, 0) + p);
     // corners b .. b+3, side midpoint b+4, centre b+5
-    for (const std::array<int, 3>& t : std::initializer_list<std::array<int, 3>>{
-             {b, b + 1, b + 5}, {b + 1, b + 2, b + 5}, {b + 2, b + 3, b + 5}, {b + 3, b + 4, b + 5},
-             {b + 4, b, b + 5}}) {
+    for (const std::array<int, 3>& t :
+         std::initializer_list<std::array<int, 3>>{{b, b + 1, b + 5},
+                                                   {b + 1, b + 2, b + 5},
+                                                   {b + 2, b + 3, b + 5},
+                                                   {b + 3, b + 4, b + 5},
+                                                   {b + 4, b, b + 5}}) {
         m.triangles.push_back(t);
         m.attribute.push_back(right_body);
     }
@@ -98,7 +101,7 @@ TEST(MeshTopology, HangingNodeAndItsConformingRepair) {
     // [0, 2] x [0, 1]: the left square in two triangles, the right one in four around its
     // centre (1.5, 0.5), one of them with the vertex (1, 0.5) on the left square's side.
     Mesh m;
-    m.vertices = {Vec2(0, 0), Vec2(1, 0),   Vec2(1, 1), Vec2(0, 1),
+    m.vertices = {Vec2(0, 0),   Vec2(1, 0), Vec2(1, 1), Vec2(0, 1),
                   Vec2(1, 0.5), Vec2(2, 0), Vec2(2, 1), Vec2(1.5, 0.5)};
     m.triangles = {{0, 1, 2}, {0, 2, 3}, {1, 5, 7}, {5, 6, 7}, {6, 2, 7}, {2, 4, 7}, {4, 1, 7}};
     EXPECT_NE(refusal(m).find("hanging node (T-junction): vertex 4 (1, 0.5) lies inside the edge "
