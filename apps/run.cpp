@@ -88,7 +88,17 @@ bool nonfinite_residual(const levels::RunResult& r) {
 } // namespace
 
 int run_scene(const RunOptions& opt, std::ostream& os) {
-    levels::Problem p = scene::load_scene(opt.scene);
+    // A signal while the scene's domains are meshed stops the meshing; nothing is written.
+    std::optional<levels::Problem> loaded;
+    try {
+        loaded = scene::load_scene(opt.scene, [&] { return opt.stop && opt.stop->load(); });
+    } catch (const Interrupted& e) {
+        const int sig = stop_signal();
+        os << "stopped by " << signal_name(sig) << " while meshing the scene (" << e.what()
+           << "); nothing written\n";
+        return 128 + (sig > 0 ? sig : 2);
+    }
+    levels::Problem p = std::move(*loaded);
     apply_overrides(p, opt);
     MLC_CHECK(opt.vtu == "binary" || opt.vtu == "ascii",
               "--vtu must be binary or ascii, found '" << opt.vtu << "'");

@@ -565,9 +565,13 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
         // level 6 on 2 processes: 0.54 of the one-process peak each), and the processes on one
         // machine share its memory. Decided alike on every process.
         const auto sizes = predict_level_sizes(problem);
-        const MemoryEstimate one = estimate_memory(sizes, options.linear, true);
+        const MemoryEstimate one =
+            estimate_memory(sizes, options.linear, true, {problem.load_steps, false});
         MemoryEstimate per = one;
-        per.bytes = 1.15 * one.bytes / comm.size() * comm::processes_on_this_machine();
+        // The per-step data is kept whole on every process.
+        per.bytes =
+            1.15 * (one.bytes - one.steps_bytes) / comm.size() * comm::processes_on_this_machine() +
+            one.steps_bytes * comm::processes_on_this_machine();
         const MemoryLimit limit = process_memory_limit();
         std::string error;
         try {

@@ -211,7 +211,7 @@ constexpr double kAggregationPerNonzero = 80.0;
 } // namespace
 
 MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const LinearSolverSpec& spec,
-                               bool coarse_to_fine) {
+                               bool coarse_to_fine, const StepsKept& steps) {
     MLC_CHECK(!sizes.empty(), "estimate_memory: no levels");
     MemoryEstimate e;
     const int finest = static_cast<int>(sizes.size()) - 1;
@@ -242,7 +242,16 @@ MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const Linear
             e.largest_level = s.level;
         }
     }
-    e.bytes = kBaseline + e.hierarchy_bytes + e.solver_bytes;
+    // Per load step: every solved level's reports, the finest level's contact states.
+    const LevelSize& f = sizes.back();
+    const double solved_levels = coarse_to_fine ? static_cast<double>(sizes.size()) : 1.0;
+    const double n_steps = std::max(1, steps.load_steps);
+    e.steps_bytes =
+        n_steps * (kStepBytesPerLevel * solved_levels + kStepBytesPerContactNode * f.contact_nodes +
+                   (steps.keep_step_states ? kStepBytesPerKeptVertex * f.vertices : 0));
+    e.output_bytes = n_steps * (kOutputBytesPerLevel * solved_levels +
+                                kOutputBytesPerContactNode * f.contact_nodes);
+    e.bytes = kBaseline + e.hierarchy_bytes + e.solver_bytes + e.steps_bytes;
     return e;
 }
 
@@ -339,11 +348,43 @@ void check_memory_fits(const MemoryEstimate& estimate, const MemoryLimit& limit,
     if (estimate.bytes <= limit.bytes) return;
     const LevelSize& f = sizes.back();
     std::ostringstream os;
+    const bool steps = estimate.steps_bytes > estimate.hierarchy_bytes + estimate.solver_bytes;
     os << std::setprecision(3) << "the run needs an estimated " << format_bytes(estimate.bytes)
        << " (finest level " << f.level << ": " << f.unknowns << " unknowns, " << f.contact_nodes
-       << " contact nodes; largest solver on level " << estimate.largest_level
-       << ") but this process may use " << format_bytes(std::max(0.0, limit.bytes)) << " ("
-       << limit.source << "): use fewer --levels";
+       << " contact nodes; largest solver on level " << estimate.largest_level;
+    if (steps)
+        os << "; " << format_bytes(estimate.steps_bytes)
+           << " of it for what every load step keeps until the files are written, which take "
+           << format_bytes(estimate.output_bytes);
+    os << ") but this process may use " << format_bytes(std::max(0.0, limit.bytes)) << " ("
+       << limit.source << "): use fewer " << (steps ? "load steps" : "--levels");
+    throw InvalidInput(os.str());
+}
+
+LevelSize level_size_from_triangles(double triangles) {
+    LevelSize s;
+    s.triangles = triangles;
+    s.vertices = triangles / 2;
+    s.edges = 1.5 * triangles;
+    s.unknowns = 2 * s.vertices;
+    s.k_nonzeros = 4 * (s.vertices + 2 * s.edges);
+    return s;
+}
+
+double meshing_memory(double triangles) {
+    const double solve =
+        estimate_memory({level_size_from_triangles(triangles)}, LinearSolverSpec{}, false).bytes;
+    return solve + kMeshingBytesPerTriangle * triangles;
+}
+
+void check_meshing_fits(double triangles, const std::string& what, const std::string& fix,
+                        const MemoryLimit& limit) {
+    const double need = meshing_memory(triangles);
+    if (need <= limit.bytes) return;
+    std::ostringstream os;
+    os << what << " needs an estimated " << format_bytes(need)
+       << " to mesh and solve as one level, but this process may use "
+       << format_bytes(std::max(0.0, limit.bytes)) << " (" << limit.source << "): " << fix;
     throw InvalidInput(os.str());
 }
 

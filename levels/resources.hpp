@@ -140,13 +140,42 @@ struct MemoryEstimate {
     double bytes = 0;           ///< total
     double hierarchy_bytes = 0; ///< meshes, K, transfers, vectors of all levels
     double solver_bytes = 0;    ///< Jacobians, smoothers, factors of the Newton-system solvers
-    int largest_level = 0;      ///< the level whose solver dominates
+    /// What the run keeps per load step until its files are written (the reports of every solved
+    /// level, the finest level's contact states, the step states when kept) and the summary
+    /// built from them: grows with the load steps.
+    double steps_bytes = 0;
+    /// Size of the files the run writes (contact_steps.csv, iterations.csv, summary.json and
+    /// the final state; not the per-step VTU files): on disk, not in memory.
+    double output_bytes = 0;
+    int largest_level = 0; ///< the level whose solver dominates
 };
 
+/// What a run keeps per load step, for estimate_memory.
+struct StepsKept {
+    int load_steps = 1;
+    bool keep_step_states = false; ///< SolveOptions::keep_step_states (a displacement per step)
+};
+
+/// Bytes a run holds per load step until its files are written: per solved level (its LevelStep
+/// and StepReport with their vectors, and the entries of summary.json built from them before it is
+/// written, most of the peak), per contact node of the finest level (its ContactNodeState and
+/// statuses), and per vertex of the finest level when the step states are kept (two doubles).
+/// Fitted on the peak resident memory of a block on a floor with two numbers of contact nodes
+/// and of load steps, rounded up.
+inline constexpr double kStepBytesPerLevel = 7168;
+inline constexpr double kStepBytesPerContactNode = 128;
+inline constexpr double kStepBytesPerKeptVertex = 16;
+/// Bytes written per load step: a contact_steps.csv row per contact node of the finest level,
+/// and per solved level its summary.json entries and iterations.csv rows (the same runs' files,
+/// rounded up).
+inline constexpr double kOutputBytesPerContactNode = 150;
+inline constexpr double kOutputBytesPerLevel = 1024;
+
 /// Estimates the peak resident memory of `levels::solve` for these sizes and solver (a fit of
-/// measured peaks on the square, hertz and dovetail ladders; README: "Memory").
+/// measured peaks on the square, hertz and dovetail ladders; README: "Memory"), with what the
+/// run keeps per load step (`steps`: MemoryEstimate::steps_bytes) and the size of its files.
 MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const LinearSolverSpec& spec,
-                               bool coarse_to_fine);
+                               bool coarse_to_fine, const StepsKept& steps = {});
 
 /// The memory this process may use: the smallest of MemAvailable (/proc/meminfo), the cgroup
 /// limit less its current usage (v2 memory.max / v1 memory.limit_in_bytes) and RLIMIT_AS less the
@@ -158,11 +187,32 @@ struct MemoryLimit {
 MemoryLimit process_memory_limit();
 
 /// Throws InvalidInput when `estimate` does not fit in `limit`, naming the level, the estimate
-/// and the limit.
+/// (and its per-step part when that is the larger one) and the limit.
 void check_memory_fits(const MemoryEstimate& estimate, const MemoryLimit& limit,
                        const std::vector<LevelSize>& sizes);
 
 /// "123 MiB" / "4.5 GiB".
 std::string format_bytes(double bytes);
+
+/// Level 0 of a mesh known only by its predicted triangle count T (before meshing): V = T / 2,
+/// E = 3 T / 2 (Euler's relation without the boundary), 2 V unknowns, the nonzeros of K
+/// 4 (V + 2 E), no multipliers.
+LevelSize level_size_from_triangles(double triangles);
+
+/// Bytes the CGAL domain mesher holds per triangle at its peak (the constrained Delaunay
+/// triangulation, the queue of bad triangles, the Mesh it returns): the growth of the peak
+/// resident memory of Scene.from_file with the triangles of uniform hertz domains, rounded up.
+inline constexpr double kMeshingBytesPerTriangle = 400.0;
+
+/// Estimated peak memory of meshing `triangles` triangles and solving them as a single level
+/// (estimate_memory of level_size_from_triangles with the default single-level solver): a
+/// mesh that fails this cannot be used whatever the levels.
+double meshing_memory(double triangles);
+
+/// Throws InvalidInput when meshing_memory(triangles) does not fit in `limit`: "<what> needs an
+/// estimated ... to mesh and solve as one level, but this process may use ... (<source>)", then
+/// `fix`. Called before meshing, so that a size field that cannot fit is refused at once.
+void check_meshing_fits(double triangles, const std::string& what, const std::string& fix,
+                        const MemoryLimit& limit);
 
 } // namespace mlc::levels

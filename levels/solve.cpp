@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Load stepping on the finest level.
 #include "levels/solve.hpp"
+#include "levels/initial_gap.hpp"
 
 #include "levels/diagnoses.hpp"
 #include "levels/resources.hpp"
@@ -228,7 +229,8 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
         options.predicted_sizes.empty() ? predict_level_sizes(problem) : options.predicted_sizes;
     res.memory = estimate_memory(res.predicted_sizes, options.linear,
                                  options.coarse_to_fine || options.solve_all_levels ||
-                                     needs_coarse_level(options.linear));
+                                     needs_coarse_level(options.linear),
+                                 {problem.load_steps, options.keep_step_states});
     res.memory_limit = process_memory_limit();
     check_memory_fits(res.memory, res.memory_limit, res.predicted_sizes);
     // Supports released or taken up between load steps (Support::active) change which components
@@ -237,6 +239,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     int phase_step = 1; // the load step whose supports the current hierarchy has
     res.hierarchy = build_hierarchy(problem.at_step(1), options.q_rule, &res.timings);
     const auto& levels = res.hierarchy.levels;
+    res.warnings = initial_gap_warnings(problem, levels.front());
     const int n_levels = res.hierarchy.n_levels();
     const int finest = n_levels - 1;
     const bool all_levels =

@@ -152,7 +152,9 @@ struct RunResult {
     int completed_steps = 0; ///< load steps completed on every solved level
     /// What makes the solution doubtful though it converged (levels/diagnoses.hpp): a rotation
     /// or strain of the finest level too large for small-displacement theory, a solution that
-    /// is not unique. One sentence each, without a "warning:" prefix.
+    /// is not unique; and notes on legal but suspicious input (initial_gap_warnings of level 0:
+    /// an initial penetration or gap larger than a fraction of the body). One sentence each,
+    /// without a "warning:" prefix.
     std::vector<std::string> warnings;
     const Level& finest() const { return hierarchy.finest(); }
     const std::vector<Level>& levels() const { return hierarchy.levels; }

@@ -1,14 +1,18 @@
 // SPDX-License-Identifier: MIT
 // Mesh queries, quality checks, uniform 1->4 refinement and structured rectangles.
 #include "mesh/mesh.hpp"
+#include "mesh/topology.hpp"
 
 #include "core/check.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iomanip>
 #include <limits>
 #include <numeric>
+#include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 namespace mlc::mesh {
@@ -160,6 +164,10 @@ void check_refined_quality(const Mesh& m) {
 }
 
 void check_quality(const Mesh& m) {
+    check_quality(m, TriangleNamer{});
+}
+
+void check_quality(const Mesh& m, const TriangleNamer& name) {
     MLC_CHECK(m.n_triangles() > 0, "the mesh has no triangles");
     const int nv = m.n_vertices();
     MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.triangles.size(),
@@ -228,6 +236,7 @@ void check_quality(const Mesh& m) {
         for (size_t k = next; k < n_sorted && by_cell[k].first <= last; ++k)
             compare(v, by_cell[k].second);
     }
+    check_topology(m, name);
     // A boundary edge lies on one triangle, an interior line on two.
     const VertexTriangles vtri = vertex_triangles(m);
     auto triangles_on = [&](int a, int b) { return vtri.on_edge(m, a, b).count; };
@@ -243,6 +252,178 @@ void check_quality(const Mesh& m) {
         MLC_CHECK(triangles_on(e.v0, e.v1) == 2,
                   "interior line (" << e.v0 << ", " << e.v1 << ") tagged '" << m.tag_name(e.tag)
                                     << "' is not an interior edge of the triangulation");
+    }
+}
+
+namespace {
+
+std::string point_text(const Vec2& p) {
+    std::ostringstream os;
+    os << std::setprecision(9) << "(" << p.x() << ", " << p.y() << ")";
+    return os.str();
+}
+
+} // namespace
+
+void check_topology(const Mesh& m, const TriangleNamer& name) {
+    auto tri_name = [&](int t) { return name ? name(t) : "triangle " + std::to_string(t); };
+    auto vertex_text = [&](int v) {
+        return "vertex " + std::to_string(v) + " " + point_text(m.vertices[static_cast<size_t>(v)]);
+    };
+    auto fail = [](const std::string& msg) { throw InvalidInput(msg); };
+    const size_t nt = m.triangles.size();
+    // Duplicated elements: the same vertex set, in any order.
+    {
+        std::vector<std::pair<std::array<int, 3>, int>> sorted(nt);
+        for (size_t t = 0; t < nt; ++t) {
+            std::array<int, 3> k = m.triangles[t];
+            std::sort(k.begin(), k.end());
+            sorted[t] = {k, static_cast<int>(t)};
+        }
+        std::sort(sorted.begin(), sorted.end());
+        for (size_t i = 1; i < nt; ++i)
+            if (sorted[i].first == sorted[i - 1].first) {
+                const auto& k = sorted[i].first;
+                fail("duplicated element: " + tri_name(sorted[i - 1].second) + " and " +
+                     tri_name(sorted[i].second) + " have the same vertices, " + vertex_text(k[0]) +
+                     ", " + vertex_text(k[1]) + " and " + vertex_text(k[2]) +
+                     " (the body is counted twice there: its stiffness doubles and its boundary "
+                     "edges become interior ones); remove one of the two");
+            }
+    }
+    // Edges and how many triangles share each: 1 on the boundary, 2 inside, more is an error.
+    struct Side {
+        std::uint64_t key;
+        int t;
+        bool operator<(const Side& o) const { return key != o.key ? key < o.key : t < o.t; }
+    };
+    std::vector<Side> sides;
+    sides.reserve(3 * nt);
+    for (size_t t = 0; t < nt; ++t)
+        for (int k = 0; k < 3; ++k)
+            sides.push_back({edge_key(m.triangles[t][static_cast<size_t>(k)],
+                                      m.triangles[t][static_cast<size_t>((k + 1) % 3)]),
+                             static_cast<int>(t)});
+    std::sort(sides.begin(), sides.end());
+    struct Edge {
+        int a, b, t;
+    };
+    std::vector<Edge> boundary; // edges of one triangle
+    for (size_t i = 0; i < sides.size();) {
+        size_t j = i + 1;
+        while (j < sides.size() && sides[j].key == sides[i].key)
+            ++j;
+        const int a = static_cast<int>(sides[i].key >> 32);
+        const int b = static_cast<int>(sides[i].key & 0xffffffffu);
+        if (j - i > 2) {
+            std::string ts;
+            for (size_t k = i; k < j; ++k)
+                ts += (k > i ? (k + 1 == j ? " and " : ", ") : "") + tri_name(sides[k].t);
+            fail("non-manifold edge: the edge from " + vertex_text(a) + " to " + vertex_text(b) +
+                 " is shared by " + std::to_string(j - i) + " triangles (" + ts +
+                 "), but an edge of a body has one triangle (on the boundary) or two (inside): "
+                 "the triangles overlap or fold over; remesh so that they tile the body");
+        }
+        if (j - i == 1) boundary.push_back({a, b, sides[i].t});
+        i = j;
+    }
+    if (boundary.empty()) return;
+    // Hanging nodes: a boundary vertex inside a boundary edge it is not an end of. Each edge goes
+    // into the (at most four) cells of a grid whose cell side is the power-of-two multiple of the
+    // shortest boundary edge that holds the edge's box widened by the tolerance; each boundary
+    // vertex looks into its cell on every grid that holds an edge.
+    const double tol = kHangingNodeTol;
+    Vec2 lo = m.vertices[static_cast<size_t>(boundary[0].a)];
+    double shortest = std::numeric_limits<double>::infinity();
+    for (const Edge& e : boundary) {
+        lo = lo.cwiseMin(m.vertices[static_cast<size_t>(e.a)]);
+        lo = lo.cwiseMin(m.vertices[static_cast<size_t>(e.b)]);
+        shortest = std::min(
+            shortest,
+            (m.vertices[static_cast<size_t>(e.b)] - m.vertices[static_cast<size_t>(e.a)]).norm());
+    }
+    if (!(shortest > 0)) return; // zero-length edges are refused by the area check
+    struct Entry {
+        int level;
+        std::int64_t cx, cy;
+        int edge;
+        bool operator<(const Entry& o) const {
+            return std::tie(level, cx, cy, edge) < std::tie(o.level, o.cx, o.cy, o.edge);
+        }
+    };
+    std::vector<Entry> grid;
+    grid.reserve(4 * boundary.size());
+    std::vector<int> levels;
+    for (size_t i = 0; i < boundary.size(); ++i) {
+        const Vec2& p = m.vertices[static_cast<size_t>(boundary[i].a)];
+        const Vec2& q = m.vertices[static_cast<size_t>(boundary[i].b)];
+        const double pad = tol * (q - p).norm();
+        const Vec2 bl = p.cwiseMin(q).array() - pad, tr = p.cwiseMax(q).array() + pad;
+        const double extent = (tr - bl).maxCoeff();
+        int level = std::max(0, static_cast<int>(std::ceil(std::log2(extent / shortest))));
+        while (std::ldexp(shortest, level) < extent)
+            ++level;
+        const double cell = std::ldexp(shortest, level);
+        const auto x0 = static_cast<std::int64_t>(std::floor((bl.x() - lo.x()) / cell));
+        const auto x1 = static_cast<std::int64_t>(std::floor((tr.x() - lo.x()) / cell));
+        const auto y0 = static_cast<std::int64_t>(std::floor((bl.y() - lo.y()) / cell));
+        const auto y1 = static_cast<std::int64_t>(std::floor((tr.y() - lo.y()) / cell));
+        for (std::int64_t cx = x0; cx <= x1; ++cx)
+            for (std::int64_t cy = y0; cy <= y1; ++cy)
+                grid.push_back({level, cx, cy, static_cast<int>(i)});
+        levels.push_back(level);
+    }
+    std::sort(grid.begin(), grid.end());
+    std::sort(levels.begin(), levels.end());
+    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+    std::vector<int> vertices;
+    vertices.reserve(2 * boundary.size());
+    for (const Edge& e : boundary) {
+        vertices.push_back(e.a);
+        vertices.push_back(e.b);
+    }
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    auto body_of_triangle = [&](int t) {
+        return m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
+    };
+    // A vertex's bodies: those of its boundary edges (two bodies may share a vertex).
+    std::vector<std::pair<int, int>> vertex_body; // (vertex, body), sorted
+    for (const Edge& e : boundary) {
+        vertex_body.emplace_back(e.a, body_of_triangle(e.t));
+        vertex_body.emplace_back(e.b, body_of_triangle(e.t));
+    }
+    std::sort(vertex_body.begin(), vertex_body.end());
+    for (int v : vertices) {
+        const Vec2& x = m.vertices[static_cast<size_t>(v)];
+        for (int level : levels) {
+            const double cell = std::ldexp(shortest, level);
+            const Entry key{level, static_cast<std::int64_t>(std::floor((x.x() - lo.x()) / cell)),
+                            static_cast<std::int64_t>(std::floor((x.y() - lo.y()) / cell)), -1};
+            for (auto it = std::lower_bound(grid.begin(), grid.end(), key);
+                 it != grid.end() && it->level == level && it->cx == key.cx && it->cy == key.cy;
+                 ++it) {
+                const Edge& e = boundary[static_cast<size_t>(it->edge)];
+                if (e.a == v || e.b == v) continue;
+                const Vec2& p = m.vertices[static_cast<size_t>(e.a)];
+                const Vec2& q = m.vertices[static_cast<size_t>(e.b)];
+                const Vec2 d = q - p, w = x - p;
+                const double len2 = d.squaredNorm();
+                const double s = w.dot(d) / len2; // along the edge, 0 .. 1
+                const double off = std::abs(d.x() * w.y() - d.y() * w.x()) / len2; // across
+                if (s <= tol || s >= 1 - tol || off > tol) continue;
+                // The same body only: bodies of one mesh may touch along non-matching edges.
+                if (!std::binary_search(vertex_body.begin(), vertex_body.end(),
+                                        std::pair<int, int>{v, body_of_triangle(e.t)}))
+                    continue;
+                fail("hanging node (T-junction): " + vertex_text(v) +
+                     " lies inside the edge from " + vertex_text(e.a) + " to " + vertex_text(e.b) +
+                     " of " + tri_name(e.t) +
+                     " but is not a vertex of it, so the triangles on the two sides of that edge "
+                     "do not share their nodes and the body has a slit there; split the edge at "
+                     "the vertex (or remesh conformingly)");
+            }
+        }
     }
 }
 

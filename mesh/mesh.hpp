@@ -85,10 +85,10 @@ struct Mesh {
 };
 
 /// Checks a mesh for use: at least one triangle, indices in range, every triangle with positive
-/// area (relative to the square of the mesh diameter), no two vertices of one body (triangle
-/// attribute) closer than a relative 1e-10 of the diameter (vertices of two touching bodies may
-/// coincide), boundary edges that are edges of one triangle, interior lines edges of two.
-/// Throws InvalidInput naming the first defect (triangle or vertex index and coordinates).
+/// area (relative to the square of the mesh diameter), no two vertices of one body (attribute)
+/// closer than 1e-10 of the diameter (two touching bodies' may coincide), no duplicated element,
+/// edge of over two triangles or hanging node (check_topology, mesh/topology.hpp), boundary edges
+/// of one triangle, interior lines of two. Throws InvalidInput naming the first defect (indices).
 void check_quality(const Mesh& m);
 
 /// The part of check_quality a refinement of a checked mesh still needs: every triangle with

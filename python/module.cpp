@@ -292,6 +292,26 @@ void raise_python(PyObject* type, const std::string& what) {
     Py_DECREF(exc);
 }
 
+/// Parses a scene with Ctrl-C honoured while its domains are meshed: the meshing polls Python's
+/// signal handlers (the GIL is held), and their exception (KeyboardInterrupt) is raised.
+template <class Parse> levels::Problem parse_honouring_signals(Parse&& parse) {
+    PyObject *etype = nullptr, *evalue = nullptr, *etrace = nullptr;
+    const scene::StopPoll poll = [&]() {
+        if (PyErr_CheckSignals() == 0) return false;
+        PyErr_Fetch(&etype, &evalue, &etrace);
+        return true;
+    };
+    try {
+        return parse(poll);
+    } catch (const Interrupted&) {
+        if (etype) {
+            PyErr_Restore(etype, evalue, etrace);
+            throw py::error_already_set();
+        }
+        throw;
+    }
+}
+
 /// Runs a study writing into `out` without the plot; returns (exit code, report text).
 template <class F> py::tuple run_study(F&& f) {
     std::ostringstream os;
@@ -353,15 +373,23 @@ PYBIND11_MODULE(_core, m) {
                 if (!f) throw InvalidInput("cannot open scene file '" + path + "'");
                 std::ostringstream text;
                 text << f.rdbuf();
-                return std::make_shared<Scene>(
-                    Scene{scene::parse_scene(text.str(), fp.string(), fp.parent_path()), path});
+                return std::make_shared<Scene>(Scene{
+                    parse_honouring_signals([&](const scene::StopPoll& poll) {
+                        return scene::parse_scene(text.str(), fp.string(), fp.parent_path(), poll);
+                    }),
+                    path});
             },
-            py::arg("path"), "A scene file (TOML); errors name the file and line")
+            py::arg("path"),
+            "A scene file (TOML); errors name the file and line. Ctrl-C while its domains are "
+            "meshed raises KeyboardInterrupt")
         .def_static(
             "from_toml",
             [](const std::string& text, const std::string& origin, const std::string& base_dir) {
                 return std::make_shared<Scene>(
-                    Scene{scene::parse_scene(text, origin, base_dir), origin});
+                    Scene{parse_honouring_signals([&](const scene::StopPoll& poll) {
+                              return scene::parse_scene(text, origin, base_dir, poll);
+                          }),
+                          origin});
             },
             py::arg("text"), py::arg("origin") = "<string>", py::arg("base_dir") = "",
             "A scene from TOML text; relative mesh files resolve against base_dir")

@@ -5,6 +5,7 @@
 #include "core/check.hpp"
 #include "levels/diagnoses.hpp"
 #include "levels/level.hpp"
+#include "levels/resources.hpp"
 #include "mesh/mesh.hpp"
 #ifdef MLC_HAVE_CGAL
 #include "mesh/cgal/domain_mesher.hpp"
@@ -38,7 +39,8 @@ using levels::Problem;
 /// Parsing context: the origin for messages and typed getters that fail with file:line.
 class Reader {
 public:
-    explicit Reader(std::string origin) : origin_(std::move(origin)) {}
+    explicit Reader(std::string origin, StopPoll stop = {})
+        : origin_(std::move(origin)), stop_(std::move(stop)) {}
 
     [[noreturn]] void fail(const toml::node* n, const std::string& msg) const {
         std::ostringstream os;
@@ -160,6 +162,8 @@ public:
         return out;
     }
     const std::string& origin() const { return origin_; }
+    /// What the meshing of a domain polls (may be empty).
+    const StopPoll& stop() const { return stop_; }
 
 private:
     double finite(double d, const toml::node* n, const std::string& what) const {
@@ -185,6 +189,7 @@ private:
         }
     }
     std::string origin_;
+    StopPoll stop_;
 };
 
 /// Wraps a library InvalidInput with the scene position of the entry that caused it.
@@ -400,13 +405,31 @@ mesh::Mesh parse_mesh_local(const Reader& rd, const toml::table& t, const std::s
         const toml::node* where_lines = t.get("lines")      ? t.get("lines")
                                         : t.get("mirror_x") ? t.get("mirror_x")
                                                             : &t;
+        // The size of the mesh, predicted before meshing: a size field that cannot fit is
+        // refused at once rather than after minutes of meshing.
+        at(rd, &t, [&] {
+            const mesh::MeshPrediction pred = mesh::predict_mesh_size(loops, sf);
+            const double triangles = (t.get("mirror_x") ? 2 : 1) * pred.triangles;
+            std::ostringstream what, fix;
+            what << std::setprecision(3) << where << ": the mesh is predicted at about "
+                 << triangles << " triangles (" << mesh::kTrianglesPerUnitIntegral
+                 << " x the integral of 1/h^2 over the domain of area " << pred.area
+                 << (t.get("mirror_x") ? ", mirrored" : "") << ", max_size = " << sf.max_size
+                 << ", min_size = " << sf.min_size << ", grading = " << sf.grading << ", "
+                 << sf.focus.size() << " focus point(s))";
+            fix << "raise min_size and max_size"
+                << (sf.min_size < sf.max_size && !sf.focus.empty() ? " (or the grading)" : "");
+            levels::check_meshing_fits(triangles, what.str(), fix.str(),
+                                       levels::process_memory_limit());
+            return 0;
+        });
         if (const toml::node* mx = t.get("mirror_x")) {
             const double x0 = rd.number(mx, where + ".mirror_x");
             const mesh::Mesh half =
-                at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines); });
+                at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines, rd.stop()); });
             return at(rd, mx, [&] { return mesh::mirror_about_x(half, x0); });
         }
-        return at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines); });
+        return at(rd, where_lines, [&] { return mesh::mesh_domain(loops, sf, lines, rd.stop()); });
 #else
         rd.fail(&t, where + ": type \"domain\" needs CGAL (this build has MLC_WITH_CGAL=OFF)");
 #endif
@@ -538,8 +561,8 @@ void recover_levels(levels::Problem& p) {
 } // namespace
 
 levels::Problem parse_scene(const std::string& text, const std::string& origin,
-                            const std::filesystem::path& base_dir) {
-    Reader rd(origin);
+                            const std::filesystem::path& base_dir, const StopPoll& stop) {
+    Reader rd(origin, stop);
     toml::table root;
     try {
         root = toml::parse(text, origin);
@@ -891,12 +914,12 @@ std::string builtin_file_text(const std::string& name) {
     return it == f.end() ? std::string() : it->second;
 }
 
-levels::Problem load_scene(const std::string& name_or_path) {
+levels::Problem load_scene(const std::string& name_or_path, const StopPoll& stop) {
     const std::filesystem::path path(name_or_path);
     const bool looks_like_file = path.extension() == ".toml" || path.has_parent_path();
     if (!looks_like_file || !std::filesystem::exists(path)) {
         const std::string text = builtin_scene_text(name_or_path);
-        if (!text.empty()) return parse_scene(text, "builtin:" + name_or_path);
+        if (!text.empty()) return parse_scene(text, "builtin:" + name_or_path, {}, stop);
     }
     if (!std::filesystem::exists(path)) {
         std::string names;
@@ -912,7 +935,7 @@ levels::Problem load_scene(const std::string& name_or_path) {
     MLC_CHECK(in.good(), "cannot read scene file '" << name_or_path << "'");
     std::stringstream ss;
     ss << in.rdbuf();
-    return parse_scene(ss.str(), path.string(), path.parent_path());
+    return parse_scene(ss.str(), path.string(), path.parent_path(), stop);
 }
 
 } // namespace mlc::scene

@@ -511,7 +511,8 @@ void walk_chord(const CDT& tr, VertexHandle from, VertexHandle to, const Vec2& f
 /// Inserts the boundary, checks and marks the domain (nesting level 1 = inside the outer loop,
 /// outside every hole), and refines it.
 void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<SegmentGeometry>& segs,
-                   const std::vector<LoopPoints>& lines, const SizeFunction& h, Meshed& p) {
+                   const std::vector<LoopPoints>& lines, const SizeFunction& h, Meshed& p,
+                   const StopPoll& stop) {
     std::vector<Vec2> x;
     for (const LoopPoints& lp : loops) {
         const int start = static_cast<int>(x.size()), n = static_cast<int>(lp.x.size());
@@ -665,7 +666,12 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
     SizeFieldCriteria criteria(shape_bound, h);
     CGAL::Delaunay_mesher_2<CDT, SizeFieldCriteria> mesher(p.tr, criteria);
     mesher.init(true); // keep our domain marks
-    mesher.refine_mesh();
+    // refine_mesh() step by step (the same insertions in the same order), so a stop request is
+    // seen: a step inserts one point, a few microseconds.
+    for (std::uint64_t step = 1; mesher.try_one_step_refine_mesh(); ++step)
+        if (stop && step % 2048 == 0 && stop())
+            throw Interrupted("meshing stopped on request after " +
+                              std::to_string(p.tr.number_of_vertices()) + " vertices");
 
     // Walk each input chord along the constrained edges that replaced it.
     p.added.assign(x.size(), {});
@@ -714,8 +720,85 @@ std::uint64_t edge_key(int a, int b) {
 
 } // namespace
 
+MeshPrediction predict_mesh_size(const std::vector<std::vector<Segment>>& loops,
+                                 const SizeField& size) {
+    size.validate();
+    std::vector<Circle> circles;
+    double diameter = 0;
+    const std::vector<SegmentGeometry> segs = resolve_segments(loops, circles, diameter);
+    // Area of each loop: the polygon of its segment ends plus, for each arc, the signed area
+    // between its chord and the arc (r^2 / 2 (theta - sin theta), theta the signed sweep).
+    std::vector<double> loop_area(loops.size(), 0.0);
+    for (const SegmentGeometry& g : segs) {
+        double a = 0.5 * (g.a.x() * g.b.y() - g.b.x() * g.a.y());
+        if (g.arc) a += 0.5 * g.r * g.r * (g.sweep - std::sin(g.sweep));
+        loop_area[static_cast<std::size_t>(g.loop)] += a;
+    }
+    MeshPrediction out;
+    out.area = std::abs(loop_area[0]);
+    for (std::size_t l = 1; l < loop_area.size(); ++l)
+        out.area -= std::abs(loop_area[l]);
+    out.area = std::max(out.area, 0.0);
+    const double M = size.max_size, m = size.min_size > 0 ? size.min_size : size.max_size;
+    const double g = size.grading;
+    double graded = out.area / (M * M);
+    if (m < M && !size.focus.empty()) {
+        // The loops as one polygon set (arcs in pieces of at most 2 degrees), for the even-odd
+        // inside test.
+        std::vector<std::vector<Vec2>> rings(loops.size());
+        for (const SegmentGeometry& sg : segs) {
+            auto& ring = rings[static_cast<std::size_t>(sg.loop)];
+            const int pieces =
+                sg.arc ? std::max(2, static_cast<int>(
+                                         std::ceil(std::abs(sg.sweep) * 90 / std::numbers::pi)))
+                       : 1;
+            for (int k = 0; k < pieces; ++k)
+                ring.push_back(sg.at(static_cast<double>(k) / pieces));
+        }
+        auto inside = [&](const Vec2& q) {
+            bool in = false;
+            for (const auto& ring : rings)
+                for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) {
+                    const Vec2 &a = ring[i], &b = ring[j];
+                    if ((a.y() > q.y()) != (b.y() > q.y()) &&
+                        q.x() < (b.x() - a.x()) * (q.y() - a.y()) / (b.y() - a.y()) + a.x())
+                        in = !in;
+                }
+            return in;
+        };
+        // Per focus point: the integral of 1 / h^2 - 1 / M^2 over its disc r < (M - m) / g
+        // (h = m + g r) within the domain, in u = m + g r on a log scale (32 midpoints), each
+        // ring's share inside the domain sampled at 32 angles. At most 2048 focus points are
+        // integrated; the others count as the mean of those (an even sample of them).
+        constexpr int n_u = 32, n_angle = 32;
+        constexpr std::size_t max_focus = 2048;
+        const std::size_t stride = (size.focus.size() + max_focus - 1) / max_focus;
+        double sum = 0;
+        std::size_t integrated = 0;
+        for (std::size_t f = 0; f < size.focus.size(); f += stride, ++integrated) {
+            const Vec2& c = size.focus[f];
+            const double ds = std::log(M / m) / n_u;
+            for (int i = 0; i < n_u; ++i) {
+                const double u = m * std::exp((i + 0.5) * ds), r = (u - m) / g;
+                int in = 0;
+                for (int k = 0; k < n_angle; ++k) {
+                    const double phi = 2 * std::numbers::pi * (k + 0.5) / n_angle;
+                    in += inside(c + r * Vec2(std::cos(phi), std::sin(phi))) ? 1 : 0;
+                }
+                // 2 pi r dr (1/u^2 - 1/M^2), dr = du / g = u ds / g
+                sum += static_cast<double>(in) / n_angle * 2 * std::numbers::pi * r * u / g * ds *
+                       (1 / (u * u) - 1 / (M * M));
+            }
+        }
+        graded += sum * static_cast<double>(size.focus.size()) / static_cast<double>(integrated);
+    }
+    out.integral = std::min(out.area / (m * m), graded);
+    out.triangles = kTrianglesPerUnitIntegral * out.integral;
+    return out;
+}
+
 Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField& size,
-                 const std::vector<Segment>& lines) {
+                 const std::vector<Segment>& lines, const StopPoll& stop) {
     size.validate();
     std::vector<Circle> circles;
     double diameter = 0;
@@ -763,7 +846,7 @@ Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField
         line_points[l].x.push_back(lgs[l].b);
 
     Meshed result;
-    refine_domain(points, segs, line_points, h, result);
+    refine_domain(points, segs, line_points, h, result, stop);
     // The mesher splits boundary chords where they are encroached; on an arc, move each such
     // vertex radially onto the circle. Arc pieces span at most 15 degrees, so the move is at most
     // 13% of the distance to the nearer chord end, and the triangles around it stay close to

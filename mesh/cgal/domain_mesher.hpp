@@ -4,6 +4,7 @@
 
 #include "mesh/mesh.hpp"
 
+#include <functional>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -59,6 +60,37 @@ struct SizeField {
 /// Prints every field of a SizeField on one line.
 std::ostream& operator<<(std::ostream& os, const SizeField& size);
 
+/// Polled by mesh_domain while it refines (every few thousand inserted points, a few
+/// milliseconds apart): returns true to stop, and mesh_domain then throws mlc::Interrupted. It may
+/// also throw itself. The library sets no signal handlers: a driver passes its stop flag here.
+using StopPoll = std::function<bool()>;
+
+/// What mesh_domain is predicted to make, from the domain and the size field alone (nothing is
+/// meshed).
+struct MeshPrediction {
+    double area = 0;      ///< area of the domain: outer loop less holes (arcs as arcs)
+    double integral = 0;  ///< upper bound of the integral of 1 / h(x)^2 over the domain
+    double triangles = 0; ///< kTrianglesPerUnitIntegral * integral
+};
+
+/// Triangles mesh_domain makes per unit of the integral of 1 / h^2 over the domain (its
+/// triangles have their longest edge <= h and angles >= 20.7 degrees): set a little above the
+/// count per unit integral of the hertz scene's domain and of uniform and graded squares, quarter
+/// discs and discs (tests/mesh/test_mesh_prediction.cpp), so that the prediction is at or just
+/// above the count. Parts of a domain narrower than h get more triangles than predicted (the
+/// angle bound makes them smaller than h there).
+inline constexpr double kTrianglesPerUnitIntegral = 6.0;
+
+/// Predicts the size of mesh_domain(loops, size) before meshing, without meshing:
+/// triangles = kTrianglesPerUnitIntegral * I, I the integral of 1 / h^2 over the domain of area A,
+/// taken as A / M^2 plus, for each focus point, the integral of 1 / h_f^2 - 1 / M^2 over the
+/// part of its disc r < (M - m) / g inside the domain (h_f = m + g r; M = max_size, m = min_size,
+/// g = grading; 32 rings of 32 points each), and at most A / m^2 (h >= m). Overlapping focus
+/// discs are counted each: an upper bound there. Throws InvalidInput for the geometry
+/// mesh_domain refuses (as it would).
+MeshPrediction predict_mesh_size(const std::vector<std::vector<Segment>>& loops,
+                                 const SizeField& size);
+
 /// Meshes a 2D domain with quality triangles (CGAL constrained Delaunay mesher).
 ///
 /// `loops[0]` is the outer boundary, counter-clockwise; each further loop bounds a hole (either
@@ -85,7 +117,11 @@ std::ostream& operator<<(std::ostream& os, const SizeField& size);
 /// the tagged interior lines of the result (Mesh::lines). Each must lie inside the domain; its
 /// ends may be inside or at a loop segment's end, and lines may meet at their ends only
 /// (InvalidInput naming the line otherwise).
+///
+/// The refinement runs one CGAL step at a time (Delaunay_mesher_2::try_one_step_refine_mesh, the
+/// same sequence of insertions as refine_mesh), polling `stop` between steps: a true answer
+/// throws mlc::Interrupted.
 Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField& size,
-                 const std::vector<Segment>& lines = {});
+                 const std::vector<Segment>& lines = {}, const StopPoll& stop = {});
 
 } // namespace mlc::mesh

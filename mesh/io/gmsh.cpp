@@ -2,6 +2,7 @@
 // Gmsh .msh reader: a strict line-by-line parser of the ASCII formats 2.2 and 4.1 that collects
 // nodes and elements, then selects triangles and boundary lines.
 #include "mesh/io/gmsh.hpp"
+#include "mesh/topology.hpp"
 
 #include "core/check.hpp"
 
@@ -607,7 +608,19 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
         // An edge of two selected triangles is a tagged interior line.
         (count == 1 ? m.boundary : m.lines).push_back(be);
     }
-    check_quality(m);
+    // Defects of the mesh name the file, and each triangle its element's line and node ids.
+    try {
+        check_quality(m, [&](int t) {
+            const std::size_t e = tri_element[static_cast<std::size_t>(t)];
+            return "triangle " + std::to_string(t) + " (the element on line " +
+                   std::to_string(d.elem_line[e]) + ", nodes " +
+                   std::to_string(d.node_ids[d.node_begin[e]]) + " " +
+                   std::to_string(d.node_ids[d.node_begin[e] + 1]) + " " +
+                   std::to_string(d.node_ids[d.node_begin[e] + 2]) + ")";
+        });
+    } catch (const InvalidInput& e) {
+        throw InvalidInput(where + ": " + e.what());
+    }
     return m;
 }
 

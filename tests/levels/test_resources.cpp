@@ -196,7 +196,65 @@ TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
     EXPECT_LT(e5.bytes, 5.0 * e4.bytes);
     EXPECT_EQ(e5.largest_level, 5);
     EXPECT_GT(levels::estimate_memory(sizes, schur, true).bytes, e5.bytes);
-    EXPECT_DOUBLE_EQ(e5.bytes, e5.hierarchy_bytes + e5.solver_bytes + 12 * 1048576.0);
+    EXPECT_DOUBLE_EQ(e5.bytes,
+                     e5.hierarchy_bytes + e5.solver_bytes + e5.steps_bytes + 12 * 1048576.0);
+}
+
+TEST(MemoryEstimate, CountsWhatEveryLoadStepKeepsAndTheFiles) {
+    // A 15-vertex block in a million load steps: its reports, contact states and summary, kept
+    // until the files are written, are gigabytes; the hierarchy and solver are kilobytes.
+    auto p = scene::load_scene(std::string(MLC_TEST_DATA_DIR) + "/many_steps.toml");
+    const auto sizes = levels::predict_level_sizes(p);
+    ASSERT_EQ(sizes.size(), 1u);
+    EXPECT_EQ(sizes[0].vertices, 15);
+    EXPECT_EQ(sizes[0].contact_nodes, 5);
+    const levels::LinearSolverSpec schur;
+    const auto one = levels::estimate_memory(sizes, schur, false, {1, false});
+    const auto many = levels::estimate_memory(sizes, schur, false, {1000000, false});
+    const double per_step = levels::kStepBytesPerLevel + 5 * levels::kStepBytesPerContactNode;
+    EXPECT_DOUBLE_EQ(one.steps_bytes, per_step);
+    EXPECT_DOUBLE_EQ(many.steps_bytes, 1e6 * per_step);
+    EXPECT_DOUBLE_EQ(many.bytes - one.bytes, (1e6 - 1) * per_step);
+    EXPECT_DOUBLE_EQ(many.output_bytes,
+                     1e6 * (levels::kOutputBytesPerLevel + 5 * levels::kOutputBytesPerContactNode));
+    // Kept step states: two doubles per vertex and step more; coarse-to-fine on two levels: the
+    // reports of both.
+    const auto kept = levels::estimate_memory(sizes, schur, false, {1000000, true});
+    EXPECT_DOUBLE_EQ(kept.steps_bytes - many.steps_bytes, 1e6 * 15 * 16);
+    p.levels = 1;
+    const auto two = levels::predict_level_sizes(p);
+    const auto c2f = levels::estimate_memory(two, schur, true, {1000, false});
+    EXPECT_DOUBLE_EQ(c2f.steps_bytes,
+                     1000 * (2 * levels::kStepBytesPerLevel +
+                             two.back().contact_nodes * levels::kStepBytesPerContactNode));
+    // Refused when it does not fit, saying it is the load steps.
+    try {
+        levels::check_memory_fits(many, {0.5 * many.bytes, "a test limit"}, sizes);
+        ADD_FAILURE() << "not refused";
+    } catch (const InvalidInput& ex) {
+        const std::string m = ex.what();
+        EXPECT_NE(m.find("for what every load step keeps until the files are written"),
+                  std::string::npos)
+            << m;
+        EXPECT_NE(m.find("use fewer load steps"), std::string::npos) << m;
+    }
+}
+
+TEST(MemoryEstimate, MeshingATriangleCountThatCannotFitIsRefused) {
+    EXPECT_DOUBLE_EQ(levels::level_size_from_triangles(1000).vertices, 500);
+    EXPECT_DOUBLE_EQ(levels::level_size_from_triangles(1000).edges, 1500);
+    EXPECT_GT(levels::meshing_memory(1e6), levels::kMeshingBytesPerTriangle * 1e6);
+    EXPECT_NO_THROW(levels::check_meshing_fits(1e6, "m", "f", {1e15, "test"}));
+    try {
+        levels::check_meshing_fits(1e9, "the mesh", "raise max_size", {1e9, "a test limit"});
+        ADD_FAILURE() << "not refused";
+    } catch (const InvalidInput& ex) {
+        EXPECT_EQ(std::string(ex.what()).rfind("the mesh needs an estimated ", 0), 0u) << ex.what();
+        EXPECT_NE(std::string(ex.what()).find("but this process may use 954 MiB (a test limit): "
+                                              "raise max_size"),
+                  std::string::npos)
+            << ex.what();
+    }
 }
 
 TEST(MemoryEstimate, ARunThatCannotFitIsRefusedBeforeAllocatingNamingLevelAndLimit) {

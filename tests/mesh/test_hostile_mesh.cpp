@@ -82,9 +82,19 @@ TEST(CheckQuality, EveryPairCloserThanTheToleranceIsADuplicate) {
                     << e.what();
             }
         }
+        // Farther than the tolerance: no duplicate. The added triangle overlaps the mesh, with
+        // vertex 1 = (0.5, 0) inside its edge (0, 2), which the topology check (after the
+        // duplicate-vertex one) refuses as a hanging node.
         auto apart = m;
         apart.vertices.push_back(m.vertices[4] + 3 * tol * dir);
         apart.triangles.push_back({0, 2, apart.n_vertices() - 1});
-        EXPECT_NO_THROW(mesh::check_quality(apart)) << "direction " << k;
+        try {
+            mesh::check_quality(apart);
+            ADD_FAILURE() << "the overlapping triangle was accepted in direction " << k;
+        } catch (const InvalidInput& e) {
+            EXPECT_NE(std::string(e.what()).find("hanging node (T-junction): vertex 1 (0.5, 0)"),
+                      std::string::npos)
+                << "direction " << k << ": " << e.what();
+        }
     }
 }
