@@ -110,17 +110,16 @@ void pin_held_components(const Problem& problem, Level& L) {
         const Vec2& x = L.mesh.vertices[static_cast<size_t>(v)];
         const char* held = L.fixed[static_cast<size_t>(v)][0] ? "u_x" : "u_y";
         MLC_CHECK(!h.ambiguous,
-                  "contact '"
-                      << problem.contacts[static_cast<size_t>(e.pair)].name << "': contactor vertex "
-                      << v << " at (" << x.x() << ", " << x.y() << ") has " << held
-                      << " prescribed by a support"
-                      << (e.n_nodes == 1 ? "" : " (and so have its target vertices)")
-                      << ", but the contact normal there, (" << e.n.x() << ", " << e.n.y()
-                      << "), is neither along nor across that direction: with friction the "
-                         "support and the contact would share a force direction and their "
-                         "reactions would not be unique. Prescribe both components of that "
-                         "vertex, release its "
-                      << held << ", or leave it out of the contact (its region)");
+                  "contact '" << problem.contacts[static_cast<size_t>(e.pair)].name
+                              << "': contactor vertex " << v << " at (" << x.x() << ", " << x.y()
+                              << ") has " << held << " prescribed by a support"
+                              << (e.n_nodes == 1 ? "" : " (and so have its target vertices)")
+                              << ", but the contact normal there, (" << e.n.x() << ", " << e.n.y()
+                              << "), is neither along nor across that direction: with friction the "
+                                 "support and the contact would share a force direction and their "
+                                 "reactions would not be unique. Prescribe both components of that "
+                                 "vertex, release its "
+                              << held << ", or leave it out of the contact (its region)");
         e.pinned = h.pinned;
     }
 }

@@ -21,9 +21,7 @@ struct ContactNodes {
     /// bit 0 lambda_t, bit 1 lambda_n). Empty: none.
     std::vector<unsigned char> pinned;
     /// true when component c (0 = t, 1 = n) of node i is pinned.
-    bool is_pinned(size_t i, int c) const {
-        return !pinned.empty() && (pinned[i] >> c & 1) != 0;
-    }
+    bool is_pinned(size_t i, int c) const { return !pinned.empty() && (pinned[i] >> c & 1) != 0; }
 };
 
 /// How Q treats the ends of a contact boundary.

@@ -55,10 +55,10 @@ TEST(HeldComponents, AnInclinedFrameWithFrictionIsAmbiguousOnlyWhereAComponentIs
     EXPECT_EQ(f.pinned, 0);
     // Within the tolerance a direction counts as held; beyond it, not.
     const double a = 0.5 * contact::kHeldDirectionTolerance;
-    EXPECT_EQ(contact::held_components(rigid(Vec2(std::sin(a), std::cos(a)), 0.5),
-                                       Fixed{{true, false}})
-                  .pinned,
-              kT);
+    EXPECT_EQ(
+        contact::held_components(rigid(Vec2(std::sin(a), std::cos(a)), 0.5), Fixed{{true, false}})
+            .pinned,
+        kT);
     EXPECT_TRUE(contact::held_components(rigid(Vec2(std::sin(4 * a), std::cos(4 * a)), 0.5),
                                          Fixed{{true, false}})
                     .ambiguous);
@@ -72,15 +72,14 @@ TEST(HeldComponents, TwoBodiesPinOnlyWhereTheTargetIsHeldToo) {
     EXPECT_EQ(contact::held_components(e, Fixed{{true, false}, {true, true}}).pinned, kT);
     // Node on facet: every target vertex with a nonzero weight must hold the component.
     const auto f = contact::node_on_facet(0, 1, 2, 0.25, Vec2(0, 1), 0.0, 0.5, 1.0, 0);
-    EXPECT_EQ(contact::held_components(f, Fixed{{true, false}, {true, false}, {false, false}})
-                  .pinned,
-              0);
+    EXPECT_EQ(
+        contact::held_components(f, Fixed{{true, false}, {true, false}, {false, false}}).pinned, 0);
     EXPECT_EQ(
         contact::held_components(f, Fixed{{true, false}, {true, false}, {true, false}}).pinned, kT);
     const auto g = contact::node_on_facet(0, 1, 2, 0.0, Vec2(0, 1), 0.0, 0.5, 1.0, 0);
-    EXPECT_EQ(contact::held_components(g, Fixed{{true, false}, {true, false}, {false, false}})
-                  .pinned,
-              kT); // vertex 2 has weight 0
+    EXPECT_EQ(
+        contact::held_components(g, Fixed{{true, false}, {true, false}, {false, false}}).pinned,
+        kT); // vertex 2 has weight 0
 }
 
 TEST(HeldComponents, APinnedTangentProjectsOnTheNormalAlone) {
