@@ -123,6 +123,39 @@ ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, d
     return with_frame(e, n, g0, mu, r, pair);
 }
 
+HeldComponents held_components(const ContactElement& e,
+                               const std::vector<std::array<bool, 2>>& fixed) {
+    std::array<bool, 2> held = {true, true}; // components prescribed at every vertex
+    for (int j = 0; j < e.n_nodes; ++j) {
+        if (e.weight[static_cast<size_t>(j)] == 0.0) continue;
+        const auto& f = fixed[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])];
+        for (size_t c = 0; c < 2; ++c)
+            held[c] = held[c] && f[c];
+    }
+    HeldComponents out;
+    if (!held[0] && !held[1]) return out;
+    // The part of a unit direction along the components left free somewhere.
+    auto is_held = [&](const Vec2& g) {
+        double free2 = 0.0;
+        for (int c = 0; c < 2; ++c)
+            if (!held[static_cast<size_t>(c)]) free2 += g[c] * g[c];
+        return std::sqrt(free2) <= kHeldDirectionTolerance;
+    };
+    if (is_held(e.n)) {
+        out.pinned = ContactElement::kPinnedN;
+        if (e.frictional()) out.pinned |= ContactElement::kPinnedT;
+        return out;
+    }
+    if (!e.frictional()) return out; // n alone, not held, never along the held span then
+    if (is_held(e.t)) {
+        out.pinned = ContactElement::kPinnedT;
+        return out;
+    }
+    // (t, n) spans the plane: it meets the held components without lying in them.
+    out.ambiguous = true;
+    return out;
+}
+
 ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vector& u_prev_full,
                       const Vector& x, int lambda_dof) {
     Vec2 du = Vec2::Zero(), du_prev = Vec2::Zero();
@@ -134,11 +167,21 @@ ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vecto
     ElementState s;
     s.d_n = e.g0 + e.n.dot(du);
     s.d_t = e.t.dot(du - du_prev);
-    if (e.frictional()) {
+    if (e.frictional())
         s.lambda = {x[lambda_dof], x[lambda_dof + 1]};
-        s.proj = project(s.lambda[0] + e.r * s.d_t, s.lambda[1] + e.r * s.d_n, e.mu);
-    } else {
+    else
         s.lambda = {0.0, x[lambda_dof]};
+    if (e.pinned & ContactElement::kPinnedN) return s; // Phi = 0, M = 0, status gap
+    if (e.frictional()) {
+        // A pinned tangent projects as sigma_t = 0: the status follows the normal alone.
+        const bool pin_t = (e.pinned & ContactElement::kPinnedT) != 0;
+        s.proj = project(pin_t ? 0.0 : s.lambda[0] + e.r * s.d_t, s.lambda[1] + e.r * s.d_n, e.mu);
+        if (pin_t) {
+            s.proj.phi[0] = 0.0;
+            s.proj.M.row(0).setZero();
+            s.proj.M.col(0).setZero();
+        }
+    } else {
         s.proj = project(0.0, s.lambda[1] + e.r * s.d_n, 0.0);
         s.proj.M(0, 0) = 0.0; // no tangential unknown: keep M_tt out of the tangent
     }

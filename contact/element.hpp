@@ -60,10 +60,42 @@ struct ContactElement {
     double mu = 0.0;         ///< Coulomb coefficient (0: frictionless)
     double r = 1.0;          ///< augmentation parameter (force / length)
     int pair = 0;            ///< index of the contact pair in the scene
+    /// Multiplier components pinned to zero because supports prescribe the relative displacement
+    /// along them (kPinnedT, kPinnedN; pin_held_components). A pinned component keeps its
+    /// unknown, but its Phi and its row and column of M are zero: its equation reads
+    /// lambda = 0, and the reaction goes to the support. A pinned normal pins every component
+    /// (a contact that carries no normal force carries no friction).
+    unsigned char pinned = 0;
     /// Frictional elements carry (lambda_t, lambda_n); frictionless ones lambda_n only.
     bool frictional() const { return mu > 0.0; }
     int n_multipliers() const { return frictional() ? 2 : 1; }
+    /// Bits of `pinned`, one per local component (a 3D element would have one per tangent).
+    static constexpr unsigned char kPinnedT = 1, kPinnedN = 2;
 };
+
+/// Directions closer than this (in the norm of their free part, for unit directions) to the
+/// span of the prescribed displacement components count as held.
+inline constexpr double kHeldDirectionTolerance = 1e-8;
+
+/// What the supports leave of an element's multipliers (held_components).
+struct HeldComponents {
+    unsigned char pinned = 0; ///< ContactElement::pinned for the element
+    /// true when a multiplier component the supports do not hold still has a part along a
+    /// held direction (an obstacle inclined to a support's axes, with friction): the support
+    /// and the contact then share a force direction and the multipliers are not unique.
+    bool ambiguous = false;
+};
+
+/// The multiplier components of `e` along which every vertex of the element (nonzero weight)
+/// has its displacement prescribed, fixed[v][c] true when component c of vertex v is: the
+/// relative displacement along them is prescribed, so their equation d = 0 holds no unknown
+/// and their multiplier appears in no equation. A direction g counts as held when its part
+/// along the components some vertex leaves free has norm at most kHeldDirectionTolerance. The
+/// normal held pins every component; otherwise a held tangent pins lambda_t. Rigid obstacles
+/// (one vertex) pin where the contactor's components are held; two-body elements only where
+/// the target vertices' matching components are held too.
+HeldComponents held_components(const ContactElement& e,
+                               const std::vector<std::array<bool, 2>>& fixed);
 
 /// Node-on-rigid elements for the given contactor vertices against an obstacle.
 std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector<int>& contactors,
@@ -100,6 +132,10 @@ struct ElementState {
 /// Evaluates element e: relative displacements from the full nodal displacement vectors
 /// (2 per vertex) of the current iterate and of the previous converged load step, and the
 /// multipliers from the unknowns x at `lambda_dof` (lambda_t then lambda_n, or lambda_n alone).
+/// Pinned components (ContactElement::pinned): a pinned tangent projects as sigma_t = 0 (stick
+/// or gap by the normal alone) with Phi_t = 0 and M's t row and column zero; a pinned normal
+/// gives Phi = 0, M = 0 and status gap. Either way a pinned component's residual row reads
+/// -lambda / r and its tangent row and column hold only -1 / r on the diagonal.
 ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vector& u_prev_full,
                       const Vector& x, int lambda_dof);
 

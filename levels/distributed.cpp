@@ -144,6 +144,7 @@ transfer::ContactNodes DistributedLevel::contact_nodes() const {
             c.vertex.push_back(v);
             c.lambda_dof.push_back(local.dofs.extra_dof(v));
             c.n_multipliers.push_back(n_extra[static_cast<size_t>(v)]);
+            c.pinned.push_back(pinned[static_cast<size_t>(v)]);
         }
     return c;
 }
@@ -230,6 +231,18 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
                                                << "' has no contactor node on '"
                                                << problem.contacts[p].contactor << "'");
     d.n_global_contacts = comm.sum(d.local.n_contact_nodes());
+    // The pinned components of every local contact node, ghosts from their owners (the owner
+    // decides them once it knows the supports of its element's vertices).
+    {
+        std::vector<double> rec(static_cast<size_t>(nv), 0.0);
+        for (const auto& e : d.local.contacts)
+            rec[static_cast<size_t>(e.vertex[0])] = e.pinned;
+        d.ghosts.vertex_records(rec, 1);
+        d.pinned.resize(static_cast<size_t>(nv));
+        for (int v = 0; v < nv; ++v)
+            d.pinned[static_cast<size_t>(v)] =
+                static_cast<unsigned char>(rec[static_cast<size_t>(v)]);
+    }
 
     // Owned unknowns first (the order puts the owned vertices first).
     const auto& dofs = d.local.dofs;

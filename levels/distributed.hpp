@@ -65,6 +65,9 @@ struct DistributedLevel {
     mesh::LocalLevel part;    ///< the local mesh moved into `local`: part.mesh is empty
     Level local;              ///< the part as a Level (owned unknowns first)
     std::vector<int> n_extra; ///< multipliers per local vertex (ghosts: their owners')
+    /// Multiplier components pinned by supports per local vertex (ContactElement::pinned;
+    /// ghosts: their owners'), for the transfers.
+    std::vector<unsigned char> pinned;
     GhostExchange ghosts;
     Index n_owned = 0;                    ///< owned unknowns: local unknowns [0, n_owned)
     std::int64_t first_dof = 0;           ///< global number of local unknown 0

@@ -12,6 +12,7 @@ transfer::ContactNodes contact_nodes(const Level& level) {
         c.vertex.push_back(level.contacts[e].vertex[0]);
         c.lambda_dof.push_back(level.lambda_dof[e]);
         c.n_multipliers.push_back(level.contacts[e].n_multipliers());
+        c.pinned.push_back(level.contacts[e].pinned);
     }
     return c;
 }

@@ -98,6 +98,32 @@ void build_ghost_contacts(const Problem& problem, Level& L, const std::vector<in
     }
 }
 
+/// Sets ContactElement::pinned of every element of L (its own and its ghost elements) from the
+/// fixed components of its vertices (contact::held_components); throws InvalidInput for an
+/// element of L's own whose supports and contact frame share a direction only in part.
+void pin_held_components(const Problem& problem, Level& L) {
+    for (auto& e : L.ghost_contacts)
+        e.pinned = contact::held_components(e, L.fixed).pinned; // refused by their owners
+    for (auto& e : L.contacts) {
+        const auto h = contact::held_components(e, L.fixed);
+        const int v = e.vertex[0];
+        const Vec2& x = L.mesh.vertices[static_cast<size_t>(v)];
+        const char* held = L.fixed[static_cast<size_t>(v)][0] ? "u_x" : "u_y";
+        MLC_CHECK(!h.ambiguous,
+                  "contact '" << problem.contacts[static_cast<size_t>(e.pair)].name
+                              << "': contactor vertex " << v << " at (" << x.x() << ", " << x.y()
+                              << ") has " << held << " prescribed by a support"
+                              << (e.n_nodes == 1 ? "" : " (and so have its target vertices)")
+                              << ", but the contact normal there, (" << e.n.x() << ", " << e.n.y()
+                              << "), is neither along nor across that direction: with friction the "
+                                 "support and the contact would share a force direction and their "
+                                 "reactions would not be unique. Prescribe both components of that "
+                                 "vertex, release its "
+                              << held << ", or leave it out of the contact (its region)");
+        e.pinned = h.pinned;
+    }
+}
+
 } // namespace
 
 Vector Level::u_fixed_at(double s) const {
@@ -230,6 +256,7 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
         part->complete(L, n_extra, contact_pair);
         build_ghost_contacts(problem, L, contact_pair, owned);
     }
+    pin_held_components(problem, L);
     std::vector<int> order;
     std::optional<mesh::MacroLattice> lattice;
     if (part) {

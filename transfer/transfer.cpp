@@ -44,6 +44,9 @@ void csr_apply(const SparseMatrix& A, const Vector& x, Vector& y, const char* wh
 /// Checks one level's contact nodes against its numbering; returns node index per vertex.
 std::vector<int> node_of_vertex(const ContactNodes& c, const fem::DofMap& dofs, const char* level) {
     const size_t n = c.vertex.size();
+    MLC_CHECK(c.pinned.empty() || c.pinned.size() == n,
+              level << " contact nodes: " << n << " vertices but " << c.pinned.size()
+                    << " pinned masks; give one per node or none");
     MLC_CHECK(c.lambda_dof.size() == n && c.n_multipliers.size() == n,
               level << " contact nodes: " << n << " vertices, " << c.lambda_dof.size()
                     << " lambda_dof, " << c.n_multipliers.size()
@@ -192,9 +195,10 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
         const int nm = fine_contacts.n_multipliers[static_cast<size_t>(j)];
         for (int q = 0; q < nm; ++q) {
             const int c = component_of_slot(nm, q);
+            if (fine_contacts.is_pinned(static_cast<size_t>(j), c)) continue;
             for (int p : fine.parents[static_cast<size_t>(v - nc)]) {
                 const int i = cnode[static_cast<size_t>(p)];
-                if (i < 0) continue;
+                if (i < 0 || coarse_contacts.is_pinned(static_cast<size_t>(i), c)) continue;
                 const int qc =
                     slot_of_component(coarse_contacts.n_multipliers[static_cast<size_t>(i)], c);
                 if (qc >= 0) f(q, c, i, qc);

@@ -17,6 +17,11 @@ struct ContactNodes {
     std::vector<int> vertex;        ///< contactor vertex
     std::vector<int> lambda_dof;    ///< first multiplier unknown
     std::vector<int> n_multipliers; ///< 1 (lambda_n) or 2 (lambda_t, lambda_n)
+    /// Per node, the components pinned to zero by supports (contact::ContactElement::pinned:
+    /// bit 0 lambda_t, bit 1 lambda_n). Empty: none.
+    std::vector<unsigned char> pinned;
+    /// true when component c (0 = t, 1 = n) of node i is pinned.
+    bool is_pinned(size_t i, int c) const { return !pinned.empty() && (pinned[i] >> c & 1) != 0; }
 };
 
 /// How Q treats the ends of a contact boundary.
@@ -85,7 +90,10 @@ struct LevelTransfer {
 ///   contact midpoint of (a, b): lambda_h(c) = (lambda_H(a, c) + lambda_H(b, c)) / 4,
 /// where a parent that is not a coarse contact node, or lacks component c, contributes 0 (the
 /// square's fully fixed corner). A fine contact midpoint neither of whose parents is a coarse
-/// contact node therefore gets 0: it has no coarse force to inherit.
+/// contact node therefore gets 0: it has no coarse force to inherit. A component pinned by
+/// supports (ContactNodes::pinned) neither receives nor gives at a midpoint: a pinned
+/// multiplier is zero, and a correction of it must not reach a free one (a coarse vertex keeps
+/// its w lambda_H, zero on both levels where it is pinned on both).
 ///
 /// Throws InvalidInput when the meshes, numberings or contact nodes do not nest.
 LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
