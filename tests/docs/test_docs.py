@@ -331,6 +331,24 @@ def test_exit_codes_of_the_driver_are_the_documented_ones(tmp_path):
     nc = run_cli(["run", "short.toml", "--quiet", "--no-continuation", "--linear", "schur",
                   "--out", str(tmp_path / "nc")], tmp_path)
     assert nc.returncode == 2 and "did not converge" in table[2], (nc.returncode, nc.stderr)
+    # A command-line parse error is bad input too, with the same prefix.
+    typo = run_cli(["run", "square", "--levls", "1"], tmp_path)
+    assert typo.returncode == 1 and typo.stderr.startswith("mlcontact: error: "), typo.stderr
+    # A NaN or Inf residual is a numerical breakdown.
+    nf = run_cli(["run", os.path.join(SRC, "tests", "data", "nonfinite_residual.toml"), "--quiet",
+                  "--out", str(tmp_path / "nf")], tmp_path)
+    assert nf.returncode == 3 and "breakdown" in table[3], (nf.returncode, nf.stderr)
+    # A plot that fails after the results were written: a matplotlib that cannot be imported.
+    broken = tmp_path / "site" / "matplotlib"
+    broken.mkdir(parents=True)
+    (broken / "__init__.py").write_text('raise RuntimeError("this matplotlib is broken")\n')
+    env = dict(os.environ, OMPI_MCA_ess_singleton_isolated="1", PYTHONPATH=str(tmp_path / "site"))
+    pl = subprocess.run([CLI, "run", "patch_matching", "--quiet", "--plot",
+                         "--out", str(tmp_path / "plot")], cwd=tmp_path, env=env,
+                        capture_output=True, text=True, timeout=300)
+    assert pl.returncode == 4 and "plot" in table[4], (pl.returncode, pl.stderr)
+    assert (tmp_path / "plot" / "contact.csv").exists()
+    assert not (tmp_path / "plot" / "contact.png").exists()
 
 
 @pytest.mark.parametrize("sig,code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
