@@ -726,7 +726,7 @@ OutputFolder::OutputFolder(std::filesystem::path dir, bool lock) : dir_(std::mov
     std::error_code ec;
     if (std::filesystem::exists(dir_, ec) && !std::filesystem::is_directory(dir_, ec))
         folder_error(dir_, "is not a folder (a file of that name exists); choose another --out");
-    std::filesystem::create_directories(dir_, ec);
+    created_ = std::filesystem::create_directories(dir_, ec);
     if (ec)
         folder_error(dir_, "cannot be created: " + ec.message() +
                                "; choose a writable folder with --out");
@@ -790,6 +790,9 @@ OutputFolder::~OutputFolder() {
     lock_registered_.reset();
     ::unlink((dir_ / lock_name).c_str()); // while still holding it (see the constructor)
     ::close(lock_fd_);
+    // A run refused or failed before its first file leaves no folder it made (only if empty).
+    std::error_code ec;
+    if (created_ && !begun_) std::filesystem::remove(dir_, ec);
 }
 
 void OutputFolder::begin_writing(const std::string& scene) {

@@ -103,7 +103,7 @@ void write_iterations_csv(const std::filesystem::path& file,
 /// lock and writing the id (with fsync) is also the probe that files can be written there, so a
 /// read-only or full file system is found before the solve. Another live run holding the lock:
 /// refused at once. Every failure throws InvalidInput naming the folder. The lock file is removed
-/// when the object is destroyed.
+/// when the object is destroyed, and so is the folder when this run made it and wrote nothing.
 ///
 /// begin_writing(), before this run's first file: removes the files listed in the folder's
 /// summary.json when that summary is complete (a finished earlier run of this folder; only names
@@ -138,6 +138,7 @@ private:
     /// The lock file, removed by a signal handler that ends the process at once.
     std::optional<RegisteredTemporary> lock_registered_;
     long took_over_from_ = 0;
+    bool created_ = false; ///< this run made the folder (removed at the end if still empty)
     bool begun_ = false;
     std::vector<std::string> files_, removed_;
 };

@@ -117,8 +117,10 @@ def test_warnings_and_not_applicable_checks_reach_summary_json(tmp):
     assert summary["warnings"] == rolls.warnings
     assert summary["checks"]["force_balance_applicable"] is True
     apart = mlcontact.solve(mlcontact.Scene.from_file(os.path.join(DATA, "hostile", "bodies_apart.toml")))
-    assert apart.warnings == [] and apart.checks["force_balance"] is None
+    # Apart by 0.5, a fifth of the lid's size: the initial-gap warning, and no other.
+    assert len(apart.warnings) == 1 and apart.warnings[0].startswith("contact 'contact1': initial gap 0.5")
+    assert apart.checks["force_balance"] is None
     apart.write(str(tmp / "apart"))
     summary = json.load(open(tmp / "apart" / "summary.json"))
-    assert summary["warnings"] == []
+    assert summary["warnings"] == apart.warnings
     assert summary["checks"]["force_balance_applicable"] is False and "force_balance" not in summary["checks"]
