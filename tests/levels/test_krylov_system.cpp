@@ -256,8 +256,9 @@ TEST(KrylovSystem, CoarseFineVariantsSolveTheFineSystem) {
     // The coarse LU and the coarse Newton-system solver are the same exact A_H^{-1}.
     EXPECT_EQ(solve_with("cgs", "cf:coarse=solver").result.iterations, cf.result.iterations);
     // The paper's inner CGS makes the preconditioner vary: outer CGS and GMRES (which assume a
-    // fixed one) fail, BiCGStab copes when the inner solve is tight enough.
-    const Outcome inner = solve_with("bicgstab", "cf:inner=cgs,tol=1e-6");
+    // fixed one) fail, BiCGStab copes when the inner solve is tight enough (at 1e-6 it copes or
+    // stagnates by the last bits of the coarse factorization, which depend on the processor).
+    const Outcome inner = solve_with("bicgstab", "cf:inner=cgs,tol=1e-8");
     EXPECT_TRUE(inner.result.converged) << inner.result;
     EXPECT_LT(inner.true_rel, 1e-8);
 }
