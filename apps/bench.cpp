@@ -914,7 +914,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     for (int t : opt.threads)
         MLC_CHECK(t >= 1 && t <= 256, "bench newton: --threads must be in 1..256, found " << t);
     check_preconditioner_names({opt.pc, opt.mgr});
-    MLC_CHECK(solvers::find_preconditioner(opt.mgr)->name == "mgr",
+    MLC_CHECK(solvers::parse_pc(opt.mgr).entry->name == "mgr",
               "bench newton: --mgr must be an mgr spec (mgr[:options]), found '" << opt.mgr << "'");
     MLC_CHECK(solvers::have_hypre(),
               "bench newton compares with hypre MGR and BoomerAMG: this build has "

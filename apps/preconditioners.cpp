@@ -5,6 +5,8 @@
 #include "core/check.hpp"
 #include "solvers/factory.hpp"
 
+#include <cctype>
+
 namespace mlc::apps {
 
 std::string pc_option_help(const std::string& lead) {
@@ -15,11 +17,12 @@ std::string pc_option_help(const std::string& lead) {
 void print_preconditioners(std::ostream& os) {
     os << "preconditioners (--pc NAME[:key=value,...]; each implies a Krylov solve):\n";
     for (const auto& e : solvers::preconditioner_registry()) {
-        os << "  " << e.usage << "\n";
+        os << "  " << e.usage() << "\n";
         os << "      options: ";
-        if (e.options.empty()) os << "none";
-        for (size_t i = 0; i < e.options.size(); ++i)
-            os << (i ? ", " : "") << e.options[i];
+        const std::vector<solvers::PcKey> keys = e.keys();
+        if (keys.empty()) os << "none";
+        for (size_t i = 0; i < keys.size(); ++i)
+            os << (i ? ", " : "") << keys[i].name;
         if (!e.positional_key.empty()) os << " (a bare value is " << e.positional_key << ")";
         os << "\n      built from: "
            << (e.needs_level_below && e.single_level_too
@@ -35,10 +38,16 @@ void print_preconditioners(std::ostream& os) {
 void check_preconditioner_names(const std::vector<std::string>& specs, bool direct) {
     for (const auto& s : specs) {
         if (direct && (s == "schur" || s == "lu")) continue;
-        MLC_CHECK(solvers::find_preconditioner(s) != nullptr,
+        std::string name = s.substr(0, s.find(':'));
+        name.erase(0, name.find_first_not_of(" \t"));
+        name.erase(name.find_last_not_of(" \t") + 1);
+        for (char& c : name)
+            c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        MLC_CHECK(solvers::preconditioner_entry(name) != nullptr,
                   "unknown preconditioner '"
                       << s << "'; valid: " << (direct ? "schur, lu (direct), " : "")
                       << solvers::preconditioner_names(", "));
+        (void)solvers::parse_pc(s); // its options too
     }
 }
 

@@ -249,7 +249,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     so.progress = opt.quiet ? nullptr : &out;
     MLC_CHECK(!opt.stop, "internal error: a distributed run has no stop flag");
     os << "mlcontact: solving '" << p.name << "' on " << comm.size() << " processes\n";
-    const bool mg = solvers::parse_preconditioner_spec(spec.pc).name == "mg";
+    const bool mg = solvers::parse_pc(spec.pc).name() == "mg";
     os << "Newton-system solver: " << spec << " (" << comm.size() << " processes: "
        << (mg ? std::string("Krylov + distributed mg")
               : "Krylov + " + spec.pc +

@@ -27,8 +27,8 @@ struct DistributedMultigrid::Impl {
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
          LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
-          use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"),
-          use_ebe_(solvers::parse_preconditioner_spec(spec_.pc).name == "ebe"), op_(levels.size()) {
+          use_mg_(solvers::parse_pc(spec_.pc).name() == "mg"),
+          use_ebe_(solvers::parse_pc(spec_.pc).name() == "ebe"), op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k)
             build_jacobian(k);
     }
@@ -477,44 +477,19 @@ solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
                   << spec.method
                   << "' has no distributed form (schur, lu, cf and sorcf need the "
                      "whole level on one process)");
-    const auto ps = solvers::parse_preconditioner_spec(spec.pc);
-    solvers::MultigridParams p;
-    if (ps.name != "mg") {
-        // A preconditioner of the matrix alone runs on each process's diagonal block.
-        const solvers::PreconditionerEntry* e = solvers::find_preconditioner(spec.pc);
-        MLC_CHECK(e && (!e->level_aware || e->name == "ebe"),
-                  "on several processes the preconditioner is mg, ebe, or one that needs the "
-                  "matrix alone (diag, ilu, sor, ...) on each process's diagonal block; '"
-                      << spec.pc
-                      << "' has no distributed form (cf, sorcf and mgr need the whole level: "
-                         "run it on one process)");
-        // Its options checked here, on every process (ebe: on no elements, not set up).
+    const solvers::PcSpec pc = solvers::parse_pc(spec.pc);
+    const std::string why = pc.distributed();
+    MLC_CHECK(why.empty(), why);
+    if (pc.name() != "mg") {
+        // A preconditioner of the matrix alone (or ebe) runs on each process's diagonal block;
+        // its options checked here, on every process (ebe: on no elements, not set up).
         static const std::vector<smoothers::ElementMatrix> none;
         solvers::LevelData d;
         d.elements = [] { return &none; };
-        solvers::make_preconditioner(spec.pc, e->level_aware ? &d : nullptr);
-        return p;
+        solvers::make_preconditioner(pc, pc.entry->level_aware ? &d : nullptr);
+        return {};
     }
-    solvers::SpecOptions o(ps);
-    p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
-    p.post_sweeps = o.get_int("post", p.post_sweeps);
-    p.omega = o.get_double("omega", p.omega);
-    const std::string coarse = o.get_string("coarse", "rediscretize");
-    MLC_CHECK(coarse == "rediscretize",
-              "mg:coarse=" << coarse
-                           << " has no distributed form; on several processes mg rediscretizes "
-                              "(coarse=rediscretize)");
-    const std::string precision = o.get_string("precision", "double");
-    MLC_CHECK(precision == "double",
-              "mg:precision=" << precision
-                              << " has no distributed form; on several processes mg's data is "
-                                 "double (precision=double)");
-    const std::string smoother = o.get_string("smoother", "block");
-    MLC_CHECK(smoother == "block",
-              "mg:smoother=" << smoother
-                             << " has no distributed form; on several processes mg smooths by "
-                                "vertex blocks (smoother=block)");
-    o.finish();
+    const solvers::MultigridParams p = pc.get<solvers::MgOptions>().cycle();
     p.validate();
     return p;
 }

@@ -61,7 +61,7 @@ public:
         params_.give_up_budget = spec.give_up_budget;
         params_.validate();
         if (below != nullptr && below->available()) below_ = below;
-        const solvers::PreconditionerEntry* entry = solvers::find_preconditioner(spec.pc);
+        const solvers::PreconditionerEntry* entry = solvers::parse_pc(spec.pc).entry;
         const solvers::LevelData data = level_data(entry);
         pc_ = solvers::make_preconditioner(spec.pc, &data);
         // Only the level-aware entries need the level below's statuses; mg also needs its

@@ -126,7 +126,7 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
             s.pc = *req.pc;
             c.reason = "Krylov solve with --pc " + s.pc + " as requested";
             // The registry says what the name is and whether it needs the level below.
-            const solvers::PreconditionerEntry* entry = solvers::find_preconditioner(s.pc);
+            const solvers::PreconditionerEntry* entry = solvers::parse_pc(s.pc).entry;
             MLC_CHECK(entry != nullptr,
                       "unknown preconditioner '"
                           << s.pc << "'; valid: " << solvers::preconditioner_names(", ")
@@ -233,7 +233,7 @@ MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const Linear
             b = kCholeskyPerNonzero * s.k_nonzeros * std::max(1.0, std::log2(s.unknowns) / 4) +
                 3 * 8.0 * m * m;
         if (method == "krylov" && finest == 0) {
-            const solvers::PreconditionerEntry* pc = solvers::find_preconditioner(spec.pc);
+            const solvers::PreconditionerEntry* pc = solvers::parse_pc(spec.pc).entry;
             if (pc != nullptr && pc->name == "mg") b += kAggregationPerNonzero * s.k_nonzeros;
         }
         e.solver_bytes += b;

@@ -31,7 +31,7 @@ namespace {
 // The registry says which preconditioners use the level below.
 bool needs_coarse_level(const LinearSolverSpec& spec) {
     if (spec.method != "krylov") return false;
-    const solvers::PreconditionerEntry* entry = solvers::find_preconditioner(spec.pc);
+    const solvers::PreconditionerEntry* entry = solvers::parse_pc(spec.pc).entry;
     return entry != nullptr && entry->needs_level_below;
 }
 

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
-/// @file The preconditioner registry: every preconditioner name the code knows, its usage line,
-/// options and whether it needs the level below, and its builder, chosen at run time from a
-/// PETSc-like text spec such as "ilu:1", "ssor:omega=1.2,sweeps=2" or "mg:pre=2". The CLI help,
-/// `study preconditioners`, `bench` and the Newton-system driver all read the names from here.
+/// @file The preconditioner registry's builders: what the level-aware preconditioners are built
+/// from (LevelData) and make_preconditioner, which builds a typed spec (solvers/pc_spec.hpp).
+/// The rows of the registry, one per name with its options and capabilities, are in
+/// factory.cpp.
 #pragma once
 
 #include "core/linear_operator.hpp"
@@ -10,53 +10,15 @@
 #include "solvers/aggregation.hpp"
 #include "solvers/coarse_fine.hpp"
 #include "solvers/mg.hpp"
+#include "solvers/pc_spec.hpp"
 
 #include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace mlc::solvers {
-
-/// A parsed spec `name[:opt,opt,...]` where each opt is `key=value`, or a bare value bound to
-/// the name's positional key (for "ilu:2" the key is "k"). Whitespace around tokens is ignored.
-struct PreconditionerSpec {
-    std::string name;                           ///< lower-case name before ':'
-    std::map<std::string, std::string> options; ///< key -> value text, keys unique
-};
-
-/// Splits `spec` into a lower-cased name and its options. A bare value is bound to the
-/// registered positional key of the name; a bare value for a name without one (or an unknown
-/// name), an empty key or value, or a repeated key throws mlc::InvalidInput. Does not check
-/// that the name or the keys are valid (make_preconditioner does).
-PreconditionerSpec parse_preconditioner_spec(std::string_view spec);
-
-/// Typed access to the options of one spec, for the builder functions of the registry.
-/// Every `get_*` marks its key as valid and used; `finish()` throws mlc::InvalidInput when the
-/// spec holds a key no `get_*` asked for (an unknown key is an error, not a warning), listing
-/// the keys that were asked for. Builders therefore read every key they accept before
-/// calling `finish()`.
-class SpecOptions {
-public:
-    /// `spec` must outlive this object.
-    explicit SpecOptions(const PreconditionerSpec& spec);
-    /// The value of `key` as text, or `fallback` when absent.
-    std::string get_string(const std::string& key, const std::string& fallback);
-    /// The value of `key` parsed as a finite double, or `fallback` when absent.
-    double get_double(const std::string& key, double fallback);
-    /// The value of `key` parsed as an integer (the whole text), or `fallback` when absent.
-    int get_int(const std::string& key, int fallback);
-    /// Throws mlc::InvalidInput for any option not read by a get_* call.
-    void finish() const;
-    /// The keys read so far, in order.
-    const std::vector<std::string>& keys_read() const { return used_; }
-
-private:
-    const PreconditionerSpec& spec_;
-    std::vector<std::string> used_;
-};
 
 /// What the level-aware preconditioners are built from: plain data of one level of the
 /// hierarchy and of the level below, filled by the Newton-system driver (levels/, which this
@@ -103,50 +65,14 @@ struct LevelData {
     const Multigrid* below_multigrid = nullptr;
 };
 
-/// One registered preconditioner name.
-struct PreconditionerEntry {
-    std::string name;                 ///< e.g. "ilu"
-    std::string usage;                ///< e.g. "ilu[:K] (K = fill level >= 0, default 0)"
-    std::string positional_key;       ///< key bound to a bare value ("k" for ilu), or empty
-    std::vector<std::string> options; ///< every option key it accepts, in usage order
-    /// Built from the level hierarchy (LevelData), not from a matrix alone.
-    bool level_aware = false;
-    /// Needs the level below (--levels >= 1, every level solved from level 0 up).
-    bool needs_level_below = false;
-    /// Builds the (not yet set up) preconditioner from the parsed options and, for the
-    /// level-aware entries, the level data (null when there is none: they throw).
-    std::unique_ptr<Preconditioner> (*build)(SpecOptions& options, const LevelData* level);
-    /// Uses the level below when there is one, and builds without it on a single level (mg:
-    /// the algebraic aggregation hierarchy): `--levels 0` accepts it.
-    bool single_level_too = false;
-};
+/// Builds the preconditioner of `spec` (not yet set up: call `setup(A)` before `apply`); the
+/// level-aware entries (cf, sorcf, ebe, mg, mgr) read `level` and throw InvalidInput without
+/// it. A value out of range throws InvalidInput.
+std::unique_ptr<Preconditioner> make_preconditioner(const PcSpec& spec,
+                                                    const LevelData* level = nullptr);
 
-/// All registered names, in the order they are listed in help and error messages. To add one,
-/// append an entry to the table in factory.cpp (name, usage, positional key, options,
-/// level-awareness, builder function).
-const std::vector<PreconditionerEntry>& preconditioner_registry();
-
-/// The entry of the name of `spec` ("mg" or "mg:pre=2" -> the mg entry), or null.
-const PreconditionerEntry* find_preconditioner(std::string_view spec);
-
-/// The registered names separated by `separator`.
-std::string preconditioner_names(std::string_view separator = ", ");
-
-/// Builds a preconditioner from `spec` (not yet set up: call `setup(A)` before `apply`).
-///
-/// Valid specs:
-/// - "none": identity;
-/// - "diag": Jacobi (zero diagonals patched, see smoothers/jacobi.hpp);
-/// - "ilu", "ilu:K", "ilu:k=K": ILU(K), K >= 0 (default 0);
-/// - "sor[:omega=W][,sweeps=N][,block=B]": forward (block) SOR, W in (0, 2) (default 1),
-///   N >= 1 sweeps (default 1), uniform B x B diagonal blocks (default 1: point);
-/// - "ssor[:...]": the same options, symmetric sweeps;
-/// - "lu": sparse LU (exact);
-/// - "amg[:...]": hypre BoomerAMG (symmetric positive definite matrices);
-/// - with `level` (level-aware): "cf", "sorcf", "ebe", "mg", "mgr" (hypre MGR, solvers/hypre/
-///   mgr.hpp; see their usage lines and levels/krylov_system.hpp).
-/// An unknown name or option, or a bad value, throws mlc::InvalidInput listing the valid ones.
-std::unique_ptr<Preconditioner> make_preconditioner(std::string_view spec,
+/// make_preconditioner(parse_pc(text), level): for tests and tools holding a spec's text.
+std::unique_ptr<Preconditioner> make_preconditioner(std::string_view text,
                                                     const LevelData* level = nullptr);
 
 } // namespace mlc::solvers

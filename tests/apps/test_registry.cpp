@@ -35,33 +35,28 @@ TEST(Registry, NamesAreUniqueAndEveryEntryIsComplete) {
     std::set<std::string> names;
     for (const auto& e : solvers::preconditioner_registry()) {
         EXPECT_TRUE(names.insert(e.name).second) << e.name << " registered twice";
-        EXPECT_EQ(e.usage.rfind(e.name, 0), 0u) << "usage of " << e.name << ": " << e.usage;
-        EXPECT_NE(e.build, nullptr) << e.name;
+        EXPECT_EQ(e.usage().rfind(e.name, 0), 0u) << "usage of " << e.name << ": " << e.usage();
+        EXPECT_TRUE(e.build) << e.name;
         EXPECT_TRUE(!e.needs_level_below || e.level_aware) << e.name;
-        if (!e.positional_key.empty()) {
-            EXPECT_NE(std::find(e.options.begin(), e.options.end(), e.positional_key),
-                      e.options.end())
-                << e.name;
-        }
-        for (const auto& key : e.options)
-            EXPECT_NE(e.usage.find(key), std::string::npos)
-                << e.name << "'s usage does not mention its option " << key;
+        for (const auto& key : e.keys())
+            EXPECT_NE(e.usage().find(key.name), std::string::npos)
+                << e.name << "'s usage does not mention its option " << key.name;
     }
     // The level-aware ones of the papers and ours.
     for (const char* n : {"cf", "sorcf", "mg"})
-        EXPECT_TRUE(solvers::find_preconditioner(n)->needs_level_below) << n;
-    EXPECT_TRUE(solvers::find_preconditioner("ebe")->level_aware);
-    EXPECT_FALSE(solvers::find_preconditioner("ebe")->needs_level_below);
+        EXPECT_TRUE(solvers::parse_pc(n).entry->needs_level_below) << n;
+    EXPECT_TRUE(solvers::parse_pc("ebe").entry->level_aware);
+    EXPECT_FALSE(solvers::parse_pc("ebe").entry->needs_level_below);
     // hypre MGR: the C/F split comes from the level (which unknowns are multipliers); it needs
     // no level below, so it serves meshes without levels too.
-    EXPECT_TRUE(solvers::find_preconditioner("mgr")->level_aware);
-    EXPECT_FALSE(solvers::find_preconditioner("mgr")->needs_level_below);
-    EXPECT_EQ(solvers::find_preconditioner("MG:pre=2")->name, "mg");
+    EXPECT_TRUE(solvers::parse_pc("mgr").entry->level_aware);
+    EXPECT_FALSE(solvers::parse_pc("mgr").entry->needs_level_below);
+    EXPECT_EQ(solvers::parse_pc("MG:pre=2").name(), "mg");
     // mg also builds on a single level (its aggregation hierarchy); cf and sorcf do not.
-    EXPECT_TRUE(solvers::find_preconditioner("mg")->single_level_too);
-    EXPECT_FALSE(solvers::find_preconditioner("cf")->single_level_too);
-    EXPECT_FALSE(solvers::find_preconditioner("sorcf")->single_level_too);
-    EXPECT_EQ(solvers::find_preconditioner("amgx"), nullptr);
+    EXPECT_TRUE(solvers::parse_pc("mg").entry->single_level_too);
+    EXPECT_FALSE(solvers::parse_pc("cf").entry->single_level_too);
+    EXPECT_FALSE(solvers::parse_pc("sorcf").entry->single_level_too);
+    EXPECT_THROW(solvers::parse_pc("amgx"), InvalidInput);
 }
 
 TEST(Registry, DeclaredOptionsAreExactlyTheOnesTheBuilderReads) {
@@ -76,12 +71,13 @@ TEST(Registry, DeclaredOptionsAreExactlyTheOnesTheBuilderReads) {
         } catch (const InvalidInput& err) {
             const std::string msg = err.what();
             std::ostringstream expected;
-            for (size_t i = 0; i < e.options.size(); ++i)
-                expected << (i ? ", " : "") << e.options[i];
+            const auto keys = e.keys();
+            for (size_t i = 0; i < keys.size(); ++i)
+                expected << (i ? ", " : "") << keys[i].name;
             EXPECT_NE(msg.find("unknown option 'bogus_key'"), std::string::npos) << msg;
-            EXPECT_NE(msg.find("valid options: " +
-                               (e.options.empty() ? std::string("none") : expected.str())),
-                      std::string::npos)
+            EXPECT_NE(
+                msg.find("valid options: " + (keys.empty() ? std::string("none") : expected.str())),
+                std::string::npos)
                 << e.name << ": " << msg;
         }
     }
@@ -123,12 +119,12 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
     apps::print_preconditioners(listing);
     for (const auto& e : reg) {
         EXPECT_NE(help.find(e.name), std::string::npos) << e.name << " missing from: " << help;
-        EXPECT_NE(listing.str().find(e.usage), std::string::npos) << e.name;
+        EXPECT_NE(listing.str().find(e.usage()), std::string::npos) << e.name;
     }
     // The study's and the bench's default lists name registered preconditioners, and both
     // accept every registered name and refuse others.
     for (const auto& spec : apps::PreconditionerStudyOptions{}.pcs)
-        EXPECT_NE(solvers::find_preconditioner(spec), nullptr) << spec;
+        EXPECT_NO_THROW(solvers::parse_pc(spec)) << spec;
     // The bench's default is the run's default pair, whose mg spec is registered too.
     const apps::BenchSquareOptions bench_defaults;
     EXPECT_EQ(bench_defaults.pcs, std::vector<std::string>{"default"});
@@ -136,7 +132,7 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
         const apps::BenchSolver d = apps::bench_solver(bench_defaults, "default", two_body);
         EXPECT_EQ(d.krylov, levels::kMgDefaultKrylov);
         EXPECT_EQ(d.pc, two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody);
-        EXPECT_NE(solvers::find_preconditioner(d.pc), nullptr) << d.pc;
+        EXPECT_NO_THROW(solvers::parse_pc(d.pc)) << d.pc;
     }
     // A named preconditioner without --krylov keeps CGS; --krylov applies to both.
     EXPECT_EQ(apps::bench_solver(bench_defaults, "mg", false).krylov, "cgs");
@@ -165,7 +161,7 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
              {levels::SolverRequest{.linear = std::string("krylov")}, levels::SolverRequest{}}) {
             const levels::SolverChoice c = levels::choose_solver(p, req);
             if (c.spec.method != "krylov") continue;
-            const solvers::PreconditionerEntry* e = solvers::find_preconditioner(c.spec.pc);
+            const solvers::PreconditionerEntry* e = solvers::parse_pc(c.spec.pc).entry;
             ASSERT_NE(e, nullptr) << c.spec.pc;
             EXPECT_TRUE(!e->needs_level_below || L >= 1 || e->single_level_too)
                 << c.spec.pc << " at levels " << L;

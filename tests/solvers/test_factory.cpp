@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 using namespace mlc;
 using namespace mlc::solvers;
 
@@ -36,14 +38,135 @@ TEST(Factory, BuildsEveryRegisteredName) {
     }
 }
 
-TEST(Factory, ParsesOptions) {
-    const PreconditionerSpec s = parse_preconditioner_spec("sor:omega=1.5, sweeps=3");
-    EXPECT_EQ(s.name, "sor");
-    ASSERT_EQ(s.options.size(), 2u);
-    EXPECT_EQ(s.options.at("omega"), "1.5");
-    EXPECT_EQ(s.options.at("sweeps"), "3");
-    EXPECT_EQ(parse_preconditioner_spec("ilu:4").options.at("k"), "4");
-    EXPECT_TRUE(parse_preconditioner_spec("lu").options.empty());
+TEST(Factory, ParsesOptionsIntoTheirStruct) {
+    const PcSpec s = parse_pc("sor:omega=1.5, sweeps=3");
+    EXPECT_EQ(s.name(), "sor");
+    EXPECT_EQ(s.get<SorOptions>().omega, 1.5);
+    EXPECT_EQ(s.get<SorOptions>().sweeps, 3);
+    EXPECT_EQ(s.get<SorOptions>().block, 1);
+    EXPECT_EQ(parse_pc("ilu:4").get<IluOptions>().k, 4);
+    EXPECT_EQ(parse_pc("ilu:k=4"), parse_pc("ilu:4"));
+    EXPECT_EQ(parse_pc(" MG : post=2 , pre=0 ").text(), "mg:pre=0,post=2");
+    const MgOptions& m = parse_pc("mg:omega=0.8,pre=0,post=2,smoother=lattice").get<MgOptions>();
+    EXPECT_EQ(m.omega, 0.8);
+    EXPECT_EQ(m.pre, 0);
+    EXPECT_EQ(m.post, 2);
+    EXPECT_EQ(m.coarse, MgCoarse::automatic);
+    EXPECT_EQ(m.smoother, MultigridParams::Smoother::lattice);
+    EXPECT_EQ(parse_pc("mg:coarse=galerkin").get<MgOptions>().coarse, MgCoarse::galerkin);
+    EXPECT_EQ(parse_pc("mgr:frelax=gs").get<MgrOptions>().f_relax, 3);
+    EXPECT_EQ(parse_pc("cf:inner=cgs,tol=1e-8").get<CfOptions>().params.inner_tol, 1e-8);
+    EXPECT_TRUE(parse_pc("sorcf:block=1").get<SorcfOptions>().params.block);
+    EXPECT_NE(parse_pc("mg"), parse_pc("mg:pre=2"));
+    EXPECT_NE(parse_pc("sor"), parse_pc("ssor"));
+}
+
+// The driver's own specs print exactly as they always have (reports, summary.json and
+// iterations.csv carry this text).
+TEST(Factory, CanonicalTextKeepsTheDriversSpellings) {
+    for (const char* t :
+         {"mg:pre=0,post=2", "mg:omega=0.8,pre=0,post=2", "mg:pre=0,post=2,smoother=lattice",
+          "mg:omega=0.8,pre=0,post=2,smoother=lattice", "ilu:1", "ebe", "cf", "mg", "ilu",
+          "cf:inner=cgs,tol=1e-8", "sor:omega=1.25", "ssor:omega=0.8,sweeps=2", "mg:post=2",
+          "mg:coarse=galerkin", "mg:precision=single", "sorcf:omega=1.2,block=1"})
+        EXPECT_EQ(parse_pc(t).text(), t);
+    // Defaults given explicitly print nothing; the key order is the entry's.
+    EXPECT_EQ(parse_pc("ilu:0").text(), "ilu");
+    EXPECT_EQ(parse_pc("mg:post=2,omega=1,pre=0").text(), "mg:pre=0,post=2");
+    EXPECT_EQ(parse_pc("mg:smoother=lattice,omega=0.80,pre=0,post=2").text(),
+              "mg:omega=0.8,pre=0,post=2,smoother=lattice");
+}
+
+// Every entry's default and every option it declares, set to a value other than its default,
+// read back from its canonical text to the same spec; the usage line names every key.
+TEST(Factory, EveryRegistryEntryRoundTripsThroughItsText) {
+    for (const PreconditionerEntry& e : preconditioner_registry()) {
+        ASSERT_TRUE(e.fields) << e.name << " has no parser (fields)";
+        ASSERT_TRUE(e.build) << e.name << " has no builder";
+        ASSERT_FALSE(e.summary.empty()) << e.name << " has no usage text";
+        const std::string usage = e.usage();
+        EXPECT_EQ(usage.rfind(e.name, 0), 0u) << usage;
+        const PcSpec def = parse_pc(e.name);
+        EXPECT_EQ(def.entry, &e);
+        EXPECT_EQ(def.text(), e.name);
+        EXPECT_EQ(parse_pc(def.text()), def) << e.name;
+        const std::vector<PcKey> keys = e.keys();
+        if (!e.positional_key.empty())
+            EXPECT_TRUE(std::any_of(keys.begin(), keys.end(), [&](const PcKey& k) {
+                return k.name == e.positional_key;
+            })) << e.name;
+        for (const PcKey& k : keys) {
+            EXPECT_NE(usage.find(k.name + "=" + k.placeholder), std::string::npos)
+                << usage << " lacks " << k.name;
+            ASSERT_NE(k.other, k.value) << e.name << ":" << k.name;
+            const PcSpec s = parse_pc(e.name + ":" + k.name + "=" + k.other);
+            EXPECT_NE(s, def) << e.name << ":" << k.name << "=" << k.other;
+            const std::string text = s.text();
+            EXPECT_NE(text.find(k.other), std::string::npos) << text;
+            EXPECT_EQ(parse_pc(text), s) << text;
+            EXPECT_EQ(parse_pc(text).text(), text);
+        }
+        // Every key at once, in reverse order: the text puts them back in the entry's order.
+        if (keys.size() > 1) {
+            std::string all = e.name + ":";
+            for (size_t i = keys.size(); i-- > 0;)
+                all += keys[i].name + "=" + keys[i].other + (i ? "," : "");
+            const PcSpec s = parse_pc(all);
+            EXPECT_EQ(parse_pc(s.text()), s) << all << " -> " << s.text();
+            std::string ordered = e.name + ":";
+            for (size_t i = 0; i < keys.size(); ++i)
+                ordered += (keys[i].name == e.positional_key ? "" : keys[i].name + "=") +
+                           keys[i].other + (i + 1 < keys.size() ? "," : "");
+            EXPECT_EQ(s.text(), ordered);
+        }
+    }
+}
+
+TEST(Factory, CapabilitiesAreDeclaredOnTheEntry) {
+    EXPECT_TRUE(parse_pc("mg").entry->single_level_too);
+    EXPECT_TRUE(parse_pc("cf").entry->needs_level_below);
+    EXPECT_FALSE(parse_pc("cf").entry->single_level_too);
+    EXPECT_TRUE(parse_pc("ebe").entry->element_matrices);
+    EXPECT_FALSE(parse_pc("ilu").entry->level_aware);
+    EXPECT_TRUE(parse_pc("mg:smoother=lattice").lattice_numbering());
+    EXPECT_FALSE(parse_pc("mg").lattice_numbering());
+    EXPECT_FALSE(parse_pc("ilu").lattice_numbering());
+    // On several processes: mg's rediscretized V-cycle with any sweeps, the matrix-alone
+    // preconditioners and ebe; not the coarse/fine ones, mgr, or mg's other options.
+    for (const char* ok : {"mg", "mg:omega=0.8,pre=0,post=2", "mg:coarse=rediscretize", "ilu:1",
+                           "diag", "sor", "ebe", "none"})
+        EXPECT_EQ(parse_pc(ok).distributed(), "") << ok;
+    for (const char* no : {"cf", "sorcf", "mgr", "mg:coarse=galerkin", "mg:precision=single",
+                           "mg:smoother=lattice", "mg:csize=100"})
+        EXPECT_NE(parse_pc(no).distributed(), "") << no;
+    EXPECT_NE(parse_pc("sorcf").distributed().find("'sorcf' has no distributed form"),
+              std::string::npos);
+    EXPECT_NE(parse_pc("mg:precision=single")
+                  .distributed()
+                  .find("mg:precision=single has no distributed form"),
+              std::string::npos);
+}
+
+TEST(Factory, MethodNamesReadBack) {
+    for (Method m : {Method::schur, Method::lu, Method::krylov})
+        EXPECT_EQ(parse_method(to_string(m)), m);
+    EXPECT_THROW(parse_method("cholesky"), InvalidInput);
+    for (Krylov k : {Krylov::cgs, Krylov::bicg, Krylov::bicgstab, Krylov::gmres})
+        EXPECT_EQ(parse_krylov(to_string(k)), k);
+}
+
+TEST(Factory, RegisteringRefusesAnEntryWithoutParserOrUsage) {
+    PreconditionerEntry e{.name = "toy-without-fields", .summary = "a toy"};
+    e.build = [](const PcOptions&, const LevelData*) -> std::unique_ptr<Preconditioner> {
+        return std::make_unique<IdentityPreconditioner>();
+    };
+    EXPECT_THROW(register_preconditioner(e), InvalidInput); // no fields
+    e.fields = [](PcOptions&, PcFields&) {};
+    e.summary.clear();
+    EXPECT_THROW(register_preconditioner(e), InvalidInput); // no usage text
+    e.name = "mg";
+    e.summary = "a toy";
+    EXPECT_THROW(register_preconditioner(e), InvalidInput); // taken
 }
 
 TEST(Factory, RejectsInvalidSpecs) {
