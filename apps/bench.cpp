@@ -199,9 +199,9 @@ double matrix_seconds(const traffic::Account& a) {
 BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
                          bool lattice) {
     if (pc != "default") return {opt.krylov.value_or("cgs"), pc};
-    return {
-        opt.krylov.value_or(levels::kMgDefaultKrylov),
-        levels::default_mg_spec(two_body, lattice && opt.levels >= levels::kMgDefaultLatticeLevel)};
+    return {opt.krylov.value_or(std::string(solvers::to_string(levels::kMgDefaultKrylov))),
+            levels::default_mg(two_body, lattice && opt.levels >= levels::kMgDefaultLatticeLevel)
+                .text()};
 }
 
 std::string bench_numbering(const BenchSquareOptions& opt) {
@@ -210,7 +210,10 @@ std::string bench_numbering(const BenchSquareOptions& opt) {
                                          [](const std::string& pc) { return pc == "default"; });
     const bool named_lattice =
         std::any_of(opt.pcs.begin(), opt.pcs.end(),
-                    [](const std::string& pc) { return levels::wants_lattice_sweep(pc); });
+                    [](const std::string& pc) {
+                        return pc != "default" && pc != "schur" && pc != "lu" &&
+                               solvers::parse_pc(pc).lattice_numbering();
+                    });
     return named_lattice || (all_default && opt.levels >= levels::kMgDefaultLatticeLevel)
                ? "lattice"
                : "hilbert";
@@ -271,11 +274,11 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         so.extrapolate = opt.extrapolate;
         const BenchSolver solver = bench_solver(opt, pc, two_body, lattice);
         if (pc == "schur" || pc == "lu")
-            so.linear.method = pc;
+            so.linear.method = solvers::parse_method(pc);
         else
-            so.linear = {.method = "krylov",
-                         .krylov = solver.krylov,
-                         .pc = solver.pc,
+            so.linear = {.method = solvers::Method::krylov,
+                         .krylov = solvers::parse_krylov(solver.krylov),
+                         .pc = solvers::parse_pc(solver.pc),
                          .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
         std::vector<SquareRow> rows;
@@ -922,7 +925,6 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     (void)solvers::parse_krylov(opt.krylov);
     levels::Problem problem = scene::load_scene(opt.scene);
     problem.levels = opt.levels;
-    levels::number_for(problem, opt.pc); // a lattice sweep on levels numbered for it
     // Thread counts: 1 first (hypre's runs), then the others as given.
     std::vector<int> threads{1};
     for (int t : opt.threads)
@@ -953,9 +955,9 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
             const NewtonBenchPass pass{t, t == 1, t == 1 && rep == 0};
             levels::SolveOptions so;
             so.coarse_to_fine = true;
-            so.linear = {.method = "krylov",
-                         .krylov = opt.krylov,
-                         .pc = opt.pc,
+            so.linear = {.method = solvers::Method::krylov,
+                         .krylov = solvers::parse_krylov(opt.krylov),
+                         .pc = solvers::parse_pc(opt.pc),
                          .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
             so.wrap_system_solver = [&](int level, const levels::Level& L,
@@ -976,7 +978,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
             if (unknowns == 0) {
                 unknowns = r.finest().n_unknowns();
                 nonzeros = jacobian_nonzeros(r.finest());
-                run_solver = r.steps.empty() ? "" : r.solver.spec.pc;
+                run_solver = r.steps.empty() ? "" : r.solver.spec.pc.text();
             }
             if (&into == &rows) continue;
             // Later runs: the same systems (same sequence) add their samples.

@@ -54,9 +54,9 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     const int plevel = levels::partition_level(p.mesh0.n_triangles(), p.levels, np);
     levels::SolveOptions so;
     so.coarse_to_fine = true;
-    so.linear = {.method = "krylov",
-                 .krylov = solver.krylov,
-                 .pc = solver.pc,
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::parse_krylov(solver.krylov),
+                 .pc = solvers::parse_pc(solver.pc),
                  .rel_tol = opt.rel_tol,
                  .max_iter = opt.max_iter};
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
@@ -322,9 +322,9 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
     // V-cycle a symmetric preconditioner of the symmetric K, as on one process.
     for (const std::string krylov : {"gmres", "cgs", "cg"}) {
         const bool cg = krylov == "cg";
-        const levels::LinearSolverSpec spec{.method = "krylov",
-                                            .krylov = cg ? "cgs" : krylov,
-                                            .pc = "mg",
+        const levels::LinearSolverSpec spec{.method = solvers::Method::krylov,
+                                            .krylov = solvers::parse_krylov(cg ? "cgs" : krylov),
+                                            .pc = solvers::parse_pc("mg"),
                                             .rel_tol = opt.rel_tol,
                                             .max_iter = opt.max_iter};
         ElasticRow r;

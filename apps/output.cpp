@@ -525,10 +525,10 @@ void write_summary(const std::filesystem::path& dir, const levels::Problem& p,
         {
             const auto& sp = r.solver.spec;
             toml::table sv;
-            sv.insert("method", sp.method);
-            if (sp.method == "krylov") {
-                sv.insert("krylov", sp.krylov);
-                sv.insert("pc", sp.pc);
+            sv.insert("method", std::string(solvers::to_string(sp.method)));
+            if (sp.method == solvers::Method::krylov) {
+                sv.insert("krylov", std::string(solvers::to_string(sp.krylov)));
+                sv.insert("pc", sp.pc.text());
                 sv.insert("rel_tol", sp.rel_tol);
             }
             sv.insert("automatic", r.solver.automatic);

@@ -54,21 +54,28 @@ void apply_overrides(levels::Problem& p, const RunOptions& opt) {
     p.validate();
 }
 
+levels::SolverRequest solver_request(const RunOptions& opt) {
+    levels::SolverRequest req;
+    if (opt.linear) req.linear = solvers::parse_method(*opt.linear);
+    if (opt.krylov) req.krylov = solvers::parse_krylov(*opt.krylov);
+    if (opt.pc) req.pc = solvers::parse_pc(*opt.pc);
+    req.rel_tol = opt.linear_rel_tol;
+    if (opt.numbering) req.numbering = levels::parse_numbering(*opt.numbering, "--numbering");
+    return req;
+}
+
 levels::SolveOptions run_solve_options(levels::Problem& p, const RunOptions& opt,
-                                       levels::SolverChoice& choice) {
+                                       levels::SolverPlan& plan, int processes) {
     levels::SolveOptions so;
     so.predicted_sizes = levels::predict_level_sizes(p); // level 0 built once for both
-    choice = levels::choose_solver(
-        p, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol, opt.numbering},
-        &so.predicted_sizes);
-    // The default mg's lattice sweep needs its levels numbered by macro triangle.
-    if (choice.lattice_numbering) p.numbering = levels::Problem::Numbering::lattice;
+    plan = levels::plan_solver(p, solver_request(opt), processes, &so.predicted_sizes);
+    p.numbering = plan.numbering();
     so.coarse_to_fine = !opt.cold;
     so.extrapolate = !opt.no_extrapolation;
-    so.linear = choice.spec;
-    MLC_CHECK(!opt.no_fallback || choice.spec.method == "krylov",
+    so.linear = plan.spec;
+    MLC_CHECK(!opt.no_fallback || plan.spec.method == solvers::Method::krylov,
               "--no-fallback applies to Krylov solves only; the solver of this run is "
-                  << choice.spec.method << " (" << choice.reason << ")");
+                  << plan.spec.method << " (" << plan.reason << ")");
     so.exact_fallback = !opt.no_fallback;
     so.r_continuation = !opt.no_continuation;
     return so;
@@ -110,7 +117,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     OutputFolder folder(dir);
     set_stop_summary(dir / "summary.json", killed_summary(p.name, SIGINT, 1),
                      killed_summary(p.name, SIGTERM, 1));
-    levels::SolverChoice choice;
+    levels::SolverPlan choice;
     levels::SolveOptions so = run_solve_options(p, opt, choice);
     so.progress = opt.quiet ? nullptr : &os;
     so.progress_eta = opt.progress_eta;
@@ -129,7 +136,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
         // The BLAS behind CHOLMOD (README "The BLAS behind schur").
         const std::string blas = parallel::blas_library();
         const bool openblas = blas.find("OpenBLAS") != std::string::npos;
-        if (choice.spec.method == "schur" && !openblas && blas != "none")
+        if (choice.spec.method == solvers::Method::schur && !openblas && blas != "none")
             os << "note: the BLAS is " << blas << ", not OpenBLAS: schur's set-up runs 1.9-2.5x "
                << "slower with it (scripts/deps.sh installs libopenblas0-serial)\n";
         if (openblas && blas.find("SINGLE_THREADED") == std::string::npos &&

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "levels/problem.hpp"
+#include "levels/resources.hpp"
 #include "levels/solve.hpp"
 #include <atomic>
 
@@ -17,9 +18,8 @@ namespace mlc::apps {
 struct RunOptions {
     std::string scene = "square"; ///< file path or built-in scene name
     std::optional<int> levels;    ///< overrides [scene].levels
-    /// "hilbert" or "lattice" (levels::Problem::numbering); unset: lattice where the default
-    /// solver sweeps by lattices (levels 4 and finer, levels::SolverChoice::lattice_numbering),
-    /// else hilbert.
+    /// "hilbert" or "lattice" (levels::Problem::numbering); unset: lattice where the solver
+    /// sweeps by lattices (levels::plan_solver), else hilbert.
     std::optional<std::string> numbering;
     std::optional<double> mu;      ///< overrides mu of every contact pair
     std::optional<double> r;       ///< overrides r of every contact pair
@@ -28,7 +28,7 @@ struct RunOptions {
     bool quiet = false;            ///< no per-step progress
     bool cold = false;             ///< finest level from the previous step only (no coarse-to-fine)
     /// Newton-system solver: schur | lu | krylov; unset with no Krylov option: chosen by size
-    /// (levels::choose_solver).
+    /// (levels::plan_solver).
     std::optional<std::string> linear;
     std::optional<std::string> krylov;    ///< Krylov method (implies a Krylov solve)
     std::optional<std::string> pc;        ///< preconditioner spec (implies a Krylov solve)
@@ -59,13 +59,16 @@ struct RunOptions {
 /// as the command line checks it, and validates the result. Throws InvalidInput naming the option.
 void apply_overrides(levels::Problem& p, const RunOptions& opt);
 
+/// The solver options of `opt` parsed (the one place their text is read): --linear, --krylov,
+/// --pc, --linear-tol and --numbering as a typed request. Throws InvalidInput naming the option.
+levels::SolverRequest solver_request(const RunOptions& opt);
+
 /// The solve options of `mlcontact run` for `p` (after apply_overrides): the Newton-system solver
-/// chosen as the driver chooses it (levels::choose_solver, returned in `choice`), coarse-to-fine
-/// unless opt.cold, no progress stream; when the default solver sweeps by lattices
-/// (SolverChoice::lattice_numbering), p's levels are numbered for it. The Python module solves
+/// planned for `processes` processes (levels::plan_solver, returned in `plan`), coarse-to-fine
+/// unless opt.cold, no progress stream; p.numbering is the plan's. The Python module solves
 /// with these, so that its numbers are the driver's.
 levels::SolveOptions run_solve_options(levels::Problem& p, const RunOptions& opt,
-                                       levels::SolverChoice& choice);
+                                       levels::SolverPlan& plan, int processes = 1);
 
 /// Runs a scene. The output folder is checked and locked before the solve (OutputFolder: a
 /// folder another run is writing is refused). Returns the process exit code: 0 on success, 2 when

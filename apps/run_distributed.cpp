@@ -33,24 +33,6 @@
 
 namespace mlc::apps {
 
-levels::LinearSolverSpec distributed_solver_spec(const RunOptions& opt, bool two_body) {
-    MLC_CHECK(!opt.linear || *opt.linear == "krylov",
-              "--linear " << *opt.linear
-                          << " has no distributed form (it needs the whole level on one "
-                             "process); on several processes the Newton systems are solved by "
-                             "a Krylov method with mg (--linear krylov, the default there)");
-    levels::LinearSolverSpec s;
-    s.method = "krylov";
-    // The driver's own default (BiCGStab + V(0,2) mg) when no preconditioner is named; a named
-    // one keeps the Krylov method it always had (CGS, BiCGStab with a two-body pair).
-    s.krylov =
-        opt.krylov.value_or(opt.pc ? (two_body ? "bicgstab" : "cgs") : levels::kMgDefaultKrylov);
-    s.pc = opt.pc.value_or(levels::default_mg_spec(two_body));
-    if (opt.linear_rel_tol) s.rel_tol = *opt.linear_rel_tol;
-    s.validate();
-    return s;
-}
-
 namespace {
 
 /// The contact boundary of a distributed run's finest level, gathered on rank 0 (empty
@@ -200,7 +182,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     MLC_CHECK(p.levels >= 1, "a run on several processes needs --levels >= 1 (level 0 is solved "
                              "on every process; the levels above it are distributed)");
     const bool two_body = levels::has_two_body_pair(p);
-    const levels::LinearSolverSpec spec = distributed_solver_spec(opt, two_body);
+    const levels::SolverPlan plan = levels::plan_solver(p, solver_request(opt), comm.size());
+    const levels::LinearSolverSpec& spec = plan.spec;
     const int finest = p.levels;
     int plevel = opt.partition_level
                      ? *opt.partition_level
@@ -249,10 +232,10 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     so.progress = opt.quiet ? nullptr : &out;
     MLC_CHECK(!opt.stop, "internal error: a distributed run has no stop flag");
     os << "mlcontact: solving '" << p.name << "' on " << comm.size() << " processes\n";
-    const bool mg = solvers::parse_pc(spec.pc).name() == "mg";
+    const bool mg = spec.pc.name() == "mg";
     os << "Newton-system solver: " << spec << " (" << comm.size() << " processes: "
        << (mg ? std::string("Krylov + distributed mg")
-              : "Krylov + " + spec.pc +
+              : "Krylov + " + spec.pc.text() +
                     " on each process's diagonal block, Jacobi across the cuts; levels 0-p on "
                     "every process")
        << ")\n";
@@ -513,9 +496,9 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
             root_t.insert("warnings", std::move(w));
         }
         toml::table sv;
-        sv.insert("method", spec.method);
-        sv.insert("krylov", spec.krylov);
-        sv.insert("pc", spec.pc);
+        sv.insert("method", std::string(solvers::to_string(spec.method)));
+        sv.insert("krylov", std::string(solvers::to_string(spec.krylov)));
+        sv.insert("pc", spec.pc.text());
         sv.insert("rel_tol", spec.rel_tol);
         sv.insert("distributed", true);
         root_t.insert("solver", sv);

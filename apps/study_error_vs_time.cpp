@@ -28,7 +28,7 @@ struct Config {
     /// multigrid (1..L: it needs a level below).
     enum class Family { exact, ilu, mg } family = Family::exact;
     /// The run's default: from this level on its pc gains kMgDefaultLatticeOption (the lattice
-    /// sweep, on levels numbered for it), as choose_solver's default does; 0 = never.
+    /// sweep, on levels numbered for it), as the planner's default does; 0 = never.
     int lattice_from = 0;
 };
 
@@ -37,43 +37,43 @@ std::vector<Config> configurations(const levels::Problem& problem) {
     using F = Config::Family;
     // The multilevel solvers: the run's default above the crossover (BiCGStab + mg's V(0,2)
     // cycle, damped with a two-body pair; from level kMgDefaultLatticeLevel on with the lattice
-    // sweep on levels numbered by lattices: `lattice_from`), `--pc mg` (CGS + V(1,1), the
-    // default before 2026-11-26) and hypre's MGR with `--pc mgr`, to the run's default linear
+    // sweep on levels numbered by lattices: `lattice_from`), `--pc mg` (CGS + V(1,1), an
+    // earlier default) and hypre's MGR with `--pc mgr`, to the run's default linear
     // tolerance.
     const levels::LinearSolverSpec def{
-        .method = "krylov",
+        .method = solvers::Method::krylov,
         .krylov = levels::kMgDefaultKrylov,
-        .pc = levels::default_mg_spec(levels::has_two_body_pair(problem)),
+        .pc = levels::default_mg(levels::has_two_body_pair(problem)),
         .rel_tol = 1e-10};
     c.push_back(
         {"c2f default bicgstab+mg", true, def, 1e-10, F::mg, levels::kMgDefaultLatticeLevel});
     const levels::LinearSolverSpec mg{
-        .method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-10};
+        .method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .rel_tol = 1e-10};
     c.push_back({"c2f cgs+mg", true, mg, 1e-10, F::mg});
     c.push_back({"cold cgs+mg", false, mg, 1e-10, F::mg});
 #if defined(MLC_HAVE_HYPRE)
     const levels::LinearSolverSpec mgr{
-        .method = "krylov", .krylov = "cgs", .pc = "mgr", .rel_tol = 1e-10};
+        .method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mgr"), .rel_tol = 1e-10};
     c.push_back({"c2f cgs+mgr", true, mgr, 1e-10, F::exact});
 #endif
     c.push_back({"c2f schur", true, {}, 1e-10});
     c.push_back({"cold schur", false, {}, 1e-10});
     c.push_back({"c2f schur newton 1e-6", true, {}, 1e-6});
-    c.push_back({"c2f lu", true, {.method = "lu"}, 1e-10});
-    c.push_back({"cold lu", false, {.method = "lu"}, 1e-10});
+    c.push_back({"c2f lu", true, {.method = solvers::Method::lu}, 1e-10});
+    c.push_back({"cold lu", false, {.method = solvers::Method::lu}, 1e-10});
     c.push_back({"c2f gmres+ilu0 1e-8",
                  true,
-                 {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8},
+                 {.method = solvers::Method::krylov, .krylov = solvers::Krylov::gmres, .pc = solvers::parse_pc("ilu:0"), .rel_tol = 1e-8},
                  1e-8,
                  F::ilu});
     c.push_back({"cold gmres+ilu0 1e-8",
                  false,
-                 {.method = "krylov", .krylov = "gmres", .pc = "ilu:0", .rel_tol = 1e-8},
+                 {.method = solvers::Method::krylov, .krylov = solvers::Krylov::gmres, .pc = solvers::parse_pc("ilu:0"), .rel_tol = 1e-8},
                  1e-8,
                  F::ilu});
     c.push_back({"c2f cgs+ilu0 1e-6",
                  true,
-                 {.method = "krylov", .krylov = "cgs", .pc = "ilu:0", .rel_tol = 1e-6},
+                 {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("ilu:0"), .rel_tol = 1e-6},
                  1e-6,
                  F::ilu});
     return c;
@@ -82,7 +82,9 @@ std::vector<Config> configurations(const levels::Problem& problem) {
 /// The linear solver a configuration runs on level `level`.
 levels::LinearSolverSpec linear_for(const Config& c, int level) {
     levels::LinearSolverSpec s = c.linear;
-    if (c.lattice_from > 0 && level >= c.lattice_from) s.pc += levels::kMgDefaultLatticeOption;
+    if (c.lattice_from > 0 && level >= c.lattice_from)
+        std::get<solvers::MgOptions>(s.pc.options).smoother =
+            solvers::MultigridParams::Smoother::lattice;
     return s;
 }
 
@@ -175,7 +177,7 @@ Errors errors_against(const levels::RunResult& ref, int l, const levels::RunResu
 std::string error_vs_time_pc(const levels::Problem& problem, const std::string& configuration,
                              int level) {
     for (const auto& c : configurations(problem))
-        if (c.name == configuration) return linear_for(c, level).pc;
+        if (c.name == configuration) return linear_for(c, level).pc.text();
     throw InvalidInput("study error-vs-time has no configuration named '" + configuration + "'");
 }
 
@@ -221,7 +223,7 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
     for (const auto& c : configurations(problem)) {
         if (!opt.only.empty() && c.name.find(opt.only) == std::string::npos) continue;
         // mg needs a level below; the lattice sweep (smoother=lattice) levels 4 and finer.
-        const int lo = levels::wants_lattice_sweep(c.linear.pc) ? levels::kMgDefaultLatticeLevel
+        const int lo = c.linear.pc.lattice_numbering() ? levels::kMgDefaultLatticeLevel
                        : c.family == Config::Family::mg         ? 1
                                                                 : 0;
         const int hi = c.family == Config::Family::ilu ? std::min(opt.max_level, opt.ilu_max_level)
@@ -233,7 +235,6 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
             levels::SolveOptions so;
             so.coarse_to_fine = c.coarse_to_fine;
             so.linear = linear_for(c, l);
-            levels::number_for(p, so.linear.pc); // a lattice sweep on levels numbered for it
             const double t0 = wall_seconds();
             levels::RunResult r;
             try {

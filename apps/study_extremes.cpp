@@ -42,17 +42,14 @@ std::string num(double v, int digits = 3) {
     return os.str();
 }
 
-/// mg:smoother=lattice (the default's sweep from level 4 on) on p (its levels set): the levels
-/// numbered by lattices (levels::number_for), or below level 4 (the slender case's level 1)
+/// mg:smoother=lattice (the default's sweep from level 4 on) on p (its levels set): kept from
+/// level 4 on (levels::solve numbers the levels for it), below it (the slender case's level 1)
 /// smoother=block, as the default takes there; returns whether the block sweep replaced it.
-bool sweep_for(levels::Problem& p, levels::LinearSolverSpec& solver) {
-    if (!levels::wants_lattice_sweep(solver.pc)) return false;
-    if (p.levels >= levels::kMgDefaultLatticeLevel) {
-        levels::number_for(p, solver.pc);
-        return false;
-    }
-    const std::string lattice = "smoother=lattice";
-    solver.pc.replace(solver.pc.find(lattice), lattice.size(), "smoother=block");
+bool sweep_for(const levels::Problem& p, levels::LinearSolverSpec& solver) {
+    if (!solver.pc.lattice_numbering() || p.levels >= levels::kMgDefaultLatticeLevel) return false;
+    std::get<solvers::MgOptions>(solver.pc.options).smoother =
+        solvers::MultigridParams::Smoother::block;
+    solver.numbering.reset();
     return true;
 }
 
@@ -389,27 +386,27 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     const auto dir = opt.out.empty() ? std::filesystem::path("out/studies/extremes") : opt.out;
     std::filesystem::create_directories(dir);
     // The solvers: the one asked for, or each the default may choose.
-    std::vector<levels::SolverChoice> solvers;
+    std::vector<levels::SolverPlan> solvers;
     levels::Problem sq = square();
     sq.levels = opt.levels;
     if (opt.linear || opt.krylov || opt.pc || opt.linear_rel_tol) {
-        // A lattice sweep asked for is run on levels numbered for it (every case is).
-        if (opt.pc) levels::number_for(sq, *opt.pc);
-        solvers.push_back(
-            levels::choose_solver(sq, {opt.linear, opt.krylov, opt.pc, opt.linear_rel_tol, {}}));
+        levels::SolverRequest req;
+        if (opt.linear) req.linear = mlc::solvers::parse_method(*opt.linear);
+        if (opt.krylov) req.krylov = mlc::solvers::parse_krylov(*opt.krylov);
+        if (opt.pc) req.pc = mlc::solvers::parse_pc(*opt.pc);
+        req.rel_tol = opt.linear_rel_tol;
+        solvers.push_back(levels::plan_solver(sq, req));
     } else {
-        solvers.push_back(levels::choose_solver(sq, {std::string("schur"), {}, {}, {}, {}}));
+        solvers.push_back(levels::plan_solver(sq, {.linear = mlc::solvers::Method::schur}));
         if (opt.levels >= 1) {
             // What the default takes above its crossover: BiCGStab + mg's V(0,2) cycle (one
             // body) and the same damped (with a two-body pair, as in the contrast cases); from
             // level 4 on both with the lattice sweep, on levels numbered for it.
-            const std::string krylov = levels::kMgDefaultKrylov;
             const bool lattice = opt.levels >= levels::kMgDefaultLatticeLevel;
-            for (const bool two_body : {false, true}) {
-                const std::string pc = levels::default_mg_spec(two_body, lattice);
-                levels::number_for(sq, pc);
-                solvers.push_back(levels::choose_solver(sq, {{}, krylov, pc, {}, {}}));
-            }
+            for (const bool two_body : {false, true})
+                solvers.push_back(levels::plan_solver(
+                    sq, {.krylov = levels::kMgDefaultKrylov,
+                         .pc = levels::default_mg(two_body, lattice)}));
         }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "

@@ -16,7 +16,7 @@ struct ExtremesOptions {
     double seconds_per_case = 120.0; ///< wall-clock bound; a case past it is killed and reported
     std::string only;                ///< run only the cases whose name contains this text
     std::filesystem::path out;       ///< output folder (default out/studies/extremes)
-    /// Newton-system solver of every case, as for `mlcontact run` (levels::choose_solver). None
+    /// Newton-system solver of every case, as for `mlcontact run` (levels::plan_solver). None
     /// given: every case is run with each solver the default may choose (schur, and BiCGStab +
     /// V(0,2) mg, undamped and damped, when levels >= 1), one table per solver.
     std::optional<std::string> linear, krylov, pc;

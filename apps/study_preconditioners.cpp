@@ -42,7 +42,6 @@ std::string run_combination(const levels::Problem& base, const PreconditionerStu
                             int finest) {
     levels::Problem p = base;
     p.levels = finest;
-    levels::number_for(p, pc); // a lattice sweep on levels numbered for it
     if (opt.load_steps > 0) p.load_steps = opt.load_steps;
     for (auto& c : p.contacts) {
         c.mu = mu;
@@ -50,9 +49,9 @@ std::string run_combination(const levels::Problem& base, const PreconditionerStu
     }
     levels::SolveOptions so;
     so.coarse_to_fine = true;
-    so.linear = {.method = "krylov",
-                 .krylov = krylov,
-                 .pc = pc,
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::parse_krylov(krylov),
+                 .pc = solvers::parse_pc(pc),
                  .rel_tol = opt.rel_tol,
                  .max_iter = opt.max_iter};
     std::ostringstream out;
@@ -208,7 +207,7 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
                     // run (they repeat the failing level first). The lattice sweep runs from
                     // level 4 (below it the option is refused: those levels are not run).
                     bool stop = false;
-                    const int first = levels::wants_lattice_sweep(pc)
+                    const int first = solvers::parse_pc(pc).lattice_numbering()
                                           ? std::min(opt.levels, levels::kMgDefaultLatticeLevel)
                                           : 1;
                     if (first > 1)

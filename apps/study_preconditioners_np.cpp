@@ -247,12 +247,9 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
         // What has no distributed form is refused before anything runs (the run's own message).
         for (const auto& kr : opt.krylovs)
             for (const auto& pc : opt.pcs) {
-                levels::LinearSolverSpec s;
-                s.method = "krylov";
-                s.krylov = kr;
-                s.pc = pc;
-                s.validate();
-                levels::distributed_mg_params(s);
+                const levels::SolverRequest req{.krylov = solvers::parse_krylov(kr),
+                                                .pc = solvers::parse_pc(pc)};
+                (void)levels::plan_solver(problem, req, nps.back());
             }
         mpiexec = launcher(opt.mpiexec);
     }

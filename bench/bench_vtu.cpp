@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
         p.levels = level;
         levels::SolveOptions so;
         so.predicted_sizes = levels::predict_level_sizes(p);
-        so.linear = levels::choose_solver(p, {}, &so.predicted_sizes).spec;
+        so.linear = levels::plan_solver(p, {}, 1, &so.predicted_sizes).spec;
         const double t0 = wall_seconds();
         const levels::RunResult r = levels::solve(p, so);
         const double solve_seconds = wall_seconds() - t0;

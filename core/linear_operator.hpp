@@ -5,6 +5,7 @@
 
 #include "core/types.hpp"
 
+#include <memory>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -78,6 +79,13 @@ public:
     virtual void apply_transpose(const Vector& r, Vector& z) const;
     /// Short name for reports, e.g. "ilu(0)".
     virtual std::string name() const = 0;
+    /// The product a Krylov method preconditioned by this should use for A (the matrix it was
+    /// set up on): null for A's own in-order product (the default). The multigrid returns the
+    /// unrolled product, or its finest level's lattice stencils. It refers to A and to this.
+    virtual std::unique_ptr<LinearOperator> krylov_operator(const SparseMatrix& A) const {
+        (void)A;
+        return nullptr;
+    }
 };
 
 /// Identity preconditioner (z = r).

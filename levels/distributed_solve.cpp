@@ -27,8 +27,8 @@ struct DistributedMultigrid::Impl {
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
          LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
-          use_mg_(solvers::parse_pc(spec_.pc).name() == "mg"),
-          use_ebe_(solvers::parse_pc(spec_.pc).name() == "ebe"), op_(levels.size()) {
+          use_mg_(spec_.pc.name() == "mg"), use_ebe_(spec_.pc.entry->element_matrices),
+          op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k)
             build_jacobian(k);
     }
@@ -144,7 +144,7 @@ struct DistributedMultigrid::Impl {
         const BlockPc block(*this, k);
         const Preconditioner& pc = use_mg_ ? static_cast<const Preconditioner&>(cycle) : block;
         SolveResult r =
-            solvers::solve(solvers::parse_krylov(spec_.krylov), *op_[k].J, pc, b, dx, kp);
+            solvers::solve(spec_.krylov, *op_[k].J, pc, b, dx, kp);
         r.setup_seconds = t1 - t0;
         r.solve_seconds = wall_seconds() - t1;
         return r;
@@ -173,7 +173,9 @@ struct DistributedMultigrid::Impl {
 
     std::string name() const {
         std::ostringstream os;
-        if (!use_mg_) return spec_.krylov + " + " + spec_.pc + " on each process's diagonal block";
+        if (!use_mg_)
+            return std::string(solvers::to_string(spec_.krylov)) + " + " + spec_.pc.text() +
+                   " on each process's diagonal block";
         os << spec_.krylov << " + distributed mg(pre=" << mg_.pre_sweeps
            << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega << ")";
         return os.str();
@@ -471,13 +473,13 @@ private:
 } // namespace
 
 solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
-    MLC_CHECK(spec.method == "krylov",
+    MLC_CHECK(spec.method == solvers::Method::krylov,
               "on several processes the Newton systems are solved by a Krylov method with mg "
               "(--linear krylov --pc mg); '"
                   << spec.method
                   << "' has no distributed form (schur, lu, cf and sorcf need the "
                      "whole level on one process)");
-    const solvers::PcSpec pc = solvers::parse_pc(spec.pc);
+    const solvers::PcSpec& pc = spec.pc;
     const std::string why = pc.distributed();
     MLC_CHECK(why.empty(), why);
     if (pc.name() != "mg") {

@@ -54,14 +54,14 @@ private:
 class KrylovSystemSolver final : public NewtonSystemSolver {
 public:
     KrylovSystemSolver(const Level& level, const LinearSolverSpec& spec, const LevelBelow* below)
-        : level_(level), spec_(spec), jac_(level), method_(solvers::parse_krylov(spec.krylov)) {
+        : level_(level), spec_(spec), jac_(level), method_(spec.krylov) {
         params_.rel_tol = spec.rel_tol;
         params_.max_iter = spec.max_iter;
         params_.restart = spec.restart;
         params_.give_up_budget = spec.give_up_budget;
         params_.validate();
         if (below != nullptr && below->available()) below_ = below;
-        const solvers::PreconditionerEntry* entry = solvers::parse_pc(spec.pc).entry;
+        const solvers::PreconditionerEntry* entry = spec.pc.entry;
         const solvers::LevelData data = level_data(entry);
         pc_ = solvers::make_preconditioner(spec.pc, &data);
         // Only the level-aware entries need the level below's statuses; mg also needs its
@@ -87,24 +87,20 @@ public:
         prepare(M);
         const double t1 = wall_seconds();
         if (dx.size() != b.size()) dx = Vector::Zero(b.size());
-        // mg: the unrolled mat-vec (MatVec::unrolled); the others keep Eigen's in-order one,
-        // so their published iteration counts stay bit-for-bit reproducible.
         solvers::KrylovParams params = params_;
         params.rel_tol = std::max(params_.rel_tol, forcing);
-        // mg:smoother=lattice: the product by the finest level's stencils (LatticeGS::multiply).
-        const smoothers::LatticeGS* lattice = mg_ ? mg_->finest_lattice() : nullptr;
-        SolveResult r =
-            lattice
-                ? solvers::solve(method_, smoothers::LatticeOperator(*lattice), *pc_, b, dx, params)
-            : mg_ ? solvers::solve(method_, MatrixOperator(jac_.matrix(), MatVec::unrolled), *pc_,
-                                   b, dx, params)
-                  : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params);
+        // The preconditioner says which product goes with it (mg: the unrolled one or its
+        // lattice stencils); the others keep Eigen's in-order one, so their published iteration
+        // counts stay bit-for-bit reproducible.
+        const std::unique_ptr<LinearOperator> op = pc_->krylov_operator(jac_.matrix());
+        SolveResult r = op ? solvers::solve(method_, *op, *pc_, b, dx, params)
+                           : solvers::solve(method_, jac_.matrix(), *pc_, b, dx, params);
         r.setup_seconds = t1 - t0;
         r.assembly_seconds = assembly_seconds_;
         return r;
     }
     std::string name() const override {
-        return spec_.krylov + "+" + pc_->name() +
+        return std::string(solvers::to_string(spec_.krylov)) + "+" + pc_->name() +
                (coarse_fallback_.empty()
                     ? ""
                     : " (coarse LU singular, coarse solve by the level below's " +

@@ -411,15 +411,15 @@ std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level)
 }
 
 void LinearSolverSpec::validate() const {
-    MLC_CHECK(method == "schur" || method == "lu" || method == "krylov",
-              "unknown linear solver method '" << method << "' (known: schur, lu, krylov)");
+    MLC_CHECK(method != solvers::Method::krylov || pc.entry != nullptr,
+              "a Krylov solve without a preconditioner spec");
     MLC_CHECK(rel_tol > 0 && rel_tol < 1, "linear rel_tol must lie in (0, 1), found " << rel_tol);
     MLC_CHECK(max_iter >= 1, "linear max_iter must be >= 1, found " << max_iter);
     MLC_CHECK(restart >= 1, "GMRES restart must be >= 1, found " << restart);
 }
 
 std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s) {
-    if (s.method != "krylov") return os << s.method;
+    if (s.method != solvers::Method::krylov) return os << s.method;
     return os << s.krylov << " + " << s.pc << " (rel_tol " << s.rel_tol << ", max_iter "
               << s.max_iter << ")";
 }
@@ -428,8 +428,8 @@ std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level
                                                               const LinearSolverSpec& spec,
                                                               const LevelBelow* below) {
     spec.validate();
-    if (spec.method == "schur") return make_schur_system_solver(level);
-    if (spec.method == "lu") return make_assembled_system_solver(level, make_sparse_lu_solver());
+    if (spec.method == solvers::Method::schur) return make_schur_system_solver(level);
+    if (spec.method == solvers::Method::lu) return make_assembled_system_solver(level, make_sparse_lu_solver());
     return make_krylov_system_solver(level, spec, below);
 }
 

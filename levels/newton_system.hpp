@@ -6,10 +6,12 @@
 #include "core/linear_operator.hpp"
 #include "levels/level.hpp"
 #include "solvers/mg.hpp"
+#include "solvers/pc_spec.hpp"
 #include "transfer/transfer.hpp"
 
 #include <Eigen/Dense>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -128,13 +130,13 @@ std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level)
 /// multigrid needs 5 to 30 on every scene we have; a few hundred means it is failing there.
 inline constexpr int kFallbackKrylovBudget = 500;
 
-/// How each Newton system is solved.
+/// How each Newton system is solved (levels::plan_solver fills it from a request).
 struct LinearSolverSpec {
-    /// "schur" (exact, condensed on the contact set; default), "lu" (SparseLU on the assembled
-    /// Jacobian) or "krylov" (the `krylov` method with the `pc` preconditioner).
-    std::string method = "schur";
-    std::string krylov = "cgs"; ///< cgs | bicg | bicgstab | gmres (method "krylov")
-    std::string pc = "ilu:0"; ///< preconditioner spec, e.g. "ilu:1", "cf", "sorcf:omega=1.2", "ebe"
+    /// schur (exact, condensed on the contact set; default), lu (SparseLU on the assembled
+    /// Jacobian) or krylov (the `krylov` method with the `pc` preconditioner).
+    solvers::Method method = solvers::Method::schur;
+    solvers::Krylov krylov = solvers::Krylov::cgs; ///< method krylov
+    solvers::PcSpec pc = solvers::parse_pc("ilu"); ///< method krylov: the preconditioner
     /// Relative tolerance of the linear solve, ||b - J dx|| <= rel_tol ||b||. 1e-10 keeps the
     /// Newton iterates as exact as the papers' (they solve to near round-off).
     double rel_tol = 1e-10;
@@ -144,7 +146,15 @@ struct LinearSolverSpec {
     /// solvers::KrylovParams::give_up_budget. The driver sets kFallbackKrylovBudget when an
     /// exact fallback follows a failed solve (SolveOptions::exact_fallback).
     int give_up_budget = 0;
+    /// The numbering the levels are built with (the planner sets it); unset: lattice where the
+    /// preconditioner sweeps by lattices, else the problem's (levels::hierarchy_numbering).
+    std::optional<Problem::Numbering> numbering{};
     void validate() const;
+    /// Whether the preconditioner uses the level below (a Krylov method with such an entry).
+    bool uses_level_below() const {
+        return method == solvers::Method::krylov && pc.entry != nullptr &&
+               pc.entry->needs_level_below;
+    }
 };
 
 std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s);

@@ -73,120 +73,171 @@ double mg_crossover_unknowns(const Problem& problem) {
     return has_two_body_pair(problem) ? kMgCrossoverTwoBody : kMgCrossoverOneBody;
 }
 
-bool wants_lattice_sweep(const std::string& pc) {
-    return pc.find("smoother=lattice") != std::string::npos;
+solvers::PcSpec default_mg(bool two_body, bool lattice) {
+    solvers::PcSpec s = solvers::parse_pc("mg");
+    auto& m = std::get<solvers::MgOptions>(s.options);
+    m.pre = 0;
+    m.post = 2;
+    if (two_body) m.omega = 0.8;
+    if (lattice) m.smoother = solvers::MultigridParams::Smoother::lattice;
+    return s;
 }
 
-void number_for(Problem& problem, const std::string& pc) {
-    if (wants_lattice_sweep(pc)) problem.numbering = Problem::Numbering::lattice;
-}
-
-void check_lattice_smoother(const Problem& problem, const std::string& pc, bool numbered_for_it) {
-    if (!wants_lattice_sweep(pc)) return;
-    MLC_CHECK(problem.levels >= 4,
-              "--pc " << pc
+Problem::Numbering hierarchy_numbering(const Problem& problem, const LinearSolverSpec& spec) {
+    const bool lattice = spec.method == solvers::Method::krylov && spec.pc.lattice_numbering();
+    if (!lattice) return spec.numbering.value_or(problem.numbering);
+    MLC_CHECK(problem.levels >= kMgDefaultLatticeLevel,
+              "--pc " << spec.pc
                       << ": smoother=lattice sweeps levels 4 and finer of a refined hierarchy (16 "
                          "subdivisions of every level-0 edge), and the finest level here is level "
                       << problem.levels << ": use --levels >= 4");
-    MLC_CHECK(numbered_for_it || problem.numbering == Problem::Numbering::lattice,
-              "--pc " << pc
+    MLC_CHECK(spec.numbering.value_or(Problem::Numbering::lattice) == Problem::Numbering::lattice,
+              "--pc " << spec.pc
                       << ": smoother=lattice needs the levels' unknowns numbered macro triangle "
                          "by macro triangle (--numbering lattice, which the option takes when "
                          "no numbering is given; Problem::numbering = lattice in the library): "
                          "drop --numbering hilbert");
+    return Problem::Numbering::lattice;
 }
 
-SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
-                           const std::vector<LevelSize>* known_sizes) {
-    SolverChoice c;
-    LinearSolverSpec& s = c.spec;
+namespace {
+
+// A Krylov option next to a direct method: the message naming both.
+void refuse_krylov_option_with_direct(const SolverRequest& req) {
     const bool krylov_option = req.pc || req.krylov || req.rel_tol;
-    if (req.linear && *req.linear != "krylov" && krylov_option) {
-        std::ostringstream os;
-        os << "--linear " << *req.linear << " is a direct solve, but ";
-        if (req.pc)
-            os << "--pc " << *req.pc;
-        else if (req.krylov)
-            os << "--krylov " << *req.krylov;
-        else
-            os << "--linear-tol";
-        os << " applies to Krylov solves only: drop --linear " << *req.linear
-           << " (a preconditioner alone means --linear krylov) or the Krylov option";
-        throw InvalidInput(os.str());
+    if (!req.linear || *req.linear == solvers::Method::krylov || !krylov_option) return;
+    std::ostringstream os;
+    os << "--linear " << *req.linear << " is a direct solve, but ";
+    if (req.pc)
+        os << "--pc " << *req.pc;
+    else if (req.krylov)
+        os << "--krylov " << *req.krylov;
+    else
+        os << "--linear-tol";
+    os << " applies to Krylov solves only: drop --linear " << *req.linear
+       << " (a preconditioner alone means --linear krylov) or the Krylov option";
+    throw InvalidInput(os.str());
+}
+
+// On several processes: a Krylov method with mg or a preconditioner with a distributed form.
+SolverPlan plan_distributed(const Problem& problem, const SolverRequest& req, int processes) {
+    MLC_CHECK(!req.linear || *req.linear == solvers::Method::krylov,
+              "--linear " << *req.linear
+                          << " has no distributed form (it needs the whole level on one "
+                             "process); on several processes the Newton systems are solved by "
+                             "a Krylov method with mg (--linear krylov, the default there)");
+    SolverPlan c;
+    c.processes = processes;
+    LinearSolverSpec& s = c.spec;
+    const bool two_body = has_two_body_pair(problem);
+    s.method = solvers::Method::krylov;
+    // The default (BiCGStab + V(0,2) mg) when no preconditioner is named; a named one keeps
+    // the Krylov method it always had there (CGS, BiCGStab with a two-body pair).
+    s.krylov = req.krylov.value_or(req.pc ? (two_body ? solvers::Krylov::bicgstab
+                                                      : solvers::Krylov::cgs)
+                                          : kMgDefaultKrylov);
+    s.pc = req.pc.value_or(default_mg(two_body));
+    if (req.rel_tol) s.rel_tol = *req.rel_tol;
+    const std::string why = s.pc.distributed();
+    MLC_CHECK(why.empty(), why);
+    MLC_CHECK(!req.numbering || *req.numbering == Problem::Numbering::hilbert,
+              "the lattice numbering has no distributed form: on several processes each "
+              "process numbers its unknowns along a Hilbert curve (drop --numbering lattice)");
+    s.numbering = Problem::Numbering::hilbert;
+    c.reason = req.pc ? "Krylov solve with --pc " + s.pc.text() + " as requested"
+                      : "on " + std::to_string(processes) +
+                            " processes: BiCGStab + distributed multilevel mg (V(0,2) cycle" +
+                            (two_body ? ", damped with a two-body pair)" : ")");
+    s.validate();
+    return c;
+}
+
+// A Krylov solve asked for (a preconditioner, a Krylov method, a tolerance or --linear krylov).
+void plan_krylov(const Problem& problem, const SolverRequest& req, SolverPlan& c) {
+    LinearSolverSpec& s = c.spec;
+    const bool has_levels = problem.levels >= 1;
+    s.method = solvers::Method::krylov;
+    if (req.pc) {
+        s.pc = *req.pc;
+        c.reason = "Krylov solve with --pc " + s.pc.text() + " as requested";
+        const solvers::PreconditionerEntry& entry = *s.pc.entry;
+        MLC_CHECK(has_levels || !entry.needs_level_below || entry.single_level_too,
+                  "--pc " << s.pc << " needs the level below: use --levels >= 1");
+        return;
     }
+    // mg over the levels, or over an aggregation hierarchy on a single level (there it is
+    // faster than ILU(0), which falls back to schur from the square's level-3 export on).
+    const bool two_body = has_two_body_pair(problem);
+    s.pc = default_mg(two_body);
+    if (!req.krylov) s.krylov = kMgDefaultKrylov;
+    const std::string asked = req.linear   ? std::string("--linear krylov")
+                              : req.krylov ? "--krylov " + std::string(to_string(*req.krylov))
+                                           : std::string("--linear-tol");
+    c.reason = asked + " without --pc: multilevel mg " +
+               (has_levels ? "over the levels" : "over an aggregation hierarchy (one level)") +
+               " (V(0,2) cycle)" + (two_body ? ", damped (omega = 0.8) with a two-body pair" : "");
+}
+
+// Nothing asked for: schur up to the crossover, BiCGStab + the default mg above it.
+void plan_by_size(const Problem& problem, const SolverRequest& req,
+                  const std::vector<LevelSize>* known_sizes, SolverPlan& c) {
+    LinearSolverSpec& s = c.spec;
+    c.automatic = true;
+    const bool has_levels = problem.levels >= 1;
+    const double n = known_sizes ? known_sizes->back().unknowns
+                                 : predict_level_sizes(problem).back().unknowns;
+    const double crossover = mg_crossover_unknowns(problem);
+    std::ostringstream os;
+    os << std::setprecision(3);
+    if (has_levels && n > crossover) {
+        s.method = solvers::Method::krylov;
+        const bool two_body = has_two_body_pair(problem);
+        if (!req.krylov) s.krylov = kMgDefaultKrylov;
+        // Levels 4 and finer swept by lattices, numbered for it (not when the request keeps
+        // the Hilbert numbering).
+        const bool lattice = problem.levels >= kMgDefaultLatticeLevel &&
+                             req.numbering.value_or(Problem::Numbering::lattice) ==
+                                 Problem::Numbering::lattice;
+        s.pc = default_mg(two_body, lattice);
+        os << "default: " << n << " unknowns on the finest level exceed the crossover "
+           << crossover << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
+           << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles" : "")
+           << (lattice ? "; levels 4 and finer numbered and swept macro triangle by macro "
+                         "triangle, --numbering hilbert for the block sweep)"
+                       : ")");
+    } else {
+        s.method = solvers::Method::schur;
+        if (!has_levels && n > crossover)
+            os << "default: " << n << " unknowns on a single level: exact schur (faster "
+               << "there than mg over an aggregation hierarchy, which --linear krylov builds)";
+        else
+            os << "default: " << n << " unknowns on the finest level, at most the crossover "
+               << crossover << ": exact schur (faster there)";
+    }
+    c.reason = os.str();
+}
+
+} // namespace
+
+SolverPlan plan_solver(const Problem& problem, const SolverRequest& req, int processes,
+                       const std::vector<LevelSize>* known_sizes) {
+    MLC_CHECK(processes >= 1, "plan_solver: " << processes << " processes");
+    refuse_krylov_option_with_direct(req);
+    if (processes > 1) return plan_distributed(problem, req, processes);
+    SolverPlan c;
+    LinearSolverSpec& s = c.spec;
     if (req.krylov) s.krylov = *req.krylov;
     if (req.rel_tol) s.rel_tol = *req.rel_tol;
-    const bool has_levels = problem.levels >= 1;
-    if (req.linear && *req.linear != "krylov") {
+    if (req.linear && *req.linear != solvers::Method::krylov) {
         s.method = *req.linear;
-        c.reason = "--linear " + s.method + " as requested";
-    } else if (req.linear || krylov_option) {
-        s.method = "krylov";
-        if (req.pc) {
-            s.pc = *req.pc;
-            c.reason = "Krylov solve with --pc " + s.pc + " as requested";
-            // The registry says what the name is and whether it needs the level below.
-            const solvers::PreconditionerEntry* entry = solvers::parse_pc(s.pc).entry;
-            MLC_CHECK(entry != nullptr,
-                      "unknown preconditioner '"
-                          << s.pc << "'; valid: " << solvers::preconditioner_names(", ")
-                          << " (`mlcontact preconditioners` lists their options)");
-            MLC_CHECK(has_levels || !entry->needs_level_below || entry->single_level_too,
-                      "--pc " << s.pc << " needs the level below: use --levels >= 1");
-            // A lattice sweep named without a numbering numbers the levels for it.
-            c.lattice_numbering = wants_lattice_sweep(s.pc) && !req.numbering;
-            check_lattice_smoother(problem, s.pc, c.lattice_numbering);
-        } else {
-            // mg over the levels, or over an aggregation hierarchy on a single level (there it
-            // is faster than ILU(0), which falls back to schur from the square's level-3 export
-            // on: README, the `--linear krylov` option).
-            const bool two_body = has_two_body_pair(problem);
-            s.pc = default_mg_spec(two_body);
-            if (!req.krylov) s.krylov = kMgDefaultKrylov;
-            const std::string asked = req.linear   ? std::string("--linear krylov")
-                                      : req.krylov ? "--krylov " + *req.krylov
-                                                   : std::string("--linear-tol");
-            c.reason =
-                asked + " without --pc: multilevel mg " +
-                (has_levels ? "over the levels" : "over an aggregation hierarchy (one level)") +
-                " (V(0,2) cycle)" + (two_body ? ", damped (omega = 0.8) with a two-body pair" : "");
-        }
+        c.reason = "--linear " + std::string(to_string(s.method)) + " as requested";
+    } else if (req.linear || req.pc || req.krylov || req.rel_tol) {
+        plan_krylov(problem, req, c);
     } else {
-        c.automatic = true;
-        const double n = known_sizes ? known_sizes->back().unknowns
-                                     : predict_level_sizes(problem).back().unknowns;
-        const double crossover = mg_crossover_unknowns(problem);
-        std::ostringstream os;
-        os << std::setprecision(3);
-        if (has_levels && n > crossover) {
-            s.method = "krylov";
-            // BiCGStab with a V(0,2) cycle; two-body pairs also damp the sweeps (README
-            // "Choosing the Newton-system solver", "The default cycle: V(0,2) with BiCGStab").
-            const bool two_body = has_two_body_pair(problem);
-            if (!req.krylov) s.krylov = kMgDefaultKrylov;
-            // Levels 4 and finer swept by lattices, numbered for it (not when the request keeps
-            // the Hilbert numbering).
-            c.lattice_numbering = problem.levels >= kMgDefaultLatticeLevel &&
-                                  (!req.numbering || *req.numbering == "lattice");
-            s.pc = default_mg_spec(two_body, c.lattice_numbering);
-            os << "default: " << n << " unknowns on the finest level exceed the crossover "
-               << crossover << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
-               << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles" : "")
-               << (c.lattice_numbering ? "; levels 4 and finer numbered and swept macro triangle "
-                                         "by macro triangle, --numbering hilbert for the block "
-                                         "sweep)"
-                                       : ")");
-        } else {
-            s.method = "schur";
-            if (!has_levels && n > crossover)
-                os << "default: " << n << " unknowns on a single level: exact schur (faster "
-                   << "there than mg over an aggregation hierarchy, which --linear krylov builds)";
-            else
-                os << "default: " << n << " unknowns on the finest level, at most the crossover "
-                   << crossover << ": exact schur (faster there)";
-        }
-        c.reason = os.str();
+        plan_by_size(problem, req, known_sizes, c);
     }
+    s.numbering = req.numbering;
+    s.numbering = hierarchy_numbering(problem, s);
     s.validate();
     return c;
 }
@@ -194,7 +245,7 @@ SolverChoice choose_solver(const Problem& problem, const SolverRequest& req,
 // ------------------------------------------------------------------------------------------
 namespace {
 
-// Fitted on measured peaks (README "Memory"): bytes per nonzero of K and per unknown over all
+// Fitted on measured peaks: bytes per nonzero of K and per unknown over all
 // levels, for the hierarchy and for each solver, plus the process baseline.
 constexpr double kBaseline = 12.0 * (1 << 20);
 constexpr double kHierarchyPerNonzero = 26.0;
@@ -204,8 +255,7 @@ constexpr double kKrylovPerUnknown = 130.0;
 constexpr double kLuPerNonzero = 120.0;
 constexpr double kCholeskyPerNonzero = 20.0;
 // mg on a single level adds its aggregation hierarchy: the smoothed prolongations, the Galerkin
-// coarse operators and the products that form them (square exported from level 4: peak 264 MiB
-// against 130 MiB estimated without it, 1.84 million nonzeros of K).
+// coarse operators and the products that form them.
 constexpr double kAggregationPerNonzero = 80.0;
 
 } // namespace
@@ -220,22 +270,24 @@ MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const Linear
         e.hierarchy_bytes +=
             kHierarchyPerNonzero * s.k_nonzeros + kHierarchyPerUnknown * s.unknowns;
         // The finest level's solver, and every level's in coarse-to-fine (level 0 by schur).
-        const bool solved = coarse_to_fine || s.level == finest || spec.method == "krylov";
+        const bool solved =
+            coarse_to_fine || s.level == finest || spec.method == solvers::Method::krylov;
         if (!solved) continue;
         double b = 0;
-        const std::string method = s.level == 0 && finest > 0 ? "schur" : spec.method;
+        const solvers::Method method =
+            s.level == 0 && finest > 0 ? solvers::Method::schur : spec.method;
         const double m = s.multipliers;
-        if (method == "krylov")
+        if (method == solvers::Method::krylov)
             b = kKrylovPerNonzero * s.k_nonzeros + kKrylovPerUnknown * s.unknowns;
-        else if (method == "lu")
+        else if (method == solvers::Method::lu)
             b = kLuPerNonzero * s.k_nonzeros * std::max(1.0, std::log2(s.unknowns) / 4);
         else // schur: Cholesky of K0, S (m x m) and the dense m x m LU of every Newton step
             b = kCholeskyPerNonzero * s.k_nonzeros * std::max(1.0, std::log2(s.unknowns) / 4) +
                 3 * 8.0 * m * m;
-        if (method == "krylov" && finest == 0) {
-            const solvers::PreconditionerEntry* pc = solvers::parse_pc(spec.pc).entry;
-            if (pc != nullptr && pc->name == "mg") b += kAggregationPerNonzero * s.k_nonzeros;
-        }
+        // A single level's mg builds its aggregation hierarchy.
+        if (method == solvers::Method::krylov && finest == 0 && spec.pc.entry != nullptr &&
+            spec.pc.entry->single_level_too)
+            b += kAggregationPerNonzero * s.k_nonzeros;
         e.solver_bytes += b;
         if (b >= worst) {
             worst = b;

@@ -6,6 +6,7 @@
 
 #include "levels/newton_system.hpp"
 #include "levels/problem.hpp"
+#include "solvers/pc_spec.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -34,31 +35,23 @@ struct LevelSize {
 std::vector<LevelSize> predict_level_sizes(const Problem& problem);
 
 /// Finest-level unknowns above which the default Newton-system solver is Krylov + mg (BiCGStab +
-/// the V(0,2) cycle) rather than the exact `schur` (measured with OpenBLAS behind CHOLMOD,
-/// 2026-11-26, README "Choosing the Newton-system solver"): with rigid obstacles only, mg is
-/// 1.3-1.5x faster from calumet level 2 and square level 1 on (2 844 and 2 208 unknowns), the
-/// two equal below (incline level 1, 1 187; calumet level 1, 796); with a two-body pair mg is
-/// 1.3x faster on dovetail level 1 (14 341) and axis_release level 1 (23 724), equal on mindlin
-/// level 1 (28 594), faster on every level above, and schur up to 1.27x faster on the patch tests
-/// (at most 1 405 unknowns, 20-30 ms). mg's memory is within 2 MiB of schur's or smaller
-/// wherever it is chosen. (Before 2026-11-26: 15 000 and 100 000, measured with the reference
-/// BLAS and the previous mg pairs.)
+/// the V(0,2) cycle) rather than the exact `schur`, with rigid obstacles only and with a two-body
+/// pair: where the two take about the same time with OpenBLAS behind CHOLMOD, mg's memory no
+/// larger than schur's wherever it is chosen (docs/solver-guide.md).
 inline constexpr double kMgCrossoverOneBody = 2000;
 inline constexpr double kMgCrossoverTwoBody = 10000;
 
 /// The preconditioner the driver takes for `mg` when nobody named one: a V(0,2) cycle (no
 /// pre-smoothing, two backward sweeps after the coarse correction), which needs fewer bytes per
-/// Newton step than V(1,1) for the same or fewer Krylov iterations (square level 6: a Newton
-/// step 1.09 -> 0.81 s, README "The default cycle: V(0,2) with BiCGStab"); with a two-body pair
-/// the sweeps are also damped (omega = 0.8), which halved BiCGStab's iterations on dovetail
-/// level 4 with V(1,1) and keeps them on levels 2 and 3 (with V(0,2): 20 against 85); with rigid
-/// obstacles only they are not (the square's iterations grow with omega = 0.8).
+/// Newton step than V(1,1) for the same or fewer Krylov iterations (docs/solver-guide.md); with
+/// a two-body pair the sweeps are also damped (omega = 0.8), which needs fewer BiCGStab
+/// iterations there; with rigid obstacles only they are not (the square's iterations grow with
+/// omega = 0.8). Their canonical text, as reports print it.
 inline constexpr const char* kMgDefaultOneBody = "mg:pre=0,post=2";
 inline constexpr const char* kMgDefaultTwoBody = "mg:omega=0.8,pre=0,post=2";
 /// The Krylov method the driver takes with its default mg (the V(0,2) cycle is not symmetric,
-/// and BiCGStab needs fewer V-cycles than CGS with it: square level 6, 22.4 against 26.7 GB
-/// per Newton step at the same iterations or fewer).
-inline constexpr const char* kMgDefaultKrylov = "bicgstab";
+/// and BiCGStab needs fewer V-cycles than CGS with it).
+inline constexpr solvers::Krylov kMgDefaultKrylov = solvers::Krylov::bicgstab;
 
 /// The crossover that applies to `problem` (two-body pairs or not).
 double mg_crossover_unknowns(const Problem& problem);
@@ -67,73 +60,70 @@ double mg_crossover_unknowns(const Problem& problem);
 /// two-body crossover and the damped default mg.
 bool has_two_body_pair(const Problem& problem);
 
-/// The default mg spec: kMgDefaultTwoBody with a two-body pair, else kMgDefaultOneBody.
-inline const char* default_mg_spec(bool two_body) {
-    return two_body ? kMgDefaultTwoBody : kMgDefaultOneBody;
-}
-
-/// What the user asked for; unset fields take the driver's defaults.
-struct SolverRequest {
-    std::optional<std::string> linear{}; ///< schur | lu | krylov
-    std::optional<std::string> krylov{}; ///< cgs | bicg | bicgstab | gmres
-    std::optional<std::string> pc{};     ///< preconditioner spec
-    std::optional<double> rel_tol{};     ///< Krylov relative tolerance
-    /// hilbert | lattice as requested (Problem::numbering); unset: the default solver's choice.
-    std::optional<std::string> numbering{};
-};
-
-/// The Newton-system solver of a run and why it was chosen.
-struct SolverChoice {
-    LinearSolverSpec spec;
-    bool automatic = false; ///< chosen by size (no solver flag given)
-    /// The choice sweeps levels 4 and finer with mg:smoother=lattice: the caller numbers the
-    /// levels macro triangle by macro triangle (Problem::Numbering::lattice) before building them
-    /// (apps::run_solve_options does).
-    bool lattice_numbering = false;
-    std::string reason; ///< one sentence, for the report and summary.json
-};
-
-/// The smoother option the default mg adds where its levels allow it: the lattice sweep on levels
-/// 4 and finer (README "Structured sweeps on the macro triangles": square level 6, a fine Newton
-/// step 64-100 -> 32-46 level-6 mat-vecs, V-cycle 4.6 -> 1.9 mat-vecs).
-inline constexpr const char* kMgDefaultLatticeOption = ",smoother=lattice";
 /// The finest level from which the default mg sweeps by lattices (16 subdivisions of every
 /// level-0 edge: solvers::kMinLatticeSubdivisions).
 inline constexpr int kMgDefaultLatticeLevel = 4;
 
-/// default_mg_spec(two_body), with kMgDefaultLatticeOption when `lattice`.
-inline std::string default_mg_spec(bool two_body, bool lattice) {
-    return std::string(default_mg_spec(two_body)) + (lattice ? kMgDefaultLatticeOption : "");
-}
+/// The default mg: kMgDefaultTwoBody with a two-body pair, else kMgDefaultOneBody; with
+/// `lattice`, the lattice sweep of levels 4 and finer (smoother=lattice) too.
+solvers::PcSpec default_mg(bool two_body, bool lattice = false);
 
-/// Refuses mg:smoother=lattice (InvalidInput naming the fix) where it cannot take effect: a
-/// finest level below 4, or the levels not numbered as lattices (Problem::Numbering::lattice;
-/// `numbered_for_it`: the caller will number them so). Called by choose_solver and solve.
-void check_lattice_smoother(const Problem& problem, const std::string& pc,
-                            bool numbered_for_it = false);
+/// What the user asked for, parsed at the edge (solvers::parse_pc, solvers::parse_method,
+/// solvers::parse_krylov, parse_numbering); unset fields take the planner's defaults.
+struct SolverRequest {
+    std::optional<solvers::Method> linear{};
+    std::optional<solvers::Krylov> krylov{};
+    std::optional<solvers::PcSpec> pc{};
+    std::optional<double> rel_tol{}; ///< Krylov relative tolerance
+    /// The numbering of the levels as requested; unset: the problem's, or lattice where the
+    /// preconditioner sweeps by lattices.
+    std::optional<Problem::Numbering> numbering{};
+};
 
-/// Whether a preconditioner spec asks for the lattice sweep (mg:...,smoother=lattice).
-bool wants_lattice_sweep(const std::string& pc);
+/// The whole Newton-system solver of a run: method, Krylov method, preconditioner and
+/// tolerances (`spec`, whose `numbering` is the levels' numbering the hierarchy is built with),
+/// whether the planner chose it by size, and why.
+struct SolverPlan {
+    LinearSolverSpec spec;
+    bool automatic = false; ///< chosen by size (no solver option given)
+    int processes = 1;      ///< the processes it was planned for
+    std::string reason;     ///< one sentence, for the report and summary.json
+    /// The numbering of the levels (spec.numbering, always set by the planner).
+    Problem::Numbering numbering() const {
+        return spec.numbering.value_or(Problem::Numbering::hilbert);
+    }
+    /// The levels are numbered by lattices (macro triangle by macro triangle).
+    bool lattice_numbering() const { return numbering() == Problem::Numbering::lattice; }
+};
 
-/// Numbers `problem`'s levels by lattices when `pc` asks for the lattice sweep (what `run` does
-/// when no --numbering is given): for the studies and benchmarks that take a --pc and solve with
-/// it directly.
-void number_for(Problem& problem, const std::string& pc);
+/// The one planner of every front end (run on one process and many, benches, studies, Python).
+///
+/// On one process: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
+/// without `pc` uses the default mg (damped with a two-body pair; over an aggregation hierarchy
+/// on a single level) with BiCGStab; nothing at all chooses by size: `schur` up to
+/// mg_crossover_unknowns(problem) unknowns on the finest level, Krylov + mg above it when levels
+/// exist (BiCGStab + the V(0,2) cycle, damped with a two-body pair; from level
+/// kMgDefaultLatticeLevel on with the lattice sweep on levels numbered for it, unless the
+/// request names numbering hilbert). `pc` alone without `krylov` takes CGS. A Krylov option
+/// next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying so.
+///
+/// On several processes (`processes` > 1): always a Krylov method, BiCGStab + the default mg
+/// (never schur); a named `pc` takes CGS, BiCGStab with a two-body pair; a method or
+/// preconditioner without a distributed form (PreconditionerEntry::distributed) is refused
+/// naming the alternative; the levels keep the Hilbert numbering.
+///
+/// A preconditioner that sweeps by lattices numbers the levels for it (spec.numbering lattice)
+/// and is refused below level 4 or with numbering hilbert requested; one that needs the level
+/// below is refused on a single level. `sizes`: predict_level_sizes(problem) when the caller
+/// has it already (it builds level 0).
+SolverPlan plan_solver(const Problem& problem, const SolverRequest& request, int processes = 1,
+                       const std::vector<LevelSize>* sizes = nullptr);
 
-/// Resolves a request: `pc`, `krylov` or `rel_tol` alone mean a Krylov solve; `linear krylov`
-/// without `pc` uses the default mg (damped, kMgDefaultTwoBody, with a two-body pair; over an
-/// aggregation hierarchy on a single level) with BiCGStab; nothing at all chooses
-/// by size: `schur` up to mg_crossover_unknowns(problem) unknowns on the finest level, Krylov +
-/// `mg` above it when levels exist (BiCGStab + mg's V(0,2) cycle, damped with a two-body pair;
-/// from level kMgDefaultLatticeLevel on with the lattice sweep, kMgDefaultLatticeOption, and
-/// SolverChoice::lattice_numbering set, unless the request names numbering hilbert). A `pc`
-/// that names smoother=lattice sets lattice_numbering too when the request names no numbering.
-/// `pc` alone without `krylov` takes CGS; when the driver picks mg itself (no `pc`), BiCGStab
-/// (kMgDefaultKrylov). A Krylov option next to `linear schur` or `linear lu`
-/// contradicts it and throws InvalidInput saying so. `sizes`: predict_level_sizes(problem) when the
-/// caller has it already (it builds level 0).
-SolverChoice choose_solver(const Problem& problem, const SolverRequest& request,
-                           const std::vector<LevelSize>* sizes = nullptr);
+/// The numbering the hierarchy of a solve with `spec` is built with: spec.numbering when set,
+/// else lattice when its preconditioner sweeps by lattices, else the problem's. Throws
+/// InvalidInput naming the fix when a lattice sweep cannot take effect (a finest level below 4,
+/// or numbering hilbert asked for). levels::solve calls it: no caller numbers levels by hand.
+Problem::Numbering hierarchy_numbering(const Problem& problem, const LinearSolverSpec& spec);
 
 /// Peak resident memory a run is estimated to need, and its parts.
 struct MemoryEstimate {
@@ -172,7 +162,7 @@ inline constexpr double kOutputBytesPerContactNode = 150;
 inline constexpr double kOutputBytesPerLevel = 1024;
 
 /// Estimates the peak resident memory of `levels::solve` for these sizes and solver (a fit of
-/// measured peaks on the square, hertz and dovetail ladders; README: "Memory"), with what the
+/// measured peaks on the square, hertz and dovetail ladders), with what the
 /// run keeps per load step (`steps`: MemoryEstimate::steps_bytes) and the size of its files.
 MemoryEstimate estimate_memory(const std::vector<LevelSize>& sizes, const LinearSolverSpec& spec,
                                bool coarse_to_fine, const StepsKept& steps = {});

@@ -30,9 +30,7 @@ namespace {
 
 // The registry says which preconditioners use the level below.
 bool needs_coarse_level(const LinearSolverSpec& spec) {
-    if (spec.method != "krylov") return false;
-    const solvers::PreconditionerEntry* entry = solvers::parse_pc(spec.pc).entry;
-    return entry != nullptr && entry->needs_level_below;
+    return spec.uses_level_below();
 }
 
 void print_progress(std::ostream& os, int level, int n_levels, int step, int n_steps,
@@ -216,9 +214,16 @@ StepReport continue_in_r(Level& L, int l, const LevelSize& size, const NewtonPar
 RunResult solve(const Problem& problem, const SolveOptions& options) {
     problem.validate();
     options.linear.validate();
-    if (options.linear.method == "krylov") check_lattice_smoother(problem, options.linear.pc);
+    // The levels are numbered as the solver needs them (a lattice sweep: by macro triangles).
+    const Problem::Numbering numbering = hierarchy_numbering(problem, options.linear);
+    const auto numbered_at_step = [&](int step) {
+        Problem p = problem.at_step(step);
+        p.numbering = numbering;
+        return p;
+    };
     RunResult res;
     res.solver.spec = options.linear;
+    res.solver.spec.numbering = numbering;
     res.solver.reason = "as given";
     MLC_CHECK(options.predicted_sizes.empty() ||
                   options.predicted_sizes.size() == static_cast<size_t>(problem.levels) + 1,
@@ -237,7 +242,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
     // are unknowns: the hierarchy, its solvers and Newton drivers are then rebuilt for the new
     // step's supports (Problem::at_step), and the state carried over through the nodal values.
     int phase_step = 1; // the load step whose supports the current hierarchy has
-    res.hierarchy = build_hierarchy(problem.at_step(1), options.q_rule, &res.timings);
+    res.hierarchy = build_hierarchy(numbered_at_step(1), options.q_rule, &res.timings);
     const auto& levels = res.hierarchy.levels;
     res.warnings = initial_gap_warnings(problem, levels.front());
     const int n_levels = res.hierarchy.n_levels();
@@ -257,7 +262,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             const Level& L = levels[static_cast<size_t>(l)];
             LinearSolverSpec spec = options.linear;
             if (l == 0 && l != finest) spec = LinearSolverSpec{};
-            if (options.exact_fallback && spec.method == "krylov")
+            if (options.exact_fallback && spec.method == solvers::Method::krylov)
                 spec.give_up_budget = kFallbackKrylovBudget;
             auto& lb = below[static_cast<size_t>(l)];
             lb = LevelBelow{};
@@ -272,7 +277,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
             system[static_cast<size_t>(l)] = sys.get();
             newton[static_cast<size_t>(l)] =
                 std::make_unique<ContactNewton>(L, problem.newton, std::move(sys), &res.timings);
-            if (options.exact_fallback && spec.method == "krylov") {
+            if (options.exact_fallback && spec.method == solvers::Method::krylov) {
                 const LevelSize size = res.predicted_sizes[static_cast<size_t>(l)];
                 newton[static_cast<size_t>(l)]->set_fallback([&L, size, l]() {
                     const std::string why = schur_does_not_fit(size, l);
@@ -337,7 +342,7 @@ RunResult solve(const Problem& problem, const SolveOptions& options) {
                 ScopedTimer t(&res.timings, "setup/supports_changed");
                 try {
                     res.hierarchy =
-                        build_hierarchy(problem.at_step(step), options.q_rule, &res.timings);
+                        build_hierarchy(numbered_at_step(step), options.q_rule, &res.timings);
                 } catch (const InvalidInput& e) {
                     throw InvalidInput("load step " + std::to_string(step) +
                                        ", with the supports active from this step on: " + e.what());

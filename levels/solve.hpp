@@ -137,8 +137,8 @@ struct RunResult {
     /// use, all computed before the hierarchy was built.
     std::vector<LevelSize> predicted_sizes;
     /// The Newton-system solver of levels >= 1 (SolveOptions::linear); the driver that chose
-    /// it (choose_solver) fills `automatic` and `reason`.
-    SolverChoice solver;
+    /// it (plan_solver) fills `automatic` and `reason`.
+    SolverPlan solver;
     /// The finest level's multigrid (levels, sizes, complexities, smoother, coarse solve) when
     /// its solver uses one.
     std::optional<solvers::MultigridReport> multigrid;

@@ -216,7 +216,7 @@ std::shared_ptr<Result> solve(const Scene& scene, std::optional<int> levels,
     auto res = std::make_shared<Result>();
     res->problem = scene.problem;
     apps::apply_overrides(res->problem, opt);
-    levels::SolverChoice choice;
+    levels::SolverPlan choice;
     levels::SolveOptions so = apps::run_solve_options(res->problem, opt, choice);
     so.keep_step_states = keep_steps;
     if (progress) so.progress = &std::cout;
@@ -834,9 +834,9 @@ PYBIND11_MODULE(_core, m) {
                                [](const Result& r) {
                                    const auto& sp = r.run.solver.spec;
                                    py::dict d;
-                                   d["method"] = sp.method;
-                                   d["krylov"] = sp.krylov;
-                                   d["pc"] = sp.pc;
+                                   d["method"] = std::string(solvers::to_string(sp.method));
+                                   d["krylov"] = std::string(solvers::to_string(sp.krylov));
+                                   d["pc"] = sp.pc.text();
                                    d["rel_tol"] = sp.rel_tol;
                                    d["automatic"] = r.run.solver.automatic;
                                    d["numbering"] =

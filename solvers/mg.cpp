@@ -360,6 +360,12 @@ const SparseMatrix* Multigrid::finest_operator() const {
     return levels_.back()->A;
 }
 
+std::unique_ptr<LinearOperator> Multigrid::krylov_operator(const SparseMatrix& A) const {
+    if (const smoothers::LatticeGS* lattice = finest_lattice())
+        return std::make_unique<smoothers::LatticeOperator>(*lattice);
+    return std::make_unique<MatrixOperator>(A, MatVec::unrolled);
+}
+
 const smoothers::LatticeGS* Multigrid::finest_lattice() const {
     const Level& top = *levels_.back();
     return top.A != nullptr ? top.lattice.get() : nullptr;

@@ -141,6 +141,9 @@ public:
     /// The finest level's lattice smoother (mg:smoother=lattice on a lattice level), or null:
     /// its `multiply` is the finest operator's product by the macros' stencils, after setup.
     const smoothers::LatticeGS* finest_lattice() const;
+    /// The Krylov product: the finest level's lattice stencils when it sweeps by lattices, else
+    /// the unrolled CSR product of A (MatVec::unrolled).
+    std::unique_ptr<LinearOperator> krylov_operator(const SparseMatrix& A) const override;
 
     /// Number of levels (the finest is n_levels() - 1).
     int n_levels() const { return static_cast<int>(levels_.size()); }

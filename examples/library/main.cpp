@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
         if (argc > 2) opt.levels = std::stoi(argv[2]);
         mlc::levels::Problem p = mlc::scene::load_scene(opt.scene);
         mlc::apps::apply_overrides(p, opt); // the driver's checks and overrides
-        mlc::levels::SolverChoice choice;
+        mlc::levels::SolverPlan choice;
         const mlc::levels::SolveOptions so = mlc::apps::run_solve_options(p, opt, choice);
         const mlc::levels::RunResult r = mlc::levels::solve(p, so);
         if (!r.converged) {

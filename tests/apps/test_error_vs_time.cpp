@@ -88,13 +88,13 @@ TEST(ErrorVsTime, TheDefaultRowRunsTheRunsDefaultOnEveryLevel) {
             if (std::string(name) == "patch" && level == 3) continue;
             levels::Problem p = scene;
             p.levels = level;
-            const levels::SolverChoice choice = levels::choose_solver(p, {});
-            ASSERT_TRUE(choice.spec.method == "krylov")
+            const levels::SolverPlan choice = levels::plan_solver(p, {});
+            ASSERT_TRUE(choice.spec.method == solvers::Method::krylov)
                 << name << " level " << level << ": " << choice.reason;
             EXPECT_EQ(apps::error_vs_time_pc(scene, "c2f default bicgstab+mg", level),
-                      choice.spec.pc)
+                      choice.spec.pc.text())
                 << name << " level " << level;
-            EXPECT_EQ(choice.lattice_numbering, level >= 4) << name << " level " << level;
+            EXPECT_EQ(choice.lattice_numbering(), level >= 4) << name << " level " << level;
         }
     }
     EXPECT_EQ(apps::error_vs_time_pc(scene::load_scene("square"), "c2f cgs+mg", 5), "mg");

@@ -50,7 +50,7 @@ levels::RunResult run(levels::Problem p, int level, const std::string& how) {
     }
     p.newton.rel_tol = 1e-12;
     apps::apply_overrides(p, opt);
-    levels::SolverChoice choice;
+    levels::SolverPlan choice;
     const auto so = apps::run_solve_options(p, opt, choice);
     return levels::solve(p, so);
 }

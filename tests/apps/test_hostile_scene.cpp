@@ -93,7 +93,7 @@ TEST(HostileScene, EveryDataFileGivesItsExpectedOutcome) {
             auto p = scene::parse_scene(h.text, h.path.string());
             const apps::RunOptions opt;
             apps::apply_overrides(p, opt);
-            levels::SolverChoice choice;
+            levels::SolverPlan choice;
             const levels::SolveOptions so = apps::run_solve_options(p, opt, choice);
             const levels::RunResult r = levels::solve(p, so);
             std::ostringstream report;

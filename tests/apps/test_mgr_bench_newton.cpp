@@ -22,9 +22,9 @@ TEST(MGRRun, SquareLevel2GivesTheSchurAnswer) {
     auto p = scene::load_scene("square");
     p.levels = 2;
     levels::SolveOptions exact;
-    exact.linear.method = "schur";
+    exact.linear.method = solvers::Method::schur;
     levels::SolveOptions mgr;
-    mgr.linear = {.method = "krylov", .krylov = "cgs", .pc = "mgr"};
+    mgr.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mgr")};
     const auto a = levels::solve(p, exact);
     const auto b = levels::solve(p, mgr);
     ASSERT_TRUE(a.converged) << a.failure;
@@ -55,7 +55,7 @@ TEST(BenchNewton, OneRecordPerNewtonSystemWithFiniteValues) {
     auto p = scene::load_scene("square");
     p.levels = 1;
     levels::SolveOptions so;
-    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-8};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .rel_tol = 1e-8};
     const auto r = levels::solve(p, so);
     ASSERT_TRUE(r.converged) << r.failure;
     int systems = 0;

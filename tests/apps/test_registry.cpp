@@ -130,7 +130,7 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
     EXPECT_EQ(bench_defaults.pcs, std::vector<std::string>{"default"});
     for (const bool two_body : {false, true}) {
         const apps::BenchSolver d = apps::bench_solver(bench_defaults, "default", two_body);
-        EXPECT_EQ(d.krylov, levels::kMgDefaultKrylov);
+        EXPECT_EQ(d.krylov, solvers::to_string(levels::kMgDefaultKrylov));
         EXPECT_EQ(d.pc, two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody);
         EXPECT_NO_THROW(solvers::parse_pc(d.pc)) << d.pc;
     }
@@ -158,10 +158,10 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
         auto p = scene::load_scene("square");
         p.levels = L;
         for (const levels::SolverRequest& req :
-             {levels::SolverRequest{.linear = std::string("krylov")}, levels::SolverRequest{}}) {
-            const levels::SolverChoice c = levels::choose_solver(p, req);
-            if (c.spec.method != "krylov") continue;
-            const solvers::PreconditionerEntry* e = solvers::parse_pc(c.spec.pc).entry;
+             {levels::SolverRequest{.linear = solvers::Method::krylov}, levels::SolverRequest{}}) {
+            const levels::SolverPlan c = levels::plan_solver(p, req);
+            if (c.spec.method != solvers::Method::krylov) continue;
+            const solvers::PreconditionerEntry* e = c.spec.pc.entry;
             ASSERT_NE(e, nullptr) << c.spec.pc;
             EXPECT_TRUE(!e->needs_level_below || L >= 1 || e->single_level_too)
                 << c.spec.pc << " at levels " << L;
@@ -172,14 +172,12 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
         for (const auto& e : reg) {
             if (!e.needs_level_below) continue;
             levels::SolverRequest req;
-            req.pc = e.name;
+            req.pc = solvers::parse_pc(e.name);
             if (L == 0 && !e.single_level_too)
-                EXPECT_THROW(levels::choose_solver(p, req), InvalidInput) << e.name;
+                EXPECT_THROW(levels::plan_solver(p, req), InvalidInput) << e.name;
             else
-                EXPECT_EQ(levels::choose_solver(p, req).spec.pc, e.name);
+                EXPECT_EQ(levels::plan_solver(p, req).spec.pc.text(), e.name);
         }
     }
-    levels::SolverRequest bad;
-    bad.pc = "amgx";
-    EXPECT_THROW(levels::choose_solver(scene::load_scene("square"), bad), InvalidInput);
+    EXPECT_THROW(solvers::parse_pc("amgx"), InvalidInput);
 }

@@ -454,8 +454,8 @@ TEST(NewScenes, CoarseToFineNewtonAndMgSolveEveryNewScene) {
         auto p = scene::load_scene(name);
         p.levels = 2;
         levels::SolveOptions opt;
-        opt.linear.method = "krylov";
-        opt.linear.pc = "mg";
+        opt.linear.method = solvers::Method::krylov;
+        opt.linear.pc = solvers::parse_pc("mg");
         opt.exact_fallback = false; // mg alone (measured: 13 / 99+134 / 13 iterations)
         const auto r = levels::solve(p, opt);
         ASSERT_TRUE(r.converged) << r.failure;

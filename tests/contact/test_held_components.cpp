@@ -156,13 +156,13 @@ TEST(HeldComponents, WithoutPinningTheStuckNodesNewtonMatrixIsSingular) {
     // The same node with lambda_t left free: it appears in no equation once the node sticks.
     const auto L = held_node(20.0, -2.0, 0.5, 3.0, false);
     ASSERT_EQ(L.contacts[0].pinned, 0);
-    auto solver = levels::make_newton_system_solver(L, {.method = "lu"});
+    auto solver = levels::make_newton_system_solver(L, {.method = solvers::Method::lu});
     const std::vector<Eigen::Matrix2d> stick{Eigen::Matrix2d::Identity()};
     Vector b = Vector::Ones(L.n_unknowns()), dx;
     EXPECT_THROW(solver->solve(stick, b, dx), SolverBreakdown);
     // Pinned, the stuck system is regular: lambda_t's row reads -lambda_t / r = b.
     const auto P = held_node(20.0, -2.0, 0.5, 3.0, true);
-    auto pinned = levels::make_newton_system_solver(P, {.method = "lu"});
+    auto pinned = levels::make_newton_system_solver(P, {.method = solvers::Method::lu});
     const std::vector<Eigen::Matrix2d> stick_pinned{Eigen::DiagonalMatrix<double, 2>(0.0, 1.0)};
     ASSERT_TRUE(pinned->solve(stick_pinned, b, dx).converged);
     EXPECT_DOUBLE_EQ(dx[P.lambda_dof[0]], -3.0);

@@ -50,7 +50,7 @@ void expect_same_answer(const std::string& scene, int levels, int p,
     prob.levels = levels;
     prob.newton.rel_tol = 1e-12;
     levels::SolveOptions so;
-    so.linear = {.method = "krylov", .krylov = krylov, .pc = pc, .rel_tol = 1e-12};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = 1e-12};
     const levels::RunResult one = levels::solve(prob, so);
     ASSERT_TRUE(one.converged) << one.failure;
     const levels::DistributedRunResult d = levels::solve_distributed(prob, so, comm, p);
@@ -205,15 +205,15 @@ TEST(DistributedSolve, RefusesWhatHasNoDistributedForm) {
     levels::Problem prob = scene::load_scene("square");
     prob.levels = 2;
     levels::SolveOptions so;
-    so.linear.method = "schur";
+    so.linear.method = solvers::Method::schur;
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
-    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg:coarse=galerkin"};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg:coarse=galerkin")};
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
-    so.linear.pc = "sorcf";
+    so.linear.pc = solvers::parse_pc("sorcf");
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
-    so.linear.pc = "ebe:variant=c9";
+    so.linear.pc = solvers::parse_pc("ebe:variant=c9");
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
-    so.linear.pc = "mg";
+    so.linear.pc = solvers::parse_pc("mg");
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 2), InvalidInput); // p = L
     so.coarse_to_fine = false;
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);

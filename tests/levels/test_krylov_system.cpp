@@ -43,7 +43,7 @@ struct TwoLevels {
             transfer::build_transfer(fine.mesh, coarse.dofs, fine.dofs,
                                      levels::contact_nodes(coarse), levels::contact_nodes(fine));
         ContactNewton newton_c(coarse, problem.newton,
-                               make_newton_system_solver(coarse, {.method = "schur"}));
+                               make_newton_system_solver(coarse, {.method = solvers::Method::schur}));
         Vector x = Vector::Zero(coarse.n_unknowns());
         Vector u_prev = Vector::Zero(2 * coarse.mesh.n_vertices()), u_full;
         const int N = problem.load_steps;
@@ -58,16 +58,16 @@ struct TwoLevels {
         Vector R;
         double scale = 0.0;
         newton_c.residual(1.0, u_prev, x, R, nullptr, &coarse_M, &scale);
-        coarse_solver = make_newton_system_solver(coarse, {.method = "schur"});
+        coarse_solver = make_newton_system_solver(coarse, {.method = solvers::Method::schur});
 
         ContactNewton newton_f(fine, problem.newton,
-                               make_newton_system_solver(fine, {.method = "schur"}));
+                               make_newton_system_solver(fine, {.method = solvers::Method::schur}));
         Vector x_f, u_prev_f;
         transfer.prolongate(x, x_f);
         transfer.interpolate_nodal(u_prev, u_prev_f);
         newton_f.residual(1.0, u_prev_f, x_f, R, nullptr, &fine_M, &scale);
         b = -R;
-        auto schur = make_newton_system_solver(fine, {.method = "schur"});
+        auto schur = make_newton_system_solver(fine, {.method = solvers::Method::schur});
         schur->solve(fine_M, b, dx_ref);
         J = std::make_unique<JacobianAssembler>(fine);
         J->assemble(fine_M);
@@ -96,7 +96,7 @@ struct Outcome {
 Outcome solve_with(const std::string& krylov, const std::string& pc, double rel_tol = 1e-9) {
     TwoLevels& t = two_levels();
     const LevelBelow below = t.below();
-    LinearSolverSpec spec{.method = "krylov", .krylov = krylov, .pc = pc, .rel_tol = rel_tol};
+    LinearSolverSpec spec{.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = rel_tol};
     auto solver = make_newton_system_solver(t.fine, spec, &below);
     solver->set_coarse_statuses(t.coarse_M);
     Outcome o;
@@ -265,7 +265,7 @@ TEST(KrylovSystem, CoarseFineVariantsSolveTheFineSystem) {
 
 TEST(KrylovSystem, LevelAwarePreconditionersCheckTheirInput) {
     TwoLevels& t = two_levels();
-    const LinearSolverSpec cf{.method = "krylov", .pc = "cf"};
+    const LinearSolverSpec cf{.method = solvers::Method::krylov, .pc = solvers::parse_pc("cf")};
     try {
         make_newton_system_solver(t.fine, cf, nullptr);
         ADD_FAILURE() << "cf without a coarse context must throw";
@@ -274,16 +274,16 @@ TEST(KrylovSystem, LevelAwarePreconditionersCheckTheirInput) {
             << e.what();
     }
     const LevelBelow empty;
-    EXPECT_THROW(make_newton_system_solver(t.fine, {.method = "krylov", .pc = "sorcf"}, &empty),
+    EXPECT_THROW(make_newton_system_solver(t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("sorcf")}, &empty),
                  InvalidInput);
     const LevelBelow ctx = t.below();
     for (const std::string pc : {"cf:inner=ilu", "cf:scale=half", "cf:coarse=amg", "cf:omega=1",
                                  "sorcf:block=2", "sorcf:omega=2", "ebe:variant=c2", "ebe:omega=1"})
-        EXPECT_THROW(make_newton_system_solver(t.fine, {.method = "krylov", .pc = pc}, &ctx),
+        EXPECT_THROW(make_newton_system_solver(t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc(pc)}, &ctx),
                      InvalidInput)
             << pc;
     // EBE needs no coarse level.
-    EXPECT_NO_THROW(make_newton_system_solver(t.fine, {.method = "krylov", .pc = "ebe"}, nullptr));
+    EXPECT_NO_THROW(make_newton_system_solver(t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("ebe")}, nullptr));
 }
 
 TEST(KrylovSystem, TheCoarseStatusesArePassedByTheDriver) {
@@ -292,7 +292,7 @@ TEST(KrylovSystem, TheCoarseStatusesArePassedByTheDriver) {
     TwoLevels& t = two_levels();
     const LevelBelow below = t.below();
     auto solver = make_newton_system_solver(
-        t.fine, {.method = "krylov", .pc = "cf", .rel_tol = 1e-9}, &below);
+        t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("cf"), .rel_tol = 1e-9}, &below);
     Vector dx;
     EXPECT_THROW(solver->solve(t.fine_M, t.b, dx), InvalidInput);
     EXPECT_THROW(solver->set_coarse_statuses({Eigen::Matrix2d::Identity()}), InvalidInput);

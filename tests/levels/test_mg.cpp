@@ -42,13 +42,13 @@ RunResult run_square(int levels, const std::string& krylov, const std::string& p
     p.levels = levels;
     if (load_steps > 0) p.load_steps = load_steps;
     SolveOptions so;
-    so.linear = {.method = "krylov", .krylov = krylov, .pc = pc, .rel_tol = 1e-8, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = 1e-8, .max_iter = 200};
     return solve(p, so);
 }
 
 RunResult run_square_problem(const Problem& p) {
     SolveOptions so;
-    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg", .rel_tol = 1e-8, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .rel_tol = 1e-8, .max_iter = 200};
     return solve(p, so);
 }
 
@@ -99,16 +99,16 @@ TEST(MultilevelPreconditioner, NeedsTheLevelBelowAndValidOptions) {
     SolveOptions so;
     // On a single level mg builds its aggregation hierarchy; the geometric coarse operators
     // need the level below.
-    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg:coarse=galerkin"};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg:coarse=galerkin")};
     EXPECT_THROW(solve(p, so), InvalidInput);
-    so.linear.pc = "mg:coarse=rediscretize";
+    so.linear.pc = solvers::parse_pc("mg:coarse=rediscretize");
     EXPECT_THROW(solve(p, so), InvalidInput);
-    so.linear.pc = "mg:smooth=2";
+    so.linear.pc = solvers::parse_pc("mg:smooth=2");
     EXPECT_THROW(solve(p, so), InvalidInput);
     p.levels = 1;
-    so.linear.pc = "mg:pre=0,post=0";
+    so.linear.pc = solvers::parse_pc("mg:pre=0,post=0");
     EXPECT_THROW(solve(p, so), InvalidInput);
-    so.linear.pc = "mg:sweeps=2";
+    so.linear.pc = solvers::parse_pc("mg:sweeps=2");
     EXPECT_THROW(solve(p, so), InvalidInput);
 }
 
@@ -154,9 +154,9 @@ TEST(MultilevelPreconditioner, GalerkinCoarseOperatorsConvergeLikeRediscretizati
     const RunResult ref = solve(p, {});
     ASSERT_TRUE(ref.converged);
     SolveOptions so;
-    so.linear = {.method = "krylov",
-                 .krylov = "cgs",
-                 .pc = "mg:coarse=galerkin",
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc("mg:coarse=galerkin"),
                  .rel_tol = 1e-8,
                  .max_iter = 200};
     const RunResult gal = solve(p, so);
@@ -164,7 +164,7 @@ TEST(MultilevelPreconditioner, GalerkinCoarseOperatorsConvergeLikeRediscretizati
     EXPECT_LT((gal.x - ref.x).norm(), 1e-8 * ref.x.norm());
     for (int m : max_iterations(gal))
         EXPECT_LE(m, 12);
-    so.linear.pc = "mg:coarse=algebraic";
+    so.linear.pc = solvers::parse_pc("mg:coarse=algebraic");
     EXPECT_THROW(solve(p, so), InvalidInput);
 }
 
@@ -201,7 +201,7 @@ TEST(MultilevelPreconditioner, TheExactFallbackSolvesWhatTheMultigridCannot) {
     const RunResult ref = solve(p, exact);
     ASSERT_TRUE(ref.converged) << ref.failure;
     SolveOptions so;
-    so.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg", .max_iter = 100};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .max_iter = 100};
     const RunResult fails = solve(p, so);
     EXPECT_FALSE(fails.converged);
     EXPECT_NE(fails.failure.find("linear solve failed"), std::string::npos) << fails.failure;
@@ -219,7 +219,7 @@ TEST(MultilevelPreconditioner, TheExactFallbackSolvesWhatTheMultigridCannot) {
     auto q = scene::load_scene("square");
     q.levels = 2;
     SolveOptions plain;
-    plain.linear = {.method = "krylov", .krylov = "cgs", .pc = "mg"};
+    plain.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg")};
     SolveOptions with = plain;
     with.exact_fallback = true;
     const RunResult a = solve(q, plain), b = solve(q, with);
@@ -245,9 +245,9 @@ TEST(MultilevelPreconditioner, TheDampedTwoBodyDefaultSolvesTheDovetail) {
     const RunResult ref = solve(p, {});
     ASSERT_TRUE(ref.converged) << ref.failure;
     SolveOptions so;
-    so.linear = {.method = "krylov",
-                 .krylov = "bicgstab",
-                 .pc = levels::kMgDefaultTwoBody,
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::bicgstab,
+                 .pc = solvers::parse_pc(levels::kMgDefaultTwoBody),
                  .rel_tol = 1e-10,
                  .max_iter = 200};
     const RunResult r = solve(p, so);
@@ -303,7 +303,7 @@ void expect_algebraic_mg_solves_like_schur(const Problem& p, const RunResult& re
     ASSERT_EQ(p.levels, 0);
     ASSERT_TRUE(ref.converged);
     SolveOptions so;
-    so.linear = {.method = "krylov", .krylov = krylov, .pc = pc, .rel_tol = 1e-10, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = 1e-10, .max_iter = 200};
     const RunResult r = solve(p, so);
     ASSERT_TRUE(r.converged) << r.failure;
     int worst = 0;
@@ -330,9 +330,10 @@ TEST(AlgebraicMultigrid, SolvesTheSquareExportedFromLevel2LikeSchur) {
     // What --linear krylov takes on a single level: BiCGStab + the V(0,2) cycle (measured: at
     // most 12 BiCGStab iterations per Newton step).
     SolverRequest krylov;
-    krylov.linear = "krylov";
-    const LinearSolverSpec pair = choose_solver(p, krylov).spec;
-    expect_algebraic_mg_solves_like_schur(p, ref, pair.pc, 15, pair.krylov);
+    krylov.linear = solvers::Method::krylov;
+    const LinearSolverSpec pair = plan_solver(p, krylov).spec;
+    expect_algebraic_mg_solves_like_schur(p, ref, pair.pc.text(), 15,
+                                          std::string(solvers::to_string(pair.krylov)));
 }
 
 TEST(AlgebraicMultigrid, SolvesHertzGmshAtLevel0LikeSchur) {
@@ -346,26 +347,26 @@ TEST(AlgebraicMultigrid, IsAskedForOnASingleLevelAndEstimated) {
     // default stays the exact schur on a single level (measured faster there: README "mg on a
     // mesh without levels"); --pc mg builds the aggregation hierarchy.
     const Problem p = exported_square(2);
-    EXPECT_EQ(choose_solver(p, {}).spec.method, "schur");
+    EXPECT_EQ(plan_solver(p, {}).spec.method, solvers::Method::schur);
     SolverRequest asked;
-    asked.pc = "mg";
-    const SolverChoice c = choose_solver(p, asked);
-    EXPECT_EQ(c.spec.method, "krylov");
-    EXPECT_EQ(c.spec.pc, "mg");
-    EXPECT_EQ(c.spec.krylov, "cgs");
+    asked.pc = solvers::parse_pc("mg");
+    const SolverPlan c = plan_solver(p, asked);
+    EXPECT_EQ(c.spec.method, solvers::Method::krylov);
+    EXPECT_EQ(c.spec.pc.text(), "mg");
+    EXPECT_EQ(c.spec.krylov, solvers::Krylov::cgs);
     // Its memory estimate counts the aggregation hierarchy (prolongations, Galerkin operators:
     // about as much again as the Krylov solve's own), which ILU(0) does not have.
     const auto sizes = predict_level_sizes(p);
     const double with_mg = estimate_memory(sizes, c.spec, false).solver_bytes;
     LinearSolverSpec ilu = c.spec;
-    ilu.pc = "ilu:0";
+    ilu.pc = solvers::parse_pc("ilu:0");
     EXPECT_GT(with_mg, 2.0 * estimate_memory(sizes, ilu, false).solver_bytes);
     // --linear krylov alone takes the default pair over the aggregation hierarchy (since
     // 2026-11-26; it was ILU(0), which falls back to schur from the level-3 export on).
     SolverRequest krylov;
-    krylov.linear = "krylov";
-    EXPECT_EQ(choose_solver(p, krylov).spec.pc, "mg:pre=0,post=2");
-    EXPECT_EQ(choose_solver(p, krylov).spec.krylov, "bicgstab");
+    krylov.linear = solvers::Method::krylov;
+    EXPECT_EQ(plan_solver(p, krylov).spec.pc.text(), "mg:pre=0,post=2");
+    EXPECT_EQ(plan_solver(p, krylov).spec.krylov, solvers::Krylov::bicgstab);
 }
 
 // The levels of a Gmsh mesh that is a uniform refinement (scene/scene.cpp, mesh::unrefine).
@@ -410,9 +411,9 @@ TEST(RecoveredLevels, TheExportedSquareSolvesAsTheRefinedSquareDoes) {
     EXPECT_LT(worst, 1e-8 * umax);
     // Above the crossover the default is the multigrid over the recovered levels, swept by
     // lattices on levels 4 to 7 (2 triangles refined 4 to 7 times).
-    const auto c = choose_solver(p, {});
-    EXPECT_EQ(c.spec.pc, "mg:pre=0,post=2,smoother=lattice");
-    EXPECT_TRUE(c.lattice_numbering);
+    const auto c = plan_solver(p, {});
+    EXPECT_EQ(c.spec.pc.text(), "mg:pre=0,post=2,smoother=lattice");
+    EXPECT_TRUE(c.lattice_numbering());
 }
 
 TEST(RecoveredLevels, AnUnstructuredGmshMeshHasNoneAndTheKeyNeedsGmshMeshes) {

@@ -27,7 +27,7 @@ RunResult run(const std::string& scene, int levels, const std::string& pc, int l
     p.numbering = Problem::Numbering::lattice;
     SolveOptions so;
     so.linear = {
-        .method = "krylov", .krylov = "bicgstab", .pc = pc, .rel_tol = 1e-8, .max_iter = 200};
+        .method = solvers::Method::krylov, .krylov = solvers::Krylov::bicgstab, .pc = solvers::parse_pc(pc), .rel_tol = 1e-8, .max_iter = 200};
     return solve(p, so);
 }
 
@@ -75,38 +75,42 @@ TEST(LatticeMultigrid, HertzLevel4LikeTheBlockSmoother_Slow) {
 TEST(LatticeMultigrid, RefusesWhatCannotTakeEffect) {
     auto p = scene::load_scene("square");
     p.levels = 4;
-    const SolverRequest req{.pc = std::string("mg:pre=0,post=2,smoother=lattice")};
+    const SolverRequest req{.pc = solvers::parse_pc("mg:pre=0,post=2,smoother=lattice")};
     // Named without a numbering, the option numbers the levels for itself; named beside
     // numbering hilbert it is refused.
-    EXPECT_TRUE(choose_solver(p, req).lattice_numbering);
+    EXPECT_TRUE(plan_solver(p, req).lattice_numbering());
     SolverRequest hilbert = req;
-    hilbert.numbering = "hilbert";
+    hilbert.numbering = Problem::Numbering::hilbert;
     try {
-        (void)choose_solver(p, hilbert);
+        (void)plan_solver(p, hilbert);
         ADD_FAILURE() << "no error with the Hilbert numbering";
     } catch (const InvalidInput& e) {
         EXPECT_NE(std::string(e.what()).find("drop --numbering hilbert"), std::string::npos)
             << e.what();
     }
-    // The library's solve needs the levels numbered (number_for does it from the spec).
-    SolveOptions direct;
-    direct.linear = {.method = "krylov", .krylov = "bicgstab", .pc = *req.pc, .rel_tol = 1e-8};
-    EXPECT_THROW((void)solve(p, direct), InvalidInput);
-    number_for(p, *req.pc);
-    EXPECT_EQ(p.numbering, Problem::Numbering::lattice);
-    EXPECT_NO_THROW((void)choose_solver(p, req));
+    // The library's solve numbers the levels from the spec itself (levels::hierarchy_numbering):
+    // lattice without a numbering given, refused beside numbering hilbert.
+    LinearSolverSpec direct{.method = solvers::Method::krylov,
+                            .krylov = solvers::Krylov::bicgstab,
+                            .pc = *req.pc,
+                            .rel_tol = 1e-8};
+    EXPECT_EQ(p.numbering, Problem::Numbering::hilbert);
+    EXPECT_EQ(hierarchy_numbering(p, direct), Problem::Numbering::lattice);
+    direct.numbering = Problem::Numbering::hilbert;
+    EXPECT_THROW((void)hierarchy_numbering(p, direct), InvalidInput);
+    EXPECT_NO_THROW((void)plan_solver(p, req));
     p.levels = 3;
     try {
-        (void)choose_solver(p, req);
+        (void)plan_solver(p, req);
         ADD_FAILURE() << "no error on level 3";
     } catch (const InvalidInput& e) {
         EXPECT_NE(std::string(e.what()).find("--levels >= 4"), std::string::npos) << e.what();
     }
     p.levels = 4;
     SolveOptions so;
-    so.linear = {.method = "krylov",
-                 .krylov = "bicgstab",
-                 .pc = "mg:smoother=lattice,precision=single",
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::bicgstab,
+                 .pc = solvers::parse_pc("mg:smoother=lattice,precision=single"),
                  .rel_tol = 1e-8};
     EXPECT_THROW((void)solve(p, so), InvalidInput);
 }

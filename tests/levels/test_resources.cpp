@@ -16,6 +16,23 @@
 
 using namespace mlc;
 
+namespace {
+
+// A request as the command line gives it: --linear, --krylov, --pc, --linear-tol, --numbering.
+levels::SolverRequest request(std::optional<std::string> linear, std::optional<std::string> krylov,
+                              std::optional<std::string> pc, std::optional<double> rel_tol,
+                              std::optional<std::string> numbering) {
+    levels::SolverRequest r;
+    if (linear) r.linear = solvers::parse_method(*linear);
+    if (krylov) r.krylov = solvers::parse_krylov(*krylov);
+    if (pc) r.pc = solvers::parse_pc(*pc);
+    r.rel_tol = rel_tol;
+    if (numbering) r.numbering = levels::parse_numbering(*numbering, "--numbering");
+    return r;
+}
+
+} // namespace
+
 TEST(PredictLevelSizes, RefinementCountsAreExactAndUnknownsClose) {
     for (const char* name : {"square", "hertz", "dovetail", "mindlin"}) {
         SCOPED_TRACE(name);
@@ -45,44 +62,44 @@ TEST(PredictLevelSizes, RefinementCountsAreExactAndUnknownsClose) {
 TEST(ChooseSolver, APreconditionerAloneMeansAKrylovSolve) {
     auto p = scene::load_scene("square");
     p.levels = 2;
-    const auto c = levels::choose_solver(p, {{}, {}, std::string("mg"), {}, {}});
-    EXPECT_EQ(c.spec.method, "krylov");
-    EXPECT_EQ(c.spec.pc, "mg");
-    EXPECT_EQ(c.spec.krylov, "cgs");
+    const auto c = levels::plan_solver(p, request({}, {}, std::string("mg"), {}, {}));
+    EXPECT_EQ(c.spec.method, solvers::Method::krylov);
+    EXPECT_EQ(c.spec.pc.text(), "mg");
+    EXPECT_EQ(c.spec.krylov, solvers::Krylov::cgs);
     EXPECT_FALSE(c.automatic);
     // A Krylov method or tolerance alone too, with mg where there is a level below.
-    const auto k = levels::choose_solver(p, {{}, std::string("gmres"), {}, {}, {}});
-    EXPECT_EQ(k.spec.method, "krylov");
-    EXPECT_EQ(k.spec.krylov, "gmres");
-    EXPECT_EQ(k.spec.pc, "mg:pre=0,post=2");
+    const auto k = levels::plan_solver(p, request({}, std::string("gmres"), {}, {}, {}));
+    EXPECT_EQ(k.spec.method, solvers::Method::krylov);
+    EXPECT_EQ(k.spec.krylov, solvers::Krylov::gmres);
+    EXPECT_EQ(k.spec.pc.text(), "mg:pre=0,post=2");
     // The tolerance alone: the driver's own mg pair, BiCGStab + V(0,2).
-    const auto t = levels::choose_solver(p, {{}, {}, {}, 1e-6, {}});
-    EXPECT_EQ(t.spec.method, "krylov");
+    const auto t = levels::plan_solver(p, request({}, {}, {}, 1e-6, {}));
+    EXPECT_EQ(t.spec.method, solvers::Method::krylov);
     EXPECT_EQ(t.spec.rel_tol, 1e-6);
-    EXPECT_EQ(t.spec.krylov, "bicgstab");
-    EXPECT_EQ(t.spec.pc, "mg:pre=0,post=2");
+    EXPECT_EQ(t.spec.krylov, solvers::Krylov::bicgstab);
+    EXPECT_EQ(t.spec.pc.text(), "mg:pre=0,post=2");
 }
 
 TEST(ChooseSolver, LinearKrylovUsesTheDefaultMgOnEveryMesh) {
     auto p = scene::load_scene("square");
     p.levels = 1;
-    const auto mg = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}, {}});
-    EXPECT_EQ(mg.spec.pc, "mg:pre=0,post=2");
-    EXPECT_EQ(mg.spec.krylov, "bicgstab");
+    const auto mg = levels::plan_solver(p, request(std::string("krylov"), {}, {}, {}, {}));
+    EXPECT_EQ(mg.spec.pc.text(), "mg:pre=0,post=2");
+    EXPECT_EQ(mg.spec.krylov, solvers::Krylov::bicgstab);
     // A Krylov method named beside it is kept.
-    EXPECT_EQ(levels::choose_solver(p, {std::string("krylov"), std::string("cgs"), {}, {}, {}})
+    EXPECT_EQ(levels::plan_solver(p, request(std::string("krylov"), std::string("cgs"), {}, {}, {}))
                   .spec.krylov,
               "cgs");
     // On a single level the same pair over an aggregation hierarchy (not ILU(0)), damped with a
     // two-body pair.
     p.levels = 0;
-    const auto one = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}, {}});
-    EXPECT_EQ(one.spec.pc, "mg:pre=0,post=2");
-    EXPECT_EQ(one.spec.krylov, "bicgstab");
+    const auto one = levels::plan_solver(p, request(std::string("krylov"), {}, {}, {}, {}));
+    EXPECT_EQ(one.spec.pc.text(), "mg:pre=0,post=2");
+    EXPECT_EQ(one.spec.krylov, solvers::Krylov::bicgstab);
     EXPECT_NE(one.reason.find("aggregation hierarchy"), std::string::npos) << one.reason;
     auto dt = scene::load_scene("dovetail");
     dt.levels = 0;
-    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}, {}}).spec.pc,
+    EXPECT_EQ(levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.pc.text(),
               "mg:omega=0.8,pre=0,post=2");
 }
 
@@ -91,7 +108,7 @@ TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
     p.levels = 2;
     for (const char* direct : {"schur", "lu"}) {
         try {
-            levels::choose_solver(p, {std::string(direct), {}, std::string("mg"), {}, {}});
+            levels::plan_solver(p, request(std::string(direct), {}, std::string("mg"), {}, {}));
             ADD_FAILURE() << "no error for --linear " << direct << " --pc mg";
         } catch (const InvalidInput& e) {
             EXPECT_NE(std::string(e.what()).find("--pc mg applies to Krylov solves only"),
@@ -99,11 +116,11 @@ TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
                 << e.what();
         }
         EXPECT_THROW(
-            levels::choose_solver(p, {std::string(direct), std::string("cgs"), {}, {}, {}}),
+            levels::plan_solver(p, request(std::string(direct), std::string("cgs"), {}, {}, {})),
             InvalidInput);
-        EXPECT_THROW(levels::choose_solver(p, {std::string(direct), {}, {}, 1e-8, {}}),
+        EXPECT_THROW(levels::plan_solver(p, request(std::string(direct), {}, {}, 1e-8, {})),
                      InvalidInput);
-        EXPECT_EQ(levels::choose_solver(p, {std::string(direct), {}, {}, {}, {}}).spec.method,
+        EXPECT_EQ(levels::plan_solver(p, request(std::string(direct), {}, {}, {}, {})).spec.method,
                   direct);
     }
 }
@@ -117,20 +134,20 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
             SCOPED_TRACE(L);
             p.levels = L;
             const double n = levels::predict_level_sizes(p).back().unknowns;
-            const auto c = levels::choose_solver(p, {});
+            const auto c = levels::plan_solver(p, {});
             EXPECT_TRUE(c.automatic);
             EXPECT_FALSE(c.reason.empty());
             if (L >= 1 && n > crossover) {
-                EXPECT_EQ(c.spec.method, "krylov");
+                EXPECT_EQ(c.spec.method, solvers::Method::krylov);
                 // From level 4 on with the lattice sweep (the test below).
-                EXPECT_EQ(c.spec.pc, std::string(crossover == levels::kMgCrossoverTwoBody
+                EXPECT_EQ(c.spec.pc.text(), std::string(crossover == levels::kMgCrossoverTwoBody
                                                      ? "mg:omega=0.8,pre=0,post=2"
                                                      : "mg:pre=0,post=2") +
                                          (L >= 4 ? ",smoother=lattice" : ""));
-                EXPECT_EQ(c.lattice_numbering, L >= 4);
-                EXPECT_EQ(c.spec.krylov, "bicgstab");
+                EXPECT_EQ(c.lattice_numbering(), L >= 4);
+                EXPECT_EQ(c.spec.krylov, solvers::Krylov::bicgstab);
             } else {
-                EXPECT_EQ(c.spec.method, "schur");
+                EXPECT_EQ(c.spec.method, solvers::Method::schur);
             }
         }
     }
@@ -139,46 +156,46 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
     auto sq = scene::load_scene("square");
     EXPECT_EQ(levels::mg_crossover_unknowns(sq), levels::kMgCrossoverOneBody);
     sq.levels = 0;
-    EXPECT_EQ(levels::choose_solver(sq, {}).spec.method, "schur");
+    EXPECT_EQ(levels::plan_solver(sq, {}).spec.method, solvers::Method::schur);
     sq.levels = 1;
-    EXPECT_EQ(levels::choose_solver(sq, {}).spec.pc, "mg:pre=0,post=2");
+    EXPECT_EQ(levels::plan_solver(sq, {}).spec.pc.text(), "mg:pre=0,post=2");
     auto hz = scene::load_scene("hertz");
     hz.levels = 1;
-    EXPECT_EQ(levels::choose_solver(hz, {}).spec.pc, "mg:pre=0,post=2");
+    EXPECT_EQ(levels::plan_solver(hz, {}).spec.pc.text(), "mg:pre=0,post=2");
     auto cl = scene::load_scene("calumet"); // 796 unknowns on level 1, 2 844 on level 2
     cl.levels = 1;
-    EXPECT_EQ(levels::choose_solver(cl, {}).spec.method, "schur");
+    EXPECT_EQ(levels::plan_solver(cl, {}).spec.method, solvers::Method::schur);
     cl.levels = 2;
-    EXPECT_EQ(levels::choose_solver(cl, {}).spec.pc, "mg:pre=0,post=2");
+    EXPECT_EQ(levels::plan_solver(cl, {}).spec.pc.text(), "mg:pre=0,post=2");
     auto dt = scene::load_scene("dovetail");
     EXPECT_EQ(levels::mg_crossover_unknowns(dt), levels::kMgCrossoverTwoBody);
     EXPECT_TRUE(levels::has_two_body_pair(dt));
     EXPECT_FALSE(levels::has_two_body_pair(sq));
-    EXPECT_STREQ(levels::default_mg_spec(true), "mg:omega=0.8,pre=0,post=2");
-    EXPECT_STREQ(levels::default_mg_spec(false), "mg:pre=0,post=2");
+    EXPECT_STREQ(levels::default_mg(true), "mg:omega=0.8,pre=0,post=2");
+    EXPECT_STREQ(levels::default_mg(false), "mg:pre=0,post=2");
     dt.levels = 0;
-    EXPECT_EQ(levels::choose_solver(dt, {}).spec.method, "schur");
+    EXPECT_EQ(levels::plan_solver(dt, {}).spec.method, solvers::Method::schur);
     auto pt = scene::load_scene("patch"); // two bodies, 1 405 unknowns on level 2
     pt.levels = 2;
     EXPECT_TRUE(levels::has_two_body_pair(pt));
-    EXPECT_EQ(levels::choose_solver(pt, {}).spec.method, "schur");
+    EXPECT_EQ(levels::plan_solver(pt, {}).spec.method, solvers::Method::schur);
     dt.levels = 1;
     // BiCGStab with a V(0,2) cycle, and with a two-body pair damped sweeps (fewer V-cycles
     // there); --linear krylov alone takes the same pair.
-    EXPECT_EQ(levels::choose_solver(dt, {}).spec.pc, "mg:omega=0.8,pre=0,post=2");
-    EXPECT_EQ(levels::choose_solver(dt, {}).spec.krylov, "bicgstab");
-    EXPECT_NE(levels::choose_solver(dt, {}).reason.find("BiCGStab + mg:omega=0.8,pre=0,post=2"),
+    EXPECT_EQ(levels::plan_solver(dt, {}).spec.pc.text(), "mg:omega=0.8,pre=0,post=2");
+    EXPECT_EQ(levels::plan_solver(dt, {}).spec.krylov, solvers::Krylov::bicgstab);
+    EXPECT_NE(levels::plan_solver(dt, {}).reason.find("BiCGStab + mg:omega=0.8,pre=0,post=2"),
               std::string::npos);
-    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}, {}}).spec.pc,
+    EXPECT_EQ(levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.pc.text(),
               "mg:omega=0.8,pre=0,post=2");
-    EXPECT_EQ(levels::choose_solver(dt, {std::string("krylov"), {}, {}, {}, {}}).spec.krylov,
+    EXPECT_EQ(levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.krylov,
               "bicgstab");
     // A named preconditioner is taken as given, with CGS unless a method is named.
-    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}, {}}).spec.pc, "mg");
-    EXPECT_EQ(levels::choose_solver(dt, {{}, {}, std::string("mg"), {}, {}}).spec.krylov, "cgs");
+    EXPECT_EQ(levels::plan_solver(dt, request({}, {}, std::string("mg"), {}, {})).spec.pc.text(), "mg");
+    EXPECT_EQ(levels::plan_solver(dt, request({}, {}, std::string("mg"), {}, {})).spec.krylov, solvers::Krylov::cgs);
     sq.levels = 3;
-    EXPECT_EQ(levels::choose_solver(sq, {}).spec.krylov, "bicgstab");
-    EXPECT_NE(levels::choose_solver(sq, {}).reason.find("BiCGStab + mg:pre=0,post=2"),
+    EXPECT_EQ(levels::plan_solver(sq, {}).spec.krylov, solvers::Krylov::bicgstab);
+    EXPECT_NE(levels::plan_solver(sq, {}).reason.find("BiCGStab + mg:pre=0,post=2"),
               std::string::npos);
 }
 
@@ -187,8 +204,8 @@ TEST(MemoryEstimate, GrowsWithTheLevelsAndSchurNeedsMoreThanMgOnFineLevels) {
     p.levels = 5;
     const auto sizes = levels::predict_level_sizes(p);
     levels::LinearSolverSpec mg;
-    mg.method = "krylov";
-    mg.pc = "mg";
+    mg.method = solvers::Method::krylov;
+    mg.pc = solvers::parse_pc("mg");
     levels::LinearSolverSpec schur;
     const auto e5 = levels::estimate_memory(sizes, mg, true);
     const auto e4 = levels::estimate_memory({sizes.begin(), sizes.end() - 1}, mg, true);
@@ -294,8 +311,8 @@ TEST(MemoryEstimate, SquareLevel7WithMgFitsIn24GiB) {
     const auto sizes = levels::predict_level_sizes(p);
     EXPECT_NEAR(sizes.back().unknowns, 8.4e6, 0.1e6);
     levels::LinearSolverSpec mg;
-    mg.method = "krylov";
-    mg.pc = "mg";
+    mg.method = solvers::Method::krylov;
+    mg.pc = solvers::parse_pc("mg");
     const auto e = levels::estimate_memory(sizes, mg, true);
     EXPECT_LT(e.bytes, 16.0 * 1024 * 1024 * 1024) << levels::format_bytes(e.bytes);
     EXPECT_GT(e.bytes, 4.0 * 2487 * 1048576.0 * 0.7) << levels::format_bytes(e.bytes);
@@ -309,33 +326,33 @@ TEST(ChooseSolver, TheDefaultSweepsByLatticesFromLevel4UnlessNumberingHilbertIsA
     // asked, or with any solver option named, the block sweep on the Hilbert numbering.
     auto p = scene::load_scene("square");
     p.levels = 4;
-    const auto d = levels::choose_solver(p, {});
+    const auto d = levels::plan_solver(p, {});
     EXPECT_TRUE(d.automatic);
-    EXPECT_TRUE(d.lattice_numbering);
-    EXPECT_EQ(d.spec.pc, "mg:pre=0,post=2,smoother=lattice");
-    EXPECT_EQ(d.spec.krylov, "bicgstab");
+    EXPECT_TRUE(d.lattice_numbering());
+    EXPECT_EQ(d.spec.pc.text(), "mg:pre=0,post=2,smoother=lattice");
+    EXPECT_EQ(d.spec.krylov, solvers::Krylov::bicgstab);
     EXPECT_NE(d.reason.find("macro triangle by macro triangle"), std::string::npos) << d.reason;
-    const auto l = levels::choose_solver(p, {{}, {}, {}, {}, std::string("lattice")});
-    EXPECT_TRUE(l.lattice_numbering);
-    EXPECT_EQ(l.spec.pc, d.spec.pc);
-    const auto h = levels::choose_solver(p, {{}, {}, {}, {}, std::string("hilbert")});
+    const auto l = levels::plan_solver(p, request({}, {}, {}, {}, std::string("lattice")));
+    EXPECT_TRUE(l.lattice_numbering());
+    EXPECT_EQ(l.spec.pc.text(), d.spec.pc);
+    const auto h = levels::plan_solver(p, request({}, {}, {}, {}, std::string("hilbert")));
     EXPECT_TRUE(h.automatic);
-    EXPECT_FALSE(h.lattice_numbering);
-    EXPECT_EQ(h.spec.pc, "mg:pre=0,post=2");
-    const auto named = levels::choose_solver(p, {{}, {}, std::string("mg:pre=0,post=2"), {}, {}});
-    EXPECT_FALSE(named.lattice_numbering);
-    const auto krylov = levels::choose_solver(p, {std::string("krylov"), {}, {}, {}, {}});
-    EXPECT_FALSE(krylov.lattice_numbering);
-    EXPECT_EQ(krylov.spec.pc, "mg:pre=0,post=2");
+    EXPECT_FALSE(h.lattice_numbering());
+    EXPECT_EQ(h.spec.pc.text(), "mg:pre=0,post=2");
+    const auto named = levels::plan_solver(p, request({}, {}, std::string("mg:pre=0,post=2"), {}, {}));
+    EXPECT_FALSE(named.lattice_numbering());
+    const auto krylov = levels::plan_solver(p, request(std::string("krylov"), {}, {}, {}, {}));
+    EXPECT_FALSE(krylov.lattice_numbering());
+    EXPECT_EQ(krylov.spec.pc.text(), "mg:pre=0,post=2");
     // A two-body pair keeps its damping, with the lattice sweep.
     auto dt = scene::load_scene("dovetail");
     dt.levels = 4;
-    const auto t = levels::choose_solver(dt, {});
-    EXPECT_TRUE(t.lattice_numbering);
-    EXPECT_EQ(t.spec.pc, "mg:omega=0.8,pre=0,post=2,smoother=lattice");
+    const auto t = levels::plan_solver(dt, {});
+    EXPECT_TRUE(t.lattice_numbering());
+    EXPECT_EQ(t.spec.pc.text(), "mg:omega=0.8,pre=0,post=2,smoother=lattice");
     p.levels = 3;
-    const auto three = levels::choose_solver(p, {});
+    const auto three = levels::plan_solver(p, {});
     EXPECT_TRUE(three.automatic);
-    EXPECT_FALSE(three.lattice_numbering);
-    EXPECT_EQ(three.spec.pc, "mg:pre=0,post=2");
+    EXPECT_FALSE(three.lattice_numbering());
+    EXPECT_EQ(three.spec.pc.text(), "mg:pre=0,post=2");
 }

@@ -4,7 +4,9 @@
 fresh prefix, checks the header layout (everything under include/mlcontact/, no generic core/ or
 mesh/ on the consumer's include path), configures and builds examples/library against the
 installed tree alone, runs it and the installed driver on the same scene and checks that the
-printed resultants equal the driver's summary.json values to 1e-12.
+printed resultants equal the driver's summary.json values to 1e-12. Builds
+tests/package/toy_preconditioner against the installed tree too: a preconditioner registered from
+user code, planned by levels::plan_solver and solved with.
 
 usage: check_install.py CMAKE BUILD_DIR SOURCE_DIR WORK_DIR
 """
@@ -92,3 +94,12 @@ for (name, fx, fy, closed), ref in zip(printed, summary["contacts"]):
     assert int(closed) == ref["nodes_in_contact"]
     assert scale > 0
 print(f"package: installed, example built against {prefix} and its resultants equal the driver's")
+
+# A preconditioner registered from user code and run through the planner.
+toy = os.path.join(work, "toy")
+run([cmake, "-S", os.path.join(source, "tests", "package", "toy_preconditioner"), "-B", toy,
+     f"-DCMAKE_PREFIX_PATH={prefix}", "-DCMAKE_BUILD_TYPE=Release"])
+run([cmake, "--build", toy, "-j2"])
+out = run([os.path.join(toy, "toy_preconditioner")])
+assert out.startswith("toy: registered, planned and solved"), out
+print(out, end="")
