@@ -7,10 +7,80 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <unordered_map>
 
 namespace mlc::mesh {
+
+std::optional<Vec3> CurvedSurface::project(const Vec3& p) const {
+    Vec3 d = p - center;
+    if (kind == Kind::cylinder) d -= d.dot(axis) * axis;
+    const double n = d.norm();
+    if (!(n > 0)) return std::nullopt;
+    return p + (radius / n - 1.0) * d;
+}
+
+double CurvedSurface::distance(const Vec3& p) const {
+    Vec3 d = p - center;
+    if (kind == Kind::cylinder) d -= d.dot(axis) * axis;
+    return std::abs(d.norm() - radius);
+}
+
+std::string CurvedSurface::describe() const {
+    std::ostringstream os;
+    os << std::setprecision(9);
+    auto point = [&](const Vec3& p) {
+        os << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
+    };
+    if (kind == Kind::sphere) {
+        os << "sphere (center ";
+        point(center);
+    } else {
+        os << "cylinder (axis through ";
+        point(center);
+        os << " along ";
+        point(axis);
+    }
+    os << ", radius " << radius << ")";
+    return os.str();
+}
+
+void attach_surface(TetMesh& m, const std::string& tag, CurvedSurface surface) {
+    const auto id = m.find_tag(tag);
+    if (!id || !m.is_boundary_tag(*id)) {
+        std::string known;
+        for (const auto& [name, k] : m.tag_names)
+            if (m.is_boundary_tag(k)) known += (known.empty() ? "" : ", ") + name;
+        MLC_CHECK(false, "the mesh has no boundary tag '" << tag << "' to put on a curved surface; "
+                                                          << "expected one of: " << known);
+    }
+    MLC_CHECK(surface.radius > 0 && std::isfinite(surface.radius),
+              "the curved surface of tag '" << tag << "' needs a positive radius, got "
+                                            << surface.radius);
+    if (surface.kind == CurvedSurface::Kind::cylinder) {
+        const double n = surface.axis.norm();
+        MLC_CHECK(n > 0 && std::isfinite(n),
+                  "the cylinder of tag '" << tag << "' needs a nonzero axis direction");
+        surface.axis /= n;
+    }
+    const double tol = kOnSurfaceTol * surface.radius;
+    for (int v : m.vertices_with_tag(*id)) {
+        const Vec3& p = m.vertices[static_cast<size_t>(v)];
+        const double off = surface.distance(p);
+        MLC_CHECK(off <= tol, "vertex " << v << " at (" << p.x() << ", " << p.y() << ", " << p.z()
+                                        << ") of tag '" << tag << "' lies " << off << " off the "
+                                        << surface.describe() << "; expected on it (within "
+                                        << kOnSurfaceTol
+                                        << " of the radius): check the centre, axis and radius "
+                                           "against the mesh (in its frame and units)");
+    }
+    const int index = static_cast<int>(m.surfaces.size());
+    m.surfaces.push_back(surface);
+    for (auto& f : m.boundary)
+        if (f.tag == *id) f.surface = index;
+}
 
 int TetMesh::tag(const std::string& name) const {
     auto it = tag_names.find(name);

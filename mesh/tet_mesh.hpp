@@ -8,6 +8,8 @@
 
 #include "core/types.hpp"
 
+#include <Eigen/Geometry> // Vec3::cross
+
 #include <array>
 #include <functional>
 #include <map>
@@ -20,11 +22,31 @@ namespace mlc::mesh {
 /// A 3D point or vector.
 using Vec3 = Eigen::Vector3d;
 
+/// Exact geometry boundary faces lie on, so that refinement can put new vertices on it (the 3D
+/// counterpart of Circle): a sphere, or a circular cylinder of infinite length.
+struct CurvedSurface {
+    enum class Kind { sphere, cylinder };
+    Kind kind = Kind::sphere;
+    Vec3 center = Vec3::Zero(); ///< the sphere's centre, or a point of the cylinder's axis
+    Vec3 axis = Vec3::UnitZ();  ///< the cylinder's axis direction (unit length); sphere: unused
+    double radius = 0.0;
+
+    /// The point of the surface nearest to p (radially from the centre or the axis); nullopt for
+    /// p at the centre or on the axis.
+    std::optional<Vec3> project(const Vec3& p) const;
+    /// Distance of p from the surface.
+    double distance(const Vec3& p) const;
+    /// "sphere (center (x, y, z), radius r)" or "cylinder (axis through (..) along (..),
+    /// radius r)".
+    std::string describe() const;
+};
+
 /// One boundary face (v[0], v[1], v[2]) of a tetrahedron, oriented so that its normal
 /// (v1 - v0) x (v2 - v0) points out of the body.
 struct BoundaryFace {
     std::array<int, 3> v{-1, -1, -1};
-    int tag = 0; ///< boundary tag id; names in TetMesh::tag_names
+    int tag = 0;      ///< boundary tag id; names in TetMesh::tag_names
+    int surface = -1; ///< index into TetMesh::surfaces, or -1 for a flat face
 };
 
 /// A 3D tetrahedral mesh of one or several bodies.
@@ -48,6 +70,8 @@ struct TetMesh {
     /// Tagged boundary faces (faces of one tetrahedron). Untagged boundary faces need not be
     /// listed.
     std::vector<BoundaryFace> boundary;
+    /// Curved surfaces boundary faces lie on (BoundaryFace::surface; attach_surface).
+    std::vector<CurvedSurface> surfaces;
     std::map<std::string, int> tag_names; ///< name -> tag id
     /// For a refined mesh: parents[v - n_coarse_vertices] = the two coarse vertices of new
     /// vertex v (the smaller index first). Empty for a level-0 mesh.
@@ -81,6 +105,16 @@ struct TetMesh {
     int nearest_vertex(const Vec3& p) const;
 };
 
+/// Tolerance of attach_surface, relative to the surface's radius.
+inline constexpr double kOnSurfaceTol = 1e-6;
+
+/// Declares that the boundary faces tagged `tag` lie on `surface` (a cylinder's axis is
+/// normalized), so that refinement moves the vertices it creates on them onto it. Throws
+/// InvalidInput naming the tag when it is no boundary tag (listing those there are), the radius
+/// is not positive or the axis zero, or a vertex of the tag lies farther than kOnSurfaceTol
+/// times the radius off the surface (naming the vertex, its position and the distance).
+void attach_surface(TetMesh& m, const std::string& tag, CurvedSurface surface);
+
 /// How a message names tetrahedron t (e.g. its element and line in a file); empty:
 /// "tetrahedron t".
 using TetrahedronNamer = std::function<std::string(int)>;
@@ -100,7 +134,7 @@ inline constexpr double kFlatTetrahedronTol = 1e-10;
 /// - a non-manifold boundary: an edge on more than two boundary faces (parts touching along an
 ///   edge) or a vertex where separate sheets of the boundary meet (parts touching at a point);
 /// - a BoundaryFace that is not a face of exactly one tetrahedron, or whose normal points into
-///   the body.
+///   the body, or whose surface is not in TetMesh::surfaces.
 /// O(n log n) (sorting faces and edges). Tetrahedra are named by `name`.
 void check_quality(const TetMesh& m, const TetrahedronNamer& name = {});
 

@@ -72,11 +72,16 @@ void check_indices(const TetMesh& m) {
             MLC_CHECK(v >= 0 && v < nv, "tetrahedron " << t << " refers to vertex " << v
                                                        << " but the mesh has " << nv
                                                        << " vertices");
-    for (const auto& f : m.boundary)
+    for (const auto& f : m.boundary) {
         for (int v : f.v)
             MLC_CHECK(v >= 0 && v < nv, "a boundary face tagged '"
                                             << m.tag_name(f.tag) << "' refers to vertex " << v
                                             << " but the mesh has " << nv << " vertices");
+        MLC_CHECK(f.surface >= -1 && f.surface < static_cast<int>(m.surfaces.size()),
+                  "a boundary face tagged '" << m.tag_name(f.tag) << "' refers to curved surface "
+                                             << f.surface << " but the mesh has "
+                                             << m.surfaces.size());
+    }
 }
 
 void check_flat(const TetMesh& m, const Names& names) {

@@ -35,7 +35,11 @@ inline constexpr int kFaceChildrenOf[4][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}, {
 /// Uniform 1->8 refinement by Bey's rule (kBeyChildren). Coarse vertex indices are kept; the
 /// midpoint of coarse edge e (tet_edges order) is vertex n_coarse + e, and parents[e] its two
 /// coarse vertices. The children of tetrahedron t are 8 t + c (c as in kBeyChildren) with t's
-/// attribute; the children of boundary face f are 4 f + k (kFaceChildrenOf), with f's tag.
+/// attribute; the children of boundary face f are 4 f + k (kFaceChildrenOf), with f's tag and
+/// surface. A midpoint of an edge of a boundary face on a curved surface is moved onto that
+/// surface (of the first such face in TetMesh::boundary); then every child with a moved vertex
+/// must keep the orientation Bey's rule gives it and not be flat, or InvalidInput names it,
+/// its parent and the surface's tag (the coarse mesh is too coarse for the curvature there).
 TetMesh refine(const TetMesh& coarse);
 
 /// The coarse tetrahedron a tetrahedron of refine(coarse) lies in, and which child it is.
