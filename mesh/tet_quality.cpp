@@ -210,9 +210,11 @@ void check_boundary_edges(const std::vector<FaceRecord>& boundary, const Names& 
 
 /// Union-find root with path halving.
 int root(std::vector<int>& parent, int i) {
-    while (parent[static_cast<size_t>(i)] != i)
-        i = parent[static_cast<size_t>(i)] =
-            parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+    while (parent[static_cast<size_t>(i)] != i) {
+        const int grandparent = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+        parent[static_cast<size_t>(i)] = grandparent;
+        i = grandparent;
+    }
     return i;
 }
 

@@ -8,9 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <tuple>
+#include <unistd.h>
 
 using namespace mlc;
 using namespace mlc::mesh;
@@ -156,6 +159,17 @@ TEST(TetGmsh, ReadsBothFormats) {
                         "(0, 0.9, 0) lies on 4 boundary faces (of tetrahedron 0 (the element on "
                         "line"});
     }
+}
+
+TEST(TetGmsh, ReadsAFile) {
+    const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) /
+                                       ("mlc_tet_cube_" + std::to_string(::getpid()) + ".msh");
+    std::ofstream(file) << msh41(distorted_cube());
+    const TetMesh core = read_gmsh_tet(file, "core");
+    std::filesystem::remove(file);
+    ASSERT_EQ(core.n_tetrahedra(), 1);
+    EXPECT_EQ(core.attribute, std::vector<int>{4});
+    expect_invalid([&] { read_gmsh_tet(file); }, {"cannot open '" + file.string() + "'"});
 }
 
 TEST(TetGmsh, RefusesBadFiles) {
