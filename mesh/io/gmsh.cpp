@@ -2,6 +2,7 @@
 // Gmsh .msh reader: a strict line-by-line parser of the ASCII formats 2.2 and 4.1 that collects
 // nodes and elements, then selects triangles and boundary lines.
 #include "mesh/io/gmsh.hpp"
+#include "mesh/io/gmsh_parse.hpp"
 #include "mesh/topology.hpp"
 
 #include "core/check.hpp"
@@ -21,12 +22,7 @@ namespace mlc::mesh {
 
 namespace {
 
-/// What the reader needs to know about a Gmsh element type.
-struct ElementType {
-    int dim = -1;
-    int n_nodes = 0;
-    const char* name = "";
-};
+using gmsh_io::ElementType;
 
 /// Gmsh element types (gmsh.info, "MSH file format"); dim -1 for an unknown type.
 ElementType element_type(int type) {
@@ -102,22 +98,7 @@ ElementType element_type(int type) {
     }
 }
 
-/// Everything read from the file, before selection. Elements are stored flat: element e has
-/// nodes node_ids[node_begin[e] .. node_begin[e+1]) and physical tags
-/// phys[phys_begin[e] .. phys_begin[e+1]).
-struct MshData {
-    std::vector<std::int64_t> node_id;
-    std::vector<Eigen::Vector3d> node_x;
-    std::vector<int> node_line;
-    std::vector<int> elem_type, elem_line;
-    std::vector<std::size_t> node_begin{0}, phys_begin{0};
-    std::vector<std::int64_t> node_ids;
-    std::vector<int> phys;
-    std::map<std::pair<int, int>, std::string> names;            // (dim, physical tag) -> name
-    std::map<std::pair<int, int>, std::vector<int>> entity_phys; // 4.1: (dim, entity) -> tags
-
-    std::size_t n_elements() const { return elem_type.size(); }
-};
+using gmsh_io::MshData;
 
 /// Line-by-line reader that knows where it is, for error messages.
 class Reader {
@@ -461,6 +442,22 @@ std::uint64_t edge_key(int a, int b) {
 }
 
 } // namespace
+
+namespace gmsh_io {
+
+ElementType msh_element_type(int type) {
+    return element_type(type);
+}
+
+std::string read_msh_file(const std::filesystem::path& file) {
+    return read_file(file);
+}
+
+MshData parse_msh(const std::filesystem::path& file, std::string text) {
+    return parse(file, std::move(text));
+}
+
+} // namespace gmsh_io
 
 Mesh read_gmsh(const std::filesystem::path& file, const std::string& surface) {
     return read_gmsh_text(read_file(file), file, surface);
