@@ -441,6 +441,173 @@ std::uint64_t edge_key(int a, int b) {
     return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
 }
 
+/// The file's nodes by id, with the messages' prefix `where`.
+class NodeLookup {
+public:
+    NodeLookup(const MshData& d, const std::string& where) : d_(d), where_(where) {
+        index_.reserve(d.node_id.size());
+        for (std::size_t i = 0; i < d.node_id.size(); ++i)
+            MLC_CHECK(index_.emplace(d.node_id[i], static_cast<int>(i)).second,
+                      where << ":" << d.node_line[i] << ": node id " << d.node_id[i]
+                            << " appears twice");
+    }
+    /// The file's index of node k of element e.
+    int operator()(std::size_t e, std::size_t k) const {
+        const std::int64_t id = d_.node_ids[d_.node_begin[e] + k];
+        auto it = index_.find(id);
+        MLC_CHECK(it != index_.end(), where_ << ":" << d_.elem_line[e]
+                                             << ": element refers to node id " << id
+                                             << ", which is not in $Nodes");
+        return it->second;
+    }
+
+private:
+    const MshData& d_;
+    const std::string& where_;
+    std::unordered_map<std::int64_t, int> index_;
+};
+
+/// The physical surface named `surface` (or "tagN" for an unnamed surface N); 0 for all.
+int wanted_surface(const MshData& d, const std::string& surface, const std::string& where) {
+    if (surface.empty()) return 0;
+    int wanted = 0;
+    std::set<int> surfaces;
+    for (std::size_t e = 0; e < d.n_elements(); ++e)
+        if (element_type(d.elem_type[e]).dim == 2)
+            for (std::size_t k = d.phys_begin[e]; k < d.phys_begin[e + 1]; ++k)
+                surfaces.insert(d.phys[k]);
+    bool found = false;
+    for (const auto& [key, name] : d.names)
+        if (key.first == 2 && name == surface) {
+            wanted = key.second;
+            found = true;
+        }
+    for (int s : surfaces)
+        if (!found && surface == "tag" + std::to_string(s) && !d.names.count({2, s})) {
+            wanted = s;
+            found = true;
+        }
+    if (!found) {
+        std::ostringstream known;
+        for (int s : surfaces) {
+            auto it = d.names.find({2, s});
+            known << " '" << (it == d.names.end() ? "tag" + std::to_string(s) : it->second) << "'";
+        }
+        MLC_CHECK(false, where << ": no physical surface '" << surface << "'; the file has:"
+                               << (surfaces.empty() ? " none" : "") << known.str());
+    }
+    return wanted;
+}
+
+/// The selected triangles (in node indices of the file) and the candidate boundary lines.
+struct Selection {
+    std::vector<std::array<int, 3>> tris;
+    std::vector<int> tri_phys;
+    std::vector<std::size_t> tri_element, lines;
+};
+
+Selection select_elements(const MshData& d, const NodeLookup& node, const std::string& surface,
+                          int wanted, const std::string& where) {
+    auto has_phys = [&](std::size_t e, int p) {
+        for (std::size_t k = d.phys_begin[e]; k < d.phys_begin[e + 1]; ++k)
+            if (d.phys[k] == p) return true;
+        return false;
+    };
+    Selection s;
+    for (std::size_t e = 0; e < d.n_elements(); ++e) {
+        const int type = d.elem_type[e];
+        const ElementType et = element_type(type);
+        for (std::size_t k = 0; k < static_cast<std::size_t>(et.n_nodes); ++k)
+            node(e, k);
+        // All elements of dimension >= 1 but 2-node lines, or the wanted surface's elements.
+        const bool selected =
+            surface.empty() ? et.dim >= 1 && type != 1 : et.dim == 2 && has_phys(e, wanted);
+        if (type == 1 && d.phys_begin[e + 1] > d.phys_begin[e]) s.lines.push_back(e);
+        if (!selected) continue;
+        MLC_CHECK(type == 2, where << ":" << d.elem_line[e] << ": element type " << type << " ("
+                                   << et.name
+                                   << ") is not supported; only 3-node triangles (type 2) and "
+                                      "2-node lines (type 1) are read (set Gmsh's "
+                                      "Mesh.ElementOrder = 1 and do not recombine)");
+        s.tris.push_back({node(e, 0), node(e, 1), node(e, 2)});
+        s.tri_element.push_back(e);
+        s.tri_phys.push_back(d.phys_begin[e + 1] > d.phys_begin[e] ? d.phys[d.phys_begin[e]] : 0);
+    }
+    MLC_CHECK(!s.tris.empty(),
+              where << ": no 3-node triangles found"
+                    << (surface.empty() ? "" : " in physical surface '" + surface + "'"));
+    return s;
+}
+
+/// The used nodes, in file order (new_index: file index -> vertex, or -1), and the triangles
+/// oriented counter-clockwise.
+Mesh build_triangles(const MshData& d, const Selection& s, const std::string& where,
+                     std::vector<int>& new_index) {
+    Mesh m;
+    new_index.assign(d.node_id.size(), -1);
+    for (const auto& t : s.tris)
+        for (int v : t)
+            new_index[v] = 0;
+    for (std::size_t i = 0; i < new_index.size(); ++i)
+        if (new_index[i] == 0) {
+            new_index[i] = m.n_vertices();
+            m.vertices.emplace_back(d.node_x[i].x(), d.node_x[i].y());
+        }
+    const double diam = m.diameter();
+    for (std::size_t i = 0; i < new_index.size(); ++i)
+        MLC_CHECK(new_index[i] < 0 || std::abs(d.node_x[i].z()) <= 1e-10 * diam,
+                  where << ":" << d.node_line[i] << ": node " << d.node_id[i] << " has z = "
+                        << d.node_x[i].z() << "; only planar meshes in the plane z = 0 are read");
+    for (std::size_t i = 0; i < s.tris.size(); ++i) {
+        std::array<int, 3> t = {new_index[s.tris[i][0]], new_index[s.tris[i][1]],
+                                new_index[s.tris[i][2]]};
+        const Vec2 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
+        const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+        const std::size_t e = s.tri_element[i];
+        MLC_CHECK(std::abs(area2) > 2e-14 * diam * diam,
+                  where << ":" << d.elem_line[e] << ": degenerate triangle (nodes "
+                        << d.node_ids[d.node_begin[e]] << ", " << d.node_ids[d.node_begin[e] + 1]
+                        << ", " << d.node_ids[d.node_begin[e] + 2] << ")");
+        if (area2 < 0) std::swap(t[1], t[2]);
+        m.triangles.push_back(t);
+    }
+    if (std::any_of(s.tri_phys.begin(), s.tri_phys.end(), [](int p) { return p != 0; }))
+        m.attribute = s.tri_phys;
+    return m;
+}
+
+/// The tagged line elements: boundary edges (on one triangle) and interior lines (on two). The
+/// triangles of every vertex, in triangle order: a line element (a, b) lies on the triangles that
+/// hold both, with the direction it has in the first of them.
+void tag_lines(const MshData& d, const Selection& s, const NodeLookup& node,
+               const std::vector<int>& new_index, Mesh& m) {
+    const VertexTriangles vtri = vertex_triangles(m);
+    std::set<std::uint64_t> tagged;
+    for (std::size_t e : s.lines) {
+        const int a = new_index[node(e, 0)], b = new_index[node(e, 1)];
+        if (a < 0 || b < 0) continue;
+        const auto on = vtri.on_edge(m, a, b); // its direction in the first triangle holding it
+        const int count = on.count;
+        std::array<int, 2> dir{};
+        if (count > 0) {
+            const auto& t = m.triangles[static_cast<std::size_t>(on.first[0])];
+            for (int i = 0; i < 3; ++i)
+                if ((t[i] == a && t[(i + 1) % 3] == b) || (t[i] == b && t[(i + 1) % 3] == a))
+                    dir = {t[i], t[(i + 1) % 3]};
+        }
+        const std::uint64_t key = edge_key(a, b);
+        if (count == 0 || count > 2 || !tagged.insert(key).second) continue;
+        const int p = d.phys[d.phys_begin[e]];
+        auto name = d.names.find({1, p});
+        BoundaryEdge be;
+        be.v0 = dir[0];
+        be.v1 = dir[1];
+        be.tag = m.add_tag(name == d.names.end() ? "tag" + std::to_string(p) : name->second);
+        // An edge of two selected triangles is a tagged interior line.
+        (count == 1 ? m.boundary : m.lines).push_back(be);
+    }
+}
+
 } // namespace
 
 namespace gmsh_io {
@@ -467,148 +634,16 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
                     const std::string& surface) {
     const MshData d = parse(file, text);
     const std::string where = "read_gmsh: " + file.string();
-
-    std::unordered_map<std::int64_t, int> node_index;
-    node_index.reserve(d.node_id.size());
-    for (std::size_t i = 0; i < d.node_id.size(); ++i)
-        MLC_CHECK(node_index.emplace(d.node_id[i], static_cast<int>(i)).second,
-                  where << ":" << d.node_line[i] << ": node id " << d.node_id[i]
-                        << " appears twice");
-
-    // Which physical surface is wanted.
-    int wanted = 0;
-    if (!surface.empty()) {
-        std::set<int> surfaces;
-        for (std::size_t e = 0; e < d.n_elements(); ++e)
-            if (element_type(d.elem_type[e]).dim == 2)
-                for (std::size_t k = d.phys_begin[e]; k < d.phys_begin[e + 1]; ++k)
-                    surfaces.insert(d.phys[k]);
-        bool found = false;
-        for (const auto& [key, name] : d.names)
-            if (key.first == 2 && name == surface) {
-                wanted = key.second;
-                found = true;
-            }
-        for (int s : surfaces)
-            if (!found && surface == "tag" + std::to_string(s) && !d.names.count({2, s})) {
-                wanted = s;
-                found = true;
-            }
-        if (!found) {
-            std::ostringstream known;
-            for (int s : surfaces) {
-                auto it = d.names.find({2, s});
-                known << " '" << (it == d.names.end() ? "tag" + std::to_string(s) : it->second)
-                      << "'";
-            }
-            MLC_CHECK(false, where << ": no physical surface '" << surface << "'; the file has:"
-                                   << (surfaces.empty() ? " none" : "") << known.str());
-        }
-    }
-    auto has_phys = [&](std::size_t e, int p) {
-        for (std::size_t k = d.phys_begin[e]; k < d.phys_begin[e + 1]; ++k)
-            if (d.phys[k] == p) return true;
-        return false;
-    };
-    auto node = [&](std::size_t e, std::size_t k) {
-        const std::int64_t id = d.node_ids[d.node_begin[e] + k];
-        auto it = node_index.find(id);
-        MLC_CHECK(it != node_index.end(), where << ":" << d.elem_line[e]
-                                                << ": element refers to node id " << id
-                                                << ", which is not in $Nodes");
-        return it->second;
-    };
-
-    // Selected triangles (in node indices of the file) and candidate boundary lines.
-    std::vector<std::array<int, 3>> tris;
-    std::vector<int> tri_phys;
-    std::vector<std::size_t> tri_element, lines;
-    for (std::size_t e = 0; e < d.n_elements(); ++e) {
-        const int type = d.elem_type[e];
-        const ElementType et = element_type(type);
-        for (std::size_t k = 0; k < static_cast<std::size_t>(et.n_nodes); ++k)
-            node(e, k);
-        // All elements of dimension >= 1 but 2-node lines, or the wanted surface's elements.
-        const bool selected =
-            surface.empty() ? et.dim >= 1 && type != 1 : et.dim == 2 && has_phys(e, wanted);
-        if (type == 1 && d.phys_begin[e + 1] > d.phys_begin[e]) lines.push_back(e);
-        if (!selected) continue;
-        MLC_CHECK(type == 2, where << ":" << d.elem_line[e] << ": element type " << type << " ("
-                                   << et.name
-                                   << ") is not supported; only 3-node triangles (type 2) and "
-                                      "2-node lines (type 1) are read (set Gmsh's "
-                                      "Mesh.ElementOrder = 1 and do not recombine)");
-        tris.push_back({node(e, 0), node(e, 1), node(e, 2)});
-        tri_element.push_back(e);
-        tri_phys.push_back(d.phys_begin[e + 1] > d.phys_begin[e] ? d.phys[d.phys_begin[e]] : 0);
-    }
-    MLC_CHECK(!tris.empty(),
-              where << ": no 3-node triangles found"
-                    << (surface.empty() ? "" : " in physical surface '" + surface + "'"));
-
-    // Keep the used nodes, in file order; orient triangles counter-clockwise.
-    Mesh m;
-    std::vector<int> new_index(d.node_id.size(), -1);
-    for (const auto& t : tris)
-        for (int v : t)
-            new_index[v] = 0;
-    for (std::size_t i = 0; i < new_index.size(); ++i)
-        if (new_index[i] == 0) {
-            new_index[i] = m.n_vertices();
-            m.vertices.emplace_back(d.node_x[i].x(), d.node_x[i].y());
-        }
-    const double diam = m.diameter();
-    for (std::size_t i = 0; i < new_index.size(); ++i)
-        MLC_CHECK(new_index[i] < 0 || std::abs(d.node_x[i].z()) <= 1e-10 * diam,
-                  where << ":" << d.node_line[i] << ": node " << d.node_id[i] << " has z = "
-                        << d.node_x[i].z() << "; only planar meshes in the plane z = 0 are read");
-    for (std::size_t i = 0; i < tris.size(); ++i) {
-        std::array<int, 3> t = {new_index[tris[i][0]], new_index[tris[i][1]],
-                                new_index[tris[i][2]]};
-        const Vec2 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
-        const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-        const std::size_t e = tri_element[i];
-        MLC_CHECK(std::abs(area2) > 2e-14 * diam * diam,
-                  where << ":" << d.elem_line[e] << ": degenerate triangle (nodes "
-                        << d.node_ids[d.node_begin[e]] << ", " << d.node_ids[d.node_begin[e] + 1]
-                        << ", " << d.node_ids[d.node_begin[e] + 2] << ")");
-        if (area2 < 0) std::swap(t[1], t[2]);
-        m.triangles.push_back(t);
-    }
-    if (std::any_of(tri_phys.begin(), tri_phys.end(), [](int p) { return p != 0; }))
-        m.attribute = tri_phys;
-
-    // The triangles of every vertex, in triangle order: a line element (a, b) lies on the
-    // triangles that hold both, with the direction it has in the first of them.
-    const VertexTriangles vtri = vertex_triangles(m);
-    std::set<std::uint64_t> tagged;
-    for (std::size_t e : lines) {
-        const int a = new_index[node(e, 0)], b = new_index[node(e, 1)];
-        if (a < 0 || b < 0) continue;
-        const auto on = vtri.on_edge(m, a, b); // its direction in the first triangle holding it
-        const int count = on.count;
-        std::array<int, 2> dir{};
-        if (count > 0) {
-            const auto& t = m.triangles[static_cast<std::size_t>(on.first[0])];
-            for (int i = 0; i < 3; ++i)
-                if ((t[i] == a && t[(i + 1) % 3] == b) || (t[i] == b && t[(i + 1) % 3] == a))
-                    dir = {t[i], t[(i + 1) % 3]};
-        }
-        const std::uint64_t key = edge_key(a, b);
-        if (count == 0 || count > 2 || !tagged.insert(key).second) continue;
-        const int p = d.phys[d.phys_begin[e]];
-        auto name = d.names.find({1, p});
-        BoundaryEdge be;
-        be.v0 = dir[0];
-        be.v1 = dir[1];
-        be.tag = m.add_tag(name == d.names.end() ? "tag" + std::to_string(p) : name->second);
-        // An edge of two selected triangles is a tagged interior line.
-        (count == 1 ? m.boundary : m.lines).push_back(be);
-    }
+    const NodeLookup node(d, where);
+    const int wanted = wanted_surface(d, surface, where);
+    const Selection s = select_elements(d, node, surface, wanted, where);
+    std::vector<int> new_index; // the file's node index -> vertex, or -1
+    Mesh m = build_triangles(d, s, where, new_index);
+    tag_lines(d, s, node, new_index, m);
     // Defects of the mesh name the file, and each triangle its element's line and node ids.
     try {
         check_quality(m, [&](int t) {
-            const std::size_t e = tri_element[static_cast<std::size_t>(t)];
+            const std::size_t e = s.tri_element[static_cast<std::size_t>(t)];
             return "triangle " + std::to_string(t) + " (the element on line " +
                    std::to_string(d.elem_line[e]) + ", nodes " +
                    std::to_string(d.node_ids[d.node_begin[e]]) + " " +
