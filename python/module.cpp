@@ -3,10 +3,10 @@
 // re-exports it and adds what is easier in Python (exceptions carrying results, studies' tables,
 // tractions along the contact boundary). Arrays of a result are numpy views of the C++ result
 // (the Python Result object is their base and keeps it alive), read-only.
-#include "apps/output.hpp"
-#include "apps/run.hpp"
-#include "apps/study_accuracy.hpp"
-#include "apps/study_status_transfer.hpp"
+#include "run/output.hpp"
+#include "run/run.hpp"
+#include "studies/accuracy.hpp"
+#include "studies/status_transfer.hpp"
 #include "core/check.hpp"
 #include "core/user_message.hpp"
 #include "levels/checks.hpp"

@@ -2,7 +2,7 @@
 // Scenes a researcher can write (issue 16): transformed meshes, tags on interior and mirror
 // lines, arcs on Gmsh meshes, supports with per-step activity, and the built-in scenes that use
 // them (hertz_gmsh, axis_release, incline), each against its closed form or an identity.
-#include "apps/closed_form.hpp"
+#include "run/closed_form.hpp"
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 #include "levels/checks.hpp"

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // `mlcontact run`.
-#include "apps/run.hpp"
+#include "run/run.hpp"
 
-#include "apps/interrupt.hpp"
-#include "apps/output.hpp"
-#include "apps/study_status_transfer.hpp"
+#include "run/interrupt.hpp"
+#include "run/output.hpp"
+#include "run/plot_script.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/parallel.hpp"

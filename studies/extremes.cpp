@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Stability study over stiff and extreme cases (benchmarks.md, "Stiff and extreme cases").
-#include "apps/study_extremes.hpp"
+#include "studies/extremes.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Closed-form contact references.
-#include "apps/closed_form.hpp"
+#include "run/closed_form.hpp"
 
 #include "core/check.hpp"
 

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The preconditioner study over process counts (issue 13, item 2): `mlcontact run` launched on
 // N = 1, 2, 4, ... processes per preconditioner and level, each run's iterations.csv read back.
-#include "apps/preconditioners.hpp"
-#include "apps/study_preconditioners.hpp"
-#include "apps/study_status_transfer.hpp"
+#include "run/preconditioners.hpp"
+#include "studies/preconditioners.hpp"
+#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/timer.hpp"

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Report and result files of a run.
-#include "apps/output.hpp"
-#include "apps/summary_json.hpp"
+#include "run/output.hpp"
+#include "run/summary_json.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"

@@ -4,7 +4,7 @@
 // Solves the scene once on the given level (the run's default solver), then writes the final
 // state's solution.vtu REPEAT times in each format, alternating, and prints one JSON object:
 // sizes in bytes, write times in seconds (median and all), and the ratios.
-#include "apps/output.hpp"
+#include "run/output.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/timer.hpp"

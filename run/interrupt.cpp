@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The signal handlers of the driver.
-#include "apps/interrupt.hpp"
+#include "run/interrupt.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/stop.hpp"

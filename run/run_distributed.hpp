@@ -4,7 +4,7 @@
 /// and solution.pvtu (one piece per process), contact.csv and summary.json written once.
 #pragma once
 
-#include "apps/run.hpp"
+#include "run/run.hpp"
 #include "core/communicator.hpp"
 #include "levels/newton_system.hpp"
 

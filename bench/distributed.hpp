@@ -16,7 +16,7 @@
 /// (out/bench/elastic_<scene>_L<L>_np<N>.json unless --out) is written by rank 0.
 #pragma once
 
-#include "apps/bench.hpp"
+#include "bench/bench.hpp"
 #include "core/communicator.hpp"
 #include "levels/distributed.hpp"
 #include "levels/level.hpp"

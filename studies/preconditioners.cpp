@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Preconditioner study (issue: the papers' Krylov solvers and preconditioners).
-#include "apps/study_preconditioners.hpp"
+#include "studies/preconditioners.hpp"
 
-#include "apps/preconditioners.hpp"
+#include "run/preconditioners.hpp"
 
-#include "apps/study_status_transfer.hpp"
+#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"

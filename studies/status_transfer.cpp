@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Status-transfer study (issue: level hierarchy and coarse-to-fine Newton).
-#include "apps/study_status_transfer.hpp"
+#include "studies/status_transfer.hpp"
+
+#include "run/plot_script.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
@@ -59,59 +61,6 @@ std::vector<int> distance_to_zone_boundary(const levels::Level& L,
 }
 
 } // namespace
-
-bool run_plot_script(const std::string& script, const std::filesystem::path& dir, std::ostream& os,
-                     const std::string& extra, std::string* cause) {
-    const std::filesystem::path path = std::filesystem::path(MLC_SOURCE_DIR) / "scripts" / script;
-    if (!std::filesystem::exists(path)) {
-        const std::string why =
-            path.string() + " not found (run from a source checkout to draw plots)";
-        os << "plot: " << why << "\n";
-        if (cause) *cause = why;
-        return false;
-    }
-    // Debian's interpreter has python3-matplotlib; a python3 earlier on PATH may not.
-    const std::string py =
-        std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-    auto quoted = [](const std::string& s) {
-        std::string q = "'";
-        for (char c : s)
-            q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-        return q + "'";
-    };
-    const std::string cmd = py + " " + quoted(path.string()) + " " + quoted(dir.string()) +
-                            (extra.empty() ? "" : " " + extra);
-    os << std::flush;
-    std::string output;
-    int rc = -1;
-    if (std::FILE* pipe = ::popen((cmd + " 2>&1").c_str(), "r")) {
-        char buf[4096];
-        size_t n = 0;
-        while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0)
-            output.append(buf, n);
-        rc = ::pclose(pipe);
-    }
-    if (rc == 0) {
-        os << output;
-        return true;
-    }
-    // The script's last line says what went wrong (a Python exception's type and message).
-    std::string last;
-    {
-        std::istringstream in(output);
-        for (std::string line; std::getline(in, line);)
-            if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
-    }
-    const std::string why =
-        "'" + cmd + "' failed (" +
-        (rc == -1        ? std::string("could not be started")
-         : WIFEXITED(rc) ? "exit " + std::to_string(WEXITSTATUS(rc))
-                         : "signal " + std::to_string(WTERMSIG(rc))) +
-        ")" + (last.empty() ? std::string() : ": " + last.substr(last.find_first_not_of(" \t")));
-    os << output << "plot: " << why << "\n";
-    if (cause) *cause = why;
-    return false;
-}
 
 int study_status_transfer(const levels::Problem& problem_in, const StatusTransferOptions& opt,
                           std::ostream& os) {

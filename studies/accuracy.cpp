@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Accuracy study: closed-form quantities of hertz, mindlin and patch per level, observed orders.
-#include "apps/study_accuracy.hpp"
+#include "studies/accuracy.hpp"
 
-#include "apps/closed_form.hpp"
-#include "apps/study_status_transfer.hpp"
+#include "run/closed_form.hpp"
+#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/timer.hpp"

@@ -3,7 +3,7 @@
 /// apps/run_distributed.cpp), so that both write them alike.
 #pragma once
 
-#include "apps/output.hpp"
+#include "run/output.hpp"
 #include "levels/checks.hpp"
 #include "levels/newton.hpp"
 #include "levels/solve.hpp"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The driver's view of the preconditioner registry.
-#include "apps/preconditioners.hpp"
+#include "run/preconditioners.hpp"
 
 #include "core/check.hpp"
 #include "solvers/factory.hpp"

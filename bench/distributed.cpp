@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `mlcontact bench square` on several processes.
-#include "apps/bench_distributed.hpp"
+#include "bench/distributed.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"

@@ -30,12 +30,4 @@ struct StatusTransferOptions {
 int study_status_transfer(const levels::Problem& problem, const StatusTransferOptions& opt,
                           std::ostream& os);
 
-/// Runs a plotting script of scripts/ with Debian's python3 (which has matplotlib), its output
-/// (stdout and stderr) captured. Returns false when the script is missing or failed, and says
-/// why on `os` with the script's own last message (e.g. "ModuleNotFoundError: No module named
-/// 'matplotlib'"), also stored in `cause` if given. `extra` is appended to the command line
-/// (further arguments, already quoted).
-bool run_plot_script(const std::string& script, const std::filesystem::path& dir, std::ostream& os,
-                     const std::string& extra = "", std::string* cause = nullptr);
-
 } // namespace mlc::apps

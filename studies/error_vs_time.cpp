@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Work-precision study (issue: error against run time).
-#include "apps/study_error_vs_time.hpp"
+#include "studies/error_vs_time.hpp"
 
-#include "apps/closed_form.hpp"
-#include "apps/study_status_transfer.hpp"
+#include "run/closed_form.hpp"
+#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "fem/assembly.hpp"

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
 // `mlcontact run` under mpirun with several processes (issue 12).
-#include "apps/run_distributed.hpp"
+#include "run/run_distributed.hpp"
 
-#include "apps/interrupt.hpp"
-#include "apps/output.hpp"
-#include "apps/summary_json.hpp"
+#include "run/interrupt.hpp"
+#include "run/output.hpp"
+#include "run/summary_json.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"

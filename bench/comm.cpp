@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // `mlcontact bench comm`: messages, bytes, reductions and seconds per operation of the distributed
 // mg (see the header).
-#include "apps/bench_comm.hpp"
+#include "bench/comm.hpp"
 
-#include "apps/bench_distributed.hpp"
+#include "bench/distributed.hpp"
 #include "comm/counters.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
