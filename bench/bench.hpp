@@ -14,7 +14,7 @@
 ///   level, right-hand side the full load) solved to the same relative tolerance by hypre
 ///   BoomerAMG-PCG and by our geometric V-cycle (vertex-block Gauss–Seidel, P / P^T, sparse LU
 ///   on level 0) inside CG and GMRES, side by side in one run. Under mpirun with N > 1 processes:
-///   apps/bench_distributed.hpp (bench_elastic_distributed).
+///   bench/distributed.hpp (bench_elastic_distributed).
 /// - `bench newton`: the Newton systems of the finest level, captured from a real coarse-to-fine
 ///   run (one per Newton step, through levels::SolveOptions::wrap_system_solver), each solved
 ///   from zero to the same relative tolerance by our Krylov method with `mg` as the run uses it

@@ -49,6 +49,95 @@ double median3(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+/// The sizes per level, the table of operations and the JSON file (process 0); returns the
+/// exit code.
+int report_comm(std::ostream& os, bool root, const BenchCommOptions& opt, const Communicator& comm,
+                const ElasticHierarchy& h, const std::vector<Phase>& phases, bool counting,
+                bool converged) {
+    const int np = comm.size();
+    const int p = h.partition_level;
+    const auto& dl = h.levels;
+    const size_t m = dl.size() - 1;
+    // Sizes: per level the global unknowns and the largest owned and ghost counts.
+    std::vector<double> mine;
+    for (size_t k = 0; k <= m; ++k) {
+        mine.push_back(static_cast<double>(dl[k].n_owned));
+        mine.push_back(static_cast<double>(dl[k].local.n_unknowns() - dl[k].n_owned));
+    }
+    mine.push_back(peak_rss_bytes());
+    const auto sizes = comm.allgather(std::span<const double>(mine));
+    const size_t w = mine.size();
+    auto max_over = [&](size_t c) {
+        double v = 0;
+        for (int q = 0; q < np; ++q)
+            v = std::max(v, sizes[w * static_cast<size_t>(q) + c]);
+        return v;
+    };
+
+    os << "bench comm: " << opt.scene << " elastic block, levels " << p << ".." << opt.levels
+       << " (partition level " << p << ", coarse LU of " << h.level_p.n_unknowns()
+       << " unknowns on every process), " << np << " process(es), one thread each; "
+       << (counting ? "MPI counts from the PMPI library" : "one process: times only") << "\n";
+    os << std::setw(6) << "level" << std::setw(14) << "unknowns" << std::setw(12) << "owned max"
+       << std::setw(12) << "ghost max\n";
+    for (size_t k = 0; k <= m; ++k)
+        os << std::setw(6) << p + static_cast<int>(k) << std::setw(14) << dl[k].n_global_dofs
+           << std::setw(12) << max_over(2 * k) << std::setw(12) << max_over(2 * k + 1) << "\n";
+    os << std::setw(10) << "operation" << std::setw(6) << "from" << std::setw(12) << "seconds"
+       << std::setw(10) << "msgs" << std::setw(12) << "bytes" << std::setw(8) << "reduce"
+       << std::setw(8) << "gather" << std::setw(14) << "gather bytes"
+       << "   (per operation; counts: max over processes)\n";
+    for (const Phase& ph : phases)
+        os << std::setw(10) << ph.name << std::setw(6) << ph.level << std::scientific
+           << std::setprecision(3) << std::setw(12) << ph.seconds << std::defaultfloat
+           << std::setprecision(4) << std::setw(10) << ph.max[0] << std::setw(12) << ph.max[1]
+           << std::setw(8) << ph.max[2] << std::setw(8) << ph.max[4] << std::setw(14) << ph.max[5]
+           << "\n";
+    const double cgs_its = phases.back().per_op;
+    os << "cgs: " << cgs_its << " iterations to " << opt.rel_tol
+       << (converged ? "" : "  NOT CONVERGED") << "\n";
+    if (root) {
+        const std::filesystem::path file =
+            !opt.out.empty() ? opt.out
+                             : std::filesystem::path("out/bench/comm_" + opt.scene + "_L" +
+                                                     std::to_string(opt.levels) + "_np" +
+                                                     std::to_string(np) + ".json");
+        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+        write_file_atomically(file, [&](std::ostream& js) {
+            js << std::setprecision(12) << "{\n  \"scene\": \"" << opt.scene
+               << "\",\n  \"level\": " << opt.levels << ",\n  \"processes\": " << np
+               << ",\n  \"threads_per_process\": 1,\n  \"partition_level\": " << p
+               << ",\n  \"coarse_unknowns\": " << h.level_p.n_unknowns()
+               << ",\n  \"level0_triangles\": " << h.problem.mesh0.n_triangles()
+               << ",\n  \"counted\": " << (counting ? "true" : "false")
+               << ",\n  \"ops\": " << opt.ops << ",\n  \"cgs_iterations\": " << cgs_its
+               << ",\n  \"cgs_converged\": " << (converged ? "true" : "false")
+               << ",\n  \"peak_rss_bytes_max\": " << max_over(w - 1) << ",\n  \"levels\": [";
+            for (size_t k = 0; k <= m; ++k)
+                js << (k ? ", " : "") << "{\"level\": " << p + static_cast<int>(k)
+                   << ", \"unknowns\": " << dl[k].n_global_dofs
+                   << ", \"owned_max\": " << max_over(2 * k)
+                   << ", \"ghost_max\": " << max_over(2 * k + 1) << "}";
+            js << "],\n  \"operations\": [";
+            for (size_t i = 0; i < phases.size(); ++i) {
+                const Phase& ph = phases[i];
+                js << (i ? "," : "") << "\n    {\"name\": \"" << ph.name
+                   << "\", \"level\": " << ph.level << ", \"seconds\": " << ph.seconds
+                   << ", \"max\": {";
+                for (size_t c = 0; c < 7; ++c)
+                    js << (c ? ", " : "") << "\"" << kCountNames[c] << "\": " << ph.max[c];
+                js << "}, \"mean\": {";
+                for (size_t c = 0; c < 7; ++c)
+                    js << (c ? ", " : "") << "\"" << kCountNames[c] << "\": " << ph.mean[c];
+                js << "}}";
+            }
+            js << "\n  ]\n}\n";
+        });
+        os << "wrote " << file.string() << "\n";
+    }
+    return converged ? 0 : 2;
+}
+
 } // namespace
 
 int bench_comm(const BenchCommOptions& opt, const Communicator& comm, std::ostream& out) {
@@ -154,84 +243,7 @@ int bench_comm(const BenchCommOptions& opt, const Communicator& comm, std::ostre
         return static_cast<double>(std::max(1, s.iterations));
     });
 
-    // Sizes: per level the global unknowns and the largest owned and ghost counts.
-    std::vector<double> mine;
-    for (size_t k = 0; k <= m; ++k) {
-        mine.push_back(static_cast<double>(dl[k].n_owned));
-        mine.push_back(static_cast<double>(dl[k].local.n_unknowns() - dl[k].n_owned));
-    }
-    mine.push_back(peak_rss_bytes());
-    const auto sizes = comm.allgather(std::span<const double>(mine));
-    const size_t w = mine.size();
-    auto max_over = [&](size_t c) {
-        double v = 0;
-        for (int q = 0; q < np; ++q)
-            v = std::max(v, sizes[w * static_cast<size_t>(q) + c]);
-        return v;
-    };
-
-    os << "bench comm: " << opt.scene << " elastic block, levels " << p << ".." << opt.levels
-       << " (partition level " << p << ", coarse LU of " << h->level_p.n_unknowns()
-       << " unknowns on every process), " << np << " process(es), one thread each; "
-       << (counting ? "MPI counts from the PMPI library" : "one process: times only") << "\n";
-    os << std::setw(6) << "level" << std::setw(14) << "unknowns" << std::setw(12) << "owned max"
-       << std::setw(12) << "ghost max\n";
-    for (size_t k = 0; k <= m; ++k)
-        os << std::setw(6) << p + static_cast<int>(k) << std::setw(14) << dl[k].n_global_dofs
-           << std::setw(12) << max_over(2 * k) << std::setw(12) << max_over(2 * k + 1) << "\n";
-    os << std::setw(10) << "operation" << std::setw(6) << "from" << std::setw(12) << "seconds"
-       << std::setw(10) << "msgs" << std::setw(12) << "bytes" << std::setw(8) << "reduce"
-       << std::setw(8) << "gather" << std::setw(14) << "gather bytes"
-       << "   (per operation; counts: max over processes)\n";
-    for (const Phase& ph : phases)
-        os << std::setw(10) << ph.name << std::setw(6) << ph.level << std::scientific
-           << std::setprecision(3) << std::setw(12) << ph.seconds << std::defaultfloat
-           << std::setprecision(4) << std::setw(10) << ph.max[0] << std::setw(12) << ph.max[1]
-           << std::setw(8) << ph.max[2] << std::setw(8) << ph.max[4] << std::setw(14) << ph.max[5]
-           << "\n";
-    const double cgs_its = phases.back().per_op;
-    os << "cgs: " << cgs_its << " iterations to " << opt.rel_tol
-       << (converged ? "" : "  NOT CONVERGED") << "\n";
-    if (root) {
-        const std::filesystem::path file =
-            !opt.out.empty() ? opt.out
-                             : std::filesystem::path("out/bench/comm_" + opt.scene + "_L" +
-                                                     std::to_string(opt.levels) + "_np" +
-                                                     std::to_string(np) + ".json");
-        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-        write_file_atomically(file, [&](std::ostream& js) {
-            js << std::setprecision(12) << "{\n  \"scene\": \"" << opt.scene
-               << "\",\n  \"level\": " << opt.levels << ",\n  \"processes\": " << np
-               << ",\n  \"threads_per_process\": 1,\n  \"partition_level\": " << p
-               << ",\n  \"coarse_unknowns\": " << h->level_p.n_unknowns()
-               << ",\n  \"level0_triangles\": " << h->problem.mesh0.n_triangles()
-               << ",\n  \"counted\": " << (counting ? "true" : "false")
-               << ",\n  \"ops\": " << opt.ops << ",\n  \"cgs_iterations\": " << cgs_its
-               << ",\n  \"cgs_converged\": " << (converged ? "true" : "false")
-               << ",\n  \"peak_rss_bytes_max\": " << max_over(w - 1) << ",\n  \"levels\": [";
-            for (size_t k = 0; k <= m; ++k)
-                js << (k ? ", " : "") << "{\"level\": " << p + static_cast<int>(k)
-                   << ", \"unknowns\": " << dl[k].n_global_dofs
-                   << ", \"owned_max\": " << max_over(2 * k)
-                   << ", \"ghost_max\": " << max_over(2 * k + 1) << "}";
-            js << "],\n  \"operations\": [";
-            for (size_t i = 0; i < phases.size(); ++i) {
-                const Phase& ph = phases[i];
-                js << (i ? "," : "") << "\n    {\"name\": \"" << ph.name
-                   << "\", \"level\": " << ph.level << ", \"seconds\": " << ph.seconds
-                   << ", \"max\": {";
-                for (size_t c = 0; c < 7; ++c)
-                    js << (c ? ", " : "") << "\"" << kCountNames[c] << "\": " << ph.max[c];
-                js << "}, \"mean\": {";
-                for (size_t c = 0; c < 7; ++c)
-                    js << (c ? ", " : "") << "\"" << kCountNames[c] << "\": " << ph.mean[c];
-                js << "}}";
-            }
-            js << "\n  ]\n}\n";
-        });
-        os << "wrote " << file.string() << "\n";
-    }
-    return converged ? 0 : 2;
+    return report_comm(os, root, opt, comm, *h, phases, counting, converged);
 }
 
 } // namespace mlc::apps

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
-/// @file `mlcontact bench comm` (issue 13 item 4): what one V-cycle of the distributed mg, one
+/// @file `mlcontact bench comm`: what one V-cycle of the distributed mg, one
 /// mat-vec and one Krylov iteration cost each process in messages, bytes and reductions, and in
-/// seconds: the inputs of the scaling model (scripts/scaling_model.py, README "Running on a
-/// cluster").
+/// seconds: the inputs of the scaling model (scripts/measure/scaling_model.py,
+/// docs/parallel.md).
 ///
 /// On the elastic block of a scene's level L (its contact pairs dropped, distributed as a run
-/// distributes it: apps/bench_distributed.hpp), with the mg of a run (vertex-block Gauss-Seidel,
+/// distributes it: bench/distributed.hpp), with the mg of a run (vertex-block Gauss-Seidel,
 /// one pre- and one post-sweep, gathered LU on level p), each operation is repeated `ops` times
 /// between barriers:
 ///   matvec        one product with the finest K (hypre's halo exchange);

@@ -230,6 +230,95 @@ std::unique_ptr<ElasticHierarchy> build_elastic_hierarchy(const std::string& sce
     return h;
 }
 
+namespace {
+
+/// BoomerAMG-PCG: hypre's ParCSR PCG on a copy of K made through IJ (which puts the diagonal
+/// entry first in each row, as BoomerAMG expects); the copy is part of the setup, as on one
+/// process. `x`: the last repetition's solution.
+ElasticRow boomeramg_pcg_row(const levels::DistributedLevel& fine, const Vector& b,
+                             const BenchElasticOptions& opt, const Communicator& comm, Vector& x) {
+    const Index n = fine.n_owned;
+    std::vector<int> dof_func(static_cast<size_t>(n));
+    for (Index i = 0; i < n; ++i) {
+        const int v = fine.local.dofs.vertex_of(i);
+        dof_func[static_cast<size_t>(i)] = fine.local.dofs.u_dof(v, 0) == i ? 0 : 1;
+    }
+    const solvers::RowBlocks& kb = *fine.K_blocks;
+    solvers::DistributedRows rows;
+    rows.first_row = kb.first_row;
+    rows.row_ptr.assign(1, 0);
+    for (Index i = 0; i < kb.diag.rows(); ++i) {
+        for (SparseMatrix::InnerIterator it(kb.diag, i); it; ++it) {
+            rows.cols.push_back(kb.first_col + it.col());
+            rows.values.push_back(it.value());
+        }
+        for (SparseMatrix::InnerIterator it(kb.offd, i); it; ++it) {
+            rows.cols.push_back(kb.col_map[static_cast<size_t>(it.col())]);
+            rows.values.push_back(it.value());
+        }
+        rows.row_ptr.push_back(static_cast<int>(rows.cols.size()));
+    }
+    ElasticRow r;
+    r.name = "boomeramg-pcg";
+    for (int rep = 0; rep < opt.repeat; ++rep) {
+        comm.barrier();
+        const double t0 = wall_seconds();
+        const solvers::ParMatrix K(comm, rows);
+        const double copy = wall_seconds() - t0;
+        x = Vector::Zero(n);
+        const SolveResult s =
+            solvers::boomeramg_pcg_par(K, b, x, opt.rel_tol, opt.max_iter, {}, dof_func);
+        r.setup.push_back(comm.max(copy + s.setup_seconds));
+        r.solve.push_back(comm.max(s.solve_seconds));
+        r.iterations = s.iterations;
+        r.converged = s.converged;
+    }
+    return r;
+}
+
+/// The JSON file of the distributed elastic bench (process 0); returns its path.
+std::filesystem::path write_elastic_json(const BenchElasticOptions& opt, int np, int p,
+                                         Index unknowns, std::int64_t nnz, double hierarchy_s,
+                                         double diff, double rss_max,
+                                         const std::vector<double>& all,
+                                         const std::vector<ElasticRow>& results) {
+    const std::filesystem::path file =
+        !opt.out.empty() ? opt.out
+                         : std::filesystem::path("out/bench/elastic_" + opt.scene + "_L" +
+                                                 std::to_string(opt.levels) + "_np" +
+                                                 std::to_string(np) + ".json");
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+    write_file_atomically(file, [&](std::ostream& js) {
+        js << std::setprecision(12) << "{\n  \"scene\": \"" << opt.scene
+           << "\",\n  \"level\": " << opt.levels << ",\n  \"processes\": " << np
+           << ",\n  \"threads_per_process\": 1,\n  \"partition_level\": " << p
+           << ",\n  \"unknowns\": " << unknowns << ",\n  \"nonzeros\": " << nnz
+           << ",\n  \"rel_tol\": " << opt.rel_tol << ",\n  \"repeat\": " << opt.repeat
+           << ",\n  \"levels_seconds\": " << hierarchy_s << ",\n  \"solution_difference\": " << diff
+           << ",\n  \"peak_rss_bytes_max\": " << rss_max << ",\n  \"per_process\": [";
+        for (int q = 0; q < np; ++q)
+            js << (q ? ", " : "") << "{\"rank\": " << q
+               << ", \"peak_rss_bytes\": " << all[2 * static_cast<size_t>(q)]
+               << ", \"owned_unknowns\": "
+               << static_cast<std::int64_t>(all[2 * static_cast<size_t>(q) + 1]) << "}";
+        js << "],\n  \"solvers\": [";
+        for (size_t k = 0; k < results.size(); ++k) {
+            const auto& r = results[k];
+            const double su = median_of(r.setup), so = median_of(r.solve);
+            js << (k ? "," : "") << "\n    {\"solver\": \"" << r.name
+               << "\", \"setup_seconds\": " << su << ", \"solve_seconds\": " << so
+               << ", \"total_seconds\": " << su + so << ", \"iterations\": " << r.iterations
+               << ", \"relative_residual\": " << r.relative_residual
+               << ", \"converged\": " << (r.converged ? "true" : "false")
+               << ", \"x_norm\": " << r.x_norm << ", \"x_max_norm\": " << r.x_max << "}";
+        }
+        js << "\n  ]\n}\n";
+    });
+    return file;
+}
+
+} // namespace
+
 int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator& comm,
                               std::ostream& out) {
     std::ostream null_stream(nullptr);
@@ -278,42 +367,8 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
     // entry first in each row, as BoomerAMG expects); the copy is part of the setup, as on one
     // process.
     {
-        std::vector<int> dof_func(static_cast<size_t>(n));
-        for (Index i = 0; i < n; ++i) {
-            const int v = fine.local.dofs.vertex_of(i);
-            dof_func[static_cast<size_t>(i)] = fine.local.dofs.u_dof(v, 0) == i ? 0 : 1;
-        }
-        const solvers::RowBlocks& kb = *fine.K_blocks;
-        solvers::DistributedRows rows;
-        rows.first_row = kb.first_row;
-        rows.row_ptr.assign(1, 0);
-        for (Index i = 0; i < kb.diag.rows(); ++i) {
-            for (SparseMatrix::InnerIterator it(kb.diag, i); it; ++it) {
-                rows.cols.push_back(kb.first_col + it.col());
-                rows.values.push_back(it.value());
-            }
-            for (SparseMatrix::InnerIterator it(kb.offd, i); it; ++it) {
-                rows.cols.push_back(kb.col_map[static_cast<size_t>(it.col())]);
-                rows.values.push_back(it.value());
-            }
-            rows.row_ptr.push_back(static_cast<int>(rows.cols.size()));
-        }
-        ElasticRow r;
-        r.name = "boomeramg-pcg";
         Vector x;
-        for (int rep = 0; rep < opt.repeat; ++rep) {
-            comm.barrier();
-            const double t0 = wall_seconds();
-            const solvers::ParMatrix K(comm, rows);
-            const double copy = wall_seconds() - t0;
-            x = Vector::Zero(n);
-            const SolveResult s =
-                solvers::boomeramg_pcg_par(K, b, x, opt.rel_tol, opt.max_iter, {}, dof_func);
-            r.setup.push_back(comm.max(copy + s.setup_seconds));
-            r.solve.push_back(comm.max(s.solve_seconds));
-            r.iterations = s.iterations;
-            r.converged = s.converged;
-        }
+        ElasticRow r = boomeramg_pcg_row(fine, b, opt, comm, x);
         finish(r, x);
     }
     // The distributed V-cycle inside GMRES and CGS, set up anew in every repetition (like AMG):
@@ -386,39 +441,8 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
         os << " " << levels::format_bytes(all[2 * static_cast<size_t>(q)]);
     os << "\n";
     if (root) {
-        const std::filesystem::path file =
-            !opt.out.empty()
-                ? opt.out
-                : std::filesystem::path("out/bench/elastic_" + opt.scene + "_L" +
-                                        std::to_string(L) + "_np" + std::to_string(np) + ".json");
-        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-        write_file_atomically(file, [&](std::ostream& js) {
-            js << std::setprecision(12) << "{\n  \"scene\": \"" << opt.scene
-               << "\",\n  \"level\": " << L << ",\n  \"processes\": " << np
-               << ",\n  \"threads_per_process\": 1,\n  \"partition_level\": " << p
-               << ",\n  \"unknowns\": " << fine.n_global_dofs << ",\n  \"nonzeros\": " << nnz
-               << ",\n  \"rel_tol\": " << opt.rel_tol << ",\n  \"repeat\": " << opt.repeat
-               << ",\n  \"levels_seconds\": " << hierarchy_s
-               << ",\n  \"solution_difference\": " << diff
-               << ",\n  \"peak_rss_bytes_max\": " << rss_max << ",\n  \"per_process\": [";
-            for (int q = 0; q < np; ++q)
-                js << (q ? ", " : "") << "{\"rank\": " << q
-                   << ", \"peak_rss_bytes\": " << all[2 * static_cast<size_t>(q)]
-                   << ", \"owned_unknowns\": "
-                   << static_cast<std::int64_t>(all[2 * static_cast<size_t>(q) + 1]) << "}";
-            js << "],\n  \"solvers\": [";
-            for (size_t k = 0; k < results.size(); ++k) {
-                const auto& r = results[k];
-                const double su = median_of(r.setup), so = median_of(r.solve);
-                js << (k ? "," : "") << "\n    {\"solver\": \"" << r.name
-                   << "\", \"setup_seconds\": " << su << ", \"solve_seconds\": " << so
-                   << ", \"total_seconds\": " << su + so << ", \"iterations\": " << r.iterations
-                   << ", \"relative_residual\": " << r.relative_residual
-                   << ", \"converged\": " << (r.converged ? "true" : "false")
-                   << ", \"x_norm\": " << r.x_norm << ", \"x_max_norm\": " << r.x_max << "}";
-            }
-            js << "\n  ]\n}\n";
-        });
+        const std::filesystem::path file = write_elastic_json(
+            opt, np, p, fine.n_global_dofs, nnz, hierarchy_s, diff, rss_max, all, results);
         os << "wrote " << file.string() << "\n";
     }
     return code;

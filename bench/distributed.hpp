@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file `mlcontact bench square` on several processes (mpirun -np N, N > 1; issue 12): the
+/// @file `mlcontact bench square` on several processes (mpirun -np N, N > 1): the
 /// coarse-to-fine solve of the scene with Krylov + the distributed mg
 /// (levels/distributed_solve.hpp), timed `repeat` times; per level the Krylov iterations per
 /// Newton step (mean, max) and per process its unknowns and peak RSS. The JSON

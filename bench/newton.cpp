@@ -294,6 +294,94 @@ std::string json_number(double v) {
     return os.str();
 }
 
+/// Columns of hypre's solvers (their setup has no coarser levels).
+bool is_hypre(const std::string& key) {
+    return key == "mgr" || key == "mgr+fgmres" || key == "amg";
+}
+
+/// The table and JSON array of every Newton system and solver, and the totals per solver;
+/// returns 2 when one of our solvers or MGR failed on a system, else 0.
+int report_systems(std::ostream& os, std::ostream& js, const std::vector<NewtonSystemRow>& rows,
+                   const std::vector<std::string>& keys, const std::string& ours) {
+    int code = 0;
+    std::map<std::string, double> total_setup, total_solve, total_full;
+    std::map<std::string, int> total_its, failed;
+    os << std::setw(4) << "sys" << std::setw(5) << "step" << std::setw(4) << "nwt" << std::setw(6)
+       << "gap" << std::setw(6) << "stick" << std::setw(6) << "slip";
+    for (const auto& key : keys)
+        os << "  | " << std::setw(18) << std::left << key << std::right << std::setw(6) << "its"
+           << std::setw(9) << "setup" << std::setw(9) << "solve" << std::setw(9) << "relres";
+    os << "\n";
+    for (size_t k = 0; k < rows.size(); ++k) {
+        const NewtonSystemRow& row = rows[k];
+        js << (k ? "," : "") << "\n    {\"index\": " << k << ", \"load_step\": " << row.step
+           << ", \"newton_iteration\": " << row.newton << ", \"gap\": " << row.gap
+           << ", \"stick\": " << row.stick << ", \"slip\": " << row.slip;
+        os << std::setw(4) << k << std::setw(5) << row.step << std::setw(4) << row.newton
+           << std::setw(6) << row.gap << std::setw(6) << row.stick << std::setw(6) << row.slip;
+        for (const auto& key : keys) {
+            const auto it = row.samples.find(key);
+            const SampleMedian m = it == row.samples.end() ? SampleMedian{} : median_of(it->second);
+            if (!m.present) {
+                os << "  | " << std::setw(18 + 6 + 27) << "-";
+                continue;
+            }
+            const NewtonSample& s = m.s;
+            total_setup[key] += s.setup;
+            total_full[key] += is_hypre(key) ? s.setup : s.setup_full;
+            total_solve[key] += s.solve;
+            total_its[key] += s.iterations;
+            failed[key] += !s.converged;
+            if (!s.converged && key != "amg") code = 2;
+            js << ",\n     " << json_string(key) << ": {\"iterations\": " << s.iterations
+               << ", \"setup_seconds\": " << json_number(s.setup);
+            if (!is_hypre(key))
+                js << ", \"setup_with_coarse_levels_seconds\": " << json_number(s.setup_full);
+            else
+                js << ", \"copy_to_hypre_seconds\": " << json_number(s.copy);
+            js << ", \"solve_seconds\": " << json_number(s.solve)
+               << ", \"relative_residual\": " << json_number(s.relres)
+               << ", \"converged\": " << (s.converged ? "true" : "false");
+            if (!s.failure.empty()) js << ", \"failure\": " << json_string(s.failure);
+            js << "}";
+            os << "  | " << std::setw(18) << (s.converged ? "" : "FAILED") << std::setw(6)
+               << s.iterations << std::fixed << std::setprecision(3) << std::setw(9) << s.setup
+               << std::setw(9) << s.solve << std::scientific << std::setprecision(1) << std::setw(9)
+               << s.relres << std::defaultfloat;
+        }
+        js << "}";
+        os << "\n";
+    }
+    js << "\n  ],\n  \"totals\": {";
+    os << "totals over " << rows.size() << " Newton systems (seconds; mg setup with the coarser "
+       << "levels' setups of each load step in brackets):\n";
+    for (size_t i = 0; i < keys.size(); ++i) {
+        const std::string& key = keys[i];
+        const double total = total_full[key] + total_solve[key];
+        js << (i ? "," : "") << "\n    " << json_string(key)
+           << ": {\"setup_seconds\": " << json_number(total_setup[key])
+           << ", \"setup_full_seconds\": " << json_number(total_full[key])
+           << ", \"solve_seconds\": " << json_number(total_solve[key])
+           << ", \"total_seconds\": " << json_number(total)
+           << ", \"iterations\": " << total_its[key] << ", \"failed\": " << failed[key];
+        if (key != ours && total_full[ours] + total_solve[ours] > 0)
+            js << ", \"time_over_" << ours
+               << "\": " << json_number(total / (total_full[ours] + total_solve[ours]));
+        js << "}";
+        os << "  " << std::setw(18) << std::left << key << std::right << " setup " << std::fixed
+           << std::setprecision(3) << total_setup[key];
+        if (!is_hypre(key)) os << " [" << total_full[key] << "]";
+        os << "  solve " << total_solve[key] << "  total " << total << "  iterations "
+           << total_its[key] << std::defaultfloat;
+        if (failed[key] > 0) os << "  FAILED on " << failed[key] << " system(s)";
+        if (key != ours && total_full[ours] + total_solve[ours] > 0)
+            os << "  (" << std::setprecision(3) << total / (total_full[ours] + total_solve[ours])
+               << "x " << ours << ")";
+        os << "\n";
+    }
+    return code;
+}
+
 } // namespace
 
 int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
@@ -391,9 +479,6 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     if (opt.hypre_gmres) keys.push_back("mgr+fgmres");
     if (opt.amg) keys.push_back("amg");
     const std::string ours = opt.pc + "@1";
-    const auto is_hypre = [](const std::string& key) {
-        return key == "mgr" || key == "mgr+fgmres" || key == "amg";
-    };
     const std::filesystem::path out = bench_json_path(opt.out, "newton_", opt.scene, opt.levels);
     AtomicOfstream js = open_json(out);
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"level\": " << opt.levels
@@ -417,82 +502,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     js << "},\n  \"runs_converged\": " << (runs_converged ? "true" : "false");
     if (!runs_converged) js << ", \"run_failure\": " << json_string(failure);
     js << ",\n  \"mismatched_runs\": " << mismatch_runs << ",\n  \"systems\": [";
-    std::map<std::string, double> total_setup, total_solve, total_full;
-    std::map<std::string, int> total_its, failed;
-    int code = 0;
-    os << std::setw(4) << "sys" << std::setw(5) << "step" << std::setw(4) << "nwt" << std::setw(6)
-       << "gap" << std::setw(6) << "stick" << std::setw(6) << "slip";
-    for (const auto& key : keys)
-        os << "  | " << std::setw(18) << std::left << key << std::right << std::setw(6) << "its"
-           << std::setw(9) << "setup" << std::setw(9) << "solve" << std::setw(9) << "relres";
-    os << "\n";
-    for (size_t k = 0; k < rows.size(); ++k) {
-        const NewtonSystemRow& row = rows[k];
-        js << (k ? "," : "") << "\n    {\"index\": " << k << ", \"load_step\": " << row.step
-           << ", \"newton_iteration\": " << row.newton << ", \"gap\": " << row.gap
-           << ", \"stick\": " << row.stick << ", \"slip\": " << row.slip;
-        os << std::setw(4) << k << std::setw(5) << row.step << std::setw(4) << row.newton
-           << std::setw(6) << row.gap << std::setw(6) << row.stick << std::setw(6) << row.slip;
-        for (const auto& key : keys) {
-            const auto it = row.samples.find(key);
-            const SampleMedian m = it == row.samples.end() ? SampleMedian{} : median_of(it->second);
-            if (!m.present) {
-                os << "  | " << std::setw(18 + 6 + 27) << "-";
-                continue;
-            }
-            const NewtonSample& s = m.s;
-            total_setup[key] += s.setup;
-            total_full[key] += is_hypre(key) ? s.setup : s.setup_full;
-            total_solve[key] += s.solve;
-            total_its[key] += s.iterations;
-            failed[key] += !s.converged;
-            if (!s.converged && key != "amg") code = 2;
-            js << ",\n     " << json_string(key) << ": {\"iterations\": " << s.iterations
-               << ", \"setup_seconds\": " << json_number(s.setup);
-            if (!is_hypre(key))
-                js << ", \"setup_with_coarse_levels_seconds\": " << json_number(s.setup_full);
-            else
-                js << ", \"copy_to_hypre_seconds\": " << json_number(s.copy);
-            js << ", \"solve_seconds\": " << json_number(s.solve)
-               << ", \"relative_residual\": " << json_number(s.relres)
-               << ", \"converged\": " << (s.converged ? "true" : "false");
-            if (!s.failure.empty()) js << ", \"failure\": " << json_string(s.failure);
-            js << "}";
-            os << "  | " << std::setw(18) << (s.converged ? "" : "FAILED") << std::setw(6)
-               << s.iterations << std::fixed << std::setprecision(3) << std::setw(9) << s.setup
-               << std::setw(9) << s.solve << std::scientific << std::setprecision(1) << std::setw(9)
-               << s.relres << std::defaultfloat;
-        }
-        js << "}";
-        os << "\n";
-    }
-    js << "\n  ],\n  \"totals\": {";
-    os << "totals over " << rows.size() << " Newton systems (seconds; mg setup with the coarser "
-       << "levels' setups of each load step in brackets):\n";
-    for (size_t i = 0; i < keys.size(); ++i) {
-        const std::string& key = keys[i];
-        const double total = total_full[key] + total_solve[key];
-        js << (i ? "," : "") << "\n    " << json_string(key)
-           << ": {\"setup_seconds\": " << json_number(total_setup[key])
-           << ", \"setup_full_seconds\": " << json_number(total_full[key])
-           << ", \"solve_seconds\": " << json_number(total_solve[key])
-           << ", \"total_seconds\": " << json_number(total)
-           << ", \"iterations\": " << total_its[key] << ", \"failed\": " << failed[key];
-        if (key != ours && total_full[ours] + total_solve[ours] > 0)
-            js << ", \"time_over_" << ours
-               << "\": " << json_number(total / (total_full[ours] + total_solve[ours]));
-        js << "}";
-        os << "  " << std::setw(18) << std::left << key << std::right << " setup " << std::fixed
-           << std::setprecision(3) << total_setup[key];
-        if (!is_hypre(key)) os << " [" << total_full[key] << "]";
-        os << "  solve " << total_solve[key] << "  total " << total << "  iterations "
-           << total_its[key] << std::defaultfloat;
-        if (failed[key] > 0) os << "  FAILED on " << failed[key] << " system(s)";
-        if (key != ours && total_full[ours] + total_solve[ours] > 0)
-            os << "  (" << std::setprecision(3) << total / (total_full[ours] + total_solve[ours])
-               << "x " << ours << ")";
-        os << "\n";
-    }
+    int code = report_systems(os, js, rows, keys, ours);
     js << "\n  },\n  \"peak_rss_mib\": " << peak_rss_mib() << "\n}\n";
     if (mismatch_runs > 0)
         os << "note: " << mismatch_runs
@@ -508,4 +518,3 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
 }
 
 } // namespace mlc::apps
-

@@ -145,6 +145,184 @@ double matrix_seconds(const traffic::Account& a) {
     return a.s(traffic::Kind::matvec) + a.s(traffic::Kind::smoother) + a.s(traffic::Kind::transfer);
 }
 
+/// The JSON file's head and the table's header; `def`: the default solver when one is benched.
+void print_square_header(std::ostream& os, std::ostream& js, const BenchSquareOptions& opt,
+                         int load_steps, const std::string& krylov_label,
+                         const std::string& numbering, const BenchSolver* def) {
+    js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
+       << ",\n  \"krylov\": " << json_string(krylov_label) << ",\n  \"rel_tol\": " << opt.rel_tol
+       << ",\n  \"repeat\": " << opt.repeat << ",\n  \"numbering\": " << json_string(numbering)
+       << ",\n  \"extrapolate\": " << (opt.extrapolate ? "true" : "false") << ",\n  \"runs\": [";
+    os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
+       << load_steps << " load steps, Krylov " << krylov_label << " rel_tol " << opt.rel_tol
+       << ", times are medians of " << opt.repeat << " run(s)\n";
+    if (def)
+        os << "default = " << def->krylov << " + " << def->pc
+           << " (the run's default above the crossover)\n";
+    os << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
+       << std::setw(11) << "nonzeros" << std::setw(7) << "newton" << std::setw(10) << "its/newt"
+       << std::setw(6) << "max" << std::setw(10) << "asm s" << std::setw(10) << "setup s"
+       << std::setw(10) << "solve s" << std::setw(11) << "s/newton" << std::setw(13)
+       << "us/newt/unk"
+       << "\n";
+}
+
+/// Adds one run's per-level figures to `rows` (the first run's bytes, passes and memory).
+void record_rows(const levels::RunResult& r, const std::vector<LevelTraffic>& lt, int rep,
+                 std::vector<SquareRow>& rows) {
+    if (rows.empty()) {
+        rows.resize(r.level_steps.size());
+        for (size_t l = 0; l < rows.size(); ++l) {
+            rows[l].level = static_cast<int>(l);
+            rows[l].unknowns = r.levels()[l].n_unknowns();
+            rows[l].nonzeros = jacobian_nonzeros(r.levels()[l]);
+        }
+    }
+    for (size_t l = 0; l < r.level_steps.size(); ++l) {
+        SquareRow& row = rows[l];
+        std::vector<int> its;
+        double assembly = 0, setup = 0, lin = 0, total = 0;
+        int newton = 0;
+        for (const auto& st : r.level_steps[l]) {
+            newton += st.report.iterations;
+            its.insert(its.end(), st.report.linear_iterations_per_newton.begin(),
+                       st.report.linear_iterations_per_newton.end());
+            assembly += st.report.linear_assembly_seconds;
+            setup += st.report.linear_setup_seconds;
+            lin += st.report.linear_seconds;
+            total += st.report.seconds;
+        }
+        row.newton = newton;
+        double sum = 0;
+        for (int i : its)
+            sum += i;
+        row.its_mean = its.empty() ? 0.0 : sum / static_cast<double>(its.size());
+        row.its_max = its.empty() ? 0.0 : *std::max_element(its.begin(), its.end());
+        row.assembly_s.push_back(assembly);
+        row.setup_s.push_back(setup - assembly);
+        row.solve_s.push_back(lin - setup);
+        row.total_s.push_back(total);
+        const LevelTraffic& t = lt[l];
+        row.traffic_runs.push_back(t.account);
+        row.krylov_s.push_back(t.krylov_seconds);
+        if (rep == 0) {
+            row.traffic = t.account;
+            row.solves = t.solves;
+            row.rss_growth = t.rss_growth;
+        }
+    }
+}
+
+/// One level of one solver: its JSON object, its rows of the table, the bandwidth account and
+/// the memory table.
+void report_level(std::ostream& os, std::ostream& js, std::ostream& bw_table,
+                  std::ostream& mem_table, const std::string& pc, const SquareRow& row, size_t l,
+                  const std::optional<traffic::Stream>& stream) {
+    const double assembly = median(row.assembly_s), setup = median(row.setup_s),
+                 solve = median(row.solve_s);
+    const double per_newton = row.newton > 0 ? (assembly + setup + solve) / row.newton : 0.0;
+    const double per_unknown = per_newton / static_cast<double>(row.unknowns);
+    js << (l ? "," : "") << "\n      {\"level\": " << row.level
+       << ", \"unknowns\": " << row.unknowns << ", \"nonzeros\": " << row.nonzeros
+       << ", \"newton_steps\": " << row.newton << ", \"krylov_per_newton\": " << row.its_mean
+       << ", \"krylov_per_newton_max\": " << row.its_max << ", \"assembly_seconds\": " << assembly
+       << ", \"setup_seconds\": " << setup << ", \"solve_seconds\": " << solve
+       << ", \"level_seconds\": " << median(row.total_s)
+       << ", \"seconds_per_newton\": " << per_newton
+       << ", \"seconds_per_newton_per_unknown\": " << per_unknown;
+    // Bandwidth account: the first run's bytes and passes, medians of the seconds.
+    const traffic::Account& a = row.traffic;
+    traffic::Account sec;
+    for (int k = 0; k < traffic::kKinds; ++k) {
+        std::vector<double> v;
+        for (const auto& t : row.traffic_runs)
+            v.push_back(t.seconds[static_cast<size_t>(k)]);
+        sec.seconds[static_cast<size_t>(k)] = median(v);
+    }
+    const double ks = median(row.krylov_s);
+    const double rest = std::max(0.0, ks - sec.timed_seconds());
+    const double steps = std::max(1, row.solves);
+    const double mat_gbs = gbs(matrix_bytes(a), matrix_seconds(sec));
+    const double triad = stream ? stream->triad_gbs : 0.0;
+    js << ",\n       \"bandwidth\": {\"newton_solves\": " << row.solves
+       << ", \"krylov_seconds\": " << ks << ", \"bytes\": " << whole(a.total_bytes())
+       << ", \"bytes_per_newton\": " << a.total_bytes() / steps
+       << ", \"gbs\": " << gbs(a.total_bytes(), ks) << ", \"matrix_passes_gbs\": " << mat_gbs
+       << ", \"matrix_passes_of_triad\": " << (triad > 0 ? mat_gbs / triad : 0.0)
+       << ", \"kinds\": {";
+    for (int k = 0; k < traffic::kKinds; ++k) {
+        const auto kind = static_cast<traffic::Kind>(k);
+        const bool vec = kind == traffic::Kind::vector;
+        const double s_k = vec ? rest : sec.s(kind);
+        js << (k ? ", " : "") << json_string(std::string(traffic::to_string(kind)))
+           << ": {\"bytes\": " << whole(a.b(kind)) << ", \"passes\": " << whole(a.p(kind))
+           << ", \"bytes_per_newton\": " << a.b(kind) / steps
+           << ", \"passes_per_newton\": " << a.p(kind) / steps << ", \""
+           << (vec ? "seconds_outside_timed_kinds" : "seconds") << "\": " << s_k
+           << ", \"gbs\": " << gbs(a.b(kind), s_k) << "}";
+    }
+    js << "}},\n       \"memory\": {\"solver_rss_growth_bytes\": " << whole(row.rss_growth)
+       << ", \"solver_rss_growth_bytes_per_unknown\": "
+       << row.rss_growth / static_cast<double>(row.unknowns) << "}";
+    if (row.solves > 0 && a.total_bytes() > 0) {
+        using traffic::Kind;
+        bw_table << std::setw(14) << pc << std::setw(6) << row.level << std::fixed
+                 << std::setprecision(1) << std::setw(10) << a.total_bytes() / steps / 1e6
+                 << std::setw(9) << a.b(Kind::matvec) / steps / 1e6 << std::setw(9)
+                 << a.b(Kind::smoother) / steps / 1e6 << std::setw(9)
+                 << a.b(Kind::transfer) / steps / 1e6 << std::setw(9)
+                 << a.b(Kind::vector) / steps / 1e6 << std::setw(9)
+                 << a.b(Kind::structured) / steps / 1e6 << std::setprecision(4) << std::setw(10)
+                 << ks / steps << std::setprecision(2) << std::setw(8) << gbs(a.total_bytes(), ks)
+                 << std::setw(8) << gbs(a.b(Kind::matvec), sec.s(Kind::matvec)) << std::setw(8)
+                 << gbs(a.b(Kind::smoother), sec.s(Kind::smoother)) << std::setw(8)
+                 << gbs(a.b(Kind::transfer), sec.s(Kind::transfer)) << std::setw(8)
+                 << gbs(a.b(Kind::vector), rest) << std::setw(8)
+                 << gbs(a.b(Kind::structured), sec.s(Kind::structured)) << std::setw(8) << mat_gbs
+                 << std::setw(7) << std::setprecision(0)
+                 << (triad > 0 ? 100 * mat_gbs / triad : 0.0) << std::defaultfloat << "\n";
+    }
+    mem_table << std::setw(14) << pc << std::setw(6) << row.level << std::setw(10) << row.unknowns
+              << std::fixed << std::setprecision(1) << std::setw(12)
+              << row.rss_growth / (1024.0 * 1024.0) << std::setprecision(0) << std::setw(11)
+              << row.rss_growth / static_cast<double>(row.unknowns) << std::defaultfloat << "\n";
+    js << "}";
+    os << std::setw(14) << pc << std::setw(6) << row.level << std::setw(10) << row.unknowns
+       << std::setw(11) << row.nonzeros << std::setw(7) << row.newton << std::setw(10) << std::fixed
+       << std::setprecision(1) << row.its_mean << std::setw(6) << std::setprecision(0)
+       << row.its_max << std::setw(10) << std::setprecision(3) << assembly << std::setw(10) << setup
+       << std::setw(10) << solve << std::setw(11) << std::setprecision(4) << per_newton
+       << std::setw(13) << std::setprecision(3) << 1e6 * per_unknown << std::defaultfloat << "\n";
+}
+
+/// The bandwidth account, STREAM and the memory per level, after the per-level table.
+void print_square_tables(std::ostream& os, const std::string& bw_table,
+                         const std::string& mem_table,
+                         const std::optional<traffic::Stream>& stream) {
+    os << "\nbandwidth account per Newton step (compulsory bytes, "
+          "docs/studies.md#bench-bandwidth); "
+          "MB / Newton step by kind, GB/s = bytes / seconds\n"
+       << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "MB/newt"
+       << std::setw(9) << "matvec" << std::setw(9) << "smooth" << std::setw(9) << "transf"
+       << std::setw(9) << "vector" << std::setw(9) << "struct" << std::setw(10) << "krylov s"
+       << std::setw(8) << "GB/s" << std::setw(8) << "matvec" << std::setw(8) << "smooth"
+       << std::setw(8) << "transf" << std::setw(8) << "vector" << std::setw(8) << "struct"
+       << std::setw(8) << "matrix" << std::setw(7) << "%triad"
+       << "\n"
+       << bw_table;
+    if (stream)
+        os << "STREAM (same binary, " << stream->threads << " thread(s), " << stream->n
+           << " doubles per array, best of " << stream->repeats << "): copy " << std::fixed
+           << std::setprecision(2) << stream->copy_gbs << " GB/s, triad " << stream->triad_gbs
+           << " GB/s" << std::defaultfloat << "\n";
+    os << "\nmemory per level: RSS growth while the run built the level's Newton-system solver "
+          "and ran its first Newton solve\n"
+       << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
+       << std::setw(12) << "MiB" << std::setw(11) << "B/unknown"
+       << "\n"
+       << mem_table;
+}
+
 } // namespace
 
 BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
@@ -189,22 +367,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         krylov_label = named.empty() ? def.krylov : named_krylov + " (default: " + def.krylov + ")";
     const std::filesystem::path out = bench_json_path(opt.out, "", opt.scene, opt.levels);
     AtomicOfstream js = open_json(out);
-    js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
-       << ",\n  \"krylov\": " << json_string(krylov_label) << ",\n  \"rel_tol\": " << opt.rel_tol
-       << ",\n  \"repeat\": " << opt.repeat << ",\n  \"numbering\": " << json_string(numbering)
-       << ",\n  \"extrapolate\": " << (opt.extrapolate ? "true" : "false") << ",\n  \"runs\": [";
-    os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
-       << base.load_steps << " load steps, Krylov " << krylov_label << " rel_tol " << opt.rel_tol
-       << ", times are medians of " << opt.repeat << " run(s)\n";
-    if (named.size() != opt.pcs.size())
-        os << "default = " << def.krylov << " + " << def.pc
-           << " (the run's default above the crossover)\n";
-    os << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
-       << std::setw(11) << "nonzeros" << std::setw(7) << "newton" << std::setw(10) << "its/newt"
-       << std::setw(6) << "max" << std::setw(10) << "asm s" << std::setw(10) << "setup s"
-       << std::setw(10) << "solve s" << std::setw(11) << "s/newton" << std::setw(13)
-       << "us/newt/unk"
-       << "\n";
+    print_square_header(os, js, opt, base.load_steps, krylov_label, numbering,
+                        named.size() != opt.pcs.size() ? &def : nullptr);
     int code = 0;
     // Per-call timing of the counted kernels (core/traffic.hpp) for the bandwidth account.
     const bool timing_was = traffic::timing();
@@ -263,47 +427,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
             converged = r.converged;
             failure = r.failure;
             estimate_mib = r.memory.bytes / (1024.0 * 1024.0);
-            if (rows.empty()) {
-                rows.resize(r.level_steps.size());
-                for (size_t l = 0; l < rows.size(); ++l) {
-                    rows[l].level = static_cast<int>(l);
-                    rows[l].unknowns = r.levels()[l].n_unknowns();
-                    rows[l].nonzeros = jacobian_nonzeros(r.levels()[l]);
-                }
-            }
-            for (size_t l = 0; l < r.level_steps.size(); ++l) {
-                SquareRow& row = rows[l];
-                std::vector<int> its;
-                double assembly = 0, setup = 0, lin = 0, total = 0;
-                int newton = 0;
-                for (const auto& st : r.level_steps[l]) {
-                    newton += st.report.iterations;
-                    its.insert(its.end(), st.report.linear_iterations_per_newton.begin(),
-                               st.report.linear_iterations_per_newton.end());
-                    assembly += st.report.linear_assembly_seconds;
-                    setup += st.report.linear_setup_seconds;
-                    lin += st.report.linear_seconds;
-                    total += st.report.seconds;
-                }
-                row.newton = newton;
-                double sum = 0;
-                for (int i : its)
-                    sum += i;
-                row.its_mean = its.empty() ? 0.0 : sum / static_cast<double>(its.size());
-                row.its_max = its.empty() ? 0.0 : *std::max_element(its.begin(), its.end());
-                row.assembly_s.push_back(assembly);
-                row.setup_s.push_back(setup - assembly);
-                row.solve_s.push_back(lin - setup);
-                row.total_s.push_back(total);
-                const LevelTraffic& t = lt[l];
-                row.traffic_runs.push_back(t.account);
-                row.krylov_s.push_back(t.krylov_seconds);
-                if (rep == 0) {
-                    row.traffic = t.account;
-                    row.solves = t.solves;
-                    row.rss_growth = t.rss_growth;
-                }
-            }
+            record_rows(r, lt, rep, rows);
             // The unit: one CSR mat-vec of the finest Jacobian (at the last Newton system's
             // statuses), same binary, same threads, timed after the run.
             if (rep == 0 && !last_M.empty()) {
@@ -346,90 +470,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
                  << (matvec_s > 0 ? fine_step_s / matvec_s : 0.0) << " mat-vecs"
                  << std::defaultfloat << "\n";
         js << ",\n     \"levels\": [";
-        for (size_t l = 0; l < rows.size(); ++l) {
-            const SquareRow& row = rows[l];
-            const double assembly = median(row.assembly_s), setup = median(row.setup_s),
-                         solve = median(row.solve_s);
-            const double per_newton =
-                row.newton > 0 ? (assembly + setup + solve) / row.newton : 0.0;
-            const double per_unknown = per_newton / static_cast<double>(row.unknowns);
-            js << (l ? "," : "") << "\n      {\"level\": " << row.level
-               << ", \"unknowns\": " << row.unknowns << ", \"nonzeros\": " << row.nonzeros
-               << ", \"newton_steps\": " << row.newton
-               << ", \"krylov_per_newton\": " << row.its_mean
-               << ", \"krylov_per_newton_max\": " << row.its_max
-               << ", \"assembly_seconds\": " << assembly << ", \"setup_seconds\": " << setup
-               << ", \"solve_seconds\": " << solve << ", \"level_seconds\": " << median(row.total_s)
-               << ", \"seconds_per_newton\": " << per_newton
-               << ", \"seconds_per_newton_per_unknown\": " << per_unknown;
-            // Bandwidth account: the first run's bytes and passes, medians of the seconds.
-            const traffic::Account& a = row.traffic;
-            traffic::Account sec;
-            for (int k = 0; k < traffic::kKinds; ++k) {
-                std::vector<double> v;
-                for (const auto& t : row.traffic_runs)
-                    v.push_back(t.seconds[static_cast<size_t>(k)]);
-                sec.seconds[static_cast<size_t>(k)] = median(v);
-            }
-            const double ks = median(row.krylov_s);
-            const double rest = std::max(0.0, ks - sec.timed_seconds());
-            const double steps = std::max(1, row.solves);
-            const double mat_gbs = gbs(matrix_bytes(a), matrix_seconds(sec));
-            const double triad = stream ? stream->triad_gbs : 0.0;
-            js << ",\n       \"bandwidth\": {\"newton_solves\": " << row.solves
-               << ", \"krylov_seconds\": " << ks << ", \"bytes\": " << whole(a.total_bytes())
-               << ", \"bytes_per_newton\": " << a.total_bytes() / steps
-               << ", \"gbs\": " << gbs(a.total_bytes(), ks)
-               << ", \"matrix_passes_gbs\": " << mat_gbs
-               << ", \"matrix_passes_of_triad\": " << (triad > 0 ? mat_gbs / triad : 0.0)
-               << ", \"kinds\": {";
-            for (int k = 0; k < traffic::kKinds; ++k) {
-                const auto kind = static_cast<traffic::Kind>(k);
-                const bool vec = kind == traffic::Kind::vector;
-                const double s_k = vec ? rest : sec.s(kind);
-                js << (k ? ", " : "") << json_string(std::string(traffic::to_string(kind)))
-                   << ": {\"bytes\": " << whole(a.b(kind)) << ", \"passes\": " << whole(a.p(kind))
-                   << ", \"bytes_per_newton\": " << a.b(kind) / steps
-                   << ", \"passes_per_newton\": " << a.p(kind) / steps << ", \""
-                   << (vec ? "seconds_outside_timed_kinds" : "seconds") << "\": " << s_k
-                   << ", \"gbs\": " << gbs(a.b(kind), s_k) << "}";
-            }
-            js << "}},\n       \"memory\": {\"solver_rss_growth_bytes\": " << whole(row.rss_growth)
-               << ", \"solver_rss_growth_bytes_per_unknown\": "
-               << row.rss_growth / static_cast<double>(row.unknowns) << "}";
-            if (row.solves > 0 && a.total_bytes() > 0) {
-                using traffic::Kind;
-                bw_table << std::setw(14) << pc << std::setw(6) << row.level << std::fixed
-                         << std::setprecision(1) << std::setw(10) << a.total_bytes() / steps / 1e6
-                         << std::setw(9) << a.b(Kind::matvec) / steps / 1e6 << std::setw(9)
-                         << a.b(Kind::smoother) / steps / 1e6 << std::setw(9)
-                         << a.b(Kind::transfer) / steps / 1e6 << std::setw(9)
-                         << a.b(Kind::vector) / steps / 1e6 << std::setw(9)
-                         << a.b(Kind::structured) / steps / 1e6 << std::setprecision(4)
-                         << std::setw(10) << ks / steps << std::setprecision(2) << std::setw(8)
-                         << gbs(a.total_bytes(), ks) << std::setw(8)
-                         << gbs(a.b(Kind::matvec), sec.s(Kind::matvec)) << std::setw(8)
-                         << gbs(a.b(Kind::smoother), sec.s(Kind::smoother)) << std::setw(8)
-                         << gbs(a.b(Kind::transfer), sec.s(Kind::transfer)) << std::setw(8)
-                         << gbs(a.b(Kind::vector), rest) << std::setw(8)
-                         << gbs(a.b(Kind::structured), sec.s(Kind::structured)) << std::setw(8)
-                         << mat_gbs << std::setw(7) << std::setprecision(0)
-                         << (triad > 0 ? 100 * mat_gbs / triad : 0.0) << std::defaultfloat << "\n";
-            }
-            mem_table << std::setw(14) << pc << std::setw(6) << row.level << std::setw(10)
-                      << row.unknowns << std::fixed << std::setprecision(1) << std::setw(12)
-                      << row.rss_growth / (1024.0 * 1024.0) << std::setprecision(0) << std::setw(11)
-                      << row.rss_growth / static_cast<double>(row.unknowns) << std::defaultfloat
-                      << "\n";
-            js << "}";
-            os << std::setw(14) << pc << std::setw(6) << row.level << std::setw(10) << row.unknowns
-               << std::setw(11) << row.nonzeros << std::setw(7) << row.newton << std::setw(10)
-               << std::fixed << std::setprecision(1) << row.its_mean << std::setw(6)
-               << std::setprecision(0) << row.its_max << std::setw(10) << std::setprecision(3)
-               << assembly << std::setw(10) << setup << std::setw(10) << solve << std::setw(11)
-               << std::setprecision(4) << per_newton << std::setw(13) << std::setprecision(3)
-               << 1e6 * per_unknown << std::defaultfloat << "\n";
-        }
+        for (size_t l = 0; l < rows.size(); ++l)
+            report_level(os, js, bw_table, mem_table, pc, rows[l], l, stream);
         js << "\n     ]}";
         os << std::setw(14) << pc << "  total wall " << std::fixed << std::setprecision(2)
            << median(walls) << " s (median), peak RSS " << std::setprecision(0) << rss
@@ -442,27 +484,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
            << ", \"triad_gbs\": " << stream->triad_gbs << ", \"doubles\": " << stream->n
            << ", \"repeats\": " << stream->repeats << ", \"threads\": " << stream->threads << "}";
     js << "\n}\n";
-    os << "\nbandwidth account per Newton step (compulsory bytes, docs/studies.md#bench-bandwidth); "
-          "MB / Newton step by kind, GB/s = bytes / seconds\n"
-       << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "MB/newt"
-       << std::setw(9) << "matvec" << std::setw(9) << "smooth" << std::setw(9) << "transf"
-       << std::setw(9) << "vector" << std::setw(9) << "struct" << std::setw(10) << "krylov s"
-       << std::setw(8) << "GB/s" << std::setw(8) << "matvec" << std::setw(8) << "smooth"
-       << std::setw(8) << "transf" << std::setw(8) << "vector" << std::setw(8) << "struct"
-       << std::setw(8) << "matrix" << std::setw(7) << "%triad"
-       << "\n"
-       << bw_table.str();
-    if (stream)
-        os << "STREAM (same binary, " << stream->threads << " thread(s), " << stream->n
-           << " doubles per array, best of " << stream->repeats << "): copy " << std::fixed
-           << std::setprecision(2) << stream->copy_gbs << " GB/s, triad " << stream->triad_gbs
-           << " GB/s" << std::defaultfloat << "\n";
-    os << "\nmemory per level: RSS growth while the run built the level's Newton-system solver "
-          "and ran its first Newton solve\n"
-       << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
-       << std::setw(12) << "MiB" << std::setw(11) << "B/unknown"
-       << "\n"
-       << mem_table.str();
+    print_square_tables(os, bw_table.str(), mem_table.str(), stream);
     os << "wrote " << out.string() << "\n";
     return code;
 }

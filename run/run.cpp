@@ -2,14 +2,14 @@
 // `mlcontact run`.
 #include "run/run.hpp"
 
-#include "run/interrupt.hpp"
-#include "run/output.hpp"
-#include "run/plot_script.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/parallel.hpp"
 #include "core/stop.hpp"
 #include "levels/solve.hpp"
+#include "run/interrupt.hpp"
+#include "run/output.hpp"
+#include "run/plot_script.hpp"
 #include "scene/scene.hpp"
 
 #include <cmath>
@@ -85,6 +85,73 @@ bool nonfinite_residual(const levels::RunResult& r) {
     return false;
 }
 
+/// What the run's memory estimate, multigrid, exact fallbacks and r continuations were.
+void print_solve_notes(std::ostream& os, const levels::RunResult& r) {
+    os << "memory: estimated peak " << levels::format_bytes(r.memory.bytes) << " of "
+       << levels::format_bytes(r.memory_limit.bytes) << " available (" << r.memory_limit.source
+       << "); measured peak " << levels::format_bytes(peak_rss_bytes()) << "\n";
+    if (r.multigrid) os << *r.multigrid;
+    {
+        int fallbacks = 0;
+        std::string first;
+        for (const auto& ls : r.level_steps)
+            for (const auto& st : ls) {
+                if (first.empty() && !st.report.fallback_reason.empty())
+                    first = "level " + std::to_string(st.level) + ", load step " +
+                            std::to_string(st.report.step) + ": " + st.report.fallback_reason;
+                fallbacks += st.report.fallback_solves;
+            }
+        if (fallbacks > 0)
+            os << "exact fallback: " << fallbacks
+               << " Newton system(s) solved again by the exact schur solver after the Krylov "
+                  "solve failed (first: "
+               << first << ")\n";
+        for (const auto& ls : r.level_steps)
+            for (const auto& st : ls)
+                if (st.report.continuation_factor > 0)
+                    os << "r continuation: level " << st.level << ", load step " << st.report.step
+                       << ": " << st.report.continuation_note << "\n";
+    }
+}
+
+/// The files written (the step series summed up), after "wrote".
+void print_written(std::ostream& os, const std::filesystem::path& dir, const SummaryStatus& st,
+                   const StepFiles* steps) {
+    std::vector<std::string> files;
+    for (const auto& f : st.files)
+        if (f.rfind("solution_step_", 0) != 0 && f.rfind("solution_level_", 0) != 0 &&
+            !f.ends_with(".pvd") && f != "contact.png")
+            files.push_back(f);
+    if (steps) {
+        for (const auto& c : steps->collections())
+            files.push_back(c);
+        if (steps->finest_steps() > 0)
+            files.push_back("solution_step_*.vtu (" + std::to_string(steps->finest_steps()) +
+                            " load steps)");
+    }
+    if (st.plot == "written") files.push_back("contact.png");
+    files.push_back("summary.json");
+    os << "\nwrote";
+    for (size_t i = 0; i < files.size(); ++i)
+        os << (i ? ", " : " ") << (dir / files[i]).string();
+    os << "\n";
+}
+
+/// A run stopped by a signal: what its files hold; returns the exit code 128 + signal.
+int print_stopped(std::ostream& os, const levels::RunResult& r, const SummaryStatus& st) {
+    const int sig = stop_signal();
+    if (r.stopped)
+        os << "\nstopped by " << signal_name(sig) << ": " << r.failure << "; the files above hold "
+           << (r.completed_steps > 0 ? "load steps 1-" + std::to_string(r.completed_steps)
+                                     : std::string("no load step"))
+           << "\n";
+    else
+        os << "\nstopped by " << signal_name(sig)
+           << " while the files were written: " << st.stopped_at
+           << "; summary.json lists the files written\n";
+    return 128 + (sig > 0 ? sig : 2);
+}
+
 } // namespace
 
 int run_scene(const RunOptions& opt, std::ostream& os) {
@@ -126,7 +193,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
            << ", which has ended; taken over\n";
     os << "Newton-system solver: " << choice.spec << " (" << choice.reason << ")\n";
     {
-        // The BLAS behind CHOLMOD (README "The BLAS behind schur").
+        // The BLAS behind CHOLMOD (docs/results/blas.md).
         const std::string blas = parallel::blas_library();
         const bool openblas = blas.find("OpenBLAS") != std::string::npos;
         if (choice.spec.method == "schur" && !openblas && blas != "none")
@@ -140,31 +207,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     }
     levels::RunResult r = levels::solve(p, so);
     r.solver = choice;
-    os << "memory: estimated peak " << levels::format_bytes(r.memory.bytes) << " of "
-       << levels::format_bytes(r.memory_limit.bytes) << " available (" << r.memory_limit.source
-       << "); measured peak " << levels::format_bytes(peak_rss_bytes()) << "\n";
-    if (r.multigrid) os << *r.multigrid;
-    {
-        int fallbacks = 0;
-        std::string first;
-        for (const auto& ls : r.level_steps)
-            for (const auto& st : ls) {
-                if (first.empty() && !st.report.fallback_reason.empty())
-                    first = "level " + std::to_string(st.level) + ", load step " +
-                            std::to_string(st.report.step) + ": " + st.report.fallback_reason;
-                fallbacks += st.report.fallback_solves;
-            }
-        if (fallbacks > 0)
-            os << "exact fallback: " << fallbacks
-               << " Newton system(s) solved again by the exact schur solver after the Krylov "
-                  "solve failed (first: "
-               << first << ")\n";
-        for (const auto& ls : r.level_steps)
-            for (const auto& st : ls)
-                if (st.report.continuation_factor > 0)
-                    os << "r continuation: level " << st.level << ", load step " << st.report.step
-                       << ": " << st.report.continuation_note << "\n";
-    }
+    print_solve_notes(os, r);
     os << "\n";
     print_header(os, p, r);
     print_summary(os, p, r);
@@ -228,38 +271,8 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
     st.files = folder.files();
     write_summary(dir, p, r, out, st);
     set_stop_summary({}, {}, {});
-    std::vector<std::string> files;
-    for (const auto& f : st.files)
-        if (f.rfind("solution_step_", 0) != 0 && f.rfind("solution_level_", 0) != 0 &&
-            !f.ends_with(".pvd") && f != "contact.png")
-            files.push_back(f);
-    if (steps) {
-        for (const auto& c : steps->collections())
-            files.push_back(c);
-        if (steps->finest_steps() > 0)
-            files.push_back("solution_step_*.vtu (" + std::to_string(steps->finest_steps()) +
-                            " load steps)");
-    }
-    if (st.plot == "written") files.push_back("contact.png");
-    files.push_back("summary.json");
-    os << "\nwrote";
-    for (size_t i = 0; i < files.size(); ++i)
-        os << (i ? ", " : " ") << (dir / files[i]).string();
-    os << "\n";
-    if (st.stopped) {
-        const int sig = stop_signal();
-        if (r.stopped)
-            os << "\nstopped by " << signal_name(sig) << ": " << r.failure
-               << "; the files above hold "
-               << (r.completed_steps > 0 ? "load steps 1-" + std::to_string(r.completed_steps)
-                                         : std::string("no load step"))
-               << "\n";
-        else
-            os << "\nstopped by " << signal_name(sig)
-               << " while the files were written: " << st.stopped_at
-               << "; summary.json lists the files written\n";
-        return 128 + (sig > 0 ? sig : 2);
-    }
+    print_written(os, dir, st, steps ? &*steps : nullptr);
+    if (st.stopped) return print_stopped(os, r, st);
     if (plot_failed) {
         std::cerr << "mlcontact: error: the results were written, but the plot failed: "
                   << plot_cause << "\n";

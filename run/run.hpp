@@ -48,7 +48,7 @@ struct RunOptions {
     bool progress_eta = false;  ///< progress lines with the time left (stdout is a terminal)
     /// Polled by the solve (levels::SolveOptions::stop); when it is set, the run stops after the
     /// current Newton iteration, writes the files of the completed steps and returns 128 +
-    /// stop_signal() (apps/interrupt.hpp). Null: never stops.
+    /// stop_signal() (run/interrupt.hpp). Null: never stops.
     const std::atomic<bool>* stop = nullptr;
     /// Several processes: the partition level (levels::partition_level when unset). A flag
     /// that cannot take effect on one process: refused there.

@@ -1,10 +1,7 @@
 // SPDX-License-Identifier: MIT
-// `mlcontact run` under mpirun with several processes (issue 12).
+// `mlcontact run` under mpirun with several processes.
 #include "run/run_distributed.hpp"
 
-#include "run/interrupt.hpp"
-#include "run/output.hpp"
-#include "run/summary_json.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
@@ -14,6 +11,9 @@
 #include "levels/distributed_solve.hpp"
 #include "levels/resources.hpp"
 #include "mesh/distributed.hpp"
+#include "run/interrupt.hpp"
+#include "run/output.hpp"
+#include "run/summary_json.hpp"
 #include "scene/scene.hpp"
 #include "solvers/factory.hpp"
 
@@ -182,6 +182,279 @@ std::int64_t cut_elements(const levels::DistributedLevel& F) {
     return n;
 }
 
+/// What every process owns on the finest level, summed (totals: triangles, displacement
+/// unknowns, vertices) and per process (all: `w` values per rank).
+struct ProcessFigures {
+    std::array<std::int64_t, 3> totals{};
+    std::vector<double> all;
+    size_t w = 0;
+};
+
+/// Gathers the figures of every process and prints their table.
+ProcessFigures process_figures(std::ostream& os, const levels::DistributedRunResult& r,
+                               const Communicator& comm, int finest) {
+    const auto& F = r.finest();
+    ProcessFigures pf;
+    std::int64_t owned_triangles = 0, owned_displacements = 0;
+    for (const char o : F.part.triangle_owned)
+        owned_triangles += o != 0;
+    for (Index i = 0; i < F.n_owned; ++i)
+        owned_displacements += F.local.dofs.is_displacement(i);
+    pf.totals = {owned_triangles, owned_displacements, F.part.n_owned_vertices()};
+    comm.allreduce(std::span<std::int64_t>(pf.totals), ReduceOp::sum);
+    std::vector<double> mine{
+        static_cast<double>(F.n_owned),
+        static_cast<double>(F.local.n_contact_nodes()),
+        static_cast<double>(F.part.n_owned_vertices()),
+        static_cast<double>(F.local.mesh.n_vertices() - F.part.n_owned_vertices()),
+        static_cast<double>(F.local.mesh.n_triangles()),
+        r.distributed_seconds,
+        static_cast<double>(peak_rss_bytes()),
+        static_cast<double>(cut_elements(F)),
+        static_cast<double>(F.local.ghost_contacts.size())};
+    pf.all = comm.allgather(std::span<const double>(mine));
+    pf.w = mine.size();
+    const auto& all = pf.all;
+    const size_t w = pf.w;
+    os << "\nprocesses: " << comm.size() << "\n"
+       << "  rank  owned unknowns  contact nodes  owned vertices  ghost vertices  local "
+          "triangles  distributed s  peak RSS\n";
+    for (int q = 0; q < comm.size(); ++q) {
+        const double* a = all.data() + static_cast<size_t>(q) * w;
+        os << "  " << std::setw(4) << q << std::setw(16) << static_cast<std::int64_t>(a[0])
+           << std::setw(15) << static_cast<std::int64_t>(a[1]) << std::setw(16)
+           << static_cast<std::int64_t>(a[2]) << std::setw(16) << static_cast<std::int64_t>(a[3])
+           << std::setw(17) << static_cast<std::int64_t>(a[4]) << std::setw(15) << std::fixed
+           << std::setprecision(2) << a[5] << std::defaultfloat << std::setprecision(6) << "  "
+           << levels::format_bytes(a[6]) << "\n";
+    }
+    os << "finest level " << finest << ": " << F.n_global_dofs << " unknowns, "
+       << F.n_global_contacts << " contact nodes\n";
+    return pf;
+}
+
+/// The contact interface across the cuts: elements whose contactor and targets are owned by
+/// different processes (their Jacobian rows couple the processes).
+void print_contact_interface(std::ostream& os, const Communicator& comm,
+                             const levels::DistributedLevel& F, const ProcessFigures& pf) {
+    const auto& all = pf.all;
+    const size_t w = pf.w;
+    os << "contact interface on the finest level (two-body elements):\n"
+       << "  rank  contact nodes  with targets owned elsewhere  other processes' elements "
+          "reaching owned vertices\n";
+    std::int64_t cut = 0;
+    for (int q = 0; q < comm.size(); ++q) {
+        const double* a = all.data() + static_cast<size_t>(q) * w;
+        cut += static_cast<std::int64_t>(a[7]);
+        os << "  " << std::setw(4) << q << std::setw(15) << static_cast<std::int64_t>(a[1])
+           << std::setw(30) << static_cast<std::int64_t>(a[7]) << std::setw(43)
+           << static_cast<std::int64_t>(a[8]) << "\n";
+    }
+    os << "  the partition " << (cut > 0 ? "cuts" : "does not cut") << " the interface (" << cut
+       << " of " << F.n_global_contacts << " contact elements)\n";
+}
+
+/// Newton and Krylov iterations and statuses per distributed level and load step.
+void print_level_steps(std::ostream& os, const levels::DistributedRunResult& r) {
+    os << "\n level  step  Newton  Krylov  Krylov/Newton  agreement  statuses (gap/stick/slip)\n";
+    for (size_t k = 1; k < r.level_steps.size(); ++k)
+        for (const auto& ls : r.level_steps[k]) {
+            const auto& c = ls.report.counts;
+            os << std::setw(6) << ls.level << std::setw(6) << ls.report.step << std::setw(8)
+               << ls.report.iterations << std::setw(8) << ls.report.linear_iterations
+               << std::setw(15) << std::fixed << std::setprecision(1)
+               << (ls.report.iterations > 0
+                       ? static_cast<double>(ls.report.linear_iterations) / ls.report.iterations
+                       : 0.0)
+               << std::setw(11) << std::setprecision(3) << ls.agreement() << std::defaultfloat
+               << std::setprecision(6) << "  " << c.gap << "/" << c.stick << "/"
+               << c.slip_forward + c.slip_backward << "\n";
+        }
+}
+
+/// Small-displacement theory on the finest level's final state (one process also names the
+/// element and the load step: levels::RunResult::warnings); printed and returned.
+std::vector<std::string> deformation_warnings(std::ostream& os, const levels::DistributedLevel& F,
+                                              const levels::DistributedRunResult& r,
+                                              const Communicator& comm) {
+    std::vector<std::string> warnings;
+    const levels::Deformation d = levels::max_deformation(F.local, r.u_full);
+    std::array<double, 2> m{d.rotation, d.strain};
+    comm.allreduce(std::span<double>(m), ReduceOp::max);
+    std::ostringstream w;
+    w << std::setprecision(3);
+    if (m[0] > levels::kSmallRotationLimit) {
+        w << "large rotation: an element of the finest level rotates by " << m[0]
+          << " rad in the final state, above " << levels::kSmallRotationLimit
+          << " rad: small-displacement theory does not hold there and the results are not "
+             "reliable";
+        warnings.push_back(w.str());
+        w.str("");
+    }
+    if (m[1] > levels::kSmallStrainLimit) {
+        w << "large strain: an element of the finest level has a principal strain of " << m[1]
+          << " in the final state, above " << levels::kSmallStrainLimit
+          << ": small-displacement theory does not hold there and the results are not "
+             "reliable";
+        warnings.push_back(w.str());
+    }
+    for (const auto& x : warnings)
+        os << "warning: " << x << "\n";
+    return warnings;
+}
+
+/// solution.pvtu and this process's piece, the contact values of ghost vertices taken from their
+/// owners so that every piece shows them.
+void write_solution_pvtu(const std::filesystem::path& file, const levels::DistributedLevel& F,
+                         const levels::DistributedRunResult& r, const Communicator& comm,
+                         mesh::VtuFormat vtu) {
+    // The contact values of ghost vertices from their owners, so that every piece shows them.
+    const levels::Level& L = F.local;
+    const int nv = L.mesh.n_vertices();
+    auto fields = solution_fields(L, r.u_full, r.nodes);
+    std::vector<double> rec(static_cast<size_t>(nv) * 5);
+    for (int v = 0; v < nv; ++v) {
+        rec[static_cast<size_t>(v) * 5] = fields.point[1].values[static_cast<size_t>(v)];
+        for (int j = 0; j < 2; ++j)
+            rec[static_cast<size_t>(v) * 5 + 1 + static_cast<size_t>(j)] =
+                fields.point[2].values[2 * static_cast<size_t>(v) + static_cast<size_t>(j)];
+        rec[static_cast<size_t>(v) * 5 + 3] = fields.point[3].values[static_cast<size_t>(v)];
+        rec[static_cast<size_t>(v) * 5 + 4] = fields.point[4].values[static_cast<size_t>(v)];
+    }
+    F.ghosts.vertex_records(rec, 5);
+    for (int v = 0; v < nv; ++v) {
+        fields.point[1].values[static_cast<size_t>(v)] = rec[static_cast<size_t>(v) * 5];
+        for (int j = 0; j < 2; ++j)
+            fields.point[2].values[2 * static_cast<size_t>(v) + static_cast<size_t>(j)] =
+                rec[static_cast<size_t>(v) * 5 + 1 + static_cast<size_t>(j)];
+        fields.point[3].values[static_cast<size_t>(v)] = rec[static_cast<size_t>(v) * 5 + 3];
+        fields.point[4].values[static_cast<size_t>(v)] = rec[static_cast<size_t>(v) * 5 + 4];
+    }
+    mesh::LocalLevel part = F.part;
+    part.mesh = L.mesh;
+    mesh::write_distributed_vtu(file, part, fields.point, fields.cell, comm, vtu);
+}
+
+/// contact.csv, contact_steps.csv and iterations.csv (process 0); their names added to `files`.
+void write_contact_tables(const std::filesystem::path& dir, const levels::Problem& p,
+                          const levels::DistributedRunResult& r, const ContactBoundary& cb,
+                          int plevel, std::vector<std::string>& files) {
+    write_file_atomically(dir / "contact.csv", [&](std::ostream& f) {
+        f << "x,y,ux,uy,lambda_t,lambda_n,status\n" << std::setprecision(17);
+        if (!cb.step_nodes.empty())
+            for (const auto& n : cb.step_nodes.back())
+                f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << ","
+                  << n.lambda_t << "," << n.lambda_n << "," << contact::to_string(n.status) << "\n";
+    });
+    files.push_back("contact.csv");
+    write_contact_steps(dir / "contact_steps.csv", p, cb.level, cb.step_nodes, r.completed_steps);
+    files.push_back("contact_steps.csv");
+    {
+        // Levels 0..p as one process solves them, then the distributed ones.
+        std::vector<LevelIterations> its;
+        for (size_t l = 0; l < r.serial.level_steps.size(); ++l)
+            if (!r.serial.level_steps[l].empty())
+                its.push_back({static_cast<int>(l), r.serial.levels()[l].n_unknowns(),
+                               &r.serial.level_steps[l]});
+        for (size_t k = 1; k < r.level_steps.size(); ++k)
+            its.push_back(
+                {plevel + static_cast<int>(k), r.levels[k].n_global_dofs, &r.level_steps[k], true});
+        write_iterations_csv(dir / "iterations.csv", its);
+        files.push_back("iterations.csv");
+    }
+}
+
+/// summary.json of a distributed run but for its solver (process 0).
+toml::table distributed_summary(const levels::Problem& p, const levels::DistributedRunResult& r,
+                                const Communicator& comm, const ProcessFigures& pf,
+                                const std::filesystem::path& dir, mesh::VtuFormat vtu, int plevel,
+                                const std::vector<PairResultant>& resultants,
+                                const levels::StateChecks& checks,
+                                const std::vector<std::string>& warnings) {
+    const auto& F = r.finest();
+    const int finest = p.levels;
+    const auto& totals = pf.totals;
+    const auto& all = pf.all;
+    const size_t w = pf.w;
+    toml::table root_t;
+    root_t.insert("complete", true);
+    root_t.insert("scene", p.name);
+    root_t.insert("units", p.units);
+    root_t.insert("level", static_cast<int64_t>(finest));
+    root_t.insert("unknowns", static_cast<int64_t>(F.n_global_dofs));
+    root_t.insert("contact_nodes", static_cast<int64_t>(F.n_global_contacts));
+    root_t.insert("displacement_unknowns", static_cast<int64_t>(totals[1]));
+    root_t.insert("vertices", static_cast<int64_t>(totals[2]));
+    root_t.insert("triangles", static_cast<int64_t>(totals[0]));
+    root_t.insert("converged", r.converged);
+    root_t.insert("stopped", false); // a signal ends the processes (main.cpp)
+    {
+        toml::array fl;
+        fl.push_back("solution.pvtu");
+        for (int q = 0; q < comm.size(); ++q)
+            fl.push_back(mesh::piece_path(dir / "solution.pvtu", q).filename().string());
+        for (const char* f : {"contact.csv", "contact_steps.csv", "iterations.csv"})
+            fl.push_back(f);
+        fl.push_back("summary.json");
+        root_t.insert("files", fl);
+    }
+    root_t.insert("load_steps", static_cast<int64_t>(p.load_steps));
+    root_t.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
+    root_t.insert("vtu_format", mesh::to_string(vtu));
+    root_t.insert("processes", static_cast<int64_t>(comm.size()));
+    root_t.insert("partition_level", static_cast<int64_t>(plevel));
+    root_t.insert("seconds", r.seconds);
+    toml::array procs;
+    for (int q = 0; q < comm.size(); ++q) {
+        const double* a = all.data() + static_cast<size_t>(q) * w;
+        toml::table t;
+        t.insert("rank", static_cast<int64_t>(q));
+        t.insert("owned_unknowns", static_cast<int64_t>(a[0]));
+        t.insert("contact_nodes", static_cast<int64_t>(a[1]));
+        t.insert("owned_vertices", static_cast<int64_t>(a[2]));
+        t.insert("ghost_vertices", static_cast<int64_t>(a[3]));
+        t.insert("local_triangles", static_cast<int64_t>(a[4]));
+        t.insert("distributed_seconds", a[5]);
+        t.insert("peak_rss_bytes", a[6]);
+        t.insert("cut_contact_elements", static_cast<int64_t>(a[7]));
+        t.insert("ghost_contact_elements", static_cast<int64_t>(a[8]));
+        procs.push_back(std::move(t));
+    }
+    root_t.insert("per_process", std::move(procs));
+    int total_newton = 0;
+    root_t.insert("steps", steps_json(r.steps, &total_newton));
+    root_t.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
+    toml::array lv;
+    for (size_t k = 1; k < r.level_steps.size(); ++k)
+        lv.push_back(level_json(plevel + static_cast<int>(k), r.levels[k].n_global_dofs,
+                                r.levels[k].n_global_contacts, r.level_steps[k]));
+    root_t.insert("levels", lv);
+    root_t.insert("recovered_levels", static_cast<int64_t>(p.recovered_levels));
+    root_t.insert("contacts", contacts_json(p, resultants));
+    root_t.insert("checks", checks_json(checks));
+    {
+        toml::array list;
+        for (const auto& x : warnings)
+            list.push_back(x);
+        root_t.insert("warnings", std::move(list));
+    }
+    double rss_max = 0;
+    for (int q = 0; q < comm.size(); ++q)
+        rss_max = std::max(rss_max, all[static_cast<size_t>(q) * w + 6]);
+    toml::table mt;
+    mt.insert("peak_rss_bytes", rss_max); // the largest process's
+    root_t.insert("memory", mt);
+    toml::table tt; // rank 0's
+    for (const auto& [name, e] : r.timings.table())
+        tt.insert(name, e.seconds);
+    root_t.insert("timings_seconds", tt);
+    // What the timings ran on (rank 0): threads per process and the BLAS behind level 0's
+    // schur.
+    root_t.insert("threads", static_cast<int64_t>(parallel::num_threads()));
+    root_t.insert("blas", parallel::blas_library());
+    return root_t;
+}
+
 } // namespace
 
 int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::ostream& out) {
@@ -265,73 +538,10 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
        << " distributed\n";
     levels::DistributedRunResult r = levels::solve_distributed(p, so, comm, plevel);
 
-    // Per process: what it owns on the finest level.
     const auto& F = r.finest();
-    std::int64_t owned_triangles = 0, owned_displacements = 0;
-    for (const char o : F.part.triangle_owned)
-        owned_triangles += o != 0;
-    for (Index i = 0; i < F.n_owned; ++i)
-        owned_displacements += F.local.dofs.is_displacement(i);
-    std::array<std::int64_t, 3> totals{owned_triangles, owned_displacements,
-                                       F.part.n_owned_vertices()};
-    comm.allreduce(std::span<std::int64_t>(totals), ReduceOp::sum);
-    std::vector<double> mine{
-        static_cast<double>(F.n_owned),
-        static_cast<double>(F.local.n_contact_nodes()),
-        static_cast<double>(F.part.n_owned_vertices()),
-        static_cast<double>(F.local.mesh.n_vertices() - F.part.n_owned_vertices()),
-        static_cast<double>(F.local.mesh.n_triangles()),
-        r.distributed_seconds,
-        static_cast<double>(peak_rss_bytes()),
-        static_cast<double>(cut_elements(F)),
-        static_cast<double>(F.local.ghost_contacts.size())};
-    const auto all = comm.allgather(std::span<const double>(mine));
-    const size_t w = mine.size();
-    os << "\nprocesses: " << comm.size() << "\n"
-       << "  rank  owned unknowns  contact nodes  owned vertices  ghost vertices  local "
-          "triangles  distributed s  peak RSS\n";
-    for (int q = 0; q < comm.size(); ++q) {
-        const double* a = all.data() + static_cast<size_t>(q) * w;
-        os << "  " << std::setw(4) << q << std::setw(16) << static_cast<std::int64_t>(a[0])
-           << std::setw(15) << static_cast<std::int64_t>(a[1]) << std::setw(16)
-           << static_cast<std::int64_t>(a[2]) << std::setw(16) << static_cast<std::int64_t>(a[3])
-           << std::setw(17) << static_cast<std::int64_t>(a[4]) << std::setw(15) << std::fixed
-           << std::setprecision(2) << a[5] << std::defaultfloat << std::setprecision(6) << "  "
-           << levels::format_bytes(a[6]) << "\n";
-    }
-    os << "finest level " << finest << ": " << F.n_global_dofs << " unknowns, "
-       << F.n_global_contacts << " contact nodes\n";
-    if (two_body) {
-        // The contact interface across the cuts: elements whose contactor and targets are owned
-        // by different processes (their Jacobian rows couple the processes).
-        os << "contact interface on the finest level (two-body elements):\n"
-           << "  rank  contact nodes  with targets owned elsewhere  other processes' elements "
-              "reaching owned vertices\n";
-        std::int64_t cut = 0;
-        for (int q = 0; q < comm.size(); ++q) {
-            const double* a = all.data() + static_cast<size_t>(q) * w;
-            cut += static_cast<std::int64_t>(a[7]);
-            os << "  " << std::setw(4) << q << std::setw(15) << static_cast<std::int64_t>(a[1])
-               << std::setw(30) << static_cast<std::int64_t>(a[7]) << std::setw(43)
-               << static_cast<std::int64_t>(a[8]) << "\n";
-        }
-        os << "  the partition " << (cut > 0 ? "cuts" : "does not cut") << " the interface (" << cut
-           << " of " << F.n_global_contacts << " contact elements)\n";
-    }
-    os << "\n level  step  Newton  Krylov  Krylov/Newton  agreement  statuses (gap/stick/slip)\n";
-    for (size_t k = 1; k < r.level_steps.size(); ++k)
-        for (const auto& ls : r.level_steps[k]) {
-            const auto& c = ls.report.counts;
-            os << std::setw(6) << ls.level << std::setw(6) << ls.report.step << std::setw(8)
-               << ls.report.iterations << std::setw(8) << ls.report.linear_iterations
-               << std::setw(15) << std::fixed << std::setprecision(1)
-               << (ls.report.iterations > 0
-                       ? static_cast<double>(ls.report.linear_iterations) / ls.report.iterations
-                       : 0.0)
-               << std::setw(11) << std::setprecision(3) << ls.agreement() << std::defaultfloat
-               << std::setprecision(6) << "  " << c.gap << "/" << c.stick << "/"
-               << c.slip_forward + c.slip_backward << "\n";
-        }
+    const ProcessFigures pf = process_figures(os, r, comm, finest);
+    if (two_body) print_contact_interface(os, comm, F, pf);
+    print_level_steps(os, r);
     levels::StateChecks checks;
     std::vector<PairResultant> resultants(p.contacts.size());
     if (r.converged) {
@@ -349,33 +559,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
                              static_cast<int>(std::lround(sums[3 * k + 2]))};
         print_checks(os, p, checks, resultants);
     }
-    // Small-displacement theory on the finest level's final state (one process also names the
-    // element and the load step: levels::RunResult::warnings).
-    std::vector<std::string> warnings;
-    if (r.converged) {
-        const levels::Deformation d = levels::max_deformation(F.local, r.u_full);
-        std::array<double, 2> m{d.rotation, d.strain};
-        comm.allreduce(std::span<double>(m), ReduceOp::max);
-        std::ostringstream w;
-        w << std::setprecision(3);
-        if (m[0] > levels::kSmallRotationLimit) {
-            w << "large rotation: an element of the finest level rotates by " << m[0]
-              << " rad in the final state, above " << levels::kSmallRotationLimit
-              << " rad: small-displacement theory does not hold there and the results are not "
-                 "reliable";
-            warnings.push_back(w.str());
-            w.str("");
-        }
-        if (m[1] > levels::kSmallStrainLimit) {
-            w << "large strain: an element of the finest level has a principal strain of " << m[1]
-              << " in the final state, above " << levels::kSmallStrainLimit
-              << ": small-displacement theory does not hold there and the results are not "
-                 "reliable";
-            warnings.push_back(w.str());
-        }
-        for (const auto& x : warnings)
-            os << "warning: " << x << "\n";
-    }
+    const std::vector<std::string> warnings =
+        r.converged ? deformation_warnings(os, F, r, comm) : std::vector<std::string>();
     os << "\ntimings of process 0 (the distributed levels):\n";
     if (root) r.timings.print(os);
     os << "\ntime: " << std::fixed << std::setprecision(2) << r.seconds << " s" << std::defaultfloat
@@ -391,127 +576,16 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     // Files: solution.pvtu and its pieces, contact.csv and summary.json (last).
     if (root) folder->begin_writing(p.name);
     comm.barrier();
-    {
-        // The contact values of ghost vertices from their owners, so that every piece shows them.
-        const levels::Level& L = F.local;
-        const int nv = L.mesh.n_vertices();
-        auto fields = solution_fields(L, r.u_full, r.nodes);
-        std::vector<double> rec(static_cast<size_t>(nv) * 5);
-        for (int v = 0; v < nv; ++v) {
-            rec[static_cast<size_t>(v) * 5] = fields.point[1].values[static_cast<size_t>(v)];
-            for (int j = 0; j < 2; ++j)
-                rec[static_cast<size_t>(v) * 5 + 1 + static_cast<size_t>(j)] =
-                    fields.point[2].values[2 * static_cast<size_t>(v) + static_cast<size_t>(j)];
-            rec[static_cast<size_t>(v) * 5 + 3] = fields.point[3].values[static_cast<size_t>(v)];
-            rec[static_cast<size_t>(v) * 5 + 4] = fields.point[4].values[static_cast<size_t>(v)];
-        }
-        F.ghosts.vertex_records(rec, 5);
-        for (int v = 0; v < nv; ++v) {
-            fields.point[1].values[static_cast<size_t>(v)] = rec[static_cast<size_t>(v) * 5];
-            for (int j = 0; j < 2; ++j)
-                fields.point[2].values[2 * static_cast<size_t>(v) + static_cast<size_t>(j)] =
-                    rec[static_cast<size_t>(v) * 5 + 1 + static_cast<size_t>(j)];
-            fields.point[3].values[static_cast<size_t>(v)] = rec[static_cast<size_t>(v) * 5 + 3];
-            fields.point[4].values[static_cast<size_t>(v)] = rec[static_cast<size_t>(v) * 5 + 4];
-        }
-        mesh::LocalLevel part = F.part;
-        part.mesh = L.mesh;
-        mesh::write_distributed_vtu(dir / "solution.pvtu", part, fields.point, fields.cell, comm,
-                                    vtu);
-    }
+    write_solution_pvtu(dir / "solution.pvtu", F, r, comm, vtu);
     // The contact boundary on rank 0: every process sends the contact-boundary edges that start
     // at a vertex it owns and its contact nodes after every step.
     const ContactBoundary cb = gather_contact_boundary(p, r, comm);
     std::vector<std::string> files{"solution.pvtu", "solution_<rank>.vtu (" +
                                                         std::to_string(comm.size()) + " pieces)"};
     if (root) {
-        write_file_atomically(dir / "contact.csv", [&](std::ostream& f) {
-            f << "x,y,ux,uy,lambda_t,lambda_n,status\n" << std::setprecision(17);
-            if (!cb.step_nodes.empty())
-                for (const auto& n : cb.step_nodes.back())
-                    f << n.x.x() << "," << n.x.y() << "," << n.u.x() << "," << n.u.y() << ","
-                      << n.lambda_t << "," << n.lambda_n << "," << contact::to_string(n.status)
-                      << "\n";
-        });
-        files.push_back("contact.csv");
-        write_contact_steps(dir / "contact_steps.csv", p, cb.level, cb.step_nodes,
-                            r.completed_steps);
-        files.push_back("contact_steps.csv");
-        {
-            // Levels 0..p as one process solves them, then the distributed ones.
-            std::vector<LevelIterations> its;
-            for (size_t l = 0; l < r.serial.level_steps.size(); ++l)
-                if (!r.serial.level_steps[l].empty())
-                    its.push_back({static_cast<int>(l), r.serial.levels()[l].n_unknowns(),
-                                   &r.serial.level_steps[l]});
-            for (size_t k = 1; k < r.level_steps.size(); ++k)
-                its.push_back({plevel + static_cast<int>(k), r.levels[k].n_global_dofs,
-                               &r.level_steps[k], true});
-            write_iterations_csv(dir / "iterations.csv", its);
-            files.push_back("iterations.csv");
-        }
-        toml::table root_t;
-        root_t.insert("complete", true);
-        root_t.insert("scene", p.name);
-        root_t.insert("units", p.units);
-        root_t.insert("level", static_cast<int64_t>(finest));
-        root_t.insert("unknowns", static_cast<int64_t>(F.n_global_dofs));
-        root_t.insert("contact_nodes", static_cast<int64_t>(F.n_global_contacts));
-        root_t.insert("displacement_unknowns", static_cast<int64_t>(totals[1]));
-        root_t.insert("vertices", static_cast<int64_t>(totals[2]));
-        root_t.insert("triangles", static_cast<int64_t>(totals[0]));
-        root_t.insert("converged", r.converged);
-        root_t.insert("stopped", false); // a signal ends the processes (main.cpp)
-        {
-            toml::array fl;
-            fl.push_back("solution.pvtu");
-            for (int q = 0; q < comm.size(); ++q)
-                fl.push_back(mesh::piece_path(dir / "solution.pvtu", q).filename().string());
-            for (const char* f : {"contact.csv", "contact_steps.csv", "iterations.csv"})
-                fl.push_back(f);
-            fl.push_back("summary.json");
-            root_t.insert("files", fl);
-        }
-        root_t.insert("load_steps", static_cast<int64_t>(p.load_steps));
-        root_t.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
-        root_t.insert("vtu_format", mesh::to_string(vtu));
-        root_t.insert("processes", static_cast<int64_t>(comm.size()));
-        root_t.insert("partition_level", static_cast<int64_t>(plevel));
-        root_t.insert("seconds", r.seconds);
-        toml::array procs;
-        for (int q = 0; q < comm.size(); ++q) {
-            const double* a = all.data() + static_cast<size_t>(q) * w;
-            toml::table t;
-            t.insert("rank", static_cast<int64_t>(q));
-            t.insert("owned_unknowns", static_cast<int64_t>(a[0]));
-            t.insert("contact_nodes", static_cast<int64_t>(a[1]));
-            t.insert("owned_vertices", static_cast<int64_t>(a[2]));
-            t.insert("ghost_vertices", static_cast<int64_t>(a[3]));
-            t.insert("local_triangles", static_cast<int64_t>(a[4]));
-            t.insert("distributed_seconds", a[5]);
-            t.insert("peak_rss_bytes", a[6]);
-            t.insert("cut_contact_elements", static_cast<int64_t>(a[7]));
-            t.insert("ghost_contact_elements", static_cast<int64_t>(a[8]));
-            procs.push_back(std::move(t));
-        }
-        root_t.insert("per_process", std::move(procs));
-        int total_newton = 0;
-        root_t.insert("steps", steps_json(r.steps, &total_newton));
-        root_t.insert("total_newton_iterations", static_cast<int64_t>(total_newton));
-        toml::array lv;
-        for (size_t k = 1; k < r.level_steps.size(); ++k)
-            lv.push_back(level_json(plevel + static_cast<int>(k), r.levels[k].n_global_dofs,
-                                    r.levels[k].n_global_contacts, r.level_steps[k]));
-        root_t.insert("levels", lv);
-        root_t.insert("recovered_levels", static_cast<int64_t>(p.recovered_levels));
-        root_t.insert("contacts", contacts_json(p, resultants));
-        root_t.insert("checks", checks_json(checks));
-        {
-            toml::array w;
-            for (const auto& x : warnings)
-                w.push_back(x);
-            root_t.insert("warnings", std::move(w));
-        }
+        write_contact_tables(dir, p, r, cb, plevel, files);
+        toml::table root_t =
+            distributed_summary(p, r, comm, pf, dir, vtu, plevel, resultants, checks, warnings);
         toml::table sv;
         sv.insert("method", spec.method);
         sv.insert("krylov", spec.krylov);
@@ -519,20 +593,6 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         sv.insert("rel_tol", spec.rel_tol);
         sv.insert("distributed", true);
         root_t.insert("solver", sv);
-        double rss_max = 0;
-        for (int q = 0; q < comm.size(); ++q)
-            rss_max = std::max(rss_max, all[static_cast<size_t>(q) * w + 6]);
-        toml::table mt;
-        mt.insert("peak_rss_bytes", rss_max); // the largest process's
-        root_t.insert("memory", mt);
-        toml::table tt; // rank 0's
-        for (const auto& [name, e] : r.timings.table())
-            tt.insert(name, e.seconds);
-        root_t.insert("timings_seconds", tt);
-        // What the timings ran on (rank 0): threads per process and the BLAS behind level 0's
-        // schur.
-        root_t.insert("threads", static_cast<int64_t>(parallel::num_threads()));
-        root_t.insert("blas", parallel::blas_library());
         write_file_atomically(dir / "summary.json",
                               [&](std::ostream& f) { f << toml::json_formatter{root_t} << "\n"; });
         files.push_back("summary.json");

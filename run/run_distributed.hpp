@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file `mlcontact run` on several processes (mpirun -np N, N > 1; issue 12): the one-body
+/// @file `mlcontact run` on several processes (mpirun -np N, N > 1): the one-body
 /// scenes with Krylov + the distributed mg (levels/distributed_solve.hpp), the report on rank 0,
 /// and solution.pvtu (one piece per process), contact.csv and summary.json written once.
 #pragma once

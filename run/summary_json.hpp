@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-/// @file The parts of summary.json that one-process and distributed runs share (apps/output.cpp,
-/// apps/run_distributed.cpp), so that both write them alike.
+/// @file The parts of summary.json that one-process and distributed runs share (run/output.cpp,
+/// run/run_distributed.cpp), so that both write them alike.
 #pragma once
 
 #include "run/output.hpp"

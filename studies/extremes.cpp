@@ -117,8 +117,8 @@ levels::Problem square() {
     return scene::load_scene("square");
 }
 
-std::vector<Case> make_cases() {
-    std::vector<Case> cs;
+/// The square with one parameter pushed to its extremes: friction, r, Poisson's ratio, loads.
+void add_square_parameter_cases(std::vector<Case>& cs) {
     for (double mu : {0.0, 0.01, 1.0, 2.0})
         cs.push_back({"mu=" + num(mu), "square, friction coefficient",
                       [mu](int l, const levels::LinearSolverSpec& solver) {
@@ -150,6 +150,10 @@ std::vector<Case> make_cases() {
                           }
                           return solve_case(p, l, solver);
                       }});
+}
+
+/// Extreme loadings and shapes: lift-off, gross slip, a slender strip.
+void add_loading_cases(std::vector<Case>& cs) {
     cs.push_back({"lift-off", "square with suction on top: every node opens",
                   [](int l, const levels::LinearSolverSpec& solver) {
                       auto p = square();
@@ -198,6 +202,10 @@ obstacle = { type = "line", point = [0.0, 0.0], normal = [0.0, 1.0] }
                       return solve_case(scene::parse_scene(text, "extremes:slender"),
                                         std::min(l, 1), solver);
                   }});
+}
+
+/// Two bodies of very different stiffness, and the square in two systems of units.
+void add_contrast_and_unit_cases(std::vector<Case>& cs) {
     // Two bodies, Young's moduli 1e6 apart, node on facet with friction, the default
     // r = 0.1 x the smaller E (with the larger one, r = 1e5 x the soft modulus, the statuses cycle
     // and Newton fails). Both ways round: a soft block on a stiff base, a stiff block on a soft
@@ -300,6 +308,13 @@ mu = 0.3
                           f["diagnosis"] = "results differ after unit conversion";
                       return f;
                   }});
+}
+
+std::vector<Case> make_cases() {
+    std::vector<Case> cs;
+    add_square_parameter_cases(cs);
+    add_loading_cases(cs);
+    add_contrast_and_unit_cases(cs);
     return cs;
 }
 

@@ -4,10 +4,10 @@
 
 #include "run/preconditioners.hpp"
 
-#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "levels/solve.hpp"
+#include "run/plot_script.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -169,6 +169,21 @@ constexpr PaperPoint kPaper[] = {{"ebe", 220, 1.8},     {"ebe", 780, 7.6},   {"e
                                  {"ilu", 23200, 343.5}, {"diag", 220, 1.3},  {"diag", 780, 8.2},
                                  {"diag", 2620, 50},    {"diag", 7980, 425}, {"diag", 23200, -1}};
 
+/// The "level ..." lines of a combination's output (their text after "level "), and in
+/// `failure` its "fail ..." line's text.
+std::vector<std::string> level_lines(const std::string& text, std::string& failure) {
+    std::istringstream in(text);
+    std::string line;
+    std::vector<std::string> lines;
+    while (std::getline(in, line)) {
+        if (line.rfind("fail ", 0) == 0)
+            failure = line.substr(5);
+        else if (line.rfind("level ", 0) == 0)
+            lines.push_back(line.substr(6));
+    }
+    return lines;
+}
+
 } // namespace
 
 int study_preconditioners(const levels::Problem& problem, const PreconditionerStudyOptions& opt,
@@ -218,15 +233,8 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
                         const std::string text = run_bounded(
                             [&] { return run_combination(problem, opt, kr, pc, mu, rf, finest); },
                             opt.seconds_per_run);
-                        std::istringstream in(text);
-                        std::string line, failure;
-                        std::vector<std::string> lines;
-                        while (std::getline(in, line)) {
-                            if (line.rfind("fail ", 0) == 0)
-                                failure = line.substr(5);
-                            else if (line.rfind("level ", 0) == 0)
-                                lines.push_back(line.substr(6));
-                        }
+                        std::string failure;
+                        const std::vector<std::string> lines = level_lines(text, failure);
                         for (size_t k = 0; k < lines.size(); ++k) {
                             std::istringstream ls(lines[k]);
                             LevelRow row;

@@ -44,7 +44,7 @@ struct PreconditionerStudyOptions {
 int study_preconditioners(const levels::Problem& problem, const PreconditionerStudyOptions& opt,
                           std::ostream& os);
 
-/// The preconditioners of the processes' study (`--np-list 1,2,4`, issue 13): for every
+/// The preconditioners of the processes' study (`--np-list 1,2,4`): for every
 /// (Krylov method, preconditioner, mu, r/E), process count N and finest level l = 1..L, one
 /// `mlcontact run SCENE --levels l` (N = 1: this executable alone; N > 1: under `mpiexec -n N`,
 /// where the default partition level is l - 1 at most, so level l is distributed and solved with

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: MIT
-// The preconditioner study over process counts (issue 13, item 2): `mlcontact run` launched on
+// The preconditioner study over process counts: `mlcontact run` launched on
 // N = 1, 2, 4, ... processes per preconditioner and level, each run's iterations.csv read back.
-#include "run/preconditioners.hpp"
-#include "studies/preconditioners.hpp"
-#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/timer.hpp"
 #include "levels/distributed_solve.hpp"
+#include "run/plot_script.hpp"
+#include "run/preconditioners.hpp"
+#include "studies/preconditioners.hpp"
 
 #include <toml++/toml.h>
 
@@ -219,6 +219,175 @@ std::string run_name(const Cell& c) {
     return s;
 }
 
+/// Runs one cell as `mlcontact run` (under the launcher `mpiexec` when c.np > 1) in its folder
+/// under dir/runs, reads its iterations and prints its row.
+void run_cell(Cell& c, const levels::Problem& problem, const PreconditionerStudyOptions& opt,
+              const std::filesystem::path& dir, const std::filesystem::path& self,
+              const std::vector<std::string>& mpiexec, std::ostream& os) {
+    const std::string& kr = c.krylov;
+    const std::string& pc = c.pc;
+    const double mu = c.mu, rf = c.rf;
+    const int l = c.level, np = c.np;
+    const auto rd = dir / "runs" / run_name(c);
+    std::filesystem::remove_all(rd);
+    std::filesystem::create_directories(rd);
+    std::vector<std::string> argv;
+    if (np > 1) {
+        argv = mpiexec;
+        argv.insert(argv.end(), {"-n", std::to_string(np)});
+    }
+    std::ostringstream r, m, t;
+    r << std::setprecision(17) << rf * problem.min_young_modulus();
+    m << std::setprecision(17) << mu;
+    t << std::setprecision(17) << opt.rel_tol;
+    argv.insert(argv.end(), {self.string(),
+                             "run",
+                             opt.scene_arg,
+                             "--levels",
+                             std::to_string(l),
+                             "--krylov",
+                             c.krylov,
+                             "--pc",
+                             c.pc,
+                             "--linear-tol",
+                             t.str(),
+                             "--mu",
+                             m.str(),
+                             "--r",
+                             r.str(),
+                             "--no-fallback",
+                             "--no-continuation",
+                             "--quiet",
+                             "--out",
+                             rd.string()});
+    if (opt.load_steps > 0) argv.insert(argv.end(), {"--steps", std::to_string(opt.load_steps)});
+    {
+        std::ofstream cmd(rd / "command.txt");
+        for (size_t i = 0; i < argv.size(); ++i)
+            cmd << (i ? " " : "") << argv[i];
+        cmd << "\n";
+    }
+    const ChildEnd end = run_child(argv, rd / "run.log", opt.seconds_per_run);
+    c.seconds = end.seconds;
+    const bool read = read_level(rd / "iterations.csv", c);
+    if (end.timed_out) {
+        std::ostringstream os2;
+        os2 << "time bound of " << opt.seconds_per_run << " s reached";
+        c.result = "time bound";
+        c.reason = os2.str();
+    } else if (end.exit_code == 0 && read) {
+        c.result = "converged";
+    } else if (end.exit_code == 2) {
+        c.result = "no conv";
+        c.reason = failure_reason(rd / "run.log");
+    } else {
+        c.result = "failed";
+        std::ostringstream os2;
+        if (end.signal)
+            os2 << "signal " << strsignal(end.signal) << ": ";
+        else
+            os2 << "exit " << end.exit_code << ": ";
+        os2 << failure_reason(rd / "run.log");
+        c.reason = os2.str();
+    }
+    // Keep the small files; the VTU pieces are not needed here.
+    for (const auto& e : std::filesystem::directory_iterator(rd)) {
+        const auto ext = e.path().extension();
+        if (ext == ".vtu" || ext == ".pvtu") std::filesystem::remove(e.path());
+    }
+    os << std::left << std::setw(10) << kr << std::setw(16) << pc << std::right << std::setw(6)
+       << mu << std::setw(8) << rf << std::setw(7) << l << std::setw(5) << np << std::setw(10)
+       << c.unknowns << std::setw(8) << c.newton << std::setw(11) << std::fixed
+       << std::setprecision(1) << c.mean << std::setw(8) << std::setprecision(0) << c.max
+       << std::defaultfloat << std::setprecision(6) << "  " << c.result;
+    if (!c.reason.empty()) os << " (" << c.reason << ")";
+    os << "\n" << std::flush;
+}
+
+/// preconditioners_np.csv and preconditioners_np.json.
+void write_cells(const std::filesystem::path& dir, const std::string& scene,
+                 const std::vector<int>& nps, double rel_tol, const std::vector<Cell>& cells) {
+    AtomicOfstream csv(dir / "preconditioners_np.csv");
+    csv << "krylov,pc,mu,r_over_E,level,processes,unknowns,level_distributed,newton,"
+           "krylov_per_newton_mean,krylov_per_newton_max,result,reason\n";
+    toml::array jr;
+    for (const auto& c : cells) {
+        csv << c.krylov << ",\"" << c.pc << "\"," << c.mu << "," << c.rf << "," << c.level << ","
+            << c.np << "," << c.unknowns << "," << (c.distributed ? 1 : 0) << "," << c.newton << ","
+            << std::setprecision(9) << c.mean << "," << c.max << std::setprecision(6) << ","
+            << c.result << ",\"" << c.reason << "\"\n";
+        toml::table t;
+        t.insert("krylov", c.krylov);
+        t.insert("pc", c.pc);
+        t.insert("mu", c.mu);
+        t.insert("r_over_E", c.rf);
+        t.insert("level", static_cast<int64_t>(c.level));
+        t.insert("processes", static_cast<int64_t>(c.np));
+        t.insert("unknowns", static_cast<int64_t>(c.unknowns));
+        t.insert("level_distributed", c.distributed);
+        t.insert("newton", static_cast<int64_t>(c.newton));
+        t.insert("krylov_per_newton_mean", c.mean);
+        t.insert("krylov_per_newton_max", c.max);
+        t.insert("result", c.result);
+        if (!c.reason.empty()) t.insert("reason", c.reason);
+        jr.push_back(t);
+    }
+    toml::table root;
+    root.insert("scene", scene);
+    toml::array np_arr;
+    for (int n : nps)
+        np_arr.push_back(static_cast<int64_t>(n));
+    root.insert("processes", np_arr);
+    root.insert("rel_tol", rel_tol);
+    root.insert("runs", jr);
+    AtomicOfstream js(dir / "preconditioners_np.json");
+    js << toml::json_formatter{root} << "\n";
+    csv.close();
+    js.close();
+}
+
+/// The table by processes: Krylov iterations per Newton step, mean (max), on the finest level.
+void print_by_processes(std::ostream& os, const std::vector<int>& nps,
+                        const std::vector<Cell>& cells) {
+    os << "\nKrylov iterations per Newton step on level l, mean (max), by processes N:\n"
+       << std::left << std::setw(10) << "krylov" << std::setw(16) << "pc" << std::right
+       << std::setw(6) << "mu" << std::setw(8) << "r/E" << std::setw(7) << "level" << std::setw(10)
+       << "unknowns";
+    for (int n : nps)
+        os << std::setw(16) << ("N=" + std::to_string(n));
+    os << "\n";
+    std::map<std::tuple<std::string, std::string, double, double, int>, std::map<int, const Cell*>>
+        grid;
+    std::vector<std::tuple<std::string, std::string, double, double, int>> keys;
+    for (const auto& c : cells) {
+        const auto k = std::make_tuple(c.krylov, c.pc, c.mu, c.rf, c.level);
+        if (!grid.count(k)) keys.push_back(k);
+        grid[k][c.np] = &c;
+    }
+    for (const auto& k : keys) {
+        const auto& row = grid[k];
+        std::int64_t unknowns = 0;
+        for (const auto& [n, c] : row)
+            unknowns = std::max(unknowns, c->unknowns);
+        os << std::left << std::setw(10) << std::get<0>(k) << std::setw(16) << std::get<1>(k)
+           << std::right << std::setw(6) << std::get<2>(k) << std::setw(8) << std::get<3>(k)
+           << std::setw(7) << std::get<4>(k) << std::setw(10) << unknowns;
+        for (int n : nps) {
+            const auto it = row.find(n);
+            std::ostringstream v;
+            if (it == row.end())
+                v << "not run";
+            else if (it->second->result != "converged")
+                v << it->second->result;
+            else
+                v << std::fixed << std::setprecision(1) << it->second->mean << " ("
+                  << std::setprecision(0) << it->second->max << ")";
+            os << std::setw(16) << v.str();
+        }
+        os << "\n";
+    }
+}
+
 } // namespace
 
 int study_preconditioners_np(const levels::Problem& problem, const PreconditionerStudyOptions& opt,
@@ -297,86 +466,7 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
                             c.rf = rf;
                             c.level = l;
                             c.np = np;
-                            const auto rd = dir / "runs" / run_name(c);
-                            std::filesystem::remove_all(rd);
-                            std::filesystem::create_directories(rd);
-                            std::vector<std::string> argv;
-                            if (np > 1) {
-                                argv = mpiexec;
-                                argv.insert(argv.end(), {"-n", std::to_string(np)});
-                            }
-                            std::ostringstream r, m, t;
-                            r << std::setprecision(17) << rf * problem.min_young_modulus();
-                            m << std::setprecision(17) << mu;
-                            t << std::setprecision(17) << opt.rel_tol;
-                            argv.insert(argv.end(), {self.string(),
-                                                     "run",
-                                                     opt.scene_arg,
-                                                     "--levels",
-                                                     std::to_string(l),
-                                                     "--krylov",
-                                                     kr,
-                                                     "--pc",
-                                                     pc,
-                                                     "--linear-tol",
-                                                     t.str(),
-                                                     "--mu",
-                                                     m.str(),
-                                                     "--r",
-                                                     r.str(),
-                                                     "--no-fallback",
-                                                     "--no-continuation",
-                                                     "--quiet",
-                                                     "--out",
-                                                     rd.string()});
-                            if (opt.load_steps > 0)
-                                argv.insert(argv.end(),
-                                            {"--steps", std::to_string(opt.load_steps)});
-                            {
-                                std::ofstream cmd(rd / "command.txt");
-                                for (size_t i = 0; i < argv.size(); ++i)
-                                    cmd << (i ? " " : "") << argv[i];
-                                cmd << "\n";
-                            }
-                            const ChildEnd end =
-                                run_child(argv, rd / "run.log", opt.seconds_per_run);
-                            c.seconds = end.seconds;
-                            const bool read = read_level(rd / "iterations.csv", c);
-                            if (end.timed_out) {
-                                std::ostringstream os2;
-                                os2 << "time bound of " << opt.seconds_per_run << " s reached";
-                                c.result = "time bound";
-                                c.reason = os2.str();
-                            } else if (end.exit_code == 0 && read) {
-                                c.result = "converged";
-                            } else if (end.exit_code == 2) {
-                                c.result = "no conv";
-                                c.reason = failure_reason(rd / "run.log");
-                            } else {
-                                c.result = "failed";
-                                std::ostringstream os2;
-                                if (end.signal)
-                                    os2 << "signal " << strsignal(end.signal) << ": ";
-                                else
-                                    os2 << "exit " << end.exit_code << ": ";
-                                os2 << failure_reason(rd / "run.log");
-                                c.reason = os2.str();
-                            }
-                            // Keep the small files; the VTU pieces are not needed here.
-                            for (const auto& e : std::filesystem::directory_iterator(rd)) {
-                                const auto ext = e.path().extension();
-                                if (ext == ".vtu" || ext == ".pvtu")
-                                    std::filesystem::remove(e.path());
-                            }
-                            os << std::left << std::setw(10) << kr << std::setw(16) << pc
-                               << std::right << std::setw(6) << mu << std::setw(8) << rf
-                               << std::setw(7) << l << std::setw(5) << np << std::setw(10)
-                               << c.unknowns << std::setw(8) << c.newton << std::setw(11)
-                               << std::fixed << std::setprecision(1) << c.mean << std::setw(8)
-                               << std::setprecision(0) << c.max << std::defaultfloat
-                               << std::setprecision(6) << "  " << c.result;
-                            if (!c.reason.empty()) os << " (" << c.reason << ")";
-                            os << "\n" << std::flush;
+                            run_cell(c, problem, opt, dir, self, mpiexec, os);
                             cells.push_back(c);
                             if (c.result != "converged") {
                                 if (l < opt.levels)
@@ -386,82 +476,9 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
                             }
                         }
 
-    AtomicOfstream csv(dir / "preconditioners_np.csv");
-    csv << "krylov,pc,mu,r_over_E,level,processes,unknowns,level_distributed,newton,"
-           "krylov_per_newton_mean,krylov_per_newton_max,result,reason\n";
-    toml::array jr;
-    for (const auto& c : cells) {
-        csv << c.krylov << ",\"" << c.pc << "\"," << c.mu << "," << c.rf << "," << c.level << ","
-            << c.np << "," << c.unknowns << "," << (c.distributed ? 1 : 0) << "," << c.newton << ","
-            << std::setprecision(9) << c.mean << "," << c.max << std::setprecision(6) << ","
-            << c.result << ",\"" << c.reason << "\"\n";
-        toml::table t;
-        t.insert("krylov", c.krylov);
-        t.insert("pc", c.pc);
-        t.insert("mu", c.mu);
-        t.insert("r_over_E", c.rf);
-        t.insert("level", static_cast<int64_t>(c.level));
-        t.insert("processes", static_cast<int64_t>(c.np));
-        t.insert("unknowns", static_cast<int64_t>(c.unknowns));
-        t.insert("level_distributed", c.distributed);
-        t.insert("newton", static_cast<int64_t>(c.newton));
-        t.insert("krylov_per_newton_mean", c.mean);
-        t.insert("krylov_per_newton_max", c.max);
-        t.insert("result", c.result);
-        if (!c.reason.empty()) t.insert("reason", c.reason);
-        jr.push_back(t);
-    }
-    toml::table root;
-    root.insert("scene", problem.name);
-    toml::array np_arr;
-    for (int n : nps)
-        np_arr.push_back(static_cast<int64_t>(n));
-    root.insert("processes", np_arr);
-    root.insert("rel_tol", opt.rel_tol);
-    root.insert("runs", jr);
-    AtomicOfstream js(dir / "preconditioners_np.json");
-    js << toml::json_formatter{root} << "\n";
-    csv.close();
-    js.close();
+    write_cells(dir, problem.name, nps, opt.rel_tol, cells);
 
-    // The table by processes: Krylov iterations per Newton step, mean (max), on the finest level.
-    os << "\nKrylov iterations per Newton step on level l, mean (max), by processes N:\n"
-       << std::left << std::setw(10) << "krylov" << std::setw(16) << "pc" << std::right
-       << std::setw(6) << "mu" << std::setw(8) << "r/E" << std::setw(7) << "level" << std::setw(10)
-       << "unknowns";
-    for (int n : nps)
-        os << std::setw(16) << ("N=" + std::to_string(n));
-    os << "\n";
-    std::map<std::tuple<std::string, std::string, double, double, int>, std::map<int, const Cell*>>
-        grid;
-    std::vector<std::tuple<std::string, std::string, double, double, int>> keys;
-    for (const auto& c : cells) {
-        const auto k = std::make_tuple(c.krylov, c.pc, c.mu, c.rf, c.level);
-        if (!grid.count(k)) keys.push_back(k);
-        grid[k][c.np] = &c;
-    }
-    for (const auto& k : keys) {
-        const auto& row = grid[k];
-        std::int64_t unknowns = 0;
-        for (const auto& [n, c] : row)
-            unknowns = std::max(unknowns, c->unknowns);
-        os << std::left << std::setw(10) << std::get<0>(k) << std::setw(16) << std::get<1>(k)
-           << std::right << std::setw(6) << std::get<2>(k) << std::setw(8) << std::get<3>(k)
-           << std::setw(7) << std::get<4>(k) << std::setw(10) << unknowns;
-        for (int n : nps) {
-            const auto it = row.find(n);
-            std::ostringstream v;
-            if (it == row.end())
-                v << "not run";
-            else if (it->second->result != "converged")
-                v << it->second->result;
-            else
-                v << std::fixed << std::setprecision(1) << it->second->mean << " ("
-                  << std::setprecision(0) << it->second->max << ")";
-            os << std::setw(16) << v.str();
-        }
-        os << "\n";
-    }
+    print_by_processes(os, nps, cells);
     os << "wrote " << (dir / "preconditioners_np.csv").string()
        << ", preconditioners_np.json, runs/\n";
     if (opt.plot && run_plot_script("plot_preconditioners_np.py", dir, os))

@@ -60,6 +60,33 @@ std::vector<int> distance_to_zone_boundary(const levels::Level& L,
     return dist;
 }
 
+/// Final statuses along the contact boundary per level (for the plot).
+void write_final_statuses(const std::filesystem::path& file, const levels::RunResult& warm,
+                          int levels) {
+    AtomicOfstream sc(file);
+    sc << "level,x,y,status\n" << std::setprecision(12);
+    for (int l = 0; l <= levels; ++l) {
+        const auto& L = warm.levels()[static_cast<size_t>(l)];
+        const auto& st = warm.level_steps[static_cast<size_t>(l)].back().final_statuses;
+        for (size_t e = 0; e < st.size(); ++e) {
+            const Vec2 p = L.mesh.vertices[static_cast<size_t>(L.contacts[e].vertex[0])];
+            sc << l << "," << p.x() << "," << p.y() << ","
+               << kStatusNames[static_cast<size_t>(st[e])] << "\n";
+        }
+    }
+}
+
+/// The confusion table of one level, predicted statuses against final ones.
+void print_confusion(std::ostream& os, const levels::Confusion& total) {
+    os << "        confusion (rows predicted, cols final; gap stick slip+ slip-):";
+    for (size_t a = 0; a < 4; ++a) {
+        os << (a ? " |" : " ");
+        for (size_t b = 0; b < 4; ++b)
+            os << " " << total[a][b];
+    }
+    os << "\n";
+}
+
 } // namespace
 
 int study_status_transfer(const levels::Problem& problem_in, const StatusTransferOptions& opt,
@@ -177,15 +204,7 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
         jl.insert("confusion_predicted_rows_final_cols", conf);
         jl.insert("steps", jsteps);
         jlevels.push_back(jl);
-        if (l >= 1) {
-            os << "        confusion (rows predicted, cols final; gap stick slip+ slip-):";
-            for (size_t a = 0; a < 4; ++a) {
-                os << (a ? " |" : " ");
-                for (size_t b = 0; b < 4; ++b)
-                    os << " " << total[a][b];
-            }
-            os << "\n";
-        }
+        if (l >= 1) print_confusion(os, total);
     }
     if (n_avg > 0) {
         os << "\nlevels 2.." << opt.levels << ": Newton iterations per load step, coarse-to-fine "
@@ -193,18 +212,7 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
            << " (ratio " << warm_sum / cold_sum << "); lowest predicted status agreement "
            << agree_min << "\n";
     }
-    // Final statuses along the contact boundary per level (for the plot).
-    AtomicOfstream sc(dir / "statuses.csv");
-    sc << "level,x,y,status\n" << std::setprecision(12);
-    for (int l = 0; l <= opt.levels; ++l) {
-        const auto& L = warm.levels()[static_cast<size_t>(l)];
-        const auto& st = warm.level_steps[static_cast<size_t>(l)].back().final_statuses;
-        for (size_t e = 0; e < st.size(); ++e) {
-            const Vec2 p = L.mesh.vertices[static_cast<size_t>(L.contacts[e].vertex[0])];
-            sc << l << "," << p.x() << "," << p.y() << ","
-               << kStatusNames[static_cast<size_t>(st[e])] << "\n";
-        }
-    }
+    write_final_statuses(dir / "statuses.csv", warm, opt.levels);
     toml::table root;
     root.insert("scene", problem.name);
     root.insert("levels", jlevels);
@@ -216,7 +224,6 @@ int study_status_transfer(const levels::Problem& problem_in, const StatusTransfe
     AtomicOfstream js(dir / "status_transfer.json");
     js << toml::json_formatter{root} << "\n";
     csv.close();
-    sc.close();
     js.close();
     os << "wrote " << (dir / "status_transfer.csv").string()
        << ", status_transfer.json, statuses.csv\n";

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `study error-vs-time` (issue 15 item 6): the multilevel rows exist (coarse-to-fine and cold
+// `study error-vs-time`: the multilevel rows exist (coarse-to-fine and cold
 // mg from level 1, mgr where hypre is built in), converge, and their error against the level-3
 // reference falls with the level; the other configurations are left out by --only.
 #include "studies/error_vs_time.hpp"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Hostile input (issue 7): scenes that once crashed, hung or invoked undefined behaviour in the
+// Hostile input: scenes that once crashed, hung or invoked undefined behaviour in the
 // parser (found while fuzzing it with tests/fuzz, or by review). Each is a data file in
 // tests/data/hostile/ (the Python tests read the same files, python/tests/test_hostile.py) whose
 // comment line "# expect: invalid[: text]" or "# expect: valid: N triangles" says what parsing it

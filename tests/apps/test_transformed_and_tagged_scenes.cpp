@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Scenes a researcher can write (issue 16): transformed meshes, tags on interior and mirror
+// Scenes a researcher can write: transformed meshes, tags on interior and mirror
 // lines, arcs on Gmsh meshes, supports with per-step activity, and the built-in scenes that use
 // them (hertz_gmsh, axis_release, incline), each against its closed form or an identity.
 #include "run/closed_form.hpp"
@@ -55,7 +55,7 @@ void write_msh(const mesh::Mesh& m, const std::filesystem::path& file) {
 
 std::filesystem::path temp_dir(const std::string& name) {
     const auto d = std::filesystem::temp_directory_path() /
-                   ("mlc_scenes16_" + name + "_" + std::to_string(::getpid()));
+                   ("mlc_tagged_scenes_" + name + "_" + std::to_string(::getpid()));
     std::filesystem::create_directories(d);
     return d;
 }

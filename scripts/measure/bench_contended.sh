@@ -7,10 +7,10 @@
 #   bursts    default threads beside an intermittent competitor: 50 ms busy, 50 ms asleep, ...
 # The competitors are started and stopped here. Prints the four totals and their ratios to the
 # one-thread time, and writes out/bench/contended_L<L>.json.
-# Usage: scripts/bench_contended.sh L [extra bench options, e.g. --tol 1e-6]
+# Usage: scripts/measure/bench_contended.sh L [extra bench options, e.g. --tol 1e-6]
 set -euo pipefail
-cd "$(dirname "$0")/.."
-L=${1:?usage: scripts/bench_contended.sh LEVEL [bench options]}
+cd "$(dirname "$0")/../.."
+L=${1:?usage: scripts/measure/bench_contended.sh LEVEL [bench options]}
 shift
 EXTRA=("$@")
 M=build/bin/mlcontact

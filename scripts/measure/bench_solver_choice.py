@@ -8,7 +8,7 @@ RSS of each process (wait4). Prints the medians, the solver the default chose an
 the faster and to the smaller candidate (the bar: both at most 1.15), and writes
 out/bench/solver_choice.csv and .json. Run it on an idle machine: it measures wall time.
 
-usage: scripts/bench_solver_choice.py [--repeat N] [--mg "FLAGS"] [SCENE:L1,L2 ...]
+usage: scripts/measure/bench_solver_choice.py [--repeat N] [--mg "FLAGS"] [SCENE:L1,L2 ...]
   default cases (the table of docs/results/solver-choice.md#results-solver-choice): square:1,2,3,4 hertz:1,2,3 calumet:1,2 incline:1,2 patch:1,2
   patch_matching:2 dovetail:1,2,3,4 axis_release:1,2 mindlin:1,2
 """
@@ -22,7 +22,7 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 EXE = os.path.join(ROOT, "build", "bin", "mlcontact")
 
 

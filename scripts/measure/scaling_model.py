@@ -3,8 +3,8 @@
 """A model of the distributed mg's time per V-cycle and per load step on 64 and 1024 processes
 (docs/parallel.md#cluster-model):
 
-    /usr/bin/python3 scripts/scaling_model.py measure   # the benches below (idle machine: timings)
-    /usr/bin/python3 scripts/scaling_model.py model     # the model from their JSON files
+    /usr/bin/python3 scripts/measure/scaling_model.py measure   # the benches below (idle machine: timings)
+    /usr/bin/python3 scripts/measure/scaling_model.py model     # the model from their JSON files
 
 `measure` runs `mlcontact bench comm` on the square's elastic block (out/model/):
   counts_np{2,4,8}.json  level 6 under mpirun -np 2, 4, 8 --oversubscribe with the PMPI library
@@ -42,7 +42,7 @@ import pathlib
 import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
 OUT = ROOT / "out" / "model"
 
 

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 """One process against N processes, back to back, on the same commit (docs/results/parallel.md#results-parallel):
 
-    /usr/bin/python3 scripts/bench_distributed.py --levels 6 --repeat 3 --np 2
+    /usr/bin/python3 scripts/measure/bench_distributed.py --levels 6 --repeat 3 --np 2
 
 runs `mlcontact bench square --levels L --repeat R` on one process (its default threads) and
 then `mpirun -np N mlcontact bench square ...` (one thread per process), reads both JSON files
@@ -17,7 +17,7 @@ import pathlib
 import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(__file__).resolve().parent.parent.parent
 
 
 def main():

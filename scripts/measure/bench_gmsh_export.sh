@@ -9,9 +9,9 @@
 # line per run (configuration, run, wall milliseconds) and the medians.
 # Run it on an idle machine: it measures wall time.
 #
-#   bash scripts/bench_gmsh_export.sh [L [REPEAT]]     # default: level 4, 3 repeats
+#   bash scripts/measure/bench_gmsh_export.sh [L [REPEAT]]     # default: level 4, 3 repeats
 set -euo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 level=${1:-4}
 repeat=${2:-3}
 exe=build/bin/mlcontact
