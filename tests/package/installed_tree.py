@@ -13,17 +13,23 @@ over the source tree and over the build tree, so that no path into either reache
 after renaming them. The installed tree itself is renamed (moved) after the install, so that
 nothing may depend on the prefix it was installed to either.
 
-usage: installed_tree.py CMAKE BUILD_DIR SOURCE_DIR WORK_DIR
+usage: installed_tree.py CMAKE BUILD_DIR SOURCE_DIR
 """
+import atexit
 import os
 import shutil
 import subprocess
 import sys
+import tempfile
 
-cmake, build, source, work = sys.argv[1:5]
+cmake, build, source = sys.argv[1:4]
 build, source = os.path.realpath(build), os.path.realpath(source)
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+# The installed tree and the study's output lie outside both trees (a temporary folder), since
+# both trees are hidden while the study runs; removed at the end.
+work = os.path.realpath(tempfile.mkdtemp(prefix="mlc_installed_tree_"))
+atexit.register(shutil.rmtree, work, True)
+for tree in (source, build):
+    assert not (work + "/").startswith(tree + "/"), f"the temporary folder {work} lies in {tree}"
 
 
 def run(cmd, **kw):
@@ -55,7 +61,8 @@ if shutil.which("strings"):
 empty = os.path.join(work, "empty")
 os.makedirs(empty)
 out = os.path.join(work, "study")
-hide = f"mount --bind '{empty}' '{source}' && mount --bind '{empty}' '{build}'"
+# The build tree first: it may lie inside the source tree, hidden with it.
+hide = f"mount --bind '{empty}' '{build}' && mount --bind '{empty}' '{source}'"
 check = f"test ! -e '{source}/CMakeLists.txt' && test ! -e '{build}/CMakeCache.txt'"
 script = f"{hide} && {check} && cd '{work}' && exec '{exe}' study status-transfer square --levels 2 --out '{out}'"
 env = {k: v for k, v in os.environ.items() if k not in ("MLC_PLOT_DIR", "PYTHONPATH")}
