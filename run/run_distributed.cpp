@@ -455,6 +455,25 @@ toml::table distributed_summary(const levels::Problem& p, const levels::Distribu
     return root_t;
 }
 
+/// The resultant of every contact pair on the finest level, summed over the processes.
+std::vector<PairResultant> pair_resultants(const levels::Problem& p,
+                                           const levels::DistributedRunResult& r,
+                                           const Communicator& comm) {
+    const auto& F = r.finest();
+    std::vector<PairResultant> resultants(p.contacts.size());
+    std::vector<double> sums;
+    for (size_t k = 0; k < p.contacts.size(); ++k) {
+        int closed = 0;
+        const Vec2 f = levels::contact_resultant(F.local, r.nodes, static_cast<int>(k), &closed);
+        sums.insert(sums.end(), {f.x(), f.y(), static_cast<double>(closed)});
+    }
+    comm.allreduce(std::span<double>(sums), ReduceOp::sum);
+    for (size_t k = 0; k < p.contacts.size(); ++k)
+        resultants[k] = {Vec2(sums[3 * k], sums[3 * k + 1]),
+                         static_cast<int>(std::lround(sums[3 * k + 2]))};
+    return resultants;
+}
+
 } // namespace
 
 int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::ostream& out) {
@@ -546,17 +565,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     std::vector<PairResultant> resultants(p.contacts.size());
     if (r.converged) {
         checks = levels::check_state(p, r, comm);
-        std::vector<double> sums;
-        for (size_t k = 0; k < p.contacts.size(); ++k) {
-            int closed = 0;
-            const Vec2 f =
-                levels::contact_resultant(F.local, r.nodes, static_cast<int>(k), &closed);
-            sums.insert(sums.end(), {f.x(), f.y(), static_cast<double>(closed)});
-        }
-        comm.allreduce(std::span<double>(sums), ReduceOp::sum);
-        for (size_t k = 0; k < p.contacts.size(); ++k)
-            resultants[k] = {Vec2(sums[3 * k], sums[3 * k + 1]),
-                             static_cast<int>(std::lround(sums[3 * k + 2]))};
+        resultants = pair_resultants(p, r, comm);
         print_checks(os, p, checks, resultants);
     }
     const std::vector<std::string> warnings =
