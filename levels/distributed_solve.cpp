@@ -15,7 +15,6 @@
 
 #include <Eigen/SparseLU>
 
-#include <atomic>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -611,7 +610,7 @@ void build_distributed_levels(const Problem& problem, const SolveOptions& option
 class DistributedSteps {
 public:
     DistributedSteps(const Problem& problem, const SolveOptions& options, const Communicator& comm,
-                     int p, DistributedRunResult& res);
+                     int p, SolveObserver* observer, DistributedRunResult& res);
     /// Level p's load step `st` converged: solves it on the distributed levels.
     void step(const LevelStepState& st);
     /// A distributed level failed (the serial solve is then stopped).
@@ -623,7 +622,6 @@ private:
     void take_level_p(const LevelStepState& st);
     bool solve_level(size_t k, int step, double s);
     void interpolate_from_below(size_t k, Vector& xo);
-    void print_level_step(const LevelStep& ls, int step) const;
     void accept_level(size_t k, double s, const Vector& xo);
 
     const Problem& problem_;
@@ -642,13 +640,14 @@ private:
     // (x^0 = 0: the supports never change on several processes).
     std::vector<Vector> xo_last_, xo_older_;
     bool failed_ = false;
-    std::ostream* progress_; // rank 0's
+    SolveObserver* progress_; // the caller's observer on rank 0, null elsewhere
 };
 
 DistributedSteps::DistributedSteps(const Problem& problem, const SolveOptions& options,
-                                   const Communicator& comm, int p, DistributedRunResult& res)
+                                   const Communicator& comm, int p, SolveObserver* observer,
+                                   DistributedRunResult& res)
     : problem_(problem), options_(options), comm_(comm), p_(p), res_(res),
-      m_(res.levels.size() - 1), progress_(comm.rank() == 0 ? options.progress : nullptr) {
+      m_(res.levels.size() - 1), progress_(comm.rank() == 0 ? observer : nullptr) {
     mg_ = std::make_unique<DistributedMultigrid>(res.levels, res.transfers, comm, options.linear,
                                                  res.mg);
     newton_.resize(m_ + 1);
@@ -665,7 +664,8 @@ DistributedSteps::DistributedSteps(const Problem& problem, const SolveOptions& o
         // Two-body elements read ghost values (every process alike: the call is collective).
         if (two_body) nd.fill_ghosts = [&D](Vector& x) { D.ghosts.update(D.local.dofs, x); };
         newton_[k]->set_distribution(std::move(nd));
-        newton_[k]->set_interrupt(options.interrupt_requested);
+        if (observer)
+            newton_[k]->set_interrupt([observer] { return observer->interrupt_requested(); });
     }
     res.level_steps.resize(m_ + 1);
     x_.resize(m_ + 1);
@@ -683,6 +683,7 @@ DistributedSteps::DistributedSteps(const Problem& problem, const SolveOptions& o
 
 void DistributedSteps::take_level_p(const LevelStepState& st) {
     const Level& Lp = *st.L;
+    const std::vector<ContactNodeState>& nodes = st.nodes();
     if (u_prev_p_.size() != st.u_full->size()) u_prev_p_ = Vector::Zero(st.u_full->size());
     // Level p's converged state on its unknowns, and its statuses.
     Vector xs = Vector::Zero(Lp.n_unknowns());
@@ -690,7 +691,7 @@ void DistributedSteps::take_level_p(const LevelStepState& st) {
         for (int c = 0; c < 2; ++c)
             if (const int d = Lp.dofs.u_dof(v, c); d >= 0) xs[d] = (*st.u_full)[2 * v + c];
     for (size_t e = 0; e < Lp.contacts.size(); ++e) {
-        const auto& ns = (*st.nodes)[e];
+        const auto& ns = nodes[e];
         const int d = Lp.lambda_dof[e];
         if (Lp.contacts[e].n_multipliers() == 2) {
             xs[d] = ns.lambda_t;
@@ -770,7 +771,15 @@ bool DistributedSteps::solve_level(size_t k, int step, double s) {
         xo_last_[k] = xo;
     }
     reduce_confusion(comm_, ls.confusion);
-    print_level_step(ls, step);
+    if (progress_) {
+        LevelStepProgress lp;
+        lp.step = &ls;
+        lp.load_steps = problem_.load_steps;
+        lp.n_levels = problem_.levels + 1;
+        lp.first_level = 0;
+        lp.processes = comm_.size();
+        progress_->level_step_done(lp);
+    }
     const bool ok = ls.report.converged;
     if (k == m_) res_.steps.push_back(ls.report);
     res_.level_steps[k].push_back(std::move(ls));
@@ -805,18 +814,6 @@ void DistributedSteps::interpolate_from_below(size_t k, Vector& xo) {
         }
 }
 
-void DistributedSteps::print_level_step(const LevelStep& ls, int step) const {
-    if (!progress_) return;
-    const auto& r = ls.report;
-    *progress_ << "  level " << ls.level << " step " << step << "/" << problem_.load_steps << ": "
-               << (r.converged ? "converged" : "FAILED") << " in " << r.iterations << " Newton it, "
-               << r.linear_iterations << " Krylov it, final residual " << std::scientific
-               << std::setprecision(2) << (r.residuals.empty() ? 0.0 : r.residuals.back())
-               << std::defaultfloat << std::setprecision(6) << ", " << std::fixed
-               << std::setprecision(2) << r.seconds << " s" << std::defaultfloat
-               << std::setprecision(6) << " (" << comm_.size() << " processes)" << std::endl;
-}
-
 void DistributedSteps::accept_level(size_t k, double s, const Vector& xo) {
     // The part's whole state (ghost unknowns from their owners) for the level above and the
     // output; this level's operator at its converged statuses for the multigrid.
@@ -839,10 +836,35 @@ void DistributedSteps::finish() {
     res_.u_full = u_now_[m_];
 }
 
+/// What the serial solve of levels 0..p reports to: each converged step of level p taken on
+/// by the distributed levels, a stop once one of them failed, the rest the caller's observer's
+/// (progress on rank 0 only).
+class DistributedObserver final : public SolveObserver {
+public:
+    DistributedObserver(DistributedSteps& steps, SolveObserver* user, bool root)
+        : steps_(steps), user_(user), root_(root) {}
+    void level_step_done(const LevelStepProgress& p) override {
+        if (user_ && root_) user_->level_step_done(p);
+    }
+    void level_step(const LevelStepState& st) override { steps_.step(st); }
+    bool stop_requested() override { return steps_.failed(); }
+    bool interrupt_requested() override { return user_ && user_->interrupt_requested(); }
+    std::unique_ptr<NewtonSystemSolver>
+    wrap_system_solver(int level, const Level& L,
+                       std::unique_ptr<NewtonSystemSolver> solver) override {
+        return user_ ? user_->wrap_system_solver(level, L, std::move(solver)) : std::move(solver);
+    }
+
+private:
+    DistributedSteps& steps_;
+    SolveObserver* user_;
+    bool root_;
+};
+
 } // namespace
 
 DistributedRunResult solve_distributed(const Problem& problem, const SolveOptions& options,
-                                       const Communicator& comm, int p) {
+                                       const Communicator& comm, int p, SolveObserver* observer) {
     const double t_start = wall_seconds();
     problem.validate();
     DistributedRunResult res;
@@ -850,25 +872,19 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
     res.partition_level = p;
     res.mg = check_distributable(problem, options, comm, p);
     build_distributed_levels(problem, options, comm, p, res);
-    DistributedSteps steps(problem, options, comm, p, res);
+    DistributedSteps steps(problem, options, comm, p, observer, res);
     // Levels 0..p on every process alike, each converged step of level p continued on the
     // distributed levels; a distributed level that fails stops the serial solve.
-    std::atomic<bool> stop{false};
+    DistributedObserver serial_observer(steps, observer, comm.rank() == 0);
     SolveOptions so = options;
-    so.progress = comm.rank() == 0 ? options.progress : nullptr;
-    so.stop = &stop;
     so.keep_step_states = false;
-    so.on_level_step = [&](const LevelStepState& st) {
-        steps.step(st);
-        if (steps.failed()) stop = true;
-    };
     res.serial = solve(
         [&] {
             Problem sp = problem;
             sp.levels = p;
             return sp;
         }(),
-        so);
+        so, &serial_observer);
     steps.finish();
     res.converged =
         !steps.failed() && res.serial.converged && res.completed_steps == problem.load_steps;

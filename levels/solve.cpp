@@ -37,62 +37,6 @@ bool needs_coarse_level(const LinearSolverSpec& spec) {
     return entry != nullptr && entry->needs_level_below;
 }
 
-void print_progress(std::ostream& os, int level, int n_levels, int step, int n_steps,
-                    const LevelStep& ls) {
-    const StepReport& rep = ls.report;
-    os << "  step " << std::setw(3) << step << "/" << n_steps;
-    if (n_levels > 1) os << "  level " << level;
-    os << "  load " << std::fixed << std::setprecision(3) << rep.load_factor << "  newton "
-       << std::setw(3) << rep.iterations;
-    if (rep.linear_iterations > 0) os << "  lin.it " << std::setw(5) << rep.linear_iterations;
-    os << "  residual " << std::scientific << std::setprecision(2) << rep.residuals.back()
-       << "  gap " << rep.counts.gap << " stick " << rep.counts.stick << " slip+ "
-       << rep.counts.slip_forward << " slip- " << rep.counts.slip_backward;
-    if (ls.predicted) os << "  predicted " << std::fixed << std::setprecision(3) << ls.agreement();
-    os << "  " << std::fixed << std::setprecision(2) << rep.seconds << " s" << std::defaultfloat
-       << (rep.converged ? ""
-           : rep.stopped ? "  stopped"
-                         : "  FAILED");
-}
-
-/// "0.4 s", "12 s", "3 min 05 s", "1 h 02 min".
-std::string format_duration(double t) {
-    const long s = std::lround(std::max(0.0, t));
-    std::ostringstream os;
-    if (t < 9.95)
-        os << std::fixed << std::setprecision(1) << std::max(0.0, t) << " s";
-    else if (s < 60)
-        os << s << " s";
-    else if (s < 3600)
-        os << s / 60 << " min " << std::setw(2) << std::setfill('0') << s % 60 << " s";
-    else
-        os << s / 3600 << " h " << std::setw(2) << std::setfill('0') << (s % 3600) / 60 << " min";
-    return os.str();
-}
-
-/// Estimated seconds left after load step `step` of level `level`: the remaining levels of this
-/// step and every level of the remaining steps, each at the mean time of its steps so far; a
-/// level not solved yet at the time of the level below scaled by the ratio of unknowns.
-double time_left(const std::vector<Level>& levels, int first, int level, int step, int n_steps,
-                 const std::vector<double>& seconds, const std::vector<int>& count) {
-    const int finest = static_cast<int>(levels.size()) - 1;
-    std::vector<double> per(levels.size(), 0.0);
-    for (int l = first; l <= finest; ++l) {
-        const size_t li = static_cast<size_t>(l);
-        if (count[li] > 0)
-            per[li] = seconds[li] / count[li];
-        else if (l > first)
-            per[li] = per[li - 1] * static_cast<double>(levels[li].n_unknowns()) /
-                      static_cast<double>(levels[li - 1].n_unknowns());
-    }
-    double left = 0.0, all = 0.0;
-    for (int l = first; l <= finest; ++l) {
-        all += per[static_cast<size_t>(l)];
-        if (l > level) left += per[static_cast<size_t>(l)];
-    }
-    return left + (n_steps - step) * all;
-}
-
 /// The checks before anything is built: the problem and the solver are valid, the lattice
 /// smoother has its numbering, and the run's estimated peak memory fits in what the process may
 /// use (throws InvalidInput naming both). Fills the solver, the predicted sizes and the memory
@@ -223,7 +167,8 @@ private:
 /// takes from it.
 class LoadStepping {
 public:
-    LoadStepping(const Problem& problem, const SolveOptions& options, RunResult& res);
+    LoadStepping(const Problem& problem, const SolveOptions& options, SolveObserver* observer,
+                 RunResult& res);
     void run();
 
 private:
@@ -234,13 +179,15 @@ private:
     bool try_extrapolation(size_t li, double s, LevelStep& ls);
     void interpolate_from_below(size_t li, int step, double s, LevelStep& ls);
     void newton_with_continuation(size_t li, double s, LevelStep& ls);
-    void print_level_step(int l, int step, const LevelStep& ls);
+    void report_level_step(const LevelStep& ls) const;
     std::string failure(int l, int step, double s, const StepReport& rep) const;
     void accept_level(size_t li, int step, double s);
     void finish_load_step(int step, double s);
 
     const Problem& problem_;
     const SolveOptions& options_;
+    SolveObserver* observer_; // the caller's, or null
+    SolveObserver& obs_;      // the caller's, or one that does nothing
     RunResult& res_;
     int n_levels_ = 0, finest_ = 0;
     int first_ = 0;      // the lowest level solved
@@ -258,8 +205,6 @@ private:
     // supports change, the states before then being of another set of unknowns).
     std::vector<Vector> x_older_;
     double t_start_ = 0.0;
-    std::vector<double> level_seconds_; // per level, over its steps (the time left)
-    std::vector<int> level_count_;
     // SolveOptions::r_continuation: the factor that worked on each level (0: not needed yet),
     // and the schur solver of its scaled level.
     std::vector<double> continued_;
@@ -267,8 +212,15 @@ private:
     DeformationWatch deformation_;
 };
 
-LoadStepping::LoadStepping(const Problem& problem, const SolveOptions& options, RunResult& res)
-    : problem_(problem), options_(options), res_(res) {
+SolveObserver& no_observer() {
+    static SolveObserver none;
+    return none;
+}
+
+LoadStepping::LoadStepping(const Problem& problem, const SolveOptions& options,
+                           SolveObserver* observer, RunResult& res)
+    : problem_(problem), options_(options), observer_(observer),
+      obs_(observer ? *observer : no_observer()), res_(res) {
     // Supports released or taken up between load steps (Support::active) change which components
     // are unknowns: the hierarchy, its solvers and Newton drivers are then rebuilt for the new
     // step's supports (Problem::at_step), and the state carried over through the nodal values.
@@ -300,8 +252,6 @@ LoadStepping::LoadStepping(const Problem& problem, const SolveOptions& options, 
     res.level_steps.resize(n);
     res.converged = true;
     t_start_ = wall_seconds();
-    level_seconds_.assign(n, 0.0);
-    level_count_.assign(n, 0);
     continued_.assign(n, 0.0);
     continuation_solver_.resize(n);
 }
@@ -325,7 +275,7 @@ void LoadStepping::setup_solvers() {
             if (l - 1 > first_) lb.below = &below_[li - 1];
         }
         auto sys = make_newton_system_solver(L, spec, &lb);
-        if (options_.wrap_system_solver) sys = options_.wrap_system_solver(l, L, std::move(sys));
+        sys = obs_.wrap_system_solver(l, L, std::move(sys));
         system_[li] = sys.get();
         newton_[li] =
             std::make_unique<ContactNewton>(L, problem_.newton, std::move(sys), &res_.timings);
@@ -337,8 +287,10 @@ void LoadStepping::setup_solvers() {
                 return make_schur_system_solver(L);
             });
         }
-        newton_[li]->set_interrupt(options_.interrupt_requested);
-        if (options_.stop) newton_[li]->set_stop([f = options_.stop] { return f->load(); });
+        if (observer_) {
+            newton_[li]->set_interrupt([o = observer_] { return o->interrupt_requested(); });
+            newton_[li]->set_stop([o = observer_] { return o->stop_requested(); });
+        }
     }
 }
 
@@ -433,9 +385,7 @@ bool LoadStepping::solve_level(int l, int step, double s) {
     }
     ls.report.step = step;
     tally_statuses(nw, s, u_prev_[li], x_[li], ls);
-    level_seconds_[li] += ls.report.seconds;
-    ++level_count_[li];
-    print_level_step(l, step, ls);
+    report_level_step(ls);
     const bool ok = ls.report.converged;
     if (l == finest_) res_.steps.push_back(ls.report);
     res_.level_steps[li].push_back(std::move(ls));
@@ -515,24 +465,26 @@ void LoadStepping::newton_with_continuation(size_t li, double s, LevelStep& ls) 
     if (!options_.r_continuation || ls.report.converged || ls.report.stopped || L.contacts.empty())
         return;
     x_[li] = x0;
-    NewtonPolls polls{{}, options_.interrupt_requested};
-    if (options_.stop) polls.stop = [f = options_.stop] { return f->load(); };
+    NewtonPolls polls;
+    if (observer_) {
+        polls.stop = [o = observer_] { return o->stop_requested(); };
+        polls.interrupt = [o = observer_] { return o->interrupt_requested(); };
+    }
     ls.report = continue_in_r(L, static_cast<int>(li), res_.predicted_sizes[li], problem_.newton,
                               nw, s, u_prev_[li], x0, x_[li], std::move(ls.report), continued_[li],
                               continuation_solver_[li], polls, &res_.timings);
     continued_[li] = ls.report.continuation_factor;
 }
 
-void LoadStepping::print_level_step(int l, int step, const LevelStep& ls) {
-    if (!options_.progress) return;
-    std::ostream& os = *options_.progress;
-    print_progress(os, l, n_levels_, step, problem_.load_steps, ls);
-    if (options_.progress_eta && ls.report.converged)
-        os << "  [" << format_duration(wall_seconds() - t_start_) << " elapsed, ~"
-           << format_duration(time_left(res_.hierarchy.levels, first_, l, step, problem_.load_steps,
-                                        level_seconds_, level_count_))
-           << " left]";
-    os << std::endl;
+void LoadStepping::report_level_step(const LevelStep& ls) const {
+    LevelStepProgress p;
+    p.step = &ls;
+    p.load_steps = problem_.load_steps;
+    p.n_levels = n_levels_;
+    p.first_level = first_;
+    p.levels = &res_.hierarchy.levels;
+    p.elapsed = wall_seconds() - t_start_;
+    obs_.level_step_done(p);
 }
 
 std::string LoadStepping::failure(int l, int step, double s, const StepReport& rep) const {
@@ -569,10 +521,14 @@ void LoadStepping::accept_level(size_t li, int step, double s) {
     const Level& L = res_.hierarchy.levels[li];
     ContactNewton& nw = *newton_[li];
     L.dofs.expand(x_[li], L.u_fixed_at(s), u_now_[li]);
-    if (options_.on_level_step) {
-        const auto nodes = nw.node_states(s, u_prev_[li], x_[li]);
-        options_.on_level_step({static_cast<int>(li), step, s, &L, &u_now_[li], &nodes});
-    }
+    LevelStepState st;
+    st.level = static_cast<int>(li);
+    st.step = step;
+    st.s = s;
+    st.L = &L;
+    st.u_full = &u_now_[li];
+    st.node_states = [&] { return nw.node_states(s, u_prev_[li], x_[li]); };
+    obs_.level_step(st);
     if (static_cast<int>(li) + 1 < n_levels_) {
         // The level above's preconditioner (cf, sorcf, mg) uses this level at its
         // converged statuses.
@@ -625,10 +581,10 @@ std::string residual_history(const StepReport& rep) {
     return os.str();
 }
 
-RunResult solve(const Problem& problem, const SolveOptions& options) {
+RunResult solve(const Problem& problem, const SolveOptions& options, SolveObserver* observer) {
     RunResult res;
     check_before_building(problem, options, res);
-    LoadStepping(problem, options, res).run();
+    LoadStepping(problem, options, observer, res).run();
     return res;
 }
 
