@@ -605,7 +605,7 @@ void build_distributed_levels(const Problem& problem, const SolveOptions& option
 /// The load steps of the distributed levels p+1..L: after each converged load step of level p
 /// (solved on every process by levels::solve), step() takes level p's state to this process's
 /// part of it and solves the same step on the distributed levels, coarse to fine, each level in
-/// the phases of levels::solve (extrapolation, the coarse-to-fine guess, Newton), with the
+/// the level loop of levels::solve (solve_levels over Part, levels/level_step.hpp), with the
 /// status counts and the confusion reduced over the processes.
 class DistributedSteps {
 public:
@@ -620,7 +620,7 @@ public:
 
 private:
     void take_level_p(const LevelStepState& st);
-    bool solve_level(size_t k, int step, double s);
+    class Part;
     void interpolate_from_below(size_t k, Vector& xo);
     void accept_level(size_t k, double s, const Vector& xo);
 
@@ -639,8 +639,72 @@ private:
     // SolveOptions::extrapolate: each distributed level's owned state at the last two steps
     // (x^0 = 0: the supports never change on several processes).
     std::vector<Vector> xo_last_, xo_older_;
+    std::vector<Vector> xo_; // each level's owned iterate in the current step
+    std::vector<std::unique_ptr<StepLevel>> parts_; // levels 1..m, for the level loop
     bool failed_ = false;
     SolveObserver* progress_; // the caller's observer on rank 0, null elsewhere
+};
+
+/// This process's part of distributed level k in the level loop (levels/level_step.hpp): it
+/// iterates on its owned unknowns, takes its guess from the part of the level below, and sums
+/// its status counts and confusion over the processes.
+class DistributedSteps::Part final : public StepLevel {
+public:
+    Part(DistributedSteps& run, size_t k) : run_(run), k_(k) {}
+    ContactNewton& newton() override { return *run_.newton_[k_]; }
+    const Vector& u_prev() const override { return run_.u_prev_[k_]; }
+    Vector& x() override { return run_.xo_[k_]; }
+    int index() const override { return run_.p_ + static_cast<int>(k_); }
+    void begin_step() override { run_.xo_[k_].resize(run_.res_.levels[k_].n_owned); }
+    bool extrapolate(double s, LevelStep& ls) override {
+        // As levels::solve does (SolveOptions::extrapolate): the extrapolated state when Newton
+        // would stop there at once, otherwise the interpolated coarse state.
+        if (!run_.options_.extrapolate) return false;
+        x() = run_.xo_last_[k_];
+        return take_extrapolation(newton(), s, u_prev(), run_.xo_older_[k_], x(), ls);
+    }
+    bool interpolate(int /*step*/) override {
+        run_.interpolate_from_below(k_, x());
+        return true;
+    }
+    void solve(int /*step*/, double s, LevelStep& ls) override {
+        ls.report = newton().solve(s, u_prev(), x());
+    }
+    void reduce(LevelStep& ls) override {
+        ls.report.counts = reduce_counts(run_.comm_, ls.report.counts);
+        reduce_confusion(run_.comm_, ls.confusion);
+    }
+    void settle(const LevelStep& /*ls*/) override {
+        if (!run_.options_.extrapolate) return;
+        run_.xo_older_[k_] = std::move(run_.xo_last_[k_]);
+        run_.xo_last_[k_] = x();
+    }
+    const StepReport& report(LevelStep ls) override {
+        if (run_.progress_) {
+            LevelStepProgress lp;
+            lp.step = &ls;
+            lp.load_steps = run_.problem_.load_steps;
+            lp.n_levels = run_.problem_.levels + 1;
+            lp.first_level = 0;
+            lp.processes = run_.comm_.size();
+            run_.progress_->level_step_done(lp);
+        }
+        if (k_ == run_.m_) run_.res_.steps.push_back(ls.report);
+        run_.res_.level_steps[k_].push_back(std::move(ls));
+        return run_.res_.level_steps[k_].back().report;
+    }
+    void fail(int step, double s, const StepReport& rep) override {
+        std::ostringstream os;
+        os << "load step " << step << " (load factor " << s << ") on level " << index()
+           << " did not converge: " << rep.message
+           << "; residual history:" << residual_history(rep);
+        run_.res_.failure = os.str();
+    }
+    void accept(int /*step*/, double s) override { run_.accept_level(k_, s, x()); }
+
+private:
+    DistributedSteps& run_;
+    size_t k_;
 };
 
 DistributedSteps::DistributedSteps(const Problem& problem, const SolveOptions& options,
@@ -679,6 +743,9 @@ DistributedSteps::DistributedSteps(const Problem& problem, const SolveOptions& o
     xo_older_.resize(m_ + 1);
     for (size_t k = 1; k <= m_; ++k)
         xo_last_[k] = xo_older_[k] = Vector::Zero(res.levels[k].n_owned);
+    xo_.resize(m_ + 1);
+    for (size_t k = 1; k <= m_; ++k)
+        parts_.push_back(std::make_unique<Part>(*this, k));
 }
 
 void DistributedSteps::take_level_p(const LevelStepState& st) {
@@ -728,12 +795,11 @@ void DistributedSteps::step(const LevelStepState& st) {
     if (st.level != p_ || failed_) return;
     const double t0 = wall_seconds();
     take_level_p(st);
-    // The distributed levels, coarse to fine.
-    for (size_t k = 1; k <= m_; ++k)
-        if (!solve_level(k, st.step, st.s)) {
-            failed_ = true;
-            break;
-        }
+    // The distributed levels, coarse to fine: the level loop of levels::solve.
+    std::vector<StepLevel*> parts;
+    for (const auto& part : parts_)
+        parts.push_back(part.get());
+    failed_ = !solve_levels(parts, st.step, st.s);
     if (!failed_) {
         res_.nodes =
             newton_[m_]->node_states(st.s, u_prev_[m_], x_[m_].head(res_.levels[m_].n_owned));
@@ -744,56 +810,6 @@ void DistributedSteps::step(const LevelStepState& st) {
         res_.completed_steps = st.step;
     }
     res_.distributed_seconds += wall_seconds() - t0;
-}
-
-bool DistributedSteps::solve_level(size_t k, int step, double s) {
-    const DistributedLevel& D = res_.levels[k];
-    ContactNewton& nw = *newton_[k];
-    LevelStep ls;
-    ls.level = p_ + static_cast<int>(k);
-    Vector xo(D.n_owned);
-    // As levels::solve does (SolveOptions::extrapolate): the extrapolated state when Newton
-    // would stop there at once, otherwise the interpolated coarse state.
-    bool extrapolated = false;
-    if (options_.extrapolate) {
-        xo = xo_last_[k];
-        extrapolated = take_extrapolation(nw, s, u_prev_[k], xo_older_[k], xo, ls);
-    }
-    if (!extrapolated) interpolate_from_below(k, xo);
-    ls.predicted = !extrapolated;
-    if (ls.predicted) ls.predicted_statuses = nw.statuses(s, u_prev_[k], xo);
-    if (!extrapolated) ls.report = nw.solve(s, u_prev_[k], xo);
-    ls.report.step = step;
-    ls.report.counts = reduce_counts(comm_, ls.report.counts);
-    tally_statuses(nw, s, u_prev_[k], xo, ls);
-    if (options_.extrapolate) {
-        xo_older_[k] = std::move(xo_last_[k]);
-        xo_last_[k] = xo;
-    }
-    reduce_confusion(comm_, ls.confusion);
-    if (progress_) {
-        LevelStepProgress lp;
-        lp.step = &ls;
-        lp.load_steps = problem_.load_steps;
-        lp.n_levels = problem_.levels + 1;
-        lp.first_level = 0;
-        lp.processes = comm_.size();
-        progress_->level_step_done(lp);
-    }
-    const bool ok = ls.report.converged;
-    if (k == m_) res_.steps.push_back(ls.report);
-    res_.level_steps[k].push_back(std::move(ls));
-    if (!ok) {
-        const auto& r = res_.level_steps[k].back().report;
-        std::ostringstream os;
-        os << "load step " << step << " (load factor " << s << ") on level "
-           << p_ + static_cast<int>(k) << " did not converge: " << r.message
-           << "; residual history:" << residual_history(r);
-        res_.failure = os.str();
-        return false;
-    }
-    accept_level(k, s, xo);
-    return true;
 }
 
 void DistributedSteps::interpolate_from_below(size_t k, Vector& xo) {

@@ -162,7 +162,7 @@ private:
 
 /// The load steps of one run over the levels of its hierarchy: the state of every level, its
 /// solver and Newton driver, and what the report collects. run() is the load-step loop; a load
-/// step is the level loop (solve_load_step), a level its phases: extrapolation, the
+/// step is the level loop (solve_levels) over OneLevel, whose phases are extrapolation, the
 /// coarse-to-fine guess, Newton with the r continuation, the report, and what the level above
 /// takes from it.
 class LoadStepping {
@@ -174,10 +174,9 @@ public:
 private:
     void setup_solvers();
     void change_supports(int step);
-    bool solve_load_step(int step, double s);
-    bool solve_level(int l, int step, double s);
+    class OneLevel;
     bool try_extrapolation(size_t li, double s, LevelStep& ls);
-    void interpolate_from_below(size_t li, int step, double s, LevelStep& ls);
+    void interpolate_from_below(size_t li, int step);
     void newton_with_continuation(size_t li, double s, LevelStep& ls);
     void report_level_step(const LevelStep& ls) const;
     std::string failure(int l, int step, double s, const StepReport& rep) const;
@@ -210,6 +209,54 @@ private:
     std::vector<double> continued_;
     std::vector<std::unique_ptr<NewtonSystemSolver>> continuation_solver_;
     DeformationWatch deformation_;
+    std::vector<std::unique_ptr<StepLevel>> step_levels_; // levels first..finest, for the loop
+};
+
+/// A level of the hierarchy in the level loop (levels/level_step.hpp): its state is the run's.
+class LoadStepping::OneLevel final : public StepLevel {
+public:
+    OneLevel(LoadStepping& run, int l) : run_(run), l_(l), li_(static_cast<size_t>(l)) {}
+    ContactNewton& newton() override { return *run_.newton_[li_]; }
+    const Vector& u_prev() const override { return run_.u_prev_[li_]; }
+    Vector& x() override { return run_.x_[li_]; }
+    int index() const override { return l_; }
+    void begin_step() override {
+        if (run_.options_.transfer_increment) run_.x_before_[li_] = run_.x_[li_]; // for above
+    }
+    bool extrapolate(double s, LevelStep& ls) override {
+        return run_.try_extrapolation(li_, s, ls);
+    }
+    bool interpolate(int step) override {
+        if (!run_.options_.coarse_to_fine || l_ == run_.first_) return false;
+        run_.interpolate_from_below(li_, step);
+        return true;
+    }
+    void solve(int step, double s, LevelStep& ls) override {
+        try {
+            run_.newton_with_continuation(li_, s, ls);
+        } catch (const Interrupted& e) {
+            throw Interrupted("load step " + std::to_string(step) + "/" +
+                              std::to_string(run_.problem_.load_steps) + " on level " +
+                              std::to_string(l_) + ": " + e.what());
+        }
+    }
+    const StepReport& report(LevelStep ls) override {
+        run_.report_level_step(ls);
+        if (l_ == run_.finest_) run_.res_.steps.push_back(ls.report);
+        run_.res_.level_steps[li_].push_back(std::move(ls));
+        return run_.res_.level_steps[li_].back().report;
+    }
+    void fail(int step, double s, const StepReport& rep) override {
+        run_.res_.failure = run_.failure(l_, step, s, rep);
+        run_.res_.stopped = rep.stopped;
+        run_.res_.converged = false;
+    }
+    void accept(int step, double s) override { run_.accept_level(li_, step, s); }
+
+private:
+    LoadStepping& run_;
+    int l_;
+    size_t li_;
 };
 
 SolveObserver& no_observer() {
@@ -254,6 +301,8 @@ LoadStepping::LoadStepping(const Problem& problem, const SolveOptions& options,
     t_start_ = wall_seconds();
     continued_.assign(n, 0.0);
     continuation_solver_.resize(n);
+    for (int l = first_; l < n_levels_; ++l)
+        step_levels_.push_back(std::make_unique<OneLevel>(*this, l));
 }
 
 void LoadStepping::setup_solvers() {
@@ -351,53 +400,16 @@ void LoadStepping::run() {
     for (int step = 1; step <= problem_.load_steps && res_.converged; ++step) {
         const double s = static_cast<double>(step) / problem_.load_steps;
         if (!problem_.same_supports(step, phase_step_)) change_supports(step);
-        if (!solve_load_step(step, s)) break;
+        std::vector<StepLevel*> levels;
+        for (const auto& l : step_levels_)
+            levels.push_back(l.get());
+        if (!solve_levels(levels, step, s)) break;
         finish_load_step(step, s);
     }
     res_.x = x_.back();
     deformation_.warn(res_.hierarchy.levels[static_cast<size_t>(finest_)], res_.warnings);
     if (const solvers::Multigrid* mg = system_[static_cast<size_t>(finest_)]->multigrid())
         res_.multigrid = mg->report();
-}
-
-bool LoadStepping::solve_load_step(int step, double s) {
-    for (int l = first_; l < n_levels_; ++l)
-        if (!solve_level(l, step, s)) return false;
-    return true;
-}
-
-bool LoadStepping::solve_level(int l, int step, double s) {
-    const auto li = static_cast<size_t>(l);
-    ContactNewton& nw = *newton_[li];
-    LevelStep ls;
-    ls.level = l;
-    if (options_.transfer_increment) x_before_[li] = x_[li]; // step - 1, for the level above
-    const bool extrapolated = try_extrapolation(li, s, ls);
-    if (options_.coarse_to_fine && l > first_ && !extrapolated)
-        interpolate_from_below(li, step, s, ls);
-    try {
-        if (!extrapolated) newton_with_continuation(li, s, ls);
-        // else ls.report is check()'s: converged at the extrapolated state.
-    } catch (const Interrupted& e) {
-        throw Interrupted("load step " + std::to_string(step) + "/" +
-                          std::to_string(problem_.load_steps) + " on level " + std::to_string(l) +
-                          ": " + e.what());
-    }
-    ls.report.step = step;
-    tally_statuses(nw, s, u_prev_[li], x_[li], ls);
-    report_level_step(ls);
-    const bool ok = ls.report.converged;
-    if (l == finest_) res_.steps.push_back(ls.report);
-    res_.level_steps[li].push_back(std::move(ls));
-    const StepReport& rep = res_.level_steps[li].back().report;
-    if (!ok) {
-        res_.failure = failure(l, step, s, rep);
-        res_.stopped = rep.stopped;
-        res_.converged = false;
-        return false;
-    }
-    accept_level(li, step, s);
-    return true;
 }
 
 bool LoadStepping::try_extrapolation(size_t li, double s, LevelStep& ls) {
@@ -413,7 +425,7 @@ bool LoadStepping::try_extrapolation(size_t li, double s, LevelStep& ls) {
     return take_extrapolation(*newton_[li], s, u_prev_[li], older, x_[li], ls);
 }
 
-void LoadStepping::interpolate_from_below(size_t li, int step, double s, LevelStep& ls) {
+void LoadStepping::interpolate_from_below(size_t li, int step) {
     // Initial guess (P u_H, Q lambda_H): displacements through the full nodal vectors
     // (prescribed values included), multipliers through Q.
     ScopedTimer t(&res_.timings, "newton/interpolate");
@@ -445,8 +457,6 @@ void LoadStepping::interpolate_from_below(size_t li, int step, double s, LevelSt
                 row += it.value() * xc[it.index()];
             xl[d] = (inc ? xl[d] : 0.0) + (0.0 + 1.0 * row);
         }
-    ls.predicted = true;
-    ls.predicted_statuses = newton_[li]->statuses(s, u_prev_[li], xl);
 }
 
 void LoadStepping::newton_with_continuation(size_t li, double s, LevelStep& ls) {
@@ -553,33 +563,6 @@ void LoadStepping::finish_load_step(int step, double s) {
 }
 
 } // namespace
-
-bool take_extrapolation(ContactNewton& nw, double s, const Vector& u_prev, const Vector& older,
-                        Vector& x, LevelStep& ls) {
-    Vector xe = 2.0 * x - older;
-    StepReport r = nw.check(s, u_prev, xe);
-    if (!r.converged) return false;
-    x = std::move(xe);
-    ls.report = std::move(r);
-    ls.extrapolated = true;
-    return true;
-}
-
-void tally_statuses(const ContactNewton& nw, double s, const Vector& u_prev, const Vector& x,
-                    LevelStep& ls) {
-    ls.final_statuses = nw.statuses(s, u_prev, x);
-    if (ls.predicted)
-        for (size_t e = 0; e < ls.final_statuses.size(); ++e)
-            ++ls.confusion[static_cast<size_t>(ls.predicted_statuses[e])]
-                          [static_cast<size_t>(ls.final_statuses[e])];
-}
-
-std::string residual_history(const StepReport& rep) {
-    std::ostringstream os;
-    for (double r : rep.residuals)
-        os << " " << std::scientific << std::setprecision(2) << r;
-    return os.str();
-}
 
 RunResult solve(const Problem& problem, const SolveOptions& options, SolveObserver* observer) {
     RunResult res;

@@ -4,7 +4,7 @@
 // comm::world(), the serial communicator) and under mpirun -np 2 and -np 3 (label mpi). Every
 // process compares the contact nodes it owns with the one-process run's, matched by their exact
 // coordinates. The partition-level rule is checked against its closed form everywhere. Two-body
-// scenes (issue 13): the contact elements of every part, owned and ghost, are the one-process
+// scenes: the contact elements of every part, owned and ghost, are the one-process
 // level's, and patch and dovetail give the one-process answer.
 #include "levels/distributed.hpp"
 
@@ -193,10 +193,10 @@ TEST(DistributedSolve, HertzLevelTwoIsTheOneProcessAnswer) {
 
 TEST(DistributedSolve, EbeOnEachProcessBlockIsTheOneProcessAnswer) {
     // EBE (C1) from each process's elements restricted to its owned unknowns, coloured within
-    // the process, Jacobi across the cuts (issue 13); level 0 whole, level 1 distributed (the
-    // driver's test, tests/output/test_distributed_run.py, runs level 2). BiCGStab: CGS with EBE
-    // on 2 processes stalls at 5000 iterations on level 2 (README, "Other preconditioners");
-    // BiCGStab needs about as many iterations as on one process.
+    // the process, Jacobi across the cuts; level 0 whole, level 1 distributed (the driver's
+    // test, tests/output/test_distributed_run.py, runs level 2). BiCGStab: CGS with EBE on 2
+    // processes stalls on level 2 (docs/solver-guide.md); BiCGStab needs about as many
+    // iterations as on one process.
     expect_same_answer("square", 1, 0, "bicgstab", "ebe");
 }
 
