@@ -16,7 +16,7 @@
 ///   on level 0) inside CG and GMRES, side by side in one run. Under mpirun with N > 1 processes:
 ///   bench/distributed.hpp (bench_elastic_distributed).
 /// - `bench newton`: the Newton systems of the finest level, captured from a real coarse-to-fine
-///   run (one per Newton step, through levels::SolveOptions::wrap_system_solver), each solved
+///   run (one per Newton step, through levels::SolveObserver::wrap_system_solver), each solved
 ///   from zero to the same relative tolerance by our Krylov method with `mg` as the run uses it
 ///   (at each requested thread count), with hypre MGR (solvers/hypre/mgr.hpp) and with
 ///   BoomerAMG on the whole Jacobian (the naive choice), both at one thread through our

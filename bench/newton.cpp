@@ -441,7 +441,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
                          .pc = opt.pc,
                          .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
-            so.wrap_system_solver = [&](int level, const levels::Level& L,
+            levels::SolverWrapper wrap([&](int level, const levels::Level& L,
                                         std::unique_ptr<levels::NewtonSystemSolver> s)
                 -> std::unique_ptr<levels::NewtonSystemSolver> {
                 if (level == opt.levels)
@@ -450,8 +450,8 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
                 if (level == 0) return s; // schur: no part of the multigrid
                 return std::make_unique<CoarseSetupTimer>(std::move(s),
                                                           &coarse[static_cast<size_t>(level)]);
-            };
-            const levels::RunResult r = levels::solve(problem, so);
+            });
+            const levels::RunResult r = levels::solve(problem, so, &wrap);
             if (!r.converged) {
                 runs_converged = false;
                 failure = r.failure;

@@ -405,7 +405,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
             std::vector<Eigen::Matrix2d> last_M;
             const double rss_before_run = current_rss_bytes();
             double rss_prev = -1;
-            so.wrap_system_solver = [&](int level, const levels::Level&,
+            levels::SolverWrapper wrap([&](int level, const levels::Level&,
                                         std::unique_ptr<levels::NewtonSystemSolver> sys)
                 -> std::unique_ptr<levels::NewtonSystemSolver> {
                 MLC_CHECK(level >= 0 && level <= opt.levels, "bench square: level " << level);
@@ -420,9 +420,9 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
                     level == opt.levels ? &last_M : nullptr);
                 rss_prev = lt[static_cast<size_t>(level)].rss_at_build;
                 return w;
-            };
+            });
             const double t0 = wall_seconds();
-            const levels::RunResult r = levels::solve(base, so);
+            const levels::RunResult r = levels::solve(base, so, &wrap);
             walls.push_back(wall_seconds() - t0);
             converged = r.converged;
             failure = r.failure;
@@ -438,7 +438,6 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
                 matvec_bytes = traffic::csr_bytes(J.rows(), J.cols(), J.nonZeros(), false);
             }
         }
-        so.wrap_system_solver = nullptr;
         const double rss = peak_rss_mib();
         // STREAM once, after the first solver's runs (and after its peak RSS was read).
         if (!stream) stream = traffic::measure_stream(opt.stream_doubles, opt.stream_repeats);

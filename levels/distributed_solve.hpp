@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file The coarse-to-fine solve on several processes (issue 12): levels 0..p (p the partition
+/// @file The coarse-to-fine solve on several processes: levels 0..p (p the partition
 /// level) are solved on every process by levels::solve, as one process solves them, and after
 /// each load step of level p the distributed levels p+1..L solve the same step, each process its
 /// part (levels/distributed.hpp), by Newton (levels::ContactNewton with a NewtonDistribution)
@@ -102,10 +102,14 @@ struct DistributedRunResult {
 /// Collective: solves `problem` on the processes of `comm` (at least one level above level p,
 /// rigid or two-body pairs, supports that stay the same along the path) with the partition level
 /// `partition_level` (< problem.levels). options.linear must be "krylov" with pc "mg" (its
-/// pre/post/omega options apply); options.coarse_to_fine must be on. Progress lines (every
-/// level) go to options.progress on rank 0. Throws InvalidInput naming what is not distributed
-/// or out of range, on every process alike.
+/// pre/post/omega options apply); options.coarse_to_fine must be on. The observer (null: none)
+/// sees the load steps of every level (level_step_done) on rank 0 only, is asked
+/// interrupt_requested and wraps the solvers of levels 0..p on every process; its level_step
+/// and stop_requested are not called (the distributed levels take level p's steps, and a run
+/// stops on every process alike or not at all). Throws InvalidInput naming what is not
+/// distributed or out of range, on every process alike.
 DistributedRunResult solve_distributed(const Problem& problem, const SolveOptions& options,
-                                       const Communicator& comm, int partition_level);
+                                       const Communicator& comm, int partition_level,
+                                       SolveObserver* observer = nullptr);
 
 } // namespace mlc::levels

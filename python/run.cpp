@@ -39,19 +39,25 @@ std::shared_ptr<Result> solve(const Scene& scene, std::optional<int> levels,
     levels::SolverChoice choice;
     levels::SolveOptions so = apps::run_solve_options(res->problem, opt, choice);
     so.keep_step_states = keep_steps;
-    if (progress) so.progress = &std::cout;
     // Ctrl-C: Python's handler only sets a flag while the GIL is released; it is run here,
     // between Newton iterations, and its exception (KeyboardInterrupt) re-raised after the solve.
     PyObject *etype = nullptr, *evalue = nullptr, *etrace = nullptr;
-    so.interrupt_requested = [&]() {
-        py::gil_scoped_acquire gil;
-        if (PyErr_CheckSignals() == 0) return false;
-        PyErr_Fetch(&etype, &evalue, &etrace);
-        return true;
-    };
+    struct PythonObserver final : levels::ProgressLines {
+        using ProgressLines::ProgressLines;
+        PyObject **type = nullptr, **value = nullptr, **trace = nullptr;
+        bool interrupt_requested() override {
+            py::gil_scoped_acquire gil;
+            if (PyErr_CheckSignals() == 0) return false;
+            PyErr_Fetch(type, value, trace);
+            return true;
+        }
+    } observer(progress ? &std::cout : nullptr);
+    observer.type = &etype;
+    observer.value = &evalue;
+    observer.trace = &etrace;
     try {
         py::gil_scoped_release nogil;
-        res->run = levels::solve(res->problem, so);
+        res->run = levels::solve(res->problem, so, &observer);
     } catch (const Interrupted&) {
         if (etype) {
             PyErr_Restore(etype, evalue, etrace);

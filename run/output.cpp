@@ -499,7 +499,7 @@ void StepFiles::operator()(const levels::LevelStepState& s) {
         s.level == finest_ ? "solution" : "solution_level_" + std::to_string(s.level);
     const std::string name = prefix + "_step_" + step.str() + ".vtu";
     folder_->begin_writing(scene_);
-    write_solution_vtu(dir_ / name, *s.L, *s.u_full, *s.nodes, format_);
+    write_solution_vtu(dir_ / name, *s.L, *s.u_full, s.nodes(), format_);
     folder_->add(name);
     auto& series = series_[static_cast<size_t>(s.level)];
     series.emplace_back(s.s, name);

@@ -184,7 +184,7 @@ std::string killed_summary(const std::string& scene, int sig, int processes);
 /// (solution_step_0001.vtu, ... for the finest level; solution_level_<l>_step_0001.vtu for
 /// level l < finest with every_level) and rewrites the collection of that level after each
 /// (solution.pvd, solution_level_<l>.pvd), with the load parameter s as the time. Use as
-/// SolveOptions::on_level_step. Each file written is recorded in `folder`, whose
+/// SolveObserver::level_step. Each file written is recorded in `folder`, whose
 /// begin_writing() is called before the first.
 class StepFiles {
 public:

@@ -179,14 +179,20 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
                      killed_summary(p.name, SIGTERM, 1));
     levels::SolverChoice choice;
     levels::SolveOptions so = run_solve_options(p, opt, choice);
-    so.progress = opt.quiet ? nullptr : &os;
-    so.progress_eta = opt.progress_eta;
-    so.stop = opt.stop;
     std::optional<StepFiles> steps;
-    if (opt.every_step || opt.every_level) {
-        steps.emplace(folder, p, opt.every_level, out.vtu);
-        so.on_level_step = [&](const levels::LevelStepState& s) { (*steps)(s); };
-    }
+    if (opt.every_step || opt.every_level) steps.emplace(folder, p, opt.every_level, out.vtu);
+    // Progress lines, the stop flag, and the files of every step when asked.
+    struct RunObserver final : levels::ProgressLines {
+        using ProgressLines::ProgressLines;
+        const std::atomic<bool>* stop = nullptr;
+        std::optional<StepFiles>* steps = nullptr;
+        void level_step(const levels::LevelStepState& s) override {
+            if (*steps) (**steps)(s);
+        }
+        bool stop_requested() override { return stop && stop->load(); }
+    } observer(opt.quiet ? nullptr : &os, opt.progress_eta);
+    observer.stop = opt.stop;
+    observer.steps = &steps;
     os << "mlcontact: solving '" << p.name << "'\n";
     if (folder.took_over_from() > 0)
         os << "note: the output folder's lock was left by process " << folder.took_over_from()
@@ -205,7 +211,7 @@ int run_scene(const RunOptions& opt, std::ostream& os) {
                << "against ours (short runs take up to 2x); set OPENBLAS_NUM_THREADS=1 or choose "
                << "libopenblas0-serial with update-alternatives\n";
     }
-    levels::RunResult r = levels::solve(p, so);
+    levels::RunResult r = levels::solve(p, so, &observer);
     r.solver = choice;
     print_solve_notes(os, r);
     os << "\n";

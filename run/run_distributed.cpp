@@ -538,7 +538,6 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     so.exact_fallback = !opt.no_fallback;
     so.r_continuation = !opt.no_continuation;
     so.extrapolate = !opt.no_extrapolation;
-    so.progress = opt.quiet ? nullptr : &out;
     MLC_CHECK(!opt.stop, "internal error: a distributed run has no stop flag");
     os << "mlcontact: solving '" << p.name << "' on " << comm.size() << " processes\n";
     const bool mg = solvers::parse_preconditioner_spec(spec.pc).name == "mg";
@@ -555,7 +554,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
                      " triangles per process, at most --levels - 1)")
        << ": levels 0-" << plevel << " on every process, " << plevel + 1 << "-" << finest
        << " distributed\n";
-    levels::DistributedRunResult r = levels::solve_distributed(p, so, comm, plevel);
+    levels::ProgressLines progress(opt.quiet ? nullptr : &out);
+    levels::DistributedRunResult r = levels::solve_distributed(p, so, comm, plevel, &progress);
 
     const auto& F = r.finest();
     const ProcessFigures pf = process_figures(os, r, comm, finest);

@@ -252,13 +252,13 @@ int main(int argc, char** argv) {
     so.linear = {.method = "krylov", .krylov = "bicgstab", .pc = pc, .rel_tol = 1e-8};
     std::map<std::string, Stat> out;
     Index n = 0;
-    so.wrap_system_solver = [&](int level, const levels::Level& L,
-                                std::unique_ptr<levels::NewtonSystemSolver> s)
-        -> std::unique_ptr<levels::NewtonSystemSolver> {
-        if (level != levels) return s;
-        return std::make_unique<Probe>(std::move(s), L, reps, out);
-    };
-    const levels::RunResult r = levels::solve(pr, so);
+    levels::SolverWrapper wrap(
+        [&](int level, const levels::Level& L, std::unique_ptr<levels::NewtonSystemSolver> s)
+            -> std::unique_ptr<levels::NewtonSystemSolver> {
+            if (level != levels) return s;
+            return std::make_unique<Probe>(std::move(s), L, reps, out);
+        });
+    const levels::RunResult r = levels::solve(pr, so, &wrap);
     n = r.finest().n_unknowns();
     if (lattice_numbering && levels >= 5) {
         const levels::Hierarchy& h = r.hierarchy;

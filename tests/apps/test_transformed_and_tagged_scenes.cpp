@@ -354,10 +354,14 @@ struct StepRecord {
 
 std::vector<StepRecord> run_recorded(const levels::Problem& p, levels::SolveOptions opt = {}) {
     std::vector<StepRecord> out;
-    opt.on_level_step = [&](const levels::LevelStepState& st) {
+    struct Record final : levels::SolveObserver {
+        std::function<void(const levels::LevelStepState&)> f;
+        void level_step(const levels::LevelStepState& st) override { f(st); }
+    } record;
+    record.f = [&](const levels::LevelStepState& st) {
         if (st.level != p.levels) return;
         const auto& L = *st.L;
-        const auto nf = nodal_forces(L, st.s, *st.u_full, *st.nodes);
+        const auto nf = nodal_forces(L, st.s, *st.u_full, st.nodes());
         StepRecord r;
         r.axis_reaction = reaction_x(L, nf, "cylinder_axis");
         r.axis_fixed = L.fixed[static_cast<size_t>(
@@ -367,7 +371,7 @@ std::vector<StepRecord> run_recorded(const levels::Problem& p, levels::SolveOpti
         r.block = body_balance(L, nf, 0);
         r.cylinder = body_balance(L, nf, 1);
         r.u = *st.u_full;
-        r.nodes = *st.nodes;
+        r.nodes = st.nodes();
         double lmax = 0;
         for (const auto& n : r.nodes)
             lmax = std::max(lmax, std::abs(n.lambda_n));
@@ -384,7 +388,7 @@ std::vector<StepRecord> run_recorded(const levels::Problem& p, levels::SolveOpti
         }
         out.push_back(std::move(r));
     };
-    const auto res = levels::solve(p, opt);
+    const auto res = levels::solve(p, opt, &record);
     EXPECT_TRUE(res.converged) << res.failure;
     return out;
 }

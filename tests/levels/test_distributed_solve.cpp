@@ -193,11 +193,10 @@ TEST(DistributedSolve, HertzLevelTwoIsTheOneProcessAnswer) {
 
 TEST(DistributedSolve, EbeOnEachProcessBlockIsTheOneProcessAnswer) {
     // EBE (C1) from each process's elements restricted to its owned unknowns, coloured within
-    // the process, Jacobi across the cuts; level 0 whole, level 1 distributed (the
-    // driver's test, tests/output/test_distributed_run.py, runs level 2). BiCGStab: CGS with EBE
-    // on 2 processes stalls at 5000 iterations on level 2 (docs/parallel.md,
-    // "Other preconditioners");
-    // BiCGStab needs about as many iterations as on one process.
+    // the process, Jacobi across the cuts; level 0 whole, level 1 distributed (the driver's
+    // test, tests/output/test_distributed_run.py, runs level 2). BiCGStab: CGS with EBE on 2
+    // processes stalls on level 2 (docs/solver-guide.md); BiCGStab needs about as many
+    // iterations as on one process.
     expect_same_answer("square", 1, 0, "bicgstab", "ebe");
 }
 
