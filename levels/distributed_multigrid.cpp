@@ -7,7 +7,9 @@
 #include "core/timer.hpp"
 #include "levels/krylov_system.hpp"
 #include "levels/newton_system.hpp"
+#include "levels/resources.hpp"
 #include "smoothers/block_sor.hpp"
+#include "smoothers/lattice_gs.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/krylov.hpp"
 
@@ -19,15 +21,17 @@
 namespace mlc::levels {
 
 /// The Newton systems of the distributed levels and their multigrid (distributed_solve.hpp).
-struct DistributedMultigrid::Impl {
+struct DistributedMultigrid::Impl final : solvers::VCycle {
     Impl(const std::vector<DistributedLevel>& levels,
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
          LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
           use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"),
           use_ebe_(solvers::parse_preconditioner_spec(spec_.pc).name == "ebe"), op_(levels.size()) {
-        for (size_t k = 1; k < levels.size(); ++k)
+        for (size_t k = 1; k < levels.size(); ++k) {
             build_jacobian(k);
+            transfer_.emplace_back(*transfers[k - 1].T);
+        }
     }
 
     /// Level p at its converged statuses: the gathered coarse solve (map built on first use).
@@ -108,22 +112,45 @@ struct DistributedMultigrid::Impl {
             } else {
                 o.block_pc->update_values(o.blocks->diag);
             }
-        } else if (!o.smoother) {
-            std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
-            for (Index i = 0; i < L.n_owned; ++i)
-                vertex_of[static_cast<size_t>(i)] = L.local.dofs.vertex_of(i);
-            o.smoother = std::make_unique<smoothers::BlockSOR>(
-                smoothers::BlockSORParams{.omega = mg_.omega,
-                                          .block_size = 2,
-                                          .block_starts = solvers::vertex_block_starts(vertex_of),
-                                          .parts = 1,
-                                          .kernel = smoothers::Kernel::unrolled});
-            o.smoother->setup(o.blocks->diag);
+        } else if (!o.smoother && !o.lattice) {
+            make_smoother(k);
+        } else if (o.lattice) {
+            o.lattice->update_values(o.blocks->diag);
         } else {
             o.smoother->update_values(o.blocks->diag);
         }
         o.last_M = M;
         o.prepared = true;
+    }
+
+    /// The smoother of level k's diagonal block, set up: mg:smoother=lattice's sweep on a level
+    /// with lattice rows of at least solvers::kMinLatticeSubdivisions subdivisions (as on one
+    /// process), else vertex-block Gauss-Seidel in mg's precision. One threaded part: each
+    /// process sweeps its block in one piece.
+    void make_smoother(size_t k) {
+        Op& o = op_[k];
+        const DistributedLevel& L = levels_[k];
+        std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
+        for (Index i = 0; i < L.n_owned; ++i)
+            vertex_of[static_cast<size_t>(i)] = L.local.dofs.vertex_of(i);
+        std::vector<Index> starts = solvers::vertex_block_starts(vertex_of);
+        const auto& rows = L.local.lattice;
+        if (mg_.smoother == solvers::MultigridParams::Smoother::lattice && rows &&
+            rows->n >= solvers::kMinLatticeSubdivisions) {
+            o.lattice = std::make_unique<smoothers::LatticeGS>(
+                std::move(starts), *rows,
+                smoothers::LatticeGSParams{.omega = mg_.omega, .parts = 1});
+            o.lattice->setup(o.blocks->diag);
+            return;
+        }
+        o.smoother = std::make_unique<smoothers::BlockSOR>(
+            smoothers::BlockSORParams{.omega = mg_.omega,
+                                      .block_size = 2,
+                                      .block_starts = std::move(starts),
+                                      .parts = 1,
+                                      .kernel = smoothers::Kernel::unrolled,
+                                      .precision = mg_.precision});
+        o.smoother->setup(o.blocks->diag);
     }
 
     SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
@@ -172,7 +199,10 @@ struct DistributedMultigrid::Impl {
         std::ostringstream os;
         if (!use_mg_) return spec_.krylov + " + " + spec_.pc + " on each process's diagonal block";
         os << spec_.krylov << " + distributed mg(pre=" << mg_.pre_sweeps
-           << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega << ")";
+           << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega;
+        if (mg_.precision == Precision::float32) os << ",precision=single";
+        if (mg_.smoother == solvers::MultigridParams::Smoother::lattice) os << ",smoother=lattice";
+        os << ")";
         return os.str();
     }
 
@@ -181,7 +211,10 @@ struct DistributedMultigrid::Impl {
         int block = -1;
     };
 
-    struct Op {
+    /// One distributed level: its operator (the owned rows of J), the smoother of its diagonal
+    /// block (Jacobi across the cuts: the other processes' unknowns held at their values, which
+    /// hypre's halo exchange brings) and the cycle's work vectors.
+    struct Op final : solvers::CycleOperator, solvers::CycleSmoother {
         /// J's owned rows (the one copy of J: hypre's J and the smoother read them in place).
         std::unique_ptr<solvers::RowBlocks> blocks;
         std::vector<int> kpos; ///< position in blocks->diag of every entry of K's diagonal block
@@ -192,7 +225,10 @@ struct DistributedMultigrid::Impl {
         /// off-diagonal block is K's (no contact entry in it).
         std::vector<int> kopos;
         std::unique_ptr<solvers::ParMatrix> J;
+        /// The smoother of the diagonal block: the lattice sweep where the level has lattice
+        /// rows and mg:smoother=lattice asks for it, else vertex-block Gauss-Seidel.
         std::unique_ptr<smoothers::BlockSOR> smoother;
+        std::unique_ptr<smoothers::LatticeGS> lattice;
         std::unique_ptr<Preconditioner> block_pc; ///< without mg: spec.pc on the diagonal block
         /// ebe: the elements of the diagonal block (elastic, restricted; then contact), which
         /// block_pc borrows.
@@ -201,6 +237,49 @@ struct DistributedMultigrid::Impl {
         std::vector<Eigen::Matrix2d> last_M;
         bool prepared = false;
         mutable Vector res, t, rc, ec, d, ghost;
+
+        /// y -= A_offd z (the halo exchange of z).
+        void minus_offdiagonal(const Vector& z, Vector& y) const {
+            J->ghost_values(z, ghost);
+            J->subtract_offdiagonal(ghost, y);
+        }
+        void residual(const Vector& r, const Vector& z, Vector& out) const override {
+            J->apply(z, t);
+            out = r - t;
+        }
+        void forward_from_zero(const Vector& r, Vector& z, Vector& out) const override {
+            if (lattice)
+                lattice->forward_from_zero(r, z, out); // out = r - A_diag z
+            else
+                smoother->forward_from_zero(r, z, out);
+            minus_offdiagonal(z, out);
+        }
+        void smooth(const Vector& r, Vector& z, smoothers::Sweep direction,
+                    int count) const override {
+            for (int s = 0; s < count; ++s) {
+                d = r;
+                minus_offdiagonal(z, d);
+                if (lattice)
+                    lattice->smooth(d, z, direction, 1);
+                else
+                    smoother->sweep(d, z, direction);
+            }
+        }
+    };
+
+    /// The transfer from the level below: T a ParCSR matrix, R = T^T.
+    struct Transfer final : solvers::CycleTransfer {
+        explicit Transfer(const solvers::ParMatrix& prolongation) : T(prolongation) {}
+        const solvers::ParMatrix& T;
+        mutable Vector t;
+        void restrict_residual(const Vector& res, Vector& rc) const override {
+            T.apply_transpose(res, rc);
+        }
+        void prolongate(const Vector& e, Vector& z, bool add) const override {
+            T.apply(e, t);
+            if (!add) z.setZero(t.size());
+            z += t;
+        }
     };
 
     /// Without mg: the preconditioner of each process's diagonal block (Jacobi across the cuts).
@@ -221,7 +300,9 @@ struct DistributedMultigrid::Impl {
     public:
         Cycle(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
         void setup(const SparseMatrix&) override {}
-        void apply(const Vector& r, Vector& z) const override { s_.cycle(k_, r, z); }
+        void apply(const Vector& r, Vector& z) const override {
+            s_.cycle(static_cast<int>(k_), r, z);
+        }
         std::string name() const override { return s_.name(); }
 
     private:
@@ -352,52 +433,29 @@ struct DistributedMultigrid::Impl {
         coarse_rhs_.resize(Lp.n_unknowns());
     }
 
-    void cycle(size_t k, const Vector& r, Vector& z) const {
-        if (k == 0) {
-            const auto full = comm_.allgather(std::span<const double>(r.data(), r.size()));
-            for (size_t g = 0; g < full.size(); ++g)
-                coarse_rhs_[coarse_map_[g]] = full[g];
-            const Vector zs = lu_.solve(coarse_rhs_);
-            const DistributedLevel& D = levels_[0];
-            z.resize(D.n_owned);
-            for (Index i = 0; i < D.n_owned; ++i)
-                z[i] = zs[coarse_map_[static_cast<size_t>(D.first_dof + i)]];
-            return;
-        }
-        const Op& o = op_[k];
-        const solvers::ParMatrix& T = *transfers_[k - 1].T;
-        // Hybrid Gauss-Seidel: the sweeps run on the process's diagonal block with the other
-        // processes' unknowns held at their values (hypre's halo exchange brings them).
-        auto minus_offdiagonal = [&](Vector& y) { // y -= A_offd z
-            o.J->ghost_values(z, o.ghost);
-            o.J->subtract_offdiagonal(o.ghost, y);
-        };
-        if (mg_.pre_sweeps == 0) {
-            z.setZero(r.size());
-            o.res = r;
-        } else {
-            o.smoother->forward_from_zero(r, z, o.res); // res = r - A_diag z
-            for (int s = 1; s < mg_.pre_sweeps; ++s) {
-                o.d = r;
-                minus_offdiagonal(o.d);
-                o.smoother->sweep(o.d, z, smoothers::Sweep::forward);
-            }
-            if (mg_.pre_sweeps > 1) {
-                o.J->apply(z, o.t);
-                o.res = r - o.t;
-            } else {
-                minus_offdiagonal(o.res);
-            }
-        }
-        T.apply_transpose(o.res, o.rc);
-        cycle(k - 1, o.rc, o.ec);
-        T.apply(o.ec, o.t);
-        z += o.t;
-        for (int s = 0; s < mg_.post_sweeps; ++s) {
-            o.d = r;
-            minus_offdiagonal(o.d);
-            o.smoother->sweep(o.d, z, smoothers::Sweep::backward);
-        }
+    solvers::CycleLevel cycle_level(int k) const override {
+        const Op& o = op_[static_cast<size_t>(k)];
+        return {o,
+                o,
+                transfer_[static_cast<size_t>(k) - 1],
+                mg_.pre_sweeps,
+                mg_.post_sweeps,
+                o.res,
+                o.rc,
+                o.ec};
+    }
+
+    /// The gathered coarse solve: the residual gathered on every process, solved by the LU of
+    /// level p, this process's entries kept.
+    void coarse_solve(const Vector& r, Vector& z) const override {
+        const auto full = comm_.allgather(std::span<const double>(r.data(), r.size()));
+        for (size_t g = 0; g < full.size(); ++g)
+            coarse_rhs_[coarse_map_[g]] = full[g];
+        const Vector zs = lu_.solve(coarse_rhs_);
+        const DistributedLevel& D = levels_[0];
+        z.resize(D.n_owned);
+        for (Index i = 0; i < D.n_owned; ++i)
+            z[i] = zs[coarse_map_[static_cast<size_t>(D.first_dof + i)]];
     }
 
     const std::vector<DistributedLevel>& levels_;
@@ -408,6 +466,7 @@ struct DistributedMultigrid::Impl {
     bool use_mg_ = true;   ///< else spec_.pc on each process's diagonal block
     bool use_ebe_ = false; ///< spec_.pc is ebe (on each process's diagonal block)
     std::vector<Op> op_;
+    std::vector<Transfer> transfer_; ///< transfer_[k - 1]: level k - 1 -> k
     const Level* coarse_level_ = nullptr;
     std::unique_ptr<JacobianAssembler> coarse_asm_;
     Eigen::SparseLU<SparseMatrixCol> lu_;
@@ -480,19 +539,35 @@ solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
               "mg:coarse=" << coarse
                            << " has no distributed form; on several processes mg rediscretizes "
                               "(coarse=rediscretize)");
+    // Per process on its diagonal block, as one process smooths its level.
     const std::string precision = o.get_string("precision", "double");
-    MLC_CHECK(precision == "double",
-              "mg:precision=" << precision
-                              << " has no distributed form; on several processes mg's data is "
-                                 "double (precision=double)");
+    MLC_CHECK(precision == "double" || precision == "single",
+              "option precision=" << precision << " of mg: valid double, single");
+    p.precision = precision == "single" ? Precision::float32 : Precision::float64;
     const std::string smoother = o.get_string("smoother", "block");
-    MLC_CHECK(smoother == "block",
-              "mg:smoother=" << smoother
-                             << " has no distributed form; on several processes mg smooths by "
-                                "vertex blocks (smoother=block)");
+    MLC_CHECK(smoother == "block" || smoother == "lattice",
+              "option smoother=" << smoother << " of mg: valid block, lattice");
+    p.smoother = smoother == "lattice" ? solvers::MultigridParams::Smoother::lattice
+                                       : solvers::MultigridParams::Smoother::block;
     o.finish();
     p.validate();
     return p;
+}
+
+LinearSolverSpec serial_levels_spec(const LinearSolverSpec& spec, int partition_level) {
+    LinearSolverSpec s = spec;
+    if (spec.method != "krylov" || partition_level >= kMgDefaultLatticeLevel) return s;
+    auto ps = solvers::parse_preconditioner_spec(spec.pc);
+    const auto it = ps.options.find("smoother");
+    if (ps.name != "mg" || it == ps.options.end() || it->second != "lattice") return s;
+    ps.options.erase(it);
+    s.pc = ps.name;
+    char sep = ':';
+    for (const auto& [key, value] : ps.options) {
+        s.pc += sep + key + "=" + value;
+        sep = ',';
+    }
+    return s;
 }
 
 } // namespace mlc::levels

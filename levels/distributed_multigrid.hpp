@@ -57,4 +57,9 @@ private:
 /// spec is not a Krylov method with mg (naming what has no distributed form).
 solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec);
 
+/// The solver of levels 0..p of a distributed run (solved on every process by levels::solve):
+/// `spec` itself, but without mg:smoother=lattice when p is below the first level the lattice
+/// sweep applies to (those levels are swept by vertex blocks either way).
+LinearSolverSpec serial_levels_spec(const LinearSolverSpec& spec, int partition_level);
+
 } // namespace mlc::levels

@@ -165,6 +165,7 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
     std::ostream* progress = comm.rank() == 0 ? options.progress : nullptr;
 
     SolveOptions so = options;
+    so.linear = serial_levels_spec(options.linear, p);
     so.progress = progress;
     so.stop = &stop;
     so.keep_step_states = false;

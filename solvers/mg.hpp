@@ -32,6 +32,7 @@
 #include "core/linear_operator.hpp"
 #include "smoothers/block_sor.hpp"
 #include "smoothers/lattice_gs.hpp"
+#include "solvers/vcycle.hpp"
 
 #include <memory>
 #include <ostream>
@@ -119,7 +120,7 @@ std::ostream& operator<<(std::ostream& os, const MultigridReport& r);
 
 /// The multigrid preconditioner (see the file comment). Not thread-safe (mutable work vectors);
 /// `apply` does not allocate when the coarse solver does not.
-class Multigrid final : public Preconditioner {
+class Multigrid final : public Preconditioner, private VCycle {
 public:
     /// A multigrid on `levels` (coarsest first, at least two; T and R of every level above the
     /// coarsest, with consistent sizes). The coarse solve is a sparse LU of the coarsest
@@ -179,7 +180,8 @@ public:
 private:
     struct Level;
     Multigrid() = default;
-    void cycle(int k, const Vector& r, Vector& z) const;
+    CycleLevel cycle_level(int k) const override;
+    void coarse_solve(const Vector& r, Vector& z) const override;
     void set_galerkin_operators(const SparseMatrix& A);
     bool refresh_galerkin_operators(const SparseMatrix& A);
 
