@@ -167,8 +167,13 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         const Cycle cycle(*this, k);
         const BlockPc block(*this, k);
         const Preconditioner& pc = use_mg_ ? static_cast<const Preconditioner&>(cycle) : block;
-        SolveResult r =
-            solvers::solve(solvers::parse_krylov(spec_.krylov), *op_[k].J, pc, b, dx, kp);
+        // With the lattice sweep, the Krylov product's diagonal block by its structured kernel
+        // (as one process multiplies by its finest level's lattice smoother).
+        const Op& o = op_[k];
+        const LatticeProduct lattice_product(o);
+        const LinearOperator& A =
+            o.lattice ? static_cast<const LinearOperator&>(lattice_product) : *o.J;
+        SolveResult r = solvers::solve(solvers::parse_krylov(spec_.krylov), A, pc, b, dx, kp);
         r.setup_seconds = t1 - t0;
         r.solve_seconds = wall_seconds() - t1;
         return r;
@@ -265,6 +270,20 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
                     smoother->sweep(d, z, direction);
             }
         }
+    };
+
+    /// J with its diagonal block multiplied by the lattice smoother's structured kernel.
+    class LatticeProduct final : public LinearOperator {
+    public:
+        explicit LatticeProduct(const Op& o) : o_(o) {}
+        Index rows() const override { return o_.J->rows(); }
+        Index cols() const override { return o_.J->cols(); }
+        void apply(const Vector& x, Vector& y) const override {
+            o_.J->apply(x, y, smoothers::LatticeOperator(*o_.lattice));
+        }
+
+    private:
+        const Op& o_;
     };
 
     /// The transfer from the level below: T a ParCSR matrix, R = T^T.
