@@ -179,7 +179,7 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         return r;
     }
 
-    /// EBE on the diagonal block (issue 13): the elastic element matrices of every local triangle
+    /// EBE on the diagonal block: the elastic element matrices of every local triangle
     /// restricted to the owned unknowns (so that they sum to the diagonal block of K; the
     /// triangles cut by the partition contribute their owned rows and columns), then the contact
     /// elements (all at owned vertices) at the statuses M. EBE colours them within the process.

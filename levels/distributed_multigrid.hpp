@@ -1,8 +1,14 @@
 // SPDX-License-Identifier: MIT
-/// @file The distributed multigrid: one V-cycle over the distributed levels of a run on several
-/// processes (levels/distributed.hpp), on each the operator of its converged statuses
-/// (rediscretized, as mg does on one process), its Newton system's on the finest, and on level p
-/// the gathered coarse solve.
+/// @file The distributed multigrid: the V-cycle of solvers/vcycle.hpp (the one-process
+/// multigrid's) over the distributed levels of a run on several processes
+/// (levels/distributed.hpp). On each level the operator of its converged statuses (rediscretized,
+/// as mg does on one process; its Newton system's on the finest) as a ParCSR matrix, whose halo
+/// exchange gives the residuals; the smoother of each process's diagonal block, the other
+/// processes' unknowns held at their values (Jacobi across the cuts): mg:smoother=lattice's sweep
+/// where the level is numbered by lattices (the macro triangles a process owns whole), else
+/// vertex-block Gauss-Seidel, in double or (mg:precision=single) single precision; T a ParCSR
+/// matrix, R = T^T. On level p the gathered coarse solve: the residual gathered on every process
+/// and solved by the sparse LU of level p's Jacobian at its converged statuses.
 #pragma once
 
 #include "core/communicator.hpp"

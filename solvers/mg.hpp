@@ -12,7 +12,8 @@
 ///     coarse:      z <- z + T_k B_{k-1} R_k (r - A_k z)    (B_{k-1}: the cycle of level k-1)
 ///     post-smooth: z <- z + S_bwd (r - A_k z)              (nu2 backward sweeps)
 ///
-/// and on level 0 z = A_0^{-1} r by the coarse solver (sparse LU unless replaced). T_k is the
+/// (the cycle of solvers/vcycle.hpp, shared with the distributed multigrid) and on level 0
+/// z = A_0^{-1} r by the coarse solver (sparse LU unless replaced). T_k is the
 /// prolongation from level k-1 (P on displacements, Q on multipliers: transfer::LevelTransfer::T)
 /// and R_k = T_k^T. Every step is linear in r and nothing depends on the iteration, so the cycle
 /// is a fixed linear operator: CGS, BiCGStab and (non-flexible) GMRES all apply. With forward

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file A square matrix distributed by rows over the processes of a Communicator, held once as
 /// hypre's ParCSR matrix (per process a diagonal and an off-diagonal block; hypre exchanges the
-/// halo of a mat-vec), built and refreshed through hypre's IJ interface (issue 12, item 3).
+/// halo of a mat-vec), built and refreshed through hypre's IJ interface.
 /// Compiled only with MLC_WITH_HYPRE (MLC_HAVE_HYPRE defined); without it the constructor throws
 /// InvalidInput saying so. hypre and MPI stay in the .cpp.
 #pragma once
@@ -61,10 +61,10 @@ public:
               int n_cols);
     /// Collective. A ParCSR matrix on `blocks`' arrays, not a copy: hypre reads blocks.diag and
     /// blocks.offd where they are, so values written into them later are the matrix's (what the
-    /// smoother of a process's diagonal block and the Newton assembly write into; issue 12,
-    /// "one copy of each operator"). `blocks` must outlive this object and keep its patterns.
-    /// The row and column partitions follow the blocks in rank order, as above. update_values()
-    /// throws InvalidInput on such a matrix (write into the blocks).
+    /// smoother of a process's diagonal block and the Newton assembly write into: one copy of each
+    /// operator). `blocks` must outlive this object and keep its patterns. The row and column
+    /// partitions follow the blocks in rank order, as above. update_values() throws InvalidInput on
+    /// such a matrix (write into the blocks).
     ParMatrix(const Communicator& comm, RowBlocks& blocks);
     ~ParMatrix() override;
     ParMatrix(const ParMatrix&) = delete;
