@@ -272,9 +272,7 @@ void number_unknowns(const Problem& problem, Level& L, const LevelPart* part,
     std::vector<int> order;
     std::optional<mesh::MacroLattice> lattice;
     if (part) {
-        MLC_CHECK(problem.numbering == Problem::Numbering::hilbert,
-                  "the lattice numbering has no distributed form: on several processes each "
-                  "process numbers its unknowns along a Hilbert curve (drop --numbering lattice)");
+        // The part's order (levels/distributed.cpp numbers it, by lattices too).
         if (!part->order.empty()) order = part->order;
     } else if (problem.numbering == Problem::Numbering::lattice) {
         // The refinements of mesh0 this level is, when it is (4^d times mesh0's triangles).

@@ -493,6 +493,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
                              "on every process; the levels above it are distributed)");
     const bool two_body = levels::has_two_body_pair(p);
     const levels::LinearSolverSpec spec = distributed_solver_spec(opt, two_body);
+    levels::number_for(p, spec.pc); // mg:smoother=lattice: each part numbered by lattices
     const int finest = p.levels;
     int plevel = opt.partition_level
                      ? *opt.partition_level

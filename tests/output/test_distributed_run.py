@@ -212,7 +212,7 @@ def test_ebe_runs_on_each_process_block(tmp_path):
     (["--linear", "schur"], "--linear schur has no distributed form"),
     (["--pc", "sorcf"], "'sorcf' has no distributed form"),
     (["--cold"], "--cold is one process only"),
-    (["--pc", "mg:precision=single"], "mg:precision=single has no distributed form"),
+    (["--pc", "mg:coarse=galerkin"], "mg:coarse=galerkin has no distributed form"),
     (["--partition-level", "3"], "--partition-level must lie in [0, 2] for --levels 3"),
 ])
 def test_what_has_no_distributed_form_is_refused_once(tmp_path, args, message):
