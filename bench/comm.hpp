@@ -2,7 +2,7 @@
 /// @file `mlcontact bench comm`: what one V-cycle of the distributed mg, one
 /// mat-vec and one Krylov iteration cost each process in messages, bytes and reductions, and in
 /// seconds: the inputs of the scaling model (scripts/measure/scaling_model.py,
-/// docs/parallel.md).
+/// docs/parallel.md#cluster-communication).
 ///
 /// On the elastic block of a scene's level L (its contact pairs dropped, distributed as a run
 /// distributes it: bench/distributed.hpp), with the mg of a run (vertex-block Gauss-Seidel,

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file The benches' subcommands (`mlcontact bench ...`), see docs/studies.md.
+/// @file The benches' subcommands (`mlcontact bench ...`), see docs/studies.md#bench.
 #pragma once
 
 #include "run/command.hpp"

@@ -4,7 +4,7 @@
 /// passes every call on to the MPI library by its PMPI_ name. comm::mpi_counters()
 /// (comm/counters.hpp) reads the counts through mlc_pmpi_counters when this library is loaded.
 ///
-/// Three kinds, as the scaling model of docs/parallel.md counts them:
+/// Three kinds, as the scaling model of docs/parallel.md#cluster-model counts them:
 ///   point-to-point: messages sent (Send, Isend, Irsend, Rsend, Ssend, Issend, and each started
 ///     persistent send) and their bytes;
 ///   reductions: Allreduce, Reduce, Scan, Exscan calls and their bytes (the reduced vector);

@@ -40,7 +40,7 @@ void set_num_threads(int n);
 /// one); "none" when no BLAS is loaded. Computed once per process. The reference BLAS (Debian's
 /// libblas3) makes `schur`'s set-up slower than OpenBLAS (libopenblas0-serial, which
 /// scripts/deps.sh installs); a threaded OpenBLAS starts its threads when the library loads,
-/// and they spin against this pool (docs/guide/install.md). The report notes both; summary.json
+/// and they spin against this pool (docs/guide/install.md#install-dependencies). The report notes both; summary.json
 /// names the library.
 std::string blas_library();
 

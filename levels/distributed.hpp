@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file The levels of a distributed run (docs/parallel.md): each process builds its part of every
+/// @file The levels of a distributed run (docs/parallel.md#parallel-how): each process builds its part of every
 /// level above the partition level p from mesh::distribute's local meshes, with the unknowns it
 /// owns numbered first, the stiffness and prolongations as hypre ParCSR matrices
 /// (solvers::ParMatrix), and the values of the unknowns at ghost vertices fetched from their
@@ -126,7 +126,7 @@ DistributedTransfer build_distributed_transfer(const DistributedLevel& coarse,
                                                const Communicator& comm,
                                                transfer::QRule rule = transfer::QRule::paper);
 
-/// The partition level of a run on `n_processes` processes (docs/parallel.md): the coarsest level
+/// The partition level of a run on `n_processes` processes (docs/parallel.md#parallel-partition-level): the coarsest level
 /// with at least kTrianglesPerProcess triangles per process, and at most `finest - 1` (so that at
 /// least one level above it is distributed), at least 0. `level0_triangles`: the triangles of level
 /// 0 (each level has four times those of the one below).

@@ -387,7 +387,7 @@ smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& la
     // The visit: the blocks in the numbering's order, each macro's interior in serpentine rows
     // (row j = 1, 3, ... left to right, j = 2, 4, ... right to left): as cheap to sweep as the
     // numbering's row-by-row order (the rows still stream) and a better Gauss-Seidel order on
-    // the square (fewer BiCGStab iterations per Newton step; docs/solver-guide.md).
+    // the square (fewer BiCGStab iterations per Newton step; docs/solver-guide.md#solver-why-default).
     const int N = rows.n;
     const long np = mesh::MacroLattice::interior_points(N);
     const long n_macros = np > 0 ? static_cast<long>(rows.first_row.size()) / np : 0;

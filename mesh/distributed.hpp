@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file A mesh hierarchy distributed over the processes of a Communicator: one level p is
 /// partitioned, each process keeps its triangles plus one layer of ghost triangles and refines
-/// them locally, so every process holds a nested hierarchy of its own part (docs/parallel.md,
-/// "How it works").
+/// them locally, so every process holds a nested hierarchy of its own part (docs/parallel.md#parallel-how).
 ///
 /// Every process holds the whole level-p mesh (the levels up to p are small and redundant) and
 /// partitions it the same way (partition_triangles is deterministic), so building the hierarchy

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Scene parsing with toml++: the top-level tables are read in order by the readers of kSections,
-// every key checked against the schema documented in docs/guide/scenes.md.
+// every key checked against the schema documented in docs/guide/scenes.md#scene-keys.
 #include "scene/scene.hpp"
 
 #include "core/check.hpp"

@@ -64,7 +64,7 @@ out=$dir/ctest.log
 # single-precision multigrids against their references, the recovered levels and the held corner.
 # What they run is covered here by the unit tests of the same code (levels, solvers, contact,
 # smoothers, transfer, the hierarchy tests); this keeps .ci/run well under 40 minutes
-# (docs/testing.md).
+# (docs/testing.md#testing-hostile).
 heavy="^(NewScenes\.CoarseToFineNewtonAndMgSolveEveryNewScene|ErrorVsTime\.MultilevelRowsConvergeAndTheirErrorFallsWithTheLevel|Mindlin\.PartialSlipStickZoneMatchesCattaneoMindlin|AlgebraicMultigrid\.SolvesTheSquareExportedFromLevel2LikeSchur|PredictLevelSizes\.RefinementCountsAreExactAndUnknownsClose"
 heavy+="|Multigrid\.VCycleIsLevelIndependentAsCGPreconditioner|Krylov\.BicgstabOverTheThreadsIsTheWholeVectorIterationBitForBit|CoarseToFine\.SquareMatchesColdStartWithHalfTheNewtonIterations|MultilevelPreconditioner\.TheDampedTwoBodyDefaultSolvesTheDovetail"
 heavy+="|LatticeTransfer\.TAndRThroughTheLatticeAreTheirCsrProductsBitForBit|LatticeMultigrid\.SquareLevel4LikeTheBlockSmoother|SinglePrecisionMultigrid\.SquareLevel3LikeDouble|CoarseToFine\.IncrementTransferGivesTheSameSolutionAndPredictsAtLeastAsWell"

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Construction and application of the two-level interpolation P (displacements) and Q (contact
-// multipliers) of Alart & Lebon (1995), sect. 2.4 (docs/theory.md, "The level hierarchy and the
-// transfers P and Q").
+// multipliers) of Alart & Lebon (1995), sect. 2.4 (docs/theory.md#theory-transfer).
 #include "transfer/transfer.hpp"
 
 #include "core/check.hpp"
