@@ -13,7 +13,7 @@
 # cmake/rewrite_includes.cmake), a mechanical rewrite of the #include lines only.
 include(CMakePackageConfigHelpers)
 include(GNUInstallDirs)
-set(_mlc_folders core comm mesh fem contact transfer smoothers solvers levels scene apps)
+set(_mlc_folders core comm mesh fem contact transfer smoothers solvers levels scene run studies bench)
 set(_mlc_targets)
 foreach(f ${_mlc_folders})
   list(APPEND _mlc_targets mlc_${f})
@@ -30,6 +30,9 @@ install(TARGETS ${_mlc_targets} mlc_all EXPORT mlcontactTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS mlcontact RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# The plotting scripts, found by the driver and the Python module in share/mlcontact/plots
+# above them (run/plot_script.hpp).
+install(FILES ${MLC_PLOT_SCRIPTS} DESTINATION ${CMAKE_INSTALL_DATADIR}/mlcontact/plots)
 install(CODE "set(MLC_HEADER_ROOT \"\$ENV{DESTDIR}\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_INCLUDEDIR}/mlcontact\")
 set(MLC_FOLDERS \"${_mlc_folders}\")
 include(\"${PROJECT_SOURCE_DIR}/cmake/rewrite_includes.cmake\")")

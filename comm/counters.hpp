@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file What this process has sent through MPI, as counted by the PMPI library
-/// comm/pmpi_counters.cpp (libmlc_pmpi_counters.so, loaded with LD_PRELOAD under mpirun; issue 13
-/// item 4). Without it loaded (or without MPI) mpi_counts() says so, and nothing else changes.
+/// comm/pmpi_counters.cpp (libmlc_pmpi_counters.so, loaded with LD_PRELOAD under mpirun; `mlcontact
+/// bench comm`). Without it loaded (or without MPI) mpi_counts() says so, and nothing else changes.
 #pragma once
 
 #include <cstdint>

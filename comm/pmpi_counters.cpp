@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: MIT
-/// @file A PMPI profiling library (issue 13, item 4): loaded with LD_PRELOAD under mpirun, it
+/// @file A PMPI profiling library (`mlcontact bench comm`): loaded with LD_PRELOAD under mpirun, it
 /// counts what this process sends through MPI, whoever calls it (our comm layer or hypre), and
 /// passes every call on to the MPI library by its PMPI_ name. comm::mpi_counters()
 /// (comm/counters.hpp) reads the counts through mlc_pmpi_counters when this library is loaded.
 ///
-/// Three kinds, as the scaling model of the README counts them:
+/// Three kinds, as the scaling model of docs/parallel.md#cluster-model counts them:
 ///   point-to-point: messages sent (Send, Isend, Irsend, Rsend, Ssend, Issend, and each started
 ///     persistent send) and their bytes;
 ///   reductions: Allreduce, Reduce, Scan, Exscan calls and their bytes (the reduced vector);

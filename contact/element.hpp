@@ -43,7 +43,7 @@ template <size_t N> constexpr std::array<int, N> filled_minus_one() {
 } // namespace detail
 
 /// One contact element: a contactor vertex and up to kMaxNodes - 1 target vertices with weights
-/// w so that the relative displacement is u_rel = sum_j w_j u_(vertex j) (formulation.md §2):
+/// w so that the relative displacement is u_rel = sum_j w_j u_(vertex j) (docs/theory.md#theory-contact-elements):
 /// node on rigid (1), node on node (1, -1), node on facet (1, -(1-alpha), -alpha), segment-
 /// integrated node on facet (1, -M_i1 / D_i, ..., -M_im / D_i). Entries at and beyond n_nodes
 /// are unused.
@@ -144,7 +144,7 @@ ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vecto
 void add_residual(const ContactElement& e, const ElementState& s, const fem::DofMap& dofs,
                   int lambda_dof, Vector& R);
 
-/// Element tangent entries (formulation.md §2) in a fixed order: every (row, col) pair of the
+/// Element tangent entries (docs/theory.md#theory-element-blocks) in a fixed order: every (row, col) pair of the
 /// element's free unknowns appears once, whatever the status, so the Jacobian pattern never
 /// changes. Calls `add(row, col, value)` for each.
 ///   uu: w_j w_k r G M G^T, u-lambda: w_j G M, lambda-u: w_k M G^T, lambda-lambda: (M - I) / r,

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Alart–Curnier projection (Alart & Lebon 1995, eqs. 5-8; formulation.md §2).
+// Alart–Curnier projection (Alart & Lebon 1995, eqs. 5-8; docs/theory.md#theory-augmented-lagrangian).
 #include "contact/law.hpp"
 
 #include <cmath>

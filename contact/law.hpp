@@ -27,7 +27,7 @@ struct Projection {
 };
 
 /// Projection of sigma = (sigma_t, sigma_n) for friction coefficient mu >= 0:
-/// Phi_n = min(sigma_n, 0), Phi_t = clamp(sigma_t, -mu |Phi_n|, mu |Phi_n|) (formulation.md §2).
+/// Phi_n = min(sigma_n, 0), Phi_t = clamp(sigma_t, -mu |Phi_n|, mu |Phi_n|) (docs/theory.md#theory-augmented-lagrangian).
 /// M: gap 0; stick I; slip with eps = sign(sigma_t): [[0, -eps mu], [0, 1]].
 /// The boundaries (sigma_n = 0, |sigma_t| = -mu sigma_n) belong to stick, as in the table.
 Projection project(double sigma_t, double sigma_n, double mu);

@@ -84,7 +84,7 @@ struct SearchResult {
     std::vector<int> not_found;           ///< contactor vertices that found none (left out)
 };
 
-/// Node-on-facet search (formulation.md §2). A contactor vertex c of `m` is a contact node when
+/// Node-on-facet search (docs/theory.md#theory-contact-elements). A contactor vertex c of `m` is a contact node when
 /// `reference` has a facet within search_radius * h0(c) of it, h0(c) = `reference.local_size`,
 /// and c is not beyond the ends of the reference target (FacetIndex::closest). Pass the level-0
 /// target facets as `reference` (vertex indices of level 0 are kept by refinement): the decision

@@ -21,7 +21,7 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-/// A solve stopped on request (levels::SolveOptions::interrupt_requested), between Newton
+/// A solve stopped on request (levels::SolveObserver::interrupt_requested), between Newton
 /// iterations; the message says where.
 class Interrupted : public std::runtime_error {
 public:

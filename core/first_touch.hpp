@@ -3,11 +3,11 @@
 /// pages of a fresh allocation are first touched by all threads instead of one.
 ///
 /// Memory a process touches for the first time costs a page fault per page: the kernel maps and
-/// clears it (and on a virtual machine the host may have to back it too). On the reference machine
-/// of the README (a VM), one thread writes fresh pages at 0.7-1.1 GB/s and two threads at 2.4-3.4
-/// GB/s, against 25 GB/s for pages already mapped. The level-7 square touches 8 GB of new memory,
-/// so the large arrays that the set-up and the first solves allocate are filled here. Elementwise:
-/// the values are those of std::fill / std::copy, whichever thread writes them.
+/// clears it (and on a virtual machine the host may have to back it too): writing fresh pages is
+/// several times slower than writing pages already mapped, and faster with more threads. A fine
+/// level touches gigabytes of new memory, so the large arrays that the set-up and the first
+/// solves allocate are filled here.
+/// Elementwise: the values are those of std::fill / std::copy, whichever thread writes them.
 #pragma once
 
 #include "core/parallel.hpp"

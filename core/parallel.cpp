@@ -31,8 +31,8 @@ namespace mlc::parallel {
 namespace {
 
 /// How long an idle thread spins before it sleeps: long enough to stay awake through the Krylov
-/// vector operations between two sweeps of a 2-million-unknown level (the level-6 square took
-/// 32.7 s with 50 us, 29.3 s with 2 ms), short enough to give the core back when a V-cycle ends.
+/// vector operations between two sweeps of a level of millions of unknowns, short enough to give
+/// the core back when a V-cycle ends.
 constexpr std::chrono::microseconds spin_time{2000};
 
 inline void cpu_relax() {

@@ -38,10 +38,10 @@ void set_num_threads(int n);
 /// The BLAS library the process calls (the file behind `libblas.so.3`, which Debian's alternatives
 /// choose), and OpenBLAS's configuration when it is OpenBLAS ("SINGLE_THREADED" for the serial
 /// one); "none" when no BLAS is loaded. Computed once per process. The reference BLAS (Debian's
-/// libblas3) makes `schur`'s set-up 1.9-2.5x slower than OpenBLAS (libopenblas0-serial, which
+/// libblas3) makes `schur`'s set-up slower than OpenBLAS (libopenblas0-serial, which
 /// scripts/deps.sh installs); a threaded OpenBLAS starts its threads when the library loads,
-/// and they spin against this pool (a level-3 square run took 0.17-0.20 s with it against
-/// 0.10-0.15 s with the serial one). The report notes both; summary.json names the library.
+/// and they spin against this pool (docs/guide/install.md#install-dependencies). The report notes both; summary.json
+/// names the library.
 std::string blas_library();
 
 /// The default: OMP_NUM_THREADS if set to a positive number (its first entry), else the number of

@@ -18,7 +18,7 @@ bool stop_requested() noexcept;
 /// The signal of the first stop request, or 0.
 int stop_request_signal() noexcept;
 
-/// The flag itself, for code that polls an atomic (levels::SolveOptions::stop).
+/// The flag itself, for code that polls an atomic (levels::SolveObserver::stop_requested).
 const std::atomic<bool>& stop_request_flag() noexcept;
 
 /// Whether a stop request also stops file writing (write_file_atomically, the VTU writers):

@@ -21,7 +21,7 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 using SparseMatrixCol = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 /// A SparseMatrix that moves by swapping its arrays. Eigen 3.4's SparseMatrix has no move
 /// constructor or move assignment, so moving one copies it: a Level moved into the hierarchy
-/// copied its K (1.4 GB at level 7 of the square) twice. Used for the large matrices of structs
+/// copied its K twice. Used for the large matrices of structs
 /// that are returned and moved (fem::ElasticSystem, transfer::LevelTransfer); it is a
 /// SparseMatrix everywhere else.
 class MovableSparseMatrix : public SparseMatrix {

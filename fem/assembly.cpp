@@ -67,10 +67,10 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
             if (int d = dofs.u_dof(v, c); d >= 0) sys.f[d] = nodal_load_full[2 * v + c];
 
     // The pattern, straight into CSR: vertex w's free components are in the row of each free
-    // component of v when v and w share a triangle. (Triplets and setFromTriplets took 36 x 16
-    // bytes per triangle, 2.4 GB at level 6 of the square, and a sort.) Each vertex's rows are
-    // written by one thread: the loops over vertices below run over core/parallel's threads.
-    // Triangles of each vertex, ascending per vertex: the serial summation order.
+    // component of v when v and w share a triangle. (Triplets and setFromTriplets would take 36 x
+    // 16 bytes per triangle and a sort.) Each vertex's rows are written by one thread: the loops
+    // over vertices below run over core/parallel's threads. Triangles of each vertex, ascending per
+    // vertex: the serial summation order.
     const mesh::VertexTriangles vtri = mesh::vertex_triangles(m);
     const std::vector<int>& vt_start = vtri.offset;
     const std::vector<int>& vt = vtri.triangles;

@@ -19,7 +19,7 @@ namespace mlc::levels {
 double force_balance_error(const Level& level, double s, const Vector& u_full,
                            const std::vector<ContactNodeState>& nodes);
 
-/// Quality figures of a converged state, all relative (see the README).
+/// Quality figures of a converged state, all relative (docs/verification.md#verification-identities).
 struct StateChecks {
     double force_balance =
         0.0; ///< |resultant of loads, contact forces, reactions| / sum of magnitudes

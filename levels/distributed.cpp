@@ -4,9 +4,12 @@
 
 #include "core/check.hpp"
 #include "levels/hierarchy.hpp"
+#include "mesh/lattice.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace mlc::levels {
@@ -69,6 +72,79 @@ int n_extra_of(const fem::DofMap& dofs, int v) {
     while (e + k < dofs.n_dofs() && dofs.vertex_of(e + k) == v && !dofs.is_displacement(e + k))
         ++k;
     return k;
+}
+
+/// Problem::Numbering::lattice on a part: the interior lattice points of the macro triangles
+/// (level-0 triangles) that lie whole among this process's owned triangles, on a level of at
+/// least 16 subdivisions per macro edge (solvers::kMinLatticeSubdivisions, as build_level numbers
+/// one process's levels); std::nullopt otherwise. Macro m of the result is the m-th such macro.
+/// The part's triangles are refine()'s of level p's in increasing level-p order (children of
+/// local triangle t are 4t..4t+3), so a whole macro's triangles follow each other in refine
+/// order, which mesh::macro_lattice reads.
+std::optional<mesh::MacroLattice> owned_macro_lattice(const Problem& problem,
+                                                      const mesh::LocalLevel& part) {
+    if (problem.numbering != Problem::Numbering::lattice) return std::nullopt;
+    const std::int64_t t0 = problem.mesh0.n_triangles();
+    const long nt = part.mesh.n_triangles();
+    int depth = -1; // this level is depth refinements of mesh0
+    for (int d = 0; d <= 14 && t0 > 0; ++d)
+        if (t0 << (2 * d) == part.n_global_triangles) depth = d;
+    if (depth < 4 || nt == 0) return std::nullopt;
+    // Refinements of level p in the part: local triangles per level-p triangle.
+    long groups = 1;
+    for (long t = 1; t < nt; ++t)
+        groups += part.triangle_ancestor[static_cast<size_t>(t)] !=
+                  part.triangle_ancestor[static_cast<size_t>(t - 1)];
+    int k = -1;
+    for (int d = 0; d <= depth; ++d)
+        if (groups << (2 * d) == nt) k = d;
+    if (k < 0) return std::nullopt;
+    const int p = depth - k;
+    const long per_macro = 1L << (2 * depth);
+    // The whole owned macros' triangles, macro after macro, on their own vertex numbering.
+    mesh::Mesh sub;
+    std::vector<int> local_of, sub_of(static_cast<size_t>(part.mesh.n_vertices()), -1);
+    for (long t = 0; t < nt;) {
+        const int m = part.triangle_ancestor[static_cast<size_t>(t)] >> (2 * p);
+        long e = t;
+        bool owned = true;
+        while (e < nt && part.triangle_ancestor[static_cast<size_t>(e)] >> (2 * p) == m) {
+            owned = owned && part.triangle_owned[static_cast<size_t>(e)] != 0;
+            ++e;
+        }
+        if (owned && e - t == per_macro)
+            for (long q = t; q < e; ++q) {
+                std::array<int, 3> tri = part.mesh.triangles[static_cast<size_t>(q)];
+                for (int& v : tri) {
+                    int& s = sub_of[static_cast<size_t>(v)];
+                    if (s < 0) {
+                        s = static_cast<int>(local_of.size());
+                        local_of.push_back(v);
+                    }
+                    v = s;
+                }
+                sub.triangles.push_back(tri);
+            }
+        t = e;
+    }
+    if (sub.triangles.empty()) return std::nullopt;
+    sub.vertices.resize(local_of.size());
+    auto lattice = mesh::macro_lattice(sub, depth);
+    if (!lattice) return std::nullopt;
+    for (int& v : lattice->vertex)
+        v = local_of[static_cast<size_t>(v)];
+    return lattice;
+}
+
+/// The lattice rows of a part's owned unknowns (the diagonal block the multigrid smooths): the
+/// part's lattice_rows with the points and blocks of other processes' unknowns left out.
+smoothers::LatticeRows owned_lattice_rows(const Level& L, const mesh::MacroLattice& lattice,
+                                          Index n_owned) {
+    smoothers::LatticeRows rows = lattice_rows(L, lattice);
+    for (Index& r : rows.first_row)
+        if (r >= n_owned) r = -1;
+    std::erase_if(rows.visit, [n_owned](Index r) { return r >= n_owned; });
+    return rows;
 }
 } // namespace
 
@@ -160,7 +236,23 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
     lp.owned.resize(static_cast<size_t>(nv));
     for (int v = 0; v < nv; ++v)
         lp.owned[static_cast<size_t>(v)] = part.vertex_owner[static_cast<size_t>(v)] == me;
+    // Owned vertices first: the interior points of the owned lattice macros (numbering
+    // lattice), then the others along a Hilbert curve; then the ghosts.
+    const std::optional<mesh::MacroLattice> lattice = owned_macro_lattice(problem, part);
     lp.order = mesh::hilbert_order(part.mesh.vertices);
+    std::vector<char> placed(static_cast<size_t>(nv), 0);
+    if (lattice) {
+        std::vector<int> order;
+        order.reserve(lp.order.size());
+        for (const int v : lattice->vertex)
+            if (lp.owned[static_cast<size_t>(v)]) {
+                order.push_back(v);
+                placed[static_cast<size_t>(v)] = 1;
+            }
+        for (const int v : lp.order)
+            if (!placed[static_cast<size_t>(v)]) order.push_back(v);
+        lp.order = std::move(order);
+    }
     std::stable_partition(lp.order.begin(), lp.order.end(),
                           [&](int v) { return lp.owned[static_cast<size_t>(v)] != 0; });
     // An error on one process before `complete` (whose exchanges are collective) is agreed on
@@ -267,6 +359,9 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
         MLC_CHECK(g[i] >= 0, "internal error: unknown " << i << " has no global number");
         d.global_dof[static_cast<size_t>(i)] = std::llround(g[i]);
     }
+    if (lattice)
+        d.local.lattice = std::make_shared<const smoothers::LatticeRows>(
+            owned_lattice_rows(d.local, *lattice, d.n_owned));
     d.K_blocks = std::make_unique<solvers::RowBlocks>(d.row_blocks(d.local.elastic.K));
     d.local.elastic.K = SparseMatrix(); // its owned rows are in K_blocks
     d.K = std::make_unique<solvers::ParMatrix>(comm, *d.K_blocks);

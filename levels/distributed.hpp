@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
-/// @file The levels of a distributed run (issue 12): each process builds its part of every level
-/// above the partition level p from mesh::distribute's local meshes, with the unknowns it owns
-/// numbered first, the stiffness and prolongations as hypre ParCSR matrices (solvers::ParMatrix),
-/// and the values of the unknowns at ghost vertices fetched from their owners.
+/// @file The levels of a distributed run (docs/parallel.md#parallel-how): each process builds its part of every
+/// level above the partition level p from mesh::distribute's local meshes, with the unknowns it
+/// owns numbered first, the stiffness and prolongations as hypre ParCSR matrices
+/// (solvers::ParMatrix), and the values of the unknowns at ghost vertices fetched from their
+/// owners.
 ///
 /// Numbering. A process's part of a level is a levels::Level built on its local mesh (owned and
 /// ghost triangles) by build_level with a LevelPart: the owned vertices come first (in Hilbert
@@ -125,11 +126,10 @@ DistributedTransfer build_distributed_transfer(const DistributedLevel& coarse,
                                                const Communicator& comm,
                                                transfer::QRule rule = transfer::QRule::paper);
 
-/// The partition level of a run on `n_processes` processes (README, "Running on several
-/// processes"): the coarsest level with at least kTrianglesPerProcess triangles per process,
-/// and at most `finest - 1` (so that at least one level above it is distributed), at least 0.
-/// `level0_triangles`: the triangles of level 0 (each level has four times those of the one
-/// below).
+/// The partition level of a run on `n_processes` processes (docs/parallel.md#parallel-partition-level): the coarsest level
+/// with at least kTrianglesPerProcess triangles per process, and at most `finest - 1` (so that at
+/// least one level above it is distributed), at least 0. `level0_triangles`: the triangles of level
+/// 0 (each level has four times those of the one below).
 inline constexpr int kTrianglesPerProcess = 2000;
 int partition_level(std::int64_t level0_triangles, int finest, int n_processes);
 

@@ -6,6 +6,7 @@
 #include "contact/element.hpp"
 #include "core/check.hpp"
 #include "levels/krylov_system.hpp"
+#include "levels/level_step.hpp"
 #include "levels/newton.hpp"
 #include "levels/newton_system.hpp"
 #include "smoothers/block_sor.hpp"
@@ -14,442 +15,11 @@
 
 #include <Eigen/SparseLU>
 
-#include <atomic>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
 
 namespace mlc::levels {
-
-/// The Newton systems of the distributed levels and their multigrid (distributed_solve.hpp).
-struct DistributedMultigrid::Impl {
-    Impl(const std::vector<DistributedLevel>& levels,
-         const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
-         LinearSolverSpec spec, solvers::MultigridParams mg)
-        : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
-          use_mg_(spec_.pc.name() == "mg"), use_ebe_(spec_.pc.entry->element_matrices),
-          op_(levels.size()) {
-        for (size_t k = 1; k < levels.size(); ++k)
-            build_jacobian(k);
-    }
-
-    /// Level p at its converged statuses: the gathered coarse solve (map built on first use).
-    void set_coarse(const Level& Lp, const std::vector<Eigen::Matrix2d>& M) {
-        if (!use_mg_) return; // no coarse level without mg
-        if (coarse_level_ != &Lp) {
-            coarse_level_ = &Lp;
-            coarse_asm_ = std::make_unique<JacobianAssembler>(Lp);
-            build_coarse_map(Lp);
-            analyzed_ = false;
-        }
-        coarse_asm_->assemble(M);
-        const SparseMatrixCol A = coarse_asm_->matrix();
-        if (!analyzed_) {
-            lu_.analyzePattern(A);
-            analyzed_ = true;
-        }
-        lu_.factorize(A);
-        MLC_CHECK(lu_.info() == Eigen::Success,
-                  "the coarse Jacobian of level p is singular (sparse LU failed)");
-    }
-
-    /// J_k(M) assembled, its ParCSR values refreshed, the smoother set up on the diagonal block.
-    void prepare(size_t k, const std::vector<Eigen::Matrix2d>& M) {
-        Op& o = op_[k];
-        // Unchanged on every process (the refresh below is collective).
-        const bool same = o.prepared && M.size() == o.last_M.size() &&
-                          std::equal(M.begin(), M.end(), o.last_M.begin());
-        if (comm_.min(same ? 1 : 0) == 1) return;
-        // J = K + the contact tangents, in place in J's blocks (hypre's matrix reads them there).
-        // The owned rows of J: the tangents of this process's elements and of the ghost elements
-        // (other processes' contact nodes reaching owned vertices), whose columns may be other
-        // processes' unknowns (the off-diagonal block).
-        const DistributedLevel& L = levels_[k];
-        const size_t n_el = L.local.contacts.size() + L.local.ghost_contacts.size();
-        MLC_CHECK(M.size() == n_el, "internal error: " << M.size() << " status matrices for "
-                                                       << n_el << " contact elements");
-        double* v = o.blocks->diag.valuePtr();
-        std::fill(v, v + o.blocks->diag.nonZeros(), 0.0);
-        const double* kv = L.K_blocks->diag.valuePtr();
-        for (size_t q = 0; q < o.kpos.size(); ++q)
-            v[o.kpos[q]] += kv[q];
-        double* vo = o.blocks->offd.valuePtr();
-        if (o.kopos.empty()) {
-            // The off-diagonal block is K's (no contact coupling across the cuts): copied once.
-            if (!o.prepared)
-                std::copy_n(L.K_blocks->offd.valuePtr(), L.K_blocks->offd.nonZeros(), vo);
-        } else {
-            std::fill(vo, vo + o.blocks->offd.nonZeros(), 0.0);
-            const double* kov = L.K_blocks->offd.valuePtr();
-            for (size_t q = 0; q < o.kopos.size(); ++q)
-                vo[o.kopos[q]] += kov[q];
-        }
-        size_t c = 0;
-        auto add = [&](int, int, double value) {
-            const Entry& p = o.cpos[c++];
-            if (p.block == 0)
-                v[p.pos] += value;
-            else if (p.block == 1)
-                vo[p.pos] += value;
-        };
-        for (size_t e = 0; e < L.local.contacts.size(); ++e)
-            contact::for_each_tangent_entry(L.local.contacts[e], M[e], L.local.dofs,
-                                            L.local.lambda_dof[e], add);
-        for (size_t e = 0; e < L.local.ghost_contacts.size(); ++e)
-            contact::for_each_tangent_entry(L.local.ghost_contacts[e],
-                                            M[L.local.contacts.size() + e], L.local.dofs,
-                                            L.local.ghost_lambda_dof[e], add);
-        if (!use_mg_) {
-            if (use_ebe_) refresh_block_elements(k, M);
-            if (!o.block_pc) {
-                // EBE: built from the process's elements restricted to its owned unknowns.
-                solvers::LevelData d;
-                d.has_multipliers = !L.local.contacts.empty();
-                d.elements = [&o]() { return &o.elements; };
-                o.block_pc = solvers::make_preconditioner(spec_.pc, use_ebe_ ? &d : nullptr);
-                o.block_pc->setup(o.blocks->diag);
-            } else {
-                o.block_pc->update_values(o.blocks->diag);
-            }
-        } else if (!o.smoother) {
-            std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
-            for (Index i = 0; i < L.n_owned; ++i)
-                vertex_of[static_cast<size_t>(i)] = L.local.dofs.vertex_of(i);
-            o.smoother = std::make_unique<smoothers::BlockSOR>(
-                smoothers::BlockSORParams{.omega = mg_.omega,
-                                          .block_size = 2,
-                                          .block_starts = solvers::vertex_block_starts(vertex_of),
-                                          .parts = 1,
-                                          .kernel = smoothers::Kernel::unrolled});
-            o.smoother->setup(o.blocks->diag);
-        } else {
-            o.smoother->update_values(o.blocks->diag);
-        }
-        o.last_M = M;
-        o.prepared = true;
-    }
-
-    SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
-                      double forcing) {
-        const double t0 = wall_seconds();
-        prepare(k, M);
-        const double t1 = wall_seconds();
-        solvers::KrylovParams kp;
-        kp.rel_tol = std::max(forcing, spec_.rel_tol);
-        kp.max_iter = spec_.max_iter;
-        kp.restart = spec_.restart;
-        kp.give_up_budget = spec_.give_up_budget;
-        kp.comm = &comm_;
-        const Cycle cycle(*this, k);
-        const BlockPc block(*this, k);
-        const Preconditioner& pc = use_mg_ ? static_cast<const Preconditioner&>(cycle) : block;
-        SolveResult r =
-            solvers::solve(spec_.krylov, *op_[k].J, pc, b, dx, kp);
-        r.setup_seconds = t1 - t0;
-        r.solve_seconds = wall_seconds() - t1;
-        return r;
-    }
-
-    /// EBE on the diagonal block (issue 13): the elastic element matrices of every local triangle
-    /// restricted to the owned unknowns (so that they sum to the diagonal block of K; the
-    /// triangles cut by the partition contribute their owned rows and columns), then the contact
-    /// elements (all at owned vertices) at the statuses M. EBE colours them within the process.
-    void refresh_block_elements(size_t k, const std::vector<Eigen::Matrix2d>& M) {
-        Op& o = op_[k];
-        const DistributedLevel& D = levels_[k];
-        if (o.elements.empty()) {
-            o.elements = elastic_element_matrices(D.local);
-            restrict_elements(o.elements, D.n_owned);
-            o.n_elastic = o.elements.size();
-            o.elements.resize(o.n_elastic + D.local.contacts.size());
-        }
-        for (size_t e = 0; e < D.local.contacts.size(); ++e) {
-            smoothers::ElementMatrix& el = o.elements[o.n_elastic + e];
-            contact_element_matrix(D.local, e, M[e], el);
-            for ([[maybe_unused]] const int d : el.dofs)
-                MLC_ASSERT(d < D.n_owned, "a contact element outside the owned unknowns");
-        }
-    }
-
-    std::string name() const {
-        std::ostringstream os;
-        if (!use_mg_)
-            return std::string(solvers::to_string(spec_.krylov)) + " + " + spec_.pc.text() +
-                   " on each process's diagonal block";
-        os << spec_.krylov << " + distributed mg(pre=" << mg_.pre_sweeps
-           << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega << ")";
-        return os.str();
-    }
-
-    struct Entry {
-        int pos = 0;
-        int block = -1;
-    };
-
-    struct Op {
-        /// J's owned rows (the one copy of J: hypre's J and the smoother read them in place).
-        std::unique_ptr<solvers::RowBlocks> blocks;
-        std::vector<int> kpos; ///< position in blocks->diag of every entry of K's diagonal block
-        /// Position of every contact tangent entry, in visiting order (owned elements, then
-        /// ghost elements): block 0 diag, 1 offd, -1 a row owned elsewhere (not stored).
-        std::vector<Entry> cpos;
-        /// Position in blocks->offd of every entry of K's off-diagonal block; empty when J's
-        /// off-diagonal block is K's (no contact entry in it).
-        std::vector<int> kopos;
-        std::unique_ptr<solvers::ParMatrix> J;
-        std::unique_ptr<smoothers::BlockSOR> smoother;
-        std::unique_ptr<Preconditioner> block_pc; ///< without mg: spec.pc on the diagonal block
-        /// ebe: the elements of the diagonal block (elastic, restricted; then contact), which
-        /// block_pc borrows.
-        std::vector<smoothers::ElementMatrix> elements;
-        size_t n_elastic = 0;
-        std::vector<Eigen::Matrix2d> last_M;
-        bool prepared = false;
-        mutable Vector res, t, rc, ec, d, ghost;
-    };
-
-    /// Without mg: the preconditioner of each process's diagonal block (Jacobi across the cuts).
-    class BlockPc final : public Preconditioner {
-    public:
-        BlockPc(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
-        void setup(const SparseMatrix&) override {}
-        void apply(const Vector& r, Vector& z) const override { s_.op_[k_].block_pc->apply(r, z); }
-        std::string name() const override { return s_.name(); }
-
-    private:
-        const DistributedMultigrid::Impl& s_;
-        size_t k_;
-    };
-
-    /// One V-cycle from level k as a Preconditioner.
-    class Cycle final : public Preconditioner {
-    public:
-        Cycle(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
-        void setup(const SparseMatrix&) override {}
-        void apply(const Vector& r, Vector& z) const override { s_.cycle(k_, r, z); }
-        std::string name() const override { return s_.name(); }
-
-    private:
-        const DistributedMultigrid::Impl& s_;
-        size_t k_;
-    };
-
-    void build_jacobian(size_t k) {
-        const DistributedLevel& D = levels_[k];
-        const solvers::RowBlocks& Kb = *D.K_blocks;
-        const Level& L = D.local;
-        const int n = static_cast<int>(D.n_owned);
-        Op& o = op_[k];
-        o.blocks = std::make_unique<solvers::RowBlocks>();
-        solvers::RowBlocks& B = *o.blocks;
-        B.first_row = Kb.first_row;
-        B.first_col = Kb.first_col;
-        // The contact entries of the owned rows: (row, local column) in visiting order, -1 rows
-        // for those owned elsewhere.
-        std::vector<std::pair<int, int>> centries;
-        const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-        auto visit = [&](int row, int col, double) {
-            centries.emplace_back(row < n ? row : -1, col);
-        };
-        for (size_t e = 0; e < L.contacts.size(); ++e)
-            contact::for_each_tangent_entry(L.contacts[e], I, L.dofs, L.lambda_dof[e], visit);
-        for (size_t e = 0; e < L.ghost_contacts.size(); ++e)
-            contact::for_each_tangent_entry(L.ghost_contacts[e], I, L.dofs, L.ghost_lambda_dof[e],
-                                            visit);
-        // Off-diagonal columns: K's and the contact couplings to other processes' unknowns.
-        std::vector<std::int64_t> col_map = Kb.col_map;
-        for (auto [r, c] : centries)
-            if (r >= 0 && c >= n) col_map.push_back(D.global_dof[static_cast<size_t>(c)]);
-        std::sort(col_map.begin(), col_map.end());
-        col_map.erase(std::unique(col_map.begin(), col_map.end()), col_map.end());
-        const bool offd_grows = col_map.size() != Kb.col_map.size() ||
-                                std::any_of(centries.begin(), centries.end(), [&](auto rc) {
-                                    return rc.first >= 0 && rc.second >= n;
-                                });
-        auto offd_col = [&](std::int64_t g) {
-            const auto it = std::lower_bound(col_map.begin(), col_map.end(), g);
-            MLC_ASSERT(it != col_map.end() && *it == g, "an off-diagonal column is not mapped");
-            return static_cast<int>(it - col_map.begin());
-        };
-        std::vector<Eigen::Triplet<double>> trip;
-        trip.reserve(static_cast<size_t>(Kb.diag.nonZeros()) + centries.size());
-        for (int i = 0; i < n; ++i)
-            for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
-                trip.emplace_back(i, it.col(), 0.0);
-        for (auto [r, c] : centries)
-            if (r >= 0 && c < n) trip.emplace_back(r, c, 0.0);
-        B.diag.resize(n, n);
-        B.diag.setFromTriplets(trip.begin(), trip.end());
-        B.diag.makeCompressed();
-        if (!offd_grows) {
-            B.offd = Kb.offd;
-            B.col_map = Kb.col_map;
-        } else {
-            trip.clear();
-            for (int i = 0; i < n; ++i)
-                for (SparseMatrix::InnerIterator it(Kb.offd, i); it; ++it)
-                    trip.emplace_back(i, offd_col(Kb.col_map[static_cast<size_t>(it.col())]), 0.0);
-            for (auto [r, c] : centries)
-                if (r >= 0 && c >= n)
-                    trip.emplace_back(r, offd_col(D.global_dof[static_cast<size_t>(c)]), 0.0);
-            B.offd.resize(n, static_cast<Index>(col_map.size()));
-            B.offd.setFromTriplets(trip.begin(), trip.end());
-            B.offd.makeCompressed();
-            B.col_map = col_map;
-        }
-        trip = {};
-        auto position = [](const SparseMatrix& A, int row, int col) {
-            const int* begin = A.innerIndexPtr() + A.outerIndexPtr()[row];
-            const int* end = A.innerIndexPtr() + A.outerIndexPtr()[row + 1];
-            const int* it = std::lower_bound(begin, end, col);
-            MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
-            return static_cast<int>(it - A.innerIndexPtr());
-        };
-        o.kpos.reserve(static_cast<size_t>(Kb.diag.nonZeros()));
-        for (int i = 0; i < n; ++i)
-            for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
-                o.kpos.push_back(position(B.diag, i, static_cast<int>(it.col())));
-        if (offd_grows)
-            for (int i = 0; i < n; ++i)
-                for (SparseMatrix::InnerIterator it(Kb.offd, i); it; ++it)
-                    o.kopos.push_back(
-                        position(B.offd, i, offd_col(Kb.col_map[static_cast<size_t>(it.col())])));
-        o.cpos.reserve(centries.size());
-        for (auto [r, c] : centries)
-            if (r < 0)
-                o.cpos.push_back({0, -1});
-            else if (c < n)
-                o.cpos.push_back({position(B.diag, r, c), 0});
-            else
-                o.cpos.push_back(
-                    {position(B.offd, r, offd_col(D.global_dof[static_cast<size_t>(c)])), 1});
-        o.J = std::make_unique<solvers::ParMatrix>(comm_, B);
-    }
-
-    void build_coarse_map(const Level& Lp) {
-        const DistributedLevel& D = levels_[0];
-        std::vector<std::int64_t> mine(static_cast<size_t>(D.n_owned), -1);
-        const auto& dofs = D.local.dofs;
-        for (int v = 0; v < D.local.mesh.n_vertices(); ++v) {
-            const auto& loc = D.part.vertex_location[static_cast<size_t>(v)];
-            MLC_CHECK(loc.kind == mesh::Location::Kind::vertex,
-                      "internal error: a vertex of level p's part is not a level-p vertex");
-            for (int c = 0; c < 2; ++c) {
-                const int d = dofs.u_dof(v, c);
-                if (d >= 0 && d < D.n_owned)
-                    mine[static_cast<size_t>(d)] = Lp.dofs.u_dof(loc.id, c);
-            }
-            const int e = dofs.extra_dof(v);
-            for (int q = 0; e >= 0 && q < D.n_extra[static_cast<size_t>(v)]; ++q)
-                if (e + q < D.n_owned)
-                    mine[static_cast<size_t>(e + q)] = Lp.dofs.extra_dof(loc.id) + q;
-        }
-        coarse_map_ = comm_.allgather(std::span<const std::int64_t>(mine));
-        MLC_CHECK(static_cast<Index>(coarse_map_.size()) == Lp.n_unknowns(),
-                  "internal error: level p has " << Lp.n_unknowns() << " unknowns, its parts "
-                                                 << coarse_map_.size());
-        std::vector<char> seen(coarse_map_.size(), 0);
-        for (const auto s : coarse_map_) {
-            MLC_CHECK(s >= 0 && s < Lp.n_unknowns() && !seen[static_cast<size_t>(s)],
-                      "internal error: the parts of level p do not number its unknowns once");
-            seen[static_cast<size_t>(s)] = 1;
-        }
-        coarse_rhs_.resize(Lp.n_unknowns());
-    }
-
-    void cycle(size_t k, const Vector& r, Vector& z) const {
-        if (k == 0) {
-            const auto full = comm_.allgather(std::span<const double>(r.data(), r.size()));
-            for (size_t g = 0; g < full.size(); ++g)
-                coarse_rhs_[coarse_map_[g]] = full[g];
-            const Vector zs = lu_.solve(coarse_rhs_);
-            const DistributedLevel& D = levels_[0];
-            z.resize(D.n_owned);
-            for (Index i = 0; i < D.n_owned; ++i)
-                z[i] = zs[coarse_map_[static_cast<size_t>(D.first_dof + i)]];
-            return;
-        }
-        const Op& o = op_[k];
-        const solvers::ParMatrix& T = *transfers_[k - 1].T;
-        // Hybrid Gauss-Seidel: the sweeps run on the process's diagonal block with the other
-        // processes' unknowns held at their values (hypre's halo exchange brings them).
-        auto minus_offdiagonal = [&](Vector& y) { // y -= A_offd z
-            o.J->ghost_values(z, o.ghost);
-            o.J->subtract_offdiagonal(o.ghost, y);
-        };
-        if (mg_.pre_sweeps == 0) {
-            z.setZero(r.size());
-            o.res = r;
-        } else {
-            o.smoother->forward_from_zero(r, z, o.res); // res = r - A_diag z
-            for (int s = 1; s < mg_.pre_sweeps; ++s) {
-                o.d = r;
-                minus_offdiagonal(o.d);
-                o.smoother->sweep(o.d, z, smoothers::Sweep::forward);
-            }
-            if (mg_.pre_sweeps > 1) {
-                o.J->apply(z, o.t);
-                o.res = r - o.t;
-            } else {
-                minus_offdiagonal(o.res);
-            }
-        }
-        T.apply_transpose(o.res, o.rc);
-        cycle(k - 1, o.rc, o.ec);
-        T.apply(o.ec, o.t);
-        z += o.t;
-        for (int s = 0; s < mg_.post_sweeps; ++s) {
-            o.d = r;
-            minus_offdiagonal(o.d);
-            o.smoother->sweep(o.d, z, smoothers::Sweep::backward);
-        }
-    }
-
-    const std::vector<DistributedLevel>& levels_;
-    const std::vector<DistributedTransfer>& transfers_;
-    const Communicator& comm_;
-    LinearSolverSpec spec_;
-    solvers::MultigridParams mg_;
-    bool use_mg_ = true;   ///< else spec_.pc on each process's diagonal block
-    bool use_ebe_ = false; ///< spec_.pc is ebe (on each process's diagonal block)
-    std::vector<Op> op_;
-    const Level* coarse_level_ = nullptr;
-    std::unique_ptr<JacobianAssembler> coarse_asm_;
-    Eigen::SparseLU<SparseMatrixCol> lu_;
-    bool analyzed_ = false;
-    std::vector<std::int64_t> coarse_map_;
-    mutable Vector coarse_rhs_;
-};
-
-DistributedMultigrid::DistributedMultigrid(const std::vector<DistributedLevel>& levels,
-                                           const std::vector<DistributedTransfer>& transfers,
-                                           const Communicator& comm, LinearSolverSpec spec,
-                                           solvers::MultigridParams mg)
-    : impl_(std::make_unique<Impl>(levels, transfers, comm, std::move(spec), mg)) {}
-DistributedMultigrid::~DistributedMultigrid() = default;
-void DistributedMultigrid::set_coarse(const Level& level_p, const std::vector<Eigen::Matrix2d>& M) {
-    impl_->set_coarse(level_p, M);
-}
-void DistributedMultigrid::prepare(size_t k, const std::vector<Eigen::Matrix2d>& M) {
-    impl_->prepare(k, M);
-}
-SolveResult DistributedMultigrid::solve(size_t k, const std::vector<Eigen::Matrix2d>& M,
-                                        const Vector& b, Vector& dx, double forcing) {
-    return impl_->solve(k, M, b, dx, forcing);
-}
-const solvers::ParMatrix& DistributedMultigrid::matrix(size_t k) const {
-    MLC_CHECK(k >= 1 && k < impl_->op_.size() && impl_->op_[k].prepared,
-              "DistributedMultigrid::matrix: level " << k << " is not prepared");
-    return *impl_->op_[k].J;
-}
-std::unique_ptr<Preconditioner> DistributedMultigrid::preconditioner(size_t k) const {
-    MLC_CHECK(k >= 1 && k < impl_->op_.size(),
-              "DistributedMultigrid::preconditioner: no level " << k);
-    return std::make_unique<Impl::Cycle>(*impl_, k);
-}
-std::string DistributedMultigrid::name() const {
-    return impl_->name();
-}
 
 namespace {
 
@@ -472,30 +42,6 @@ private:
 
 } // namespace
 
-solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
-    MLC_CHECK(spec.method == solvers::Method::krylov,
-              "on several processes the Newton systems are solved by a Krylov method with mg "
-              "(--linear krylov --pc mg); '"
-                  << spec.method
-                  << "' has no distributed form (schur, lu, cf and sorcf need the "
-                     "whole level on one process)");
-    const solvers::PcSpec& pc = spec.pc;
-    const std::string why = pc.distributed();
-    MLC_CHECK(why.empty(), why);
-    if (pc.name() != "mg") {
-        // A preconditioner of the matrix alone (or ebe) runs on each process's diagonal block;
-        // its options checked here, on every process (ebe: on no elements, not set up).
-        static const std::vector<smoothers::ElementMatrix> none;
-        solvers::LevelData d;
-        d.elements = [] { return &none; };
-        solvers::make_preconditioner(pc, pc.entry->level_aware ? &d : nullptr);
-        return {};
-    }
-    const solvers::MultigridParams p = pc.get<solvers::MgOptions>().cycle();
-    p.validate();
-    return p;
-}
-
 namespace {
 
 /// Sums a confusion table over the processes.
@@ -516,15 +62,12 @@ StatusCounts reduce_counts(const Communicator& comm, StatusCounts c) {
     return {v[0], v[1], v[2], v[3]};
 }
 
-} // namespace
-
-DistributedRunResult solve_distributed(const Problem& problem, const SolveOptions& options,
-                                       const Communicator& comm, int p) {
-    const double t_start = wall_seconds();
-    problem.validate();
-    DistributedRunResult res;
-    res.n_processes = comm.size();
-    res.partition_level = p;
+/// The checks before anything is built, alike on every process: the partition level, the
+/// coarse-to-fine mode, supports that stay, the distributed multigrid's options (returned), and
+/// the memory of a process (about 1/N of the one-process run, the processes on one machine
+/// sharing its memory).
+solvers::MultigridParams check_distributable(const Problem& problem, const SolveOptions& options,
+                                             const Communicator& comm, int p) {
     const int L = problem.levels;
     MLC_CHECK(p >= 0 && p < L, "the partition level must lie in [0, " << L - 1 << "] for --levels "
                                                                       << L << ", found " << p);
@@ -536,251 +79,356 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
                   "supports released or taken up along the loading path are solved on one "
                   "process only so far (load step "
                       << step << ")");
-    res.mg = distributed_mg_params(options.linear);
-    {
-        // Memory: a process holds about 1/N of what one process needs for the run (the square at
-        // level 6 on 2 processes: 0.54 of the one-process peak each), and the processes on one
-        // machine share its memory. Decided alike on every process.
-        const auto sizes = predict_level_sizes(problem);
-        const MemoryEstimate one =
-            estimate_memory(sizes, options.linear, true, {problem.load_steps, false});
-        MemoryEstimate per = one;
-        // The per-step data is kept whole on every process.
-        per.bytes =
-            1.15 * (one.bytes - one.steps_bytes) / comm.size() * comm::processes_on_this_machine() +
-            one.steps_bytes * comm::processes_on_this_machine();
-        const MemoryLimit limit = process_memory_limit();
-        std::string error;
-        try {
-            check_memory_fits(per, limit, sizes);
-        } catch (const InvalidInput& e) {
-            error = std::string(e.what()) + " (the " +
-                    std::to_string(comm::processes_on_this_machine()) +
-                    " processes on this machine together; each holds about 1/" +
-                    std::to_string(comm.size()) + " of the run)";
-        }
-        MLC_CHECK(comm.max(error.empty() ? 0 : 1) == 0,
-                  (error.empty() ? std::string("the run does not fit in another process's memory")
-                                 : error));
+    const solvers::MultigridParams mg = distributed_mg_params(options.linear);
+    const auto sizes = predict_level_sizes(problem);
+    const MemoryEstimate one =
+        estimate_memory(sizes, options.linear, true, {problem.load_steps, false});
+    MemoryEstimate per = one;
+    // The per-step data is kept whole on every process.
+    per.bytes =
+        1.15 * (one.bytes - one.steps_bytes) / comm.size() * comm::processes_on_this_machine() +
+        one.steps_bytes * comm::processes_on_this_machine();
+    const MemoryLimit limit = process_memory_limit();
+    std::string error;
+    try {
+        check_memory_fits(per, limit, sizes);
+    } catch (const InvalidInput& e) {
+        error = std::string(e.what()) + " (the " +
+                std::to_string(comm::processes_on_this_machine()) +
+                " processes on this machine together; each holds about 1/" +
+                std::to_string(comm.size()) + " of the run)";
     }
+    MLC_CHECK(
+        comm.max(error.empty() ? 0 : 1) == 0,
+        (error.empty() ? std::string("the run does not fit in another process's memory") : error));
+    return mg;
+}
 
-    // The partitioned level p and this process's part of it and of the levels above.
+/// The partitioned level p and this process's part of it and of the levels above, and the
+/// transfers between them, into res.levels and res.transfers.
+void build_distributed_levels(const Problem& problem, const SolveOptions& options,
+                              const Communicator& comm, int p, DistributedRunResult& res) {
     mesh::Mesh mp = problem.mesh0;
     for (int l = 0; l < p; ++l)
         mp = mesh::refine(mp);
     {
         ScopedTimer t(&res.timings, "setup/distribute");
-        auto dh = mesh::distribute(mp, L - p, comm, {}, contact_ghost_reach(problem, mp));
+        auto dh =
+            mesh::distribute(mp, problem.levels - p, comm, {}, contact_ghost_reach(problem, mp));
         mp = mesh::Mesh{};
         for (auto& lv : dh.levels)
             res.levels.push_back(build_distributed_level(problem, std::move(lv), comm));
     }
-    const size_t m = res.levels.size() - 1; // distributed levels above p: 1..m
-    {
-        ScopedTimer t(&res.timings, "setup/transfers");
-        for (size_t k = 1; k <= m; ++k)
-            res.transfers.push_back(
-                build_distributed_transfer(res.levels[k - 1], res.levels[k], comm, options.q_rule));
+    ScopedTimer t(&res.timings, "setup/transfers");
+    for (size_t k = 1; k < res.levels.size(); ++k)
+        res.transfers.push_back(
+            build_distributed_transfer(res.levels[k - 1], res.levels[k], comm, options.q_rule));
+}
+
+/// The load steps of the distributed levels p+1..L: after each converged load step of level p
+/// (solved on every process by levels::solve), step() takes level p's state to this process's
+/// part of it and solves the same step on the distributed levels, coarse to fine, each level in
+/// the level loop of levels::solve (solve_levels over Part, levels/level_step.hpp), with the
+/// status counts and the confusion reduced over the processes.
+class DistributedSteps {
+public:
+    DistributedSteps(const Problem& problem, const SolveOptions& options, const Communicator& comm,
+                     int p, SolveObserver* observer, DistributedRunResult& res);
+    /// Level p's load step `st` converged: solves it on the distributed levels.
+    void step(const LevelStepState& st);
+    /// A distributed level failed (the serial solve is then stopped).
+    bool failed() const { return failed_; }
+    /// The finest level's state, into res.
+    void finish();
+
+private:
+    void take_level_p(const LevelStepState& st);
+    class Part;
+    void interpolate_from_below(size_t k, Vector& xo);
+    void accept_level(size_t k, double s, const Vector& xo);
+
+    const Problem& problem_;
+    const SolveOptions& options_;
+    const Communicator& comm_;
+    int p_;
+    DistributedRunResult& res_;
+    size_t m_; // distributed levels above p: 1..m
+    std::unique_ptr<DistributedMultigrid> mg_;
+    std::vector<std::unique_ptr<ContactNewton>> newton_;
+    // Per level: the state of the last converged step (local unknowns with ghosts, nodal
+    // displacements of the part's vertices).
+    std::vector<Vector> x_, u_prev_, u_now_;
+    Vector u_prev_p_; // level p's (serial) nodal displacements at the previous step
+    // SolveOptions::extrapolate: each distributed level's owned state at the last two steps
+    // (x^0 = 0: the supports never change on several processes).
+    std::vector<Vector> xo_last_, xo_older_;
+    std::vector<Vector> xo_; // each level's owned iterate in the current step
+    std::vector<std::unique_ptr<StepLevel>> parts_; // levels 1..m, for the level loop
+    bool failed_ = false;
+    SolveObserver* progress_; // the caller's observer on rank 0, null elsewhere
+};
+
+/// This process's part of distributed level k in the level loop (levels/level_step.hpp): it
+/// iterates on its owned unknowns, takes its guess from the part of the level below, and sums
+/// its status counts and confusion over the processes.
+class DistributedSteps::Part final : public StepLevel {
+public:
+    Part(DistributedSteps& run, size_t k) : run_(run), k_(k) {}
+    ContactNewton& newton() override { return *run_.newton_[k_]; }
+    const Vector& u_prev() const override { return run_.u_prev_[k_]; }
+    Vector& x() override { return run_.xo_[k_]; }
+    int index() const override { return run_.p_ + static_cast<int>(k_); }
+    void begin_step() override { run_.xo_[k_].resize(run_.res_.levels[k_].n_owned); }
+    bool extrapolate(double s, LevelStep& ls) override {
+        // As levels::solve does (SolveOptions::extrapolate): the extrapolated state when Newton
+        // would stop there at once, otherwise the interpolated coarse state.
+        if (!run_.options_.extrapolate) return false;
+        x() = run_.xo_last_[k_];
+        return take_extrapolation(newton(), s, u_prev(), run_.xo_older_[k_], x(), ls);
     }
-    DistributedMultigrid mg(res.levels, res.transfers, comm, options.linear, res.mg);
-    std::vector<std::unique_ptr<ContactNewton>> newton(m + 1);
+    bool interpolate(int /*step*/) override {
+        run_.interpolate_from_below(k_, x());
+        return true;
+    }
+    void solve(int /*step*/, double s, LevelStep& ls) override {
+        ls.report = newton().solve(s, u_prev(), x());
+    }
+    void reduce(LevelStep& ls) override {
+        ls.report.counts = reduce_counts(run_.comm_, ls.report.counts);
+        reduce_confusion(run_.comm_, ls.confusion);
+    }
+    void settle(const LevelStep& /*ls*/) override {
+        if (!run_.options_.extrapolate) return;
+        run_.xo_older_[k_] = std::move(run_.xo_last_[k_]);
+        run_.xo_last_[k_] = x();
+    }
+    const StepReport& report(LevelStep ls) override {
+        if (run_.progress_) {
+            LevelStepProgress lp;
+            lp.step = &ls;
+            lp.load_steps = run_.problem_.load_steps;
+            lp.n_levels = run_.problem_.levels + 1;
+            lp.first_level = 0;
+            lp.processes = run_.comm_.size();
+            run_.progress_->level_step_done(lp);
+        }
+        if (k_ == run_.m_) run_.res_.steps.push_back(ls.report);
+        run_.res_.level_steps[k_].push_back(std::move(ls));
+        return run_.res_.level_steps[k_].back().report;
+    }
+    void fail(int step, double s, const StepReport& rep) override {
+        std::ostringstream os;
+        os << "load step " << step << " (load factor " << s << ") on level " << index()
+           << " did not converge: " << rep.message
+           << "; residual history:" << residual_history(rep);
+        run_.res_.failure = os.str();
+    }
+    void accept(int /*step*/, double s) override { run_.accept_level(k_, s, x()); }
+
+private:
+    DistributedSteps& run_;
+    size_t k_;
+};
+
+DistributedSteps::DistributedSteps(const Problem& problem, const SolveOptions& options,
+                                   const Communicator& comm, int p, SolveObserver* observer,
+                                   DistributedRunResult& res)
+    : problem_(problem), options_(options), comm_(comm), p_(p), res_(res),
+      m_(res.levels.size() - 1), progress_(comm.rank() == 0 ? observer : nullptr) {
+    mg_ = std::make_unique<DistributedMultigrid>(res.levels, res.transfers, comm, options.linear,
+                                                 res.mg);
+    newton_.resize(m_ + 1);
     const bool two_body =
         std::any_of(problem.contacts.begin(), problem.contacts.end(), [](const ContactPair& c) {
             return c.element != ContactElementKind::node_on_rigid;
         });
-    for (size_t k = 1; k <= m; ++k) {
-        newton[k] = std::make_unique<ContactNewton>(res.levels[k].local, problem.newton,
-                                                    std::make_unique<DistributedSystem>(mg, k),
-                                                    &res.timings);
+    for (size_t k = 1; k <= m_; ++k) {
+        newton_[k] = std::make_unique<ContactNewton>(res.levels[k].local, problem.newton,
+                                                     std::make_unique<DistributedSystem>(*mg_, k),
+                                                     &res.timings);
         const DistributedLevel& D = res.levels[k];
         NewtonDistribution nd{&comm, D.n_owned, D.K.get(), {}};
         // Two-body elements read ghost values (every process alike: the call is collective).
         if (two_body) nd.fill_ghosts = [&D](Vector& x) { D.ghosts.update(D.local.dofs, x); };
-        newton[k]->set_distribution(std::move(nd));
-        newton[k]->set_interrupt(options.interrupt_requested);
+        newton_[k]->set_distribution(std::move(nd));
+        if (observer)
+            newton_[k]->set_interrupt([observer] { return observer->interrupt_requested(); });
     }
-    res.level_steps.resize(m + 1);
-
-    // Per level: the state of the last converged step (local unknowns with ghosts, nodal
-    // displacements of the part's vertices).
-    std::vector<Vector> x(m + 1), u_prev(m + 1), u_now(m + 1);
-    for (size_t k = 0; k <= m; ++k) {
-        x[k] = Vector::Zero(res.levels[k].local.n_unknowns());
-        u_prev[k] = Vector::Zero(2 * res.levels[k].local.mesh.n_vertices());
+    res.level_steps.resize(m_ + 1);
+    x_.resize(m_ + 1);
+    u_prev_.resize(m_ + 1);
+    u_now_.resize(m_ + 1);
+    for (size_t k = 0; k <= m_; ++k) {
+        x_[k] = Vector::Zero(res.levels[k].local.n_unknowns());
+        u_prev_[k] = Vector::Zero(2 * res.levels[k].local.mesh.n_vertices());
     }
-    Vector u_prev_p; // level p's (serial) nodal displacements at the previous step
-    // SolveOptions::extrapolate: each distributed level's owned state at the last two steps
-    // (x^0 = 0: the supports never change on several processes, checked above).
-    std::vector<Vector> xo_last(m + 1), xo_older(m + 1);
-    for (size_t k = 1; k <= m; ++k)
-        xo_last[k] = xo_older[k] = Vector::Zero(res.levels[k].n_owned);
-    std::atomic<bool> stop{false};
-    bool failed = false;
-    std::ostream* progress = comm.rank() == 0 ? options.progress : nullptr;
+    xo_last_.resize(m_ + 1);
+    xo_older_.resize(m_ + 1);
+    for (size_t k = 1; k <= m_; ++k)
+        xo_last_[k] = xo_older_[k] = Vector::Zero(res.levels[k].n_owned);
+    xo_.resize(m_ + 1);
+    for (size_t k = 1; k <= m_; ++k)
+        parts_.push_back(std::make_unique<Part>(*this, k));
+}
 
+void DistributedSteps::take_level_p(const LevelStepState& st) {
+    const Level& Lp = *st.L;
+    const std::vector<ContactNodeState>& nodes = st.nodes();
+    if (u_prev_p_.size() != st.u_full->size()) u_prev_p_ = Vector::Zero(st.u_full->size());
+    // Level p's converged state on its unknowns, and its statuses.
+    Vector xs = Vector::Zero(Lp.n_unknowns());
+    for (int v = 0; v < Lp.mesh.n_vertices(); ++v)
+        for (int c = 0; c < 2; ++c)
+            if (const int d = Lp.dofs.u_dof(v, c); d >= 0) xs[d] = (*st.u_full)[2 * v + c];
+    for (size_t e = 0; e < Lp.contacts.size(); ++e) {
+        const auto& ns = nodes[e];
+        const int d = Lp.lambda_dof[e];
+        if (Lp.contacts[e].n_multipliers() == 2) {
+            xs[d] = ns.lambda_t;
+            xs[d + 1] = ns.lambda_n;
+        } else {
+            xs[d] = ns.lambda_n;
+        }
+    }
+    std::vector<Eigen::Matrix2d> Mp(Lp.contacts.size());
+    for (size_t e = 0; e < Lp.contacts.size(); ++e)
+        Mp[e] =
+            contact::evaluate(Lp.contacts[e], *st.u_full, u_prev_p_, xs, Lp.lambda_dof[e]).proj.M;
+    {
+        ScopedTimer t(&res_.timings, "distributed/coarse_setup");
+        mg_->set_coarse(Lp, Mp);
+    }
+    // Level p's part: its local unknowns and nodal values, from the serial state.
+    const DistributedLevel& D = res_.levels[0];
+    const auto& dofs = D.local.dofs;
+    u_now_[0].resize(2 * D.local.mesh.n_vertices());
+    for (int v = 0; v < D.local.mesh.n_vertices(); ++v) {
+        const int vp = D.part.vertex_location[static_cast<size_t>(v)].id;
+        for (int c = 0; c < 2; ++c) {
+            u_now_[0][2 * v + c] = (*st.u_full)[2 * vp + c];
+            if (const int d = dofs.u_dof(v, c); d >= 0) x_[0][d] = xs[Lp.dofs.u_dof(vp, c)];
+        }
+        const int e = dofs.extra_dof(v);
+        for (int q = 0; e >= 0 && q < D.n_extra[static_cast<size_t>(v)]; ++q)
+            x_[0][e + q] = xs[Lp.dofs.extra_dof(vp) + q];
+    }
+}
+
+void DistributedSteps::step(const LevelStepState& st) {
+    if (st.level != p_ || failed_) return;
+    const double t0 = wall_seconds();
+    take_level_p(st);
+    // The distributed levels, coarse to fine: the level loop of levels::solve.
+    std::vector<StepLevel*> parts;
+    for (const auto& part : parts_)
+        parts.push_back(part.get());
+    failed_ = !solve_levels(parts, st.step, st.s);
+    if (!failed_) {
+        res_.nodes =
+            newton_[m_]->node_states(st.s, u_prev_[m_], x_[m_].head(res_.levels[m_].n_owned));
+        res_.step_nodes.push_back(res_.nodes);
+        for (size_t k = 1; k <= m_; ++k)
+            u_prev_[k] = u_now_[k];
+        u_prev_p_ = *st.u_full;
+        res_.completed_steps = st.step;
+    }
+    res_.distributed_seconds += wall_seconds() - t0;
+}
+
+void DistributedSteps::interpolate_from_below(size_t k, Vector& xo) {
+    ScopedTimer t(&res_.timings, "newton/interpolate");
+    const DistributedLevel& D = res_.levels[k];
+    const Level& Lk = D.local;
+    const auto& T = res_.transfers[k - 1].local;
+    Vector uf;
+    T.interpolate_nodal(u_now_[k - 1], uf);
+    const Vector q = T.Q * x_[k - 1];
+    for (int v = 0; v < Lk.mesh.n_vertices(); ++v)
+        for (int c = 0; c < 2; ++c)
+            if (const int d = Lk.dofs.u_dof(v, c); d >= 0 && d < D.n_owned) xo[d] = uf[2 * v + c];
+    for (size_t e = 0; e < Lk.contacts.size(); ++e)
+        for (int j = 0; j < Lk.contacts[e].n_multipliers(); ++j) {
+            const Index d = Lk.lambda_dof[e] + j;
+            xo[d] = q[d];
+        }
+}
+
+void DistributedSteps::accept_level(size_t k, double s, const Vector& xo) {
+    // The part's whole state (ghost unknowns from their owners) for the level above and the
+    // output; this level's operator at its converged statuses for the multigrid.
+    const DistributedLevel& D = res_.levels[k];
+    const Level& Lk = D.local;
+    x_[k].setZero();
+    x_[k].head(D.n_owned) = xo;
+    D.ghosts.update(Lk.dofs, x_[k]);
+    Lk.dofs.expand(x_[k], Lk.u_fixed_at(s), u_now_[k]);
+    if (k < m_) {
+        Vector R;
+        std::vector<Eigen::Matrix2d> converged;
+        newton_[k]->residual(s, u_prev_[k], xo, R, nullptr, &converged, nullptr);
+        mg_->prepare(k, converged);
+    }
+}
+
+void DistributedSteps::finish() {
+    res_.x = x_[m_];
+    res_.u_full = u_now_[m_];
+}
+
+/// What the serial solve of levels 0..p reports to: each converged step of level p taken on
+/// by the distributed levels, a stop once one of them failed, the rest the caller's observer's
+/// (progress on rank 0 only).
+class DistributedObserver final : public SolveObserver {
+public:
+    DistributedObserver(DistributedSteps& steps, SolveObserver* user, bool root)
+        : steps_(steps), user_(user), root_(root) {}
+    void level_step_done(const LevelStepProgress& p) override {
+        if (user_ && root_) user_->level_step_done(p);
+    }
+    void level_step(const LevelStepState& st) override { steps_.step(st); }
+    bool stop_requested() override { return steps_.failed(); }
+    bool interrupt_requested() override { return user_ && user_->interrupt_requested(); }
+    std::unique_ptr<NewtonSystemSolver>
+    wrap_system_solver(int level, const Level& L,
+                       std::unique_ptr<NewtonSystemSolver> solver) override {
+        return user_ ? user_->wrap_system_solver(level, L, std::move(solver)) : std::move(solver);
+    }
+
+private:
+    DistributedSteps& steps_;
+    SolveObserver* user_;
+    bool root_;
+};
+
+} // namespace
+
+DistributedRunResult solve_distributed(const Problem& problem, const SolveOptions& options,
+                                       const Communicator& comm, int p, SolveObserver* observer) {
+    const double t_start = wall_seconds();
+    problem.validate();
+    DistributedRunResult res;
+    res.n_processes = comm.size();
+    res.partition_level = p;
+    res.mg = check_distributable(problem, options, comm, p);
+    build_distributed_levels(problem, options, comm, p, res);
+    DistributedSteps steps(problem, options, comm, p, observer, res);
+    // Levels 0..p on every process alike, each converged step of level p continued on the
+    // distributed levels; a distributed level that fails stops the serial solve.
+    DistributedObserver serial_observer(steps, observer, comm.rank() == 0);
     SolveOptions so = options;
-    so.progress = progress;
-    so.stop = &stop;
+    so.linear = serial_levels_spec(options.linear, p);
     so.keep_step_states = false;
-    so.on_level_step = [&](const LevelStepState& st) {
-        if (st.level != p || failed) return;
-        const double t0 = wall_seconds();
-        const Level& Lp = *st.L;
-        const double s = st.s;
-        if (u_prev_p.size() != st.u_full->size()) u_prev_p = Vector::Zero(st.u_full->size());
-        // Level p's converged state on its unknowns, and its statuses.
-        Vector xs = Vector::Zero(Lp.n_unknowns());
-        for (int v = 0; v < Lp.mesh.n_vertices(); ++v)
-            for (int c = 0; c < 2; ++c)
-                if (const int d = Lp.dofs.u_dof(v, c); d >= 0) xs[d] = (*st.u_full)[2 * v + c];
-        for (size_t e = 0; e < Lp.contacts.size(); ++e) {
-            const auto& ns = (*st.nodes)[e];
-            const int d = Lp.lambda_dof[e];
-            if (Lp.contacts[e].n_multipliers() == 2) {
-                xs[d] = ns.lambda_t;
-                xs[d + 1] = ns.lambda_n;
-            } else {
-                xs[d] = ns.lambda_n;
-            }
-        }
-        std::vector<Eigen::Matrix2d> Mp(Lp.contacts.size());
-        for (size_t e = 0; e < Lp.contacts.size(); ++e)
-            Mp[e] = contact::evaluate(Lp.contacts[e], *st.u_full, u_prev_p, xs, Lp.lambda_dof[e])
-                        .proj.M;
-        {
-            ScopedTimer t(&res.timings, "distributed/coarse_setup");
-            mg.set_coarse(Lp, Mp);
-        }
-        // Level p's part: its local unknowns and nodal values, from the serial state.
-        {
-            const DistributedLevel& D = res.levels[0];
-            const auto& dofs = D.local.dofs;
-            u_now[0].resize(2 * D.local.mesh.n_vertices());
-            for (int v = 0; v < D.local.mesh.n_vertices(); ++v) {
-                const int vp = D.part.vertex_location[static_cast<size_t>(v)].id;
-                for (int c = 0; c < 2; ++c) {
-                    u_now[0][2 * v + c] = (*st.u_full)[2 * vp + c];
-                    if (const int d = dofs.u_dof(v, c); d >= 0) x[0][d] = xs[Lp.dofs.u_dof(vp, c)];
-                }
-                const int e = dofs.extra_dof(v);
-                for (int q = 0; e >= 0 && q < D.n_extra[static_cast<size_t>(v)]; ++q)
-                    x[0][e + q] = xs[Lp.dofs.extra_dof(vp) + q];
-            }
-        }
-        // The distributed levels, coarse to fine.
-        for (size_t k = 1; k <= m && !failed; ++k) {
-            const DistributedLevel& D = res.levels[k];
-            const Level& Lk = D.local;
-            ContactNewton& nw = *newton[k];
-            LevelStep ls;
-            ls.level = p + static_cast<int>(k);
-            Vector xo(D.n_owned);
-            // As levels::solve does (SolveOptions::extrapolate): the extrapolated state when
-            // Newton would stop there at once, otherwise the interpolated coarse state.
-            bool extrapolated = false;
-            if (options.extrapolate) {
-                Vector xe = 2.0 * xo_last[k] - xo_older[k];
-                StepReport r = nw.check(s, u_prev[k], xe);
-                if (r.converged) {
-                    xo = std::move(xe);
-                    ls.report = std::move(r);
-                    extrapolated = true;
-                    ls.extrapolated = true;
-                }
-            }
-            if (!extrapolated) {
-                ScopedTimer t(&res.timings, "newton/interpolate");
-                const auto& T = res.transfers[k - 1].local;
-                Vector uf;
-                T.interpolate_nodal(u_now[k - 1], uf);
-                const Vector q = T.Q * x[k - 1];
-                for (int v = 0; v < Lk.mesh.n_vertices(); ++v)
-                    for (int c = 0; c < 2; ++c)
-                        if (const int d = Lk.dofs.u_dof(v, c); d >= 0 && d < D.n_owned)
-                            xo[d] = uf[2 * v + c];
-                for (size_t e = 0; e < Lk.contacts.size(); ++e)
-                    for (int j = 0; j < Lk.contacts[e].n_multipliers(); ++j) {
-                        const Index d = Lk.lambda_dof[e] + j;
-                        xo[d] = q[d];
-                    }
-            }
-            ls.predicted = !extrapolated;
-            if (ls.predicted) ls.predicted_statuses = nw.statuses(s, u_prev[k], xo);
-            if (!extrapolated) ls.report = nw.solve(s, u_prev[k], xo);
-            ls.report.step = st.step;
-            ls.report.counts = reduce_counts(comm, ls.report.counts);
-            ls.final_statuses = nw.statuses(s, u_prev[k], xo);
-            if (ls.predicted)
-                for (size_t e = 0; e < ls.final_statuses.size(); ++e)
-                    ++ls.confusion[static_cast<size_t>(ls.predicted_statuses[e])]
-                                  [static_cast<size_t>(ls.final_statuses[e])];
-            if (options.extrapolate) {
-                xo_older[k] = std::move(xo_last[k]);
-                xo_last[k] = xo;
-            }
-            reduce_confusion(comm, ls.confusion);
-            if (progress) {
-                const auto& r = ls.report;
-                *progress << "  level " << ls.level << " step " << st.step << "/"
-                          << problem.load_steps << ": " << (r.converged ? "converged" : "FAILED")
-                          << " in " << r.iterations << " Newton it, " << r.linear_iterations
-                          << " Krylov it, final residual " << std::scientific
-                          << std::setprecision(2)
-                          << (r.residuals.empty() ? 0.0 : r.residuals.back()) << std::defaultfloat
-                          << std::setprecision(6) << ", " << std::fixed << std::setprecision(2)
-                          << r.seconds << " s" << std::defaultfloat << std::setprecision(6) << " ("
-                          << comm.size() << " processes)" << std::endl;
-            }
-            const bool ok = ls.report.converged;
-            if (k == m) res.steps.push_back(ls.report);
-            res.level_steps[k].push_back(std::move(ls));
-            if (!ok) {
-                const auto& r = res.level_steps[k].back().report;
-                std::ostringstream os;
-                os << "load step " << st.step << " (load factor " << s << ") on level "
-                   << p + static_cast<int>(k) << " did not converge: " << r.message
-                   << "; residual history:";
-                for (double v : r.residuals)
-                    os << " " << std::scientific << std::setprecision(2) << v;
-                res.failure = os.str();
-                failed = true;
-                stop = true;
-                break;
-            }
-            // The part's whole state (ghost unknowns from their owners) for the level above and
-            // the output; this level's operator at its converged statuses for the multigrid.
-            x[k].setZero();
-            x[k].head(D.n_owned) = xo;
-            D.ghosts.update(Lk.dofs, x[k]);
-            Lk.dofs.expand(x[k], Lk.u_fixed_at(s), u_now[k]);
-            if (k < m) {
-                Vector R;
-                std::vector<Eigen::Matrix2d> converged;
-                nw.residual(s, u_prev[k], xo, R, nullptr, &converged, nullptr);
-                mg.prepare(k, converged);
-            }
-        }
-        if (!failed) {
-            res.nodes = newton[m]->node_states(s, u_prev[m], x[m].head(res.levels[m].n_owned));
-            res.step_nodes.push_back(res.nodes);
-            for (size_t k = 1; k <= m; ++k)
-                u_prev[k] = u_now[k];
-            u_prev_p = *st.u_full;
-            res.completed_steps = st.step;
-        }
-        res.distributed_seconds += wall_seconds() - t0;
-    };
     res.serial = solve(
         [&] {
             Problem sp = problem;
             sp.levels = p;
             return sp;
         }(),
-        so);
-    res.x = x[m];
-    res.u_full = u_now[m];
-    res.converged = !failed && res.serial.converged && res.completed_steps == problem.load_steps;
-    if (!failed && !res.serial.converged)
+        so, &serial_observer);
+    steps.finish();
+    res.converged =
+        !steps.failed() && res.serial.converged && res.completed_steps == problem.load_steps;
+    if (!steps.failed() && !res.serial.converged)
         res.failure =
             res.serial.failure.empty() ? "the levels up to p did not converge" : res.serial.failure;
     res.seconds = wall_seconds() - t_start;

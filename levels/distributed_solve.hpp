@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-/// @file The coarse-to-fine solve on several processes (issue 12): levels 0..p (p the partition
+/// @file The coarse-to-fine solve on several processes: levels 0..p (p the partition
 /// level) are solved on every process by levels::solve, as one process solves them, and after
 /// each load step of level p the distributed levels p+1..L solve the same step, each process its
 /// part (levels/distributed.hpp), by Newton (levels::ContactNewton with a NewtonDistribution)
@@ -21,6 +21,7 @@
 #include "core/communicator.hpp"
 #include "core/timer.hpp"
 #include "levels/distributed.hpp"
+#include "levels/distributed_multigrid.hpp"
 #include "levels/solve.hpp"
 #include "solvers/mg.hpp"
 
@@ -29,46 +30,6 @@
 #include <vector>
 
 namespace mlc::levels {
-
-/// The distributed multigrid over the levels of a distributed run and the Newton systems of its
-/// levels 1..m (levels[k] is level p + k; levels[0], level p, is the gathered coarse level).
-/// Collective calls throughout (every process calls them in the same order).
-class DistributedMultigrid {
-public:
-    /// `levels`, `transfers` (transfers[k - 1]: levels[k - 1] -> levels[k]) and `comm` must outlive
-    /// it. spec: the Krylov method, tolerance and iteration limit of solve().
-    DistributedMultigrid(const std::vector<DistributedLevel>& levels,
-                         const std::vector<DistributedTransfer>& transfers,
-                         const Communicator& comm, LinearSolverSpec spec,
-                         solvers::MultigridParams mg);
-    ~DistributedMultigrid();
-    /// The coarse solve: level p (the whole level, on every process) at the status matrices M
-    /// (one per contact element of level_p; none without contact), factored by sparse LU.
-    void set_coarse(const Level& level_p, const std::vector<Eigen::Matrix2d>& M);
-    /// Level k's operator J_k = K_k + contact tangents at M (one per contact element of the
-    /// part), assembled in place, and its smoother set up; nothing when M is the last call's on
-    /// every process.
-    void prepare(size_t k, const std::vector<Eigen::Matrix2d>& M);
-    /// J_k(M) dx = b on the owned unknowns by the Krylov method preconditioned by one V-cycle
-    /// from level k, to max(forcing, spec.rel_tol).
-    SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
-                      double forcing);
-    /// J_k as prepared last (a ParCSR view of its blocks).
-    const solvers::ParMatrix& matrix(size_t k) const;
-    /// One V-cycle from level k as a Preconditioner of J_k (borrows this object).
-    std::unique_ptr<Preconditioner> preconditioner(size_t k) const;
-    /// e.g. "cgs + distributed mg(pre=1,post=1,omega=1)".
-    std::string name() const;
-
-    struct Impl;
-
-private:
-    std::unique_ptr<Impl> impl_;
-};
-
-/// The V-cycle parameters of spec.pc ("mg[:pre=N,post=N,omega=W]"). Throws InvalidInput when
-/// spec is not a Krylov method with mg (naming what has no distributed form).
-solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec);
 
 /// What one process holds after a distributed run.
 struct DistributedRunResult {
@@ -102,10 +63,14 @@ struct DistributedRunResult {
 /// Collective: solves `problem` on the processes of `comm` (at least one level above level p,
 /// rigid or two-body pairs, supports that stay the same along the path) with the partition level
 /// `partition_level` (< problem.levels). options.linear must be "krylov" with pc "mg" (its
-/// pre/post/omega options apply); options.coarse_to_fine must be on. Progress lines (every
-/// level) go to options.progress on rank 0. Throws InvalidInput naming what is not distributed
-/// or out of range, on every process alike.
+/// pre/post/omega options apply); options.coarse_to_fine must be on. The observer (null: none)
+/// sees the load steps of every level (level_step_done) on rank 0 only, is asked
+/// interrupt_requested and wraps the solvers of levels 0..p on every process; its level_step
+/// and stop_requested are not called (the distributed levels take level p's steps, and a run
+/// stops on every process alike or not at all). Throws InvalidInput naming what is not
+/// distributed or out of range, on every process alike.
 DistributedRunResult solve_distributed(const Problem& problem, const SolveOptions& options,
-                                       const Communicator& comm, int partition_level);
+                                       const Communicator& comm, int partition_level,
+                                       SolveObserver* observer = nullptr);
 
 } // namespace mlc::levels

@@ -146,23 +146,19 @@ Level build_level(const Problem& problem, mesh::Mesh m) {
     return build_level(problem, std::move(m), nullptr);
 }
 
-Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
-    auto owned = [part](int v) { return !part || part->owned[static_cast<size_t>(v)] != 0; };
-    // A refined mesh (of a checked one, as the hierarchy builds them) only needs its areas checked;
-    // so does a process's part of a level (cut from the whole level, which the levels up to p
-    // check; its interior lines may have a triangle on one side only, at the edge of the part).
-    if (m.n_coarse_vertices > 0 || part)
-        mesh::check_refined_quality(m);
-    else
-        mesh::check_quality(m);
-    Level L;
-    L.mesh = std::move(m);
+namespace {
+
+/// Whether vertex v of a level is this process's (always, without a part).
+bool owns(const LevelPart* part, int v) {
+    return !part || part->owned[static_cast<size_t>(v)] != 0;
+}
+
+/// The supports active in step 1: Level::fixed, the prescribed values at every path point
+/// (path_u_fixed) and at the end (u_fixed).
+void set_supports(const Problem& problem, Level& L, const LevelPart* part) {
+    auto owned = [part](int v) { return owns(part, v); };
     const auto& mesh = L.mesh;
     const int nv = mesh.n_vertices();
-    for (const auto& b : problem.bodies)
-        L.materials.push_back(b.material);
-
-    // Supports: fixed components, and the prescribed values at every path point.
     const int K = problem.n_path_points();
     L.fixed.assign(static_cast<size_t>(nv), {false, false});
     L.path_u_fixed.assign(static_cast<size_t>(K), Vector::Zero(2 * nv));
@@ -195,11 +191,19 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
             }
     }
     L.u_fixed = L.path_u_fixed.back();
+}
 
+/// The contact elements of every pair (Level::contacts, contact_of_vertex, not_found) and the
+/// multipliers of each vertex (n_extra, resized to the vertices).
+void find_contact_nodes(const Problem& problem, Level& L, const LevelPart* part,
+                        std::vector<int>& n_extra) {
+    auto owned = [part](int v) { return owns(part, v); };
+    const auto& mesh = L.mesh;
+    const int nv = mesh.n_vertices();
     // Contactor nodes per pair (a vertex belongs to the first pair that claims it).
     L.contact_of_vertex.assign(static_cast<size_t>(nv), -1);
     L.not_found.assign(problem.contacts.size(), {});
-    std::vector<int> n_extra(static_cast<size_t>(nv), 0);
+    n_extra.assign(static_cast<size_t>(nv), 0);
     for (size_t p = 0; p < problem.contacts.size(); ++p) {
         const auto& pair = problem.contacts[p];
         std::vector<int> nodes;
@@ -245,10 +249,18 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
             L.contacts.push_back(e);
         }
     }
+}
 
+/// A part completed by its owners' data (LevelPart::complete, ghost contacts), the held
+/// components pinned, and the unknowns numbered: Level::dofs, lattice, lambda_dof,
+/// ghost_lambda_dof.
+void number_unknowns(const Problem& problem, Level& L, const LevelPart* part,
+                     std::vector<int>& n_extra) {
+    auto owned = [part](int v) { return owns(part, v); };
+    const int nv = L.mesh.n_vertices();
     // Unknowns numbered along a Hilbert curve: refinement appends the new vertices after the
     // coarse ones, and in that order the mat-vecs and sweeps of the large levels gather x from
-    // all over memory (at level 6 of the square one mat-vec took 1.4 times as long).
+    // all over memory.
     if (part && part->complete) {
         std::vector<int> contact_pair(static_cast<size_t>(nv), -1);
         for (const auto& e : L.contacts)
@@ -260,9 +272,7 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
     std::vector<int> order;
     std::optional<mesh::MacroLattice> lattice;
     if (part) {
-        MLC_CHECK(problem.numbering == Problem::Numbering::hilbert,
-                  "the lattice numbering has no distributed form: on several processes each "
-                  "process numbers its unknowns along a Hilbert curve (drop --numbering lattice)");
+        // The part's order (levels/distributed.cpp numbers it, by lattices too).
         if (!part->order.empty()) order = part->order;
     } else if (problem.numbering == Problem::Numbering::lattice) {
         // The refinements of mesh0 this level is, when it is (4^d times mesh0's triangles).
@@ -283,7 +293,14 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
         L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
     for (const auto& e : L.ghost_contacts)
         L.ghost_lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
+}
 
+/// The elastic operator and the loads at every path point (Level::elastic, path_f,
+/// path_f_nodal); with one path point (proportional loading) the paths are left empty.
+void assemble_loads(const Problem& problem, Level& L) {
+    const auto& mesh = L.mesh;
+    const int nv = mesh.n_vertices();
+    const int K = problem.n_path_points();
     // Loads at every path point; the last one gives the assembled right-hand side.
     std::vector<Vec2> body_force;
     bool any_body_force = false;
@@ -325,8 +342,8 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
     L.path_f_nodal.back() = L.elastic.f_nodal_full;
     if (K == 1) {
         // Proportional loading: the one path point is u_fixed, elastic.f, elastic.f_nodal_full
-        // themselves, and path_at gives s times them from empty paths, bit for bit. Three copies
-        // of the level's size fewer (200 MB at level 7 of the square).
+        // themselves, and path_at gives s times them from empty paths, bit for bit: three
+        // vectors of the level's size fewer.
         L.path_u_fixed.clear();
         L.path_f.clear();
         L.path_f_nodal.clear();
@@ -334,6 +351,27 @@ Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
         L.path_f.shrink_to_fit();
         L.path_f_nodal.shrink_to_fit();
     }
+}
+
+} // namespace
+
+Level build_level(const Problem& problem, mesh::Mesh m, const LevelPart* part) {
+    // A refined mesh (of a checked one, as the hierarchy builds them) only needs its areas checked;
+    // so does a process's part of a level (cut from the whole level, which the levels up to p
+    // check; its interior lines may have a triangle on one side only, at the edge of the part).
+    if (m.n_coarse_vertices > 0 || part)
+        mesh::check_refined_quality(m);
+    else
+        mesh::check_quality(m);
+    Level L;
+    L.mesh = std::move(m);
+    for (const auto& b : problem.bodies)
+        L.materials.push_back(b.material);
+    set_supports(problem, L, part);
+    std::vector<int> n_extra;
+    find_contact_nodes(problem, L, part, n_extra);
+    number_unknowns(problem, L, part, n_extra);
+    assemble_loads(problem, L);
     return L;
 }
 
@@ -349,8 +387,7 @@ smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& la
     // The visit: the blocks in the numbering's order, each macro's interior in serpentine rows
     // (row j = 1, 3, ... left to right, j = 2, 4, ... right to left): as cheap to sweep as the
     // numbering's row-by-row order (the rows still stream) and a better Gauss-Seidel order on
-    // the square (level 6: 5.3 BiCGStab iterations per Newton step against 6.0; README,
-    // "Structured sweeps on the macro triangles").
+    // the square (fewer BiCGStab iterations per Newton step; docs/solver-guide.md#solver-why-default).
     const int N = rows.n;
     const long np = mesh::MacroLattice::interior_points(N);
     const long n_macros = np > 0 ? static_cast<long>(rows.first_row.size()) / np : 0;

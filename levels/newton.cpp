@@ -158,6 +158,146 @@ StepReport ContactNewton::check(double s, const Vector& u_prev_full, Vector& x) 
     return solve(s, u_prev_full, x, 0);
 }
 
+namespace {
+
+/// Status cycling: the status vector `st` returns to one of `history` other than the last (seen
+/// two or more iterates ago). Distributed: only if every process's part does.
+bool statuses_cycle(const std::vector<std::vector<contact::Status>>& history,
+                    const std::vector<contact::Status>& st, const Communicator* comm) {
+    std::vector<int> differ(history.size() - 1);
+    for (size_t j = 0; j + 1 < history.size(); ++j)
+        differ[j] = history[j] == st ? 0 : 1;
+    if (comm) comm->allreduce(std::span<int>(differ), ReduceOp::max);
+    return std::find(differ.begin(), differ.end(), 0) != differ.end();
+}
+
+} // namespace
+
+bool ContactNewton::stop_test(int k, int max_iter, double norm, double scale, int changes,
+                              StepReport& rep) const {
+    const double rel = rep.residuals.back();
+    if (!std::isfinite(norm)) {
+        rep.message = "the residual became NaN/Inf at Newton iteration " + std::to_string(k);
+        return true;
+    }
+    if (norm <= params_.rel_tol * scale && (k == 0 || changes == 0)) {
+        rep.converged = true;
+        return true;
+    }
+    // Round-off floor: the problem is linear for fixed statuses, so once two consecutive
+    // steps kept every status, the last step was exact up to the linear solver's accuracy;
+    // a residual that then stops decreasing is the conditioning floor (e.g. nu -> 0.5),
+    // not a failure. Accepted and said so, if within 1e3 times the tolerance.
+    if (k >= 2 && changes == 0 && rep.status_changes.size() >= 2 &&
+        rep.status_changes[rep.status_changes.size() - 2] == 0 &&
+        rel > 0.5 * rep.residuals[rep.residuals.size() - 2] &&
+        norm <= 1e3 * params_.rel_tol * scale) {
+        rep.converged = true;
+        std::ostringstream os;
+        os << "residual stagnated at " << rel << " (round-off floor above the tolerance "
+           << params_.rel_tol << ") with statuses fixed";
+        rep.message = os.str();
+        return true;
+    }
+    if (k == max_iter) {
+        std::ostringstream os;
+        os << "no convergence in " << max_iter << " Newton iterations; relative "
+           << "residual went " << rep.residuals.front() << " -> " << rel << " (tolerance "
+           << params_.rel_tol << "), " << changes << " status changes in the last iteration";
+        if (rep.cycling_detected_at >= 0)
+            os << "; statuses cycled from iteration " << rep.cycling_detected_at
+               << " (damped steps did not break the cycle)";
+        rep.message = os.str();
+        return true;
+    }
+    if (stop_ && stop_()) {
+        rep.stopped = true;
+        rep.message = "stopped on request after " + std::to_string(k) + " Newton iterations";
+        return true;
+    }
+    return false;
+}
+
+bool ContactNewton::solve_system(int k, const std::vector<Eigen::Matrix2d>& M, const Vector& b,
+                                 Vector& dx, double forcing, StepReport& rep) {
+    SolveResult lin;
+    {
+        ScopedTimer t(timings_, "newton/linear_solve");
+        dx.setZero();
+        try {
+            if (fallback_) {
+                // The Krylov solve failed on this level before: the exact solver from then
+                // on (it is set up; another failed attempt per system would only cost).
+                lin = fallback_->solve(M, b, dx);
+                ++rep.fallback_solves;
+            } else {
+                lin = solver_->solve(M, b, dx, forcing);
+            }
+        } catch (const SolverBreakdown& e) {
+            if (!make_fallback_) throw;
+            lin = SolveResult{};
+            lin.reason = StopReason::breakdown;
+            lin.message = e.what();
+        }
+    }
+    rep.linear_iterations += lin.iterations;
+    rep.linear_iterations_per_newton.push_back(lin.iterations);
+    rep.linear_seconds += lin.setup_seconds + lin.solve_seconds;
+    rep.linear_setup_seconds += lin.setup_seconds;
+    rep.linear_assembly_seconds += lin.assembly_seconds;
+    // Inexact Newton: a Krylov solve that hit its iteration limit but reduced the linear
+    // residual by at least half still gives a descent-quality step; the Newton test decides.
+    const bool usable = !lin.converged && lin.reason == StopReason::max_iter &&
+                        std::isfinite(lin.relative_residual) && lin.relative_residual < 0.5 &&
+                        dx.allFinite();
+    if (usable) ++rep.inexact_steps;
+    if (!lin.converged && !usable && make_fallback_ && !fallback_) {
+        // The exact fallback: the same system solved again, exactly.
+        const std::string why = std::string(to_string(lin.reason)) +
+                                (lin.message.empty() ? "" : " (" + lin.message + ")");
+        try {
+            if (!fallback_) fallback_ = make_fallback_();
+        } catch (const InvalidInput& e) {
+            rep.message = "linear solve failed at Newton iteration " + std::to_string(k) + ": " +
+                          why + "; no exact fallback: " + e.what();
+            return false;
+        }
+        ScopedTimer t(timings_, "newton/fallback_solve");
+        dx.setZero();
+        const SolveResult ex = fallback_->solve(M, b, dx);
+        rep.linear_seconds += ex.setup_seconds + ex.solve_seconds;
+        if (rep.fallback_solves++ == 0)
+            rep.fallback_reason = solver_->name() + " failed at Newton iteration " +
+                                  std::to_string(k) + ": " + why + "; solved by " +
+                                  fallback_->name();
+        lin.converged = ex.converged;
+        lin.reason = ex.reason;
+        lin.message = ex.message;
+    }
+    if (!lin.converged && !usable) {
+        rep.message = "linear solve failed at Newton iteration " + std::to_string(k) + ": " +
+                      std::string(to_string(lin.reason)) +
+                      (lin.message.empty() ? "" : " (" + lin.message + ")");
+        return false;
+    }
+    return true;
+}
+
+void ContactNewton::damped_step(double s, const Vector& u_prev_full, const Vector& dx, double norm,
+                                Vector& x) const {
+    // Backtracking on the residual norm: halve the step until ||R|| decreases (at most
+    // 30 halvings; the last trial is taken whatever it gives).
+    ScopedTimer t(timings_, "newton/line_search");
+    const Index n = x.size();
+    Vector trial(n), Rt(n);
+    double alpha = 1.0;
+    for (int h = 0; h < 30; ++h, alpha *= 0.5) {
+        trial = x + alpha * dx;
+        if (residual(s, u_prev_full, trial, Rt, nullptr, nullptr, nullptr) < norm) break;
+    }
+    x = trial;
+}
+
 StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x, int max_iter) {
     const double t_start = wall_seconds();
     StepReport rep;
@@ -178,142 +318,27 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x, 
             ScopedTimer t(timings_, "newton/residual");
             norm = residual(s, u_prev_full, x, R, &st, &M, &scale);
         }
-        const double rel = scale > 0 ? norm / scale : norm;
-        rep.residuals.push_back(rel);
+        rep.residuals.push_back(scale > 0 ? norm / scale : norm);
         int changes = 0;
         if (k > 0)
             for (size_t e = 0; e < st.size(); ++e)
                 changes += st[e] != st_prev[e];
         if (dist_.comm) changes = dist_.comm->sum(changes);
         if (k > 0) rep.status_changes.push_back(changes);
-        // Status cycling: the status vector returns to one seen two or more iterates ago. The
-        // generalized Newton map can cycle between status sets (Alart & Curnier's method is only
-        // locally convergent); from then on each step is damped by backtracking on ||R||.
-        if (!damped && k > 0 && changes > 0 && history.size() >= 2) {
-            // Distributed: a status vector is seen again only if every process's part is.
-            std::vector<int> differ(history.size() - 1);
-            for (size_t j = 0; j + 1 < history.size(); ++j)
-                differ[j] = history[j] == st ? 0 : 1;
-            if (dist_.comm) dist_.comm->allreduce(std::span<int>(differ), ReduceOp::max);
-            for (size_t j = 0; j + 1 < history.size(); ++j)
-                if (differ[j] == 0) {
-                    damped = true;
-                    rep.cycling_detected_at = k;
-                    break;
-                }
+        // Status cycling: the generalized Newton map can cycle between status sets (Alart &
+        // Curnier's method is only locally convergent); from then on each step is damped by
+        // backtracking on ||R||.
+        if (!damped && k > 0 && changes > 0 && history.size() >= 2 &&
+            statuses_cycle(history, st, dist_.comm)) {
+            damped = true;
+            rep.cycling_detected_at = k;
         }
         if (!damped) history.push_back(st);
-        if (!std::isfinite(norm)) {
-            rep.message = "the residual became NaN/Inf at Newton iteration " + std::to_string(k);
-            break;
-        }
-        if (norm <= params_.rel_tol * scale && (k == 0 || changes == 0)) {
-            rep.converged = true;
-            break;
-        }
-        // Round-off floor: the problem is linear for fixed statuses, so once two consecutive
-        // steps kept every status, the last step was exact up to the linear solver's accuracy;
-        // a residual that then stops decreasing is the conditioning floor (e.g. nu -> 0.5),
-        // not a failure. Accepted and said so, if within 1e3 times the tolerance.
-        if (k >= 2 && changes == 0 && rep.status_changes.size() >= 2 &&
-            rep.status_changes[rep.status_changes.size() - 2] == 0 &&
-            rel > 0.5 * rep.residuals[rep.residuals.size() - 2] &&
-            norm <= 1e3 * params_.rel_tol * scale) {
-            rep.converged = true;
-            std::ostringstream os;
-            os << "residual stagnated at " << rel << " (round-off floor above the tolerance "
-               << params_.rel_tol << ") with statuses fixed";
-            rep.message = os.str();
-            break;
-        }
-        if (k == max_iter) {
-            std::ostringstream os;
-            os << "no convergence in " << max_iter << " Newton iterations; relative "
-               << "residual went " << rep.residuals.front() << " -> " << rel << " (tolerance "
-               << params_.rel_tol << "), " << changes << " status changes in the last iteration";
-            if (rep.cycling_detected_at >= 0)
-                os << "; statuses cycled from iteration " << rep.cycling_detected_at
-                   << " (damped steps did not break the cycle)";
-            rep.message = os.str();
-            break;
-        }
-        if (stop_ && stop_->load()) {
-            rep.stopped = true;
-            rep.message = "stopped on request after " + std::to_string(k) + " Newton iterations";
-            break;
-        }
-        SolveResult lin;
-        {
-            ScopedTimer t(timings_, "newton/linear_solve");
-            R = -R;
-            dx.setZero();
-            try {
-                if (fallback_) {
-                    // The Krylov solve failed on this level before: the exact solver from then
-                    // on (it is set up; another failed attempt per system would only cost).
-                    lin = fallback_->solve(M, R, dx);
-                    ++rep.fallback_solves;
-                } else {
-                    lin = solver_->solve(M, R, dx, forcing_term(k, norm, scale));
-                }
-            } catch (const SolverBreakdown& e) {
-                if (!make_fallback_) throw;
-                lin = SolveResult{};
-                lin.reason = StopReason::breakdown;
-                lin.message = e.what();
-            }
-        }
-        rep.linear_iterations += lin.iterations;
-        rep.linear_iterations_per_newton.push_back(lin.iterations);
-        rep.linear_seconds += lin.setup_seconds + lin.solve_seconds;
-        rep.linear_setup_seconds += lin.setup_seconds;
-        rep.linear_assembly_seconds += lin.assembly_seconds;
-        // Inexact Newton: a Krylov solve that hit its iteration limit but reduced the linear
-        // residual by at least half still gives a descent-quality step; the Newton test decides.
-        const bool usable = !lin.converged && lin.reason == StopReason::max_iter &&
-                            std::isfinite(lin.relative_residual) && lin.relative_residual < 0.5 &&
-                            dx.allFinite();
-        if (usable) ++rep.inexact_steps;
-        if (!lin.converged && !usable && make_fallback_ && !fallback_) {
-            // The exact fallback: the same system solved again, exactly.
-            const std::string why = std::string(to_string(lin.reason)) +
-                                    (lin.message.empty() ? "" : " (" + lin.message + ")");
-            try {
-                if (!fallback_) fallback_ = make_fallback_();
-            } catch (const InvalidInput& e) {
-                rep.message = "linear solve failed at Newton iteration " + std::to_string(k) +
-                              ": " + why + "; no exact fallback: " + e.what();
-                break;
-            }
-            ScopedTimer t(timings_, "newton/fallback_solve");
-            dx.setZero();
-            const SolveResult ex = fallback_->solve(M, R, dx);
-            rep.linear_seconds += ex.setup_seconds + ex.solve_seconds;
-            if (rep.fallback_solves++ == 0)
-                rep.fallback_reason = solver_->name() + " failed at Newton iteration " +
-                                      std::to_string(k) + ": " + why + "; solved by " +
-                                      fallback_->name();
-            lin.converged = ex.converged;
-            lin.reason = ex.reason;
-            lin.message = ex.message;
-        }
-        if (!lin.converged && !usable) {
-            rep.message = "linear solve failed at Newton iteration " + std::to_string(k) + ": " +
-                          std::string(to_string(lin.reason)) +
-                          (lin.message.empty() ? "" : " (" + lin.message + ")");
-            break;
-        }
+        if (stop_test(k, max_iter, norm, scale, changes, rep)) break;
+        R = -R;
+        if (!solve_system(k, M, R, dx, forcing_term(k, norm, scale), rep)) break;
         if (damped) {
-            // Backtracking on the residual norm: halve the step until ||R|| decreases (at most
-            // 30 halvings; the last trial is taken whatever it gives).
-            ScopedTimer t(timings_, "newton/line_search");
-            Vector trial(n), Rt(n);
-            double alpha = 1.0;
-            for (int h = 0; h < 30; ++h, alpha *= 0.5) {
-                trial = x + alpha * dx;
-                if (residual(s, u_prev_full, trial, Rt, nullptr, nullptr, nullptr) < norm) break;
-            }
-            x = trial;
+            damped_step(s, u_prev_full, dx, norm, x);
             ++rep.damped_steps;
         } else {
             x += dx;

@@ -10,7 +10,6 @@
 #include "levels/level.hpp"
 #include "levels/newton_system.hpp"
 
-#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -142,22 +141,33 @@ public:
     void set_fallback(std::function<std::unique_ptr<NewtonSystemSolver>()> make) {
         make_fallback_ = std::move(make);
     }
-    /// A flag polled after every Newton iteration: once it is set, solve() returns after the
-    /// current iteration with StepReport::stopped (and converged false). Null: never stops.
-    void set_stop(const std::atomic<bool>* stop) { stop_ = stop; }
+    /// Polled after every Newton iteration: once it returns true, solve() returns after the
+    /// current iteration with StepReport::stopped (and converged false). Empty: never stops.
+    void set_stop(std::function<bool()> requested) { stop_ = std::move(requested); }
     /// Polled before every iteration of solve(); true stops it by throwing mlc::Interrupted
-    /// (levels::SolveOptions::interrupt_requested). Empty: never polled.
+    /// (levels::SolveObserver::interrupt_requested). Empty: never polled.
     void set_interrupt(std::function<bool()> requested) { interrupt_ = std::move(requested); }
 
 private:
     StepReport solve(double s, const Vector& u_prev_full, Vector& x, int max_iter);
+    // The phases of an iteration k of solve(). Whether Newton ends at the current iterate
+    // (converged, failed, at max_iter, or stopped on request), with rep.message said why.
+    bool stop_test(int k, int max_iter, double norm, double scale, int changes,
+                   StepReport& rep) const;
+    // The Newton system J(M) dx = b, with the exact fallback when the solver fails; false (and
+    // rep.message) when no usable step came out of it.
+    bool solve_system(int k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                      double forcing, StepReport& rep);
+    // x += alpha dx with alpha halved until ||R|| falls below `norm` (after status cycling).
+    void damped_step(double s, const Vector& u_prev_full, const Vector& dx, double norm,
+                     Vector& x) const;
     const Level& level_;
     NewtonParams params_;
     std::unique_ptr<NewtonSystemSolver> solver_;
     Timings* timings_;
     std::function<std::unique_ptr<NewtonSystemSolver>()> make_fallback_;
     std::unique_ptr<NewtonSystemSolver> fallback_;
-    const std::atomic<bool>* stop_ = nullptr;
+    std::function<bool()> stop_;
     std::function<bool()> interrupt_;
     NewtonDistribution dist_;
     Index n_iterate() const { return dist_.comm ? dist_.n_owned : level_.n_unknowns(); }

@@ -12,7 +12,6 @@
 #include "levels/resources.hpp"
 
 #include <array>
-#include <atomic>
 #include <functional>
 #include <optional>
 #include <ostream>
@@ -20,32 +19,29 @@
 
 namespace mlc::levels {
 
-/// A converged load step of one level, as SolveOptions::on_level_step sees it (valid during the
+/// A converged load step of one level, as SolveObserver::level_step sees it (valid during the
 /// call only).
 struct LevelStepState {
     int level = 0;
-    int step = 0;                                         ///< 1-based load step
-    double s = 0.0;                                       ///< load parameter step / load_steps
-    const Level* L = nullptr;                             ///< the level
-    const Vector* u_full = nullptr;                       ///< nodal displacements (2 per vertex)
-    const std::vector<ContactNodeState>* nodes = nullptr; ///< contact node states
+    int step = 0;                   ///< 1-based load step
+    double s = 0.0;                 ///< load parameter step / load_steps
+    const Level* L = nullptr;       ///< the level
+    const Vector* u_full = nullptr; ///< nodal displacements (2 per vertex)
+    /// The contact node states, computed on the first call.
+    const std::vector<ContactNodeState>& nodes() const;
+    /// What nodes() computes (set by the run).
+    std::function<std::vector<ContactNodeState>()> node_states;
+
+private:
+    mutable std::optional<std::vector<ContactNodeState>> nodes_;
 };
 
-/// Options of one run that are not part of the problem.
+/// Options of one run that are not part of the problem: plain values (what a run reports as it
+/// goes and asks of its caller is the SolveObserver's).
 struct SolveOptions {
-    std::ostream* progress = nullptr; ///< per-step progress lines, or null for silence
-    /// Progress lines also give the time elapsed and an estimate of the time left (the driver
-    /// sets it when its output is a terminal).
-    bool progress_eta = false;
     /// Keep the finest displacements after every step (step_u_full); the contact node states of
     /// every step (step_nodes) are always kept.
     bool keep_step_states = false;
-    /// Polled after every Newton iteration: once set, the run stops after the current
-    /// iteration (RunResult::stopped; the completed load steps are kept). Null: never stops.
-    const std::atomic<bool>* stop = nullptr;
-    /// Called after every converged load step of every solved level (levels bottom up, then
-    /// the next step), e.g. to write that step's files as soon as it is done.
-    std::function<void(const LevelStepState&)> on_level_step;
     /// Coarse-to-fine: in every load step solve level 0, interpolate (P u, Q lambda) to level 1 as
     /// the initial guess, solve there, and so on to the finest. Off ("cold"): only the finest
     /// level is solved, from its previous step's state (every level when the preconditioner
@@ -89,19 +85,6 @@ struct SolveOptions {
     /// predict_level_sizes(problem) when the caller computed it already (it builds level 0);
     /// empty: solve computes it.
     std::vector<LevelSize> predicted_sizes;
-    /// Polled before every Newton iteration on every level; when it returns true the solve stops
-    /// there by throwing mlc::Interrupted naming the level, load step and iteration. Empty: never
-    /// polled. The Python module checks Python's signal handlers here, so that Ctrl-C during
-    /// mlcontact.solve() raises KeyboardInterrupt within one Newton iteration.
-    std::function<bool()> interrupt_requested;
-    /// Wraps the Newton-system solver of each level solved (bottom up, once, before the first
-    /// load step): the wrapper receives the level's index, the level and the solver the run
-    /// built, and returns the one the run uses (forwarding prepare, set_coarse_statuses and
-    /// multigrid to it). `bench newton` records and times the finest level's systems this way.
-    /// Empty: the solvers as built.
-    std::function<std::unique_ptr<NewtonSystemSolver>(int level, const Level& L,
-                                                      std::unique_ptr<NewtonSystemSolver>)>
-        wrap_system_solver;
 };
 
 /// Confusion table of predicted (rows) against converged (columns) statuses, indexed by
@@ -119,6 +102,81 @@ struct LevelStep {
     Confusion confusion{};                           ///< predicted x final counts
     /// Fraction of contact nodes whose predicted status was final (1 when not predicted).
     double agreement() const;
+};
+
+/// A load step of one level as it ends, converged or not (SolveObserver::level_step_done).
+struct LevelStepProgress {
+    const LevelStep* step = nullptr; ///< the level's step: its report and prediction
+    int load_steps = 0;              ///< the problem's load steps
+    int n_levels = 0;                ///< levels of the hierarchy
+    int first_level = 0;             ///< the lowest level solved
+    /// The hierarchy's levels (their sizes estimate the time left); null for a distributed level.
+    const std::vector<Level>* levels = nullptr;
+    double elapsed = 0.0; ///< seconds since the first load step began
+    /// A distributed level's processes (levels/distributed_solve.hpp); 0 for a level that is
+    /// solved whole.
+    int processes = 0;
+};
+
+/// What a run reports as it goes and what it asks of its caller, as a monitor of deal.II's or
+/// PETSc's does: solve() calls these at the points named; every default does nothing.
+class SolveObserver {
+public:
+    virtual ~SolveObserver() = default;
+    /// After every load step of every solved level, converged, failed or stopped (progress).
+    virtual void level_step_done(const LevelStepProgress&) {}
+    /// After every converged load step of every solved level (levels bottom up, then the next
+    /// step), e.g. to write that step's files as soon as it is done.
+    virtual void level_step(const LevelStepState&) {}
+    /// Polled after every Newton iteration: once true, the run stops after the current iteration
+    /// (RunResult::stopped; the completed load steps are kept).
+    virtual bool stop_requested() { return false; }
+    /// Polled before every Newton iteration on every level; true stops the solve there by
+    /// throwing mlc::Interrupted naming the level, load step and iteration. The Python module
+    /// checks Python's signal handlers here, so that Ctrl-C during mlcontact.solve() raises
+    /// KeyboardInterrupt within one Newton iteration.
+    virtual bool interrupt_requested() { return false; }
+    /// The Newton-system solver of each level solved (bottom up, once, before the first load
+    /// step): receives the level's index, the level and the solver the run built, and returns the
+    /// one the run uses (forwarding prepare, set_coarse_statuses and multigrid to it). `bench
+    /// newton` records and times the finest level's systems this way.
+    virtual std::unique_ptr<NewtonSystemSolver>
+    wrap_system_solver(int /*level*/, const Level& /*L*/,
+                       std::unique_ptr<NewtonSystemSolver> solver) {
+        return solver;
+    }
+};
+
+/// Progress lines, one per load step and level, on a stream (none on a null one); with `eta`,
+/// a converged step's line also gives the time elapsed and an estimate of the time left (the
+/// driver asks for it when its output is a terminal). Derive from it to observe more.
+class ProgressLines : public SolveObserver {
+public:
+    explicit ProgressLines(std::ostream* os, bool eta = false) : os_(os), eta_(eta) {}
+    void level_step_done(const LevelStepProgress& p) override;
+
+private:
+    std::ostream* os_;
+    bool eta_;
+    std::vector<double> seconds_; // per level, over its steps
+    std::vector<int> count_;
+};
+
+/// An observer that only wraps the Newton-system solvers (SolveObserver::wrap_system_solver)
+/// by a function: the benches and tests that record or time the systems.
+class SolverWrapper : public SolveObserver {
+public:
+    using Wrap = std::function<std::unique_ptr<NewtonSystemSolver>(
+        int level, const Level& L, std::unique_ptr<NewtonSystemSolver>)>;
+    explicit SolverWrapper(Wrap wrap) : wrap_(std::move(wrap)) {}
+    std::unique_ptr<NewtonSystemSolver>
+    wrap_system_solver(int level, const Level& L,
+                       std::unique_ptr<NewtonSystemSolver> solver) override {
+        return wrap_(level, L, std::move(solver));
+    }
+
+private:
+    Wrap wrap_;
 };
 
 /// Result of a run.
@@ -146,8 +204,8 @@ struct RunResult {
     MemoryLimit memory_limit;
     bool converged = false;
     std::string failure; ///< diagnosis of the first step that failed (or where the run stopped)
-    /// Stopped on request (SolveOptions::stop) before the last load step was complete; `failure`
-    /// says where. converged is false.
+    /// Stopped on request (SolveObserver::stop_requested) before the last load step was complete;
+    /// `failure` says where. converged is false.
     bool stopped = false;
     int completed_steps = 0; ///< load steps completed on every solved level
     /// What makes the solution doubtful though it converged (levels/diagnoses.hpp): a rotation
@@ -160,10 +218,12 @@ struct RunResult {
     const std::vector<Level>& levels() const { return hierarchy.levels; }
 };
 
-/// Builds the hierarchy and solves every load step (see SolveOptions). Stops at the first level
-/// and step that does not converge (RunResult::converged false, failure set). Before building
-/// anything it estimates the peak memory of the run (estimate_memory) and throws InvalidInput
-/// when that exceeds what the process may use (process_memory_limit), naming both.
-RunResult solve(const Problem& problem, const SolveOptions& options = {});
+/// Builds the hierarchy and solves every load step (see SolveOptions), reporting to `observer`
+/// (null: none). Stops at the first level and step that does not converge (RunResult::converged
+/// false, failure set). Before building anything it estimates the peak memory of the run
+/// (estimate_memory) and throws InvalidInput when that exceeds what the process may use
+/// (process_memory_limit), naming both.
+RunResult solve(const Problem& problem, const SolveOptions& options = {},
+                SolveObserver* observer = nullptr);
 
 } // namespace mlc::levels

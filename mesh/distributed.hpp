@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file A mesh hierarchy distributed over the processes of a Communicator: one level p is
 /// partitioned, each process keeps its triangles plus one layer of ghost triangles and refines
-/// them locally, so every process holds a nested hierarchy of its own part (design.md,
-/// "Distributed"; issue 12, item 2).
+/// them locally, so every process holds a nested hierarchy of its own part (docs/parallel.md#parallel-how).
 ///
 /// Every process holds the whole level-p mesh (the levels up to p are small and redundant) and
 /// partitions it the same way (partition_triangles is deterministic), so building the hierarchy
@@ -70,7 +69,7 @@ struct LocalLevel {
     std::int64_t first_row() const { return 2 * first_vertex; }
 };
 
-/// A deeper ghost layer along a contact interface (two-body contact pairs, issue 13 item 1): the
+/// A deeper ghost layer along a contact interface (two-body contact pairs): the
 /// level-p triangles with a boundary edge tagged one of `tags` lying within `distance` of a
 /// boundary edge tagged one of `tags` of a triangle of the one-layer local mesh become ghosts too
 /// (with their refinements), so that the contact search of every local contact node, and of the
@@ -108,7 +107,7 @@ DistributedHierarchy distribute(const Mesh& level_p, int n_refinements, const Co
 /// folder of `file` (solution.pvtu -> solution_0.vtu, solution_1.vtu, ...).
 std::filesystem::path piece_path(const std::filesystem::path& file, int rank);
 
-/// Writes a distributed level as one mesh: `file` (a .pvtu, issue 12 item 5) and one .vtu piece
+/// Writes a distributed level as one mesh: `file` (a .pvtu) and one .vtu piece
 /// per process (piece_path), which ParaView and vtkXMLPUnstructuredGridReader open as one mesh.
 ///
 /// Each process writes its owned triangles (triangle_owned) and the vertices they use, with

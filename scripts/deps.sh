@@ -18,6 +18,7 @@ packages=(
   libjs-mathjax fonts-mathjax   # math rendered offline, from the built site
   chromium                      # tests: the built site opened in a headless browser
   xvfb xauth                    # offscreen VTK rendering under xvfb-run (docs/viewing.md#viewing-vtk)
+  universal-ctags               # function lengths for scripts/check_code_size.sh
 )
 missing=()
 for p in "${packages[@]}"; do

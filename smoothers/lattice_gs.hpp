@@ -41,6 +41,10 @@
 
 namespace mlc::smoothers {
 
+namespace lattice {
+struct Layout; // what the phases of LatticeGS's setup hand on (lattice_gs_setup.cpp)
+} // namespace lattice
+
 /// The rows of the interior lattice points of every macro triangle, and the visiting order.
 struct LatticeRows {
     /// Subdivisions per macro edge (2^depth); below 6 there are no deep points.
@@ -130,7 +134,14 @@ public:
     std::string name() const;
 
 private:
+    // The setup, in phases (lattice_gs_setup.cpp).
     void derive(const SparseMatrix& A);
+    void derive_blocks(lattice::Layout& lay) const;
+    void derive_parts(const SparseMatrix& A, lattice::Layout& lay) const;
+    void derive_points(const SparseMatrix& A, lattice::Layout& lay);
+    void number_visits(const lattice::Layout& lay);
+    void group_items();
+    void derive_swept_rows(const SparseMatrix& A, const lattice::Layout& lay);
     void load_rows(const SparseMatrix& A); // values of the row-swept blocks and their inverses
     bool deep_rows_match(const SparseMatrix& A) const;
     bool same_pattern(const SparseMatrix& A) const;

@@ -49,7 +49,7 @@ smoothers::BlockSORParams smoother_params(const MultigridParams& params,
 
 // One level: on level 0 the coarse solve; above it the transfer from the level below, the
 // smoother and the work vectors of the cycle.
-struct Multigrid::Level {
+struct Multigrid::Level final : CycleOperator, CycleSmoother, CycleTransfer {
     Level(const MultigridLevelData& d, const MultigridParams& p)
         : T(d.T), R(d.R), T_storage(d.T_storage), R_storage(d.R_storage), lattice_rows(d.lattice),
           params(p), smoother(smoother_params(p, d.block_starts)) {
@@ -84,6 +84,50 @@ struct Multigrid::Level {
     const SparseMatrix* A = nullptr;        // the operator (borrowed, or `owned`)
     SparseMatrix owned;                     // Galerkin operator
     mutable Vector res, rc, ec;             // levels >= 1
+
+    bool single() const { return params.precision == Precision::float32; }
+
+    // res = r - A z (with the smoother's float32 values under precision=single).
+    void residual(const Vector& r, const Vector& z, Vector& out) const override {
+        if (single()) {
+            csr_residual(csr_arrays(*A, smoother.values32()), r, z, out, traffic::Kind::matvec);
+            return;
+        }
+        const traffic::Pass pass(traffic::Kind::matvec,
+                                 traffic::csr_bytes(A->rows(), A->cols(), A->nonZeros(), true));
+        out = r;
+        out.noalias() -= *A * z;
+    }
+    void forward_from_zero(const Vector& r, Vector& z, Vector& out) const override {
+        if (lattice)
+            lattice->forward_from_zero(r, z, out);
+        else
+            smoother.forward_from_zero(r, z, out);
+    }
+    void smooth(const Vector& r, Vector& z, smoothers::Sweep direction, int count) const override {
+        if (lattice) {
+            lattice->smooth(r, z, direction, count);
+            return;
+        }
+        for (int s = 0; s < count; ++s)
+            smoother.sweep(r, z, direction);
+    }
+    void restrict_residual(const Vector& x, Vector& y) const override {
+        if (single())
+            csr_multiply(csr_arrays(*R, R32.data()), x, y, false, traffic::Kind::transfer);
+        else if (lattice_transfer)
+            lattice_transfer->restrict_residual(x, y);
+        else
+            csr_multiply(*R, x, y, false, traffic::Kind::transfer);
+    }
+    void prolongate(const Vector& e, Vector& z, bool add) const override {
+        if (single())
+            csr_multiply(csr_arrays(*T, T32.data()), e, z, add, traffic::Kind::transfer);
+        else if (lattice_transfer)
+            lattice_transfer->prolongate(e, z, add);
+        else
+            csr_multiply(*T, e, z, add, traffic::Kind::transfer);
+    }
 
     // Full setup (`full`) or a refresh reusing the structure; the first call is always full.
     void set(const SparseMatrix& M, bool full) {
@@ -291,69 +335,24 @@ void Multigrid::update_values(const SparseMatrix& A) {
     levels_.back()->set(A, false);
 }
 
-void Multigrid::cycle(int k, const Vector& r, Vector& z) const {
+CycleLevel Multigrid::cycle_level(int k) const {
     const Level& L = *levels_[static_cast<size_t>(k)];
-    if (k == 0) {
-        MLC_CHECK(L.A != nullptr || L.coarse_replaced,
-                  "Multigrid: the coarsest operator is not set");
-        const traffic::Pass pass(traffic::Kind::coarse, 0.0);
-        L.coarse->apply(r, z);
-        return;
-    }
     MLC_CHECK(L.A != nullptr, "Multigrid: the operator of level " << k << " is not set");
-    const MultigridParams& p = L.params;
-    const bool single = p.precision == Precision::float32;
-    // Without pre-smoothing z is zero until the coarse correction: the residual is r itself
-    // (restricted as it is, not copied) and the prolongation writes z = T e instead of adding
-    // T e to zeros (the same values: a row_dot is never -0.0, and 0.0 + v is v).
-    const bool from_zero = p.pre_sweeps == 0;
-    if (!from_zero) {
-        if (L.lattice) {
-            L.lattice->forward_from_zero(r, z, L.res);
-            L.lattice->smooth(r, z, smoothers::Sweep::forward, p.pre_sweeps - 1);
-        } else {
-            L.smoother.forward_from_zero(r, z, L.res);
-            for (int s = 1; s < p.pre_sweeps; ++s)
-                L.smoother.sweep(r, z, smoothers::Sweep::forward);
-        }
-        if (p.pre_sweeps > 1 && single) {
-            csr_residual(csr_arrays(*L.A, L.smoother.values32()), r, z, L.res,
-                         traffic::Kind::matvec);
-        } else if (p.pre_sweeps > 1) {
-            const traffic::Pass pass(
-                traffic::Kind::matvec,
-                traffic::csr_bytes(L.A->rows(), L.A->cols(), L.A->nonZeros(), true));
-            L.res = r;
-            L.res.noalias() -= *L.A * z;
-        }
-    }
-    const Vector& res = from_zero ? r : L.res;
-    if (single) {
-        csr_multiply(csr_arrays(*L.R, L.R32.data()), res, L.rc, false, traffic::Kind::transfer);
-        cycle(k - 1, L.rc, L.ec);
-        csr_multiply(csr_arrays(*L.T, L.T32.data()), L.ec, z, !from_zero, traffic::Kind::transfer);
-    } else if (L.lattice_transfer) {
-        L.lattice_transfer->restrict_residual(res, L.rc);
-        cycle(k - 1, L.rc, L.ec);
-        L.lattice_transfer->prolongate(L.ec, z, !from_zero);
-    } else {
-        csr_multiply(*L.R, res, L.rc, false, traffic::Kind::transfer);
-        cycle(k - 1, L.rc, L.ec);
-        csr_multiply(*L.T, L.ec, z, !from_zero, traffic::Kind::transfer);
-    }
-    if (L.lattice) {
-        L.lattice->smooth(r, z, smoothers::Sweep::backward, p.post_sweeps);
-        return;
-    }
-    for (int s = 0; s < p.post_sweeps; ++s)
-        L.smoother.sweep(r, z, smoothers::Sweep::backward);
+    return {L, L, L, L.params.pre_sweeps, L.params.post_sweeps, L.res, L.rc, L.ec};
+}
+
+void Multigrid::coarse_solve(const Vector& r, Vector& z) const {
+    const Level& L = *levels_.front();
+    MLC_CHECK(L.A != nullptr || L.coarse_replaced, "Multigrid: the coarsest operator is not set");
+    const traffic::Pass pass(traffic::Kind::coarse, 0.0);
+    L.coarse->apply(r, z);
 }
 
 void Multigrid::apply(const Vector& r, Vector& z) const {
     const Level& top = *levels_.back();
     MLC_CHECK(top.A != nullptr, "Multigrid: call setup first");
     smoothers::check_size(r, top.A->rows(), "Multigrid::apply", "r");
-    cycle(n_levels() - 1, r, z);
+    VCycle::cycle(n_levels() - 1, r, z);
 }
 
 const SparseMatrix* Multigrid::finest_operator() const {

@@ -12,7 +12,8 @@
 ///     coarse:      z <- z + T_k B_{k-1} R_k (r - A_k z)    (B_{k-1}: the cycle of level k-1)
 ///     post-smooth: z <- z + S_bwd (r - A_k z)              (nu2 backward sweeps)
 ///
-/// and on level 0 z = A_0^{-1} r by the coarse solver (sparse LU unless replaced). T_k is the
+/// (the cycle of solvers/vcycle.hpp, shared with the distributed multigrid) and on level 0
+/// z = A_0^{-1} r by the coarse solver (sparse LU unless replaced). T_k is the
 /// prolongation from level k-1 (P on displacements, Q on multipliers: transfer::LevelTransfer::T)
 /// and R_k = T_k^T. Every step is linear in r and nothing depends on the iteration, so the cycle
 /// is a fixed linear operator: CGS, BiCGStab and (non-flexible) GMRES all apply. With forward
@@ -32,6 +33,7 @@
 #include "core/linear_operator.hpp"
 #include "smoothers/block_sor.hpp"
 #include "smoothers/lattice_gs.hpp"
+#include "solvers/vcycle.hpp"
 
 #include <memory>
 #include <ostream>
@@ -119,7 +121,7 @@ std::ostream& operator<<(std::ostream& os, const MultigridReport& r);
 
 /// The multigrid preconditioner (see the file comment). Not thread-safe (mutable work vectors);
 /// `apply` does not allocate when the coarse solver does not.
-class Multigrid final : public Preconditioner {
+class Multigrid final : public Preconditioner, private VCycle {
 public:
     /// A multigrid on `levels` (coarsest first, at least two; T and R of every level above the
     /// coarsest, with consistent sizes). The coarse solve is a sparse LU of the coarsest
@@ -182,7 +184,8 @@ public:
 private:
     struct Level;
     Multigrid() = default;
-    void cycle(int k, const Vector& r, Vector& z) const;
+    CycleLevel cycle_level(int k) const override;
+    void coarse_solve(const Vector& r, Vector& z) const override;
     void set_galerkin_operators(const SparseMatrix& A);
     bool refresh_galerkin_operators(const SparseMatrix& A);
 

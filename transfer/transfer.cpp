@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Construction and application of the two-level interpolation P (displacements) and Q (contact
-// multipliers) of Alart & Lebon (1995), sect. 2.4 (formulation.md §3).
+// multipliers) of Alart & Lebon (1995), sect. 2.4 (docs/theory.md#theory-transfer).
 #include "transfer/transfer.hpp"
 
 #include "core/check.hpp"
@@ -73,21 +73,10 @@ std::vector<int> node_of_vertex(const ContactNodes& c, const fem::DofMap& dofs, 
     return of;
 }
 
-} // namespace
-
-Eigen::Vector2d multiplier_resultant(const ContactNodes& nodes, const Vector& x) {
-    Eigen::Vector2d s = Eigen::Vector2d::Zero();
-    for (size_t i = 0; i < nodes.vertex.size(); ++i) {
-        const int nm = nodes.n_multipliers[i];
-        for (int q = 0; q < nm; ++q)
-            s[component_of_slot(nm, q)] += x[nodes.lambda_dof[i] + q];
-    }
-    return s;
-}
-
-LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
-                             const fem::DofMap& fine_dofs, const ContactNodes& coarse_contacts,
-                             const ContactNodes& fine_contacts, QRule rule) {
+/// The meshes and numberings nest: the fine mesh refines the coarse one (parents of every new
+/// vertex), the numberings have the meshes' vertex counts, and the supports nest.
+void check_levels_nest(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
+                       const fem::DofMap& fine_dofs) {
     const int nf = fine.n_vertices();
     const int nc = fine.n_coarse_vertices;
     MLC_CHECK(nc > 0 && static_cast<int>(fine.parents.size()) == nf - nc,
@@ -115,9 +104,11 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
                                                    << "prescribed on the coarse level but "
                                                    << (fine_dofs.u_dof(v, c) < 0 ? "" : "not ")
                                                    << "on the fine one; supports must nest");
+}
 
-    const std::vector<int> cnode = node_of_vertex(coarse_contacts, coarse_dofs, "coarse");
-    const std::vector<int> fnode = node_of_vertex(fine_contacts, fine_dofs, "fine");
+/// The fine contact boundary contains the coarse one, with the same multipliers per vertex.
+void check_contacts_nest(int nc, const std::vector<int>& cnode, const std::vector<int>& fnode,
+                         const ContactNodes& coarse_contacts, const ContactNodes& fine_contacts) {
     for (int v = 0; v < nc; ++v) {
         const int i = cnode[static_cast<size_t>(v)];
         const int j = fnode[static_cast<size_t>(v)];
@@ -137,58 +128,61 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
                           << fine_contacts.n_multipliers[static_cast<size_t>(j)]
                           << " on the fine one");
     }
+}
 
-    LevelTransfer tr;
-    tr.rule = rule;
-
-    // Nodal P: identity at coarse vertices, 1/2, 1/2 at edge midpoints, straight into CSR (each
-    // row's entries in column order; no triplets: 16 bytes per entry and a sort, 0.6 GB at
-    // level 7 of the square).
-    {
-        tr.P_vertex.resize(nf, nc);
-        tr.P_nodal.resize(2 * nf, 2 * nc);
-        tr.P_vertex.resizeNonZeros(nc + 2 * (nf - nc));
-        tr.P_nodal.resizeNonZeros(2 * (nc + 2 * (nf - nc)));
-        int* ov = tr.P_vertex.outerIndexPtr();
-        int* iv = tr.P_vertex.innerIndexPtr();
-        double* vv = tr.P_vertex.valuePtr();
-        int* on = tr.P_nodal.outerIndexPtr();
-        int* in = tr.P_nodal.innerIndexPtr();
-        double* vn = tr.P_nodal.valuePtr();
-        int kv = 0, kn = 0;
-        ov[0] = 0;
-        on[0] = 0;
-        for (int v = 0; v < nf; ++v) {
-            if (v < nc) {
-                iv[kv] = v;
-                vv[kv++] = 1.0;
-                for (int c = 0; c < 2; ++c) {
-                    in[kn] = 2 * v + c;
-                    vn[kn++] = 1.0;
-                    on[2 * v + c + 1] = kn;
-                }
-            } else {
-                std::array<int, 2> pr = fine.parents[static_cast<size_t>(v - nc)];
-                if (pr[1] < pr[0]) std::swap(pr[0], pr[1]);
-                for (int p : pr) {
-                    iv[kv] = p;
-                    vv[kv++] = 0.5;
-                }
-                for (int c = 0; c < 2; ++c) {
-                    for (int p : pr) {
-                        in[kn] = 2 * p + c;
-                        vn[kn++] = 0.5;
-                    }
-                    on[2 * v + c + 1] = kn;
-                }
+/// Nodal P: identity at coarse vertices, 1/2, 1/2 at edge midpoints, straight into CSR (each
+/// row's entries in column order; no triplets: they would take 16 bytes per entry and a sort).
+void build_nodal_prolongation(const mesh::Mesh& fine, LevelTransfer& tr) {
+    const int nf = fine.n_vertices();
+    const int nc = fine.n_coarse_vertices;
+    tr.P_vertex.resize(nf, nc);
+    tr.P_nodal.resize(2 * nf, 2 * nc);
+    tr.P_vertex.resizeNonZeros(nc + 2 * (nf - nc));
+    tr.P_nodal.resizeNonZeros(2 * (nc + 2 * (nf - nc)));
+    int* ov = tr.P_vertex.outerIndexPtr();
+    int* iv = tr.P_vertex.innerIndexPtr();
+    double* vv = tr.P_vertex.valuePtr();
+    int* on = tr.P_nodal.outerIndexPtr();
+    int* in = tr.P_nodal.innerIndexPtr();
+    double* vn = tr.P_nodal.valuePtr();
+    int kv = 0, kn = 0;
+    ov[0] = 0;
+    on[0] = 0;
+    for (int v = 0; v < nf; ++v) {
+        if (v < nc) {
+            iv[kv] = v;
+            vv[kv++] = 1.0;
+            for (int c = 0; c < 2; ++c) {
+                in[kn] = 2 * v + c;
+                vn[kn++] = 1.0;
+                on[2 * v + c + 1] = kn;
             }
-            ov[v + 1] = kv;
+        } else {
+            std::array<int, 2> pr = fine.parents[static_cast<size_t>(v - nc)];
+            if (pr[1] < pr[0]) std::swap(pr[0], pr[1]);
+            for (int p : pr) {
+                iv[kv] = p;
+                vv[kv++] = 0.5;
+            }
+            for (int c = 0; c < 2; ++c) {
+                for (int p : pr) {
+                    in[kn] = 2 * p + c;
+                    vn[kn++] = 0.5;
+                }
+                on[2 * v + c + 1] = kn;
+            }
         }
+        ov[v + 1] = kv;
     }
+}
 
-    // Multiplier rows (Q). k[i][c]: fine contact midpoints next to coarse node i that receive
-    // component c from it; the conservative rule keeps 1 - k/4 at i so that the weights of
-    // lambda_H(i, c) over the fine nodes sum to one.
+/// Multiplier rows (Q). k[i][c]: fine contact midpoints next to coarse node i that receive
+/// component c from it; the conservative rule keeps 1 - k/4 at i so that the weights of
+/// lambda_H(i, c) over the fine nodes sum to one. Returns Q's triplets.
+std::vector<Triplet> multiplier_rows(const mesh::Mesh& fine, const std::vector<int>& cnode,
+                                     const ContactNodes& coarse_contacts,
+                                     const ContactNodes& fine_contacts, QRule rule) {
+    const int nc = fine.n_coarse_vertices;
     std::vector<std::array<int, 2>> k(coarse_contacts.vertex.size(), {0, 0});
     auto for_each_midpoint_source = [&](int j, auto&& f) {
         const int v = fine_contacts.vertex[static_cast<size_t>(j)];
@@ -236,56 +230,59 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
             });
         }
     }
+    return tq;
+}
 
+/// T = P on the displacement rows (prescribed components dropped) and Q on the multiplier
+/// rows, row by row into CSR.
+void build_full_prolongation(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
+                             const fem::DofMap& fine_dofs, LevelTransfer& tr) {
+    const int nc = fine.n_coarse_vertices;
     const Index n_f = fine_dofs.n_dofs(), n_c = coarse_dofs.n_dofs();
-    tr.Q.resize(n_f, n_c);
-    tr.Q.setFromTriplets(tq.begin(), tq.end());
-    // T = P on the displacement rows (prescribed components dropped) and Q on the multiplier
-    // rows, row by row into CSR.
-    {
-        const SparseMatrix& Q = tr.Q;
-        const int* qo = Q.outerIndexPtr();
-        // The columns of displacement row d (at most two), in increasing order.
-        auto u_cols = [&](Index d, int cols[2]) {
-            const int v = fine_dofs.vertex_of(d);
-            const int c = fine_dofs.u_dof(v, 0) == d ? 0 : 1;
-            if (v < nc) {
-                cols[0] = coarse_dofs.u_dof(v, c);
-                return 1;
+    const SparseMatrix& Q = tr.Q;
+    const int* qo = Q.outerIndexPtr();
+    // The columns of displacement row d (at most two), in increasing order.
+    auto u_cols = [&](Index d, int cols[2]) {
+        const int v = fine_dofs.vertex_of(d);
+        const int c = fine_dofs.u_dof(v, 0) == d ? 0 : 1;
+        if (v < nc) {
+            cols[0] = coarse_dofs.u_dof(v, c);
+            return 1;
+        }
+        int m = 0;
+        for (int p : fine.parents[static_cast<size_t>(v - nc)])
+            if (const int col = coarse_dofs.u_dof(p, c); col >= 0) cols[m++] = col;
+        if (m == 2 && cols[1] < cols[0]) std::swap(cols[0], cols[1]);
+        return m;
+    };
+    tr.T.resize(n_f, n_c);
+    int* to = tr.T.outerIndexPtr();
+    to[0] = 0;
+    int cols[2];
+    for (Index d = 0; d < n_f; ++d)
+        to[d + 1] = to[d] + (fine_dofs.is_displacement(d) ? u_cols(d, cols) : qo[d + 1] - qo[d]);
+    tr.T.resizeNonZeros(to[n_f]);
+    int* ti = tr.T.innerIndexPtr();
+    double* tv = tr.T.valuePtr();
+    for (Index d = 0; d < n_f; ++d) {
+        const int at = to[d];
+        if (fine_dofs.is_displacement(d)) {
+            const int m = u_cols(d, cols);
+            for (int j = 0; j < m; ++j) {
+                ti[at + j] = cols[j];
+                tv[at + j] = m == 1 && fine_dofs.vertex_of(d) < nc ? 1.0 : 0.5;
             }
-            int m = 0;
-            for (int p : fine.parents[static_cast<size_t>(v - nc)])
-                if (const int col = coarse_dofs.u_dof(p, c); col >= 0) cols[m++] = col;
-            if (m == 2 && cols[1] < cols[0]) std::swap(cols[0], cols[1]);
-            return m;
-        };
-        tr.T.resize(n_f, n_c);
-        int* to = tr.T.outerIndexPtr();
-        to[0] = 0;
-        int cols[2];
-        for (Index d = 0; d < n_f; ++d)
-            to[d + 1] =
-                to[d] + (fine_dofs.is_displacement(d) ? u_cols(d, cols) : qo[d + 1] - qo[d]);
-        tr.T.resizeNonZeros(to[n_f]);
-        int* ti = tr.T.innerIndexPtr();
-        double* tv = tr.T.valuePtr();
-        for (Index d = 0; d < n_f; ++d) {
-            const int at = to[d];
-            if (fine_dofs.is_displacement(d)) {
-                const int m = u_cols(d, cols);
-                for (int j = 0; j < m; ++j) {
-                    ti[at + j] = cols[j];
-                    tv[at + j] = m == 1 && fine_dofs.vertex_of(d) < nc ? 1.0 : 0.5;
-                }
-            } else {
-                std::copy(Q.innerIndexPtr() + qo[d], Q.innerIndexPtr() + qo[d + 1], ti + at);
-                std::copy(Q.valuePtr() + qo[d], Q.valuePtr() + qo[d + 1], tv + at);
-            }
+        } else {
+            std::copy(Q.innerIndexPtr() + qo[d], Q.innerIndexPtr() + qo[d + 1], ti + at);
+            std::copy(Q.valuePtr() + qo[d], Q.valuePtr() + qo[d + 1], tv + at);
         }
     }
-    tr.R = tr.T.transpose();
+}
 
-    // Coarse/fine splitting: unknowns on coarse vertices and their coarse counterparts.
+/// Coarse/fine splitting: unknowns on coarse vertices and their coarse counterparts.
+void split_coarse_fine(int nc, const fem::DofMap& coarse_dofs, const fem::DofMap& fine_dofs,
+                       LevelTransfer& tr) {
+    const Index n_f = fine_dofs.n_dofs(), n_c = coarse_dofs.n_dofs();
     tr.coarse_set.reserve(static_cast<size_t>(n_c));
     tr.coarse_dof.reserve(static_cast<size_t>(n_c));
     tr.fine_set.reserve(static_cast<size_t>(n_f - n_c));
@@ -312,6 +309,39 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
     MLC_CHECK(static_cast<Index>(tr.coarse_set.size()) == n_c,
               "build_transfer: " << tr.coarse_set.size() << " fine unknowns on coarse vertices but "
                                  << n_c << " coarse unknowns; the numberings do not nest");
+}
+
+} // namespace
+
+Eigen::Vector2d multiplier_resultant(const ContactNodes& nodes, const Vector& x) {
+    Eigen::Vector2d s = Eigen::Vector2d::Zero();
+    for (size_t i = 0; i < nodes.vertex.size(); ++i) {
+        const int nm = nodes.n_multipliers[i];
+        for (int q = 0; q < nm; ++q)
+            s[component_of_slot(nm, q)] += x[nodes.lambda_dof[i] + q];
+    }
+    return s;
+}
+
+LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
+                             const fem::DofMap& fine_dofs, const ContactNodes& coarse_contacts,
+                             const ContactNodes& fine_contacts, QRule rule) {
+    check_levels_nest(fine, coarse_dofs, fine_dofs);
+    const int nc = fine.n_coarse_vertices;
+    const std::vector<int> cnode = node_of_vertex(coarse_contacts, coarse_dofs, "coarse");
+    const std::vector<int> fnode = node_of_vertex(fine_contacts, fine_dofs, "fine");
+    check_contacts_nest(nc, cnode, fnode, coarse_contacts, fine_contacts);
+    LevelTransfer tr;
+    tr.rule = rule;
+    build_nodal_prolongation(fine, tr);
+    const std::vector<Triplet> tq =
+        multiplier_rows(fine, cnode, coarse_contacts, fine_contacts, rule);
+    const Index n_f = fine_dofs.n_dofs(), n_c = coarse_dofs.n_dofs();
+    tr.Q.resize(n_f, n_c);
+    tr.Q.setFromTriplets(tq.begin(), tq.end());
+    build_full_prolongation(fine, coarse_dofs, fine_dofs, tr);
+    tr.R = tr.T.transpose();
+    split_coarse_fine(nc, coarse_dofs, fine_dofs, tr);
     return tr;
 }
 

@@ -51,7 +51,7 @@ struct LevelTransfer {
     /// Q alone on the multiplier unknowns, as rows/cols of T (fine n_dofs x coarse n_dofs, zero
     /// on displacement rows). T = P_u + Q.
     MovableSparseMatrix Q;
-    /// Restriction of residuals, R = T^T (stored explicitly; style.md §3).
+    /// Restriction of residuals, R = T^T (stored explicitly).
     MovableSparseMatrix R;
     /// Coarse/fine splitting of the fine unknowns: `coarse_set` lists the fine unknowns that
     /// live on coarse vertices (their displacements, and the multipliers of coarse contact

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
-// Domain mesher: boundary split along the size field, CGAL constrained Delaunay refinement with a
-// size-field criterion, and arc vertices snapped onto their circles.
+// Domain mesher: CGAL constrained Delaunay refinement with a size-field criterion of the boundary
+// points (domain_boundary.cpp), and arc vertices snapped onto their circles.
 #include "mesh/cgal/domain_mesher.hpp"
 
 #include "core/check.hpp"
+#include "mesh/cgal/domain_detail.hpp"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
@@ -15,7 +16,6 @@
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 #include <CGAL/hilbert_sort.h>
 #include <CGAL/property_map.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -84,85 +84,7 @@ std::ostream& operator<<(std::ostream& os, const SizeField& size) {
 
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = K::Point_2;
-
-/// Per-vertex data: index in the boundary point list (-1 for vertices the mesher added) and the
-/// output index (-1 while unassigned or unused).
-struct VertexInfo {
-    int input = -1;
-    int id = -1;
-};
-
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, K,
-                                                       CGAL::Delaunay_mesh_vertex_base_2<K>>;
-using Fb = CGAL::Delaunay_mesh_face_base_2<K>;
-using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-// Any crossing or touching of boundary constraints is an input error, not something to resolve.
-using CDT =
-    CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::No_constraint_intersection_tag>;
-using VertexHandle = CDT::Vertex_handle;
-using FaceHandle = CDT::Face_handle;
-
-/// Squared sine of the smallest angle the mesher guarantees (20.7 degrees).
-constexpr double shape_bound = 0.125;
-/// Largest angle an arc piece may span: keeps the chord close to the circle, so that moving a
-/// mesher-added vertex from the chord onto the circle cannot fold a triangle.
-constexpr double max_arc_angle = std::numbers::pi / 12;
-/// Guard against size fields that would need an absurd number of boundary points.
-constexpr std::size_t max_boundary_points = 20'000'000;
-
-Vec2 to_vec(const Point& p) {
-    return {p.x(), p.y()};
-}
-
-/// h(x) of a SizeField, with the nearest focus point found by a k-d tree and a cut-off beyond
-/// which h = max_size anyway (so most queries touch a handful of nodes).
-class SizeFunction {
-public:
-    explicit SizeFunction(const SizeField& f)
-        : h_max_(f.max_size), h_min_(f.min_size > 0 ? f.min_size : f.max_size), grading_(f.grading),
-          pts_(f.focus) {
-        cutoff2_ = std::pow((h_max_ - h_min_) / grading_, 2);
-        build(0, static_cast<int>(pts_.size()), 0);
-    }
-
-    double operator()(const Vec2& x) const {
-        if (pts_.empty() || h_min_ == h_max_) return h_max_;
-        double best2 = cutoff2_;
-        nearest(x, 0, static_cast<int>(pts_.size()), 0, best2);
-        return std::min(h_max_, h_min_ + grading_ * std::sqrt(best2));
-    }
-    /// The largest spacing anywhere: length / max() bounds a segment's point count from below.
-    double max() const { return h_max_; }
-
-private:
-    void build(int lo, int hi, int depth) {
-        if (hi - lo <= 1) return;
-        const int mid = (lo + hi) / 2, axis = depth % 2;
-        std::nth_element(pts_.begin() + lo, pts_.begin() + mid, pts_.begin() + hi,
-                         [axis](const Vec2& a, const Vec2& b) { return a[axis] < b[axis]; });
-        build(lo, mid, depth + 1);
-        build(mid + 1, hi, depth + 1);
-    }
-
-    void nearest(const Vec2& q, int lo, int hi, int depth, double& best2) const {
-        if (lo >= hi) return;
-        const int mid = (lo + hi) / 2, axis = depth % 2;
-        best2 = std::min(best2, (pts_[mid] - q).squaredNorm());
-        const double diff = q[axis] - pts_[mid][axis];
-        if (diff < 0) {
-            nearest(q, lo, mid, depth + 1, best2);
-            if (diff * diff < best2) nearest(q, mid + 1, hi, depth + 1, best2);
-        } else {
-            nearest(q, mid + 1, hi, depth + 1, best2);
-            if (diff * diff < best2) nearest(q, lo, mid, depth + 1, best2);
-        }
-    }
-
-    double h_max_, h_min_, grading_, cutoff2_ = 0;
-    std::vector<Vec2> pts_;
-};
+using namespace domain;
 
 /// CGAL meshing criteria: a triangle is bad when its longest edge exceeds h(centroid)
 /// (imperatively bad) or its smallest angle is below the shape bound. Same contract as
@@ -216,249 +138,6 @@ private:
     const SizeFunction* h_;
 };
 
-/// A validated segment between its snapped end points.
-struct SegmentGeometry {
-    int loop = 0, index = 0; // position in the input, for messages
-    bool arc = false;
-    Vec2 a, b;             // end points (exactly on the circle for arcs)
-    Vec2 c = Vec2::Zero(); // arc center
-    double r = 0;          // arc radius
-    double angle0 = 0;     // arc start angle
-    double sweep = 0;      // signed arc angle (> 0 counter-clockwise)
-    int circle = -1;       // index into Mesh::circles
-    std::string tag;
-
-    double length() const { return arc ? r * std::abs(sweep) : (b - a).norm(); }
-    Vec2 at(double t) const {
-        if (!arc) return a + t * (b - a);
-        const double phi = angle0 + t * sweep;
-        return c + r * Vec2(std::cos(phi), std::sin(phi));
-    }
-    Vec2 project(const Vec2& p) const { return c + r * (p - c).normalized(); }
-};
-
-/// A closed boundary polyline: point k is joined to point k+1 (cyclically) by a chord of
-/// segment seg[k].
-struct LoopPoints {
-    std::vector<Vec2> x;
-    std::vector<int> seg;
-};
-
-std::string where(int loop, int index) {
-    return "loop " + std::to_string(loop) + ", segment " + std::to_string(index);
-}
-
-std::ostream& operator<<(std::ostream& os, const Vec2& p) {
-    return os << "(" << p.x() << ", " << p.y() << ")";
-}
-
-/// Intersection point of two circles nearest to p (p itself snapped to circle 1 if the circles
-/// do not meet near p).
-Vec2 snap_to_two_circles(const Vec2& p, const SegmentGeometry& s1, const SegmentGeometry& s2) {
-    const Vec2 d = s2.c - s1.c;
-    const double dist = d.norm();
-    const Vec2 fallback = s1.project(p);
-    if (dist == 0) return fallback;
-    const double along = (s1.r * s1.r - s2.r * s2.r + dist * dist) / (2 * dist);
-    const double h = std::sqrt(std::max(0.0, s1.r * s1.r - along * along));
-    const Vec2 m = s1.c + along / dist * d;
-    const Vec2 perp(-d.y() / dist, d.x() / dist);
-    const Vec2 q1 = m + h * perp, q2 = m - h * perp;
-    const Vec2 q = (q1 - p).norm() < (q2 - p).norm() ? q1 : q2;
-    return (q - p).norm() <= 1e-6 * std::max(s1.r, s2.r) ? q : fallback;
-}
-
-double signed_area(const std::vector<Vec2>& x) {
-    double a = 0;
-    for (std::size_t k = 0; k < x.size(); ++k) {
-        const Vec2& p = x[k];
-        const Vec2& q = x[(k + 1) % x.size()];
-        a += p.x() * q.y() - p.y() * q.x();
-    }
-    return a / 2;
-}
-
-/// Validates the loops and resolves each segment's end points (shared between neighbours, so
-/// consecutive segments meet in exactly one vertex).
-std::vector<SegmentGeometry> resolve_segments(const std::vector<std::vector<Segment>>& loops,
-                                              std::vector<Circle>& circles, double& diameter) {
-    MLC_CHECK(!loops.empty(), "mesh_domain: no boundary loops given; loops[0] must be the outer "
-                              "boundary");
-    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (std::size_t l = 0; l < loops.size(); ++l) {
-        MLC_CHECK(!loops[l].empty(), "mesh_domain: loop " << l << " has no segments");
-        for (std::size_t k = 0; k < loops[l].size(); ++k) {
-            const Segment& s = loops[l][k];
-            const std::string w = where(static_cast<int>(l), static_cast<int>(k));
-            MLC_CHECK(s.from.allFinite() && s.to.allFinite(),
-                      "mesh_domain: " << w << " has a non-finite end point " << s.from << " -> "
-                                      << s.to);
-            lo = lo.cwiseMin(s.from).cwiseMin(s.to);
-            hi = hi.cwiseMax(s.from).cwiseMax(s.to);
-            if (s.kind == Segment::Kind::arc) {
-                MLC_CHECK(s.center.allFinite() && std::isfinite(s.radius) && s.radius > 0,
-                          "mesh_domain: " << w << " is an arc with center " << s.center
-                                          << " and radius " << s.radius
-                                          << "; the radius must be positive and finite");
-                lo = lo.cwiseMin(s.center - Vec2::Constant(s.radius));
-                hi = hi.cwiseMax(s.center + Vec2::Constant(s.radius));
-            }
-        }
-    }
-    diameter = (hi - lo).norm();
-    MLC_CHECK(diameter > 0, "mesh_domain: all boundary points coincide at " << lo);
-    const double tol = 1e-9 * diameter;
-
-    std::vector<SegmentGeometry> out;
-    for (std::size_t l = 0; l < loops.size(); ++l) {
-        const auto& loop = loops[l];
-        const std::size_t n = loop.size();
-        const std::size_t first = out.size();
-        for (std::size_t k = 0; k < n; ++k) {
-            const Segment& s = loop[k];
-            const Segment& next = loop[(k + 1) % n];
-            const std::string w = where(static_cast<int>(l), static_cast<int>(k));
-            const double gap = (s.to - next.from).norm();
-            if (k + 1 < n)
-                MLC_CHECK(gap <= tol, "mesh_domain: " << w << " ends at " << s.to << " but segment "
-                                                      << k + 1 << " starts at " << next.from
-                                                      << " (gap " << gap << " > tolerance " << tol
-                                                      << "); consecutive segments must join");
-            else
-                MLC_CHECK(gap <= tol, "mesh_domain: loop "
-                                          << l << " does not close: its last segment " << k
-                                          << " ends at " << s.to << " but segment 0 starts at "
-                                          << next.from << " (gap " << gap << " > tolerance " << tol
-                                          << ")");
-            SegmentGeometry g;
-            g.loop = static_cast<int>(l);
-            g.index = static_cast<int>(k);
-            g.tag = s.tag.empty() ? "boundary" : s.tag;
-            if (s.kind == Segment::Kind::arc) {
-                g.arc = true;
-                g.c = s.center;
-                g.r = s.radius;
-                for (const Vec2& p : {s.from, s.to}) {
-                    const double off = std::abs((p - s.center).norm() - s.radius);
-                    MLC_CHECK(off <= 1e-6 * s.radius,
-                              "mesh_domain: " << w << ": end point " << p
-                                              << " is not on the arc's circle (center " << s.center
-                                              << ", radius " << s.radius
-                                              << "): its distance from the circle is " << off
-                                              << " > 1e-6 * radius; compute end points as "
-                                                 "center + radius * (cos, sin)");
-                }
-                std::size_t ci = 0;
-                while (ci < circles.size() && !((circles[ci].center - g.c).norm() <= tol &&
-                                                std::abs(circles[ci].radius - g.r) <= tol))
-                    ++ci;
-                if (ci == circles.size()) circles.push_back(Circle{g.c, g.r});
-                g.circle = static_cast<int>(ci);
-            }
-            out.push_back(g);
-        }
-        // Shared end points: segment k starts where segment k-1 ends; snap onto circles.
-        std::vector<Vec2> joint(n);
-        for (std::size_t k = 0; k < n; ++k) {
-            const SegmentGeometry& cur = out[first + k];
-            const SegmentGeometry& prev = out[first + (k + n - 1) % n];
-            Vec2 p = loop[k].from;
-            if (cur.arc && prev.arc && n > 1)
-                p = snap_to_two_circles(p, cur, prev);
-            else if (cur.arc)
-                p = cur.project(p);
-            else if (prev.arc)
-                p = prev.project(p);
-            joint[k] = p;
-        }
-        for (std::size_t k = 0; k < n; ++k) {
-            SegmentGeometry& g = out[first + k];
-            const std::string w = where(static_cast<int>(l), static_cast<int>(k));
-            g.a = joint[k];
-            g.b = joint[(k + 1) % n];
-            const bool closed = (g.b - g.a).norm() <= tol;
-            if (!g.arc) {
-                MLC_CHECK(!closed, "mesh_domain: " << w << " is a line of zero length at " << g.a);
-                continue;
-            }
-            MLC_CHECK(!closed || n == 1,
-                      "mesh_domain: " << w << " is an arc that starts and ends at " << g.a
-                                      << " (a full circle) but its loop has " << n
-                                      << " segments; a full circle must be a loop of its own");
-            g.angle0 = std::atan2(g.a.y() - g.c.y(), g.a.x() - g.c.x());
-            const double angle1 = std::atan2(g.b.y() - g.c.y(), g.b.x() - g.c.x());
-            const double two_pi = 2 * std::numbers::pi;
-            if (closed) {
-                g.sweep = loop[k].ccw ? two_pi : -two_pi;
-            } else if (loop[k].ccw) {
-                g.sweep = angle1 - g.angle0;
-                while (g.sweep <= 0)
-                    g.sweep += two_pi;
-            } else {
-                g.sweep = angle1 - g.angle0;
-                while (g.sweep >= 0)
-                    g.sweep -= two_pi;
-            }
-        }
-        MLC_CHECK(n > 1 || out[first].arc,
-                  "mesh_domain: loop " << l << " is a single line segment and encloses nothing");
-    }
-    return out;
-}
-
-/// Splits every segment with spacing following h (and at most max_arc_angle per arc piece):
-/// n = ceil(integral of ds / h) pieces, with the points placed at equal steps of that integral.
-std::vector<LoopPoints> discretize(const std::vector<SegmentGeometry>& segs, const SizeFunction& h,
-                                   int n_loops) {
-    std::vector<LoopPoints> loops(n_loops);
-    std::size_t total = 0;
-    std::vector<double> ts, cum;
-    for (std::size_t s = 0; s < segs.size(); ++s) {
-        const SegmentGeometry& g = segs[s];
-        const double length = g.length();
-        const double cap = g.arc ? g.r * max_arc_angle : std::numeric_limits<double>::infinity();
-        // Refuse before marching: even the coarsest spacing would need too many points.
-        MLC_CHECK(static_cast<double>(total) + length / std::min(h.max(), cap) <
-                      static_cast<double>(max_boundary_points),
-                  "mesh_domain: " << where(g.loop, g.index) << " is " << length
-                                  << " long; at the largest spacing " << std::min(h.max(), cap)
-                                  << " it alone needs more than " << max_boundary_points
-                                  << " boundary points; check its coordinates or max_size");
-        auto density = [&](double t) { return 1.0 / std::min(h(g.at(t)), cap); };
-        // March with a quarter of the local spacing, integrating the density by trapezoids.
-        ts.assign(1, 0.0);
-        cum.assign(1, 0.0);
-        double t = 0, f0 = density(0);
-        while (t < 1) {
-            const double t1 = std::min(1.0, t + 0.25 / (f0 * length));
-            const double f1 = density(t1);
-            cum.push_back(cum.back() + 0.5 * (f0 + f1) * (t1 - t) * length);
-            ts.push_back(t1);
-            t = t1;
-            f0 = f1;
-            MLC_CHECK(total + ts.size() / 4 < max_boundary_points,
-                      "mesh_domain: the size field needs more than "
-                          << max_boundary_points << " boundary points (" << where(g.loop, g.index)
-                          << " alone is " << length << " long); increase SizeField::min_size");
-        }
-        const int n = std::max(1, static_cast<int>(std::ceil(cum.back() - 1e-6)));
-        LoopPoints& lp = loops[g.loop];
-        lp.x.push_back(g.a);
-        lp.seg.push_back(static_cast<int>(s));
-        std::size_t j = 1;
-        for (int i = 1; i < n; ++i) {
-            const double target = cum.back() * i / n;
-            while (cum[j] < target)
-                ++j;
-            const double lambda = (target - cum[j - 1]) / (cum[j] - cum[j - 1]);
-            lp.x.push_back(g.at(ts[j - 1] + lambda * (ts[j] - ts[j - 1])));
-            lp.seg.push_back(static_cast<int>(s));
-        }
-        total += n;
-    }
-    return loops;
-}
-
 /// One constrained edge of the final triangulation with the segment it lies on.
 struct SubEdge {
     VertexHandle a, b;
@@ -508,11 +187,10 @@ void walk_chord(const CDT& tr, VertexHandle from, VertexHandle to, const Vec2& f
     }
 }
 
-/// Inserts the boundary, checks and marks the domain (nesting level 1 = inside the outer loop,
-/// outside every hole), and refines it.
-void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<SegmentGeometry>& segs,
-                   const std::vector<LoopPoints>& lines, const SizeFunction& h, Meshed& p,
-                   const StopPoll& stop) {
+/// Inserts the boundary points of the loops, flattened (per point of x: its segment and the next
+/// point of its loop in p), and the chords between them as constraints. Returns the points.
+std::vector<Vec2> insert_boundary(const std::vector<LoopPoints>& loops,
+                                  const std::vector<SegmentGeometry>& segs, Meshed& p) {
     std::vector<Vec2> x;
     for (const LoopPoints& lp : loops) {
         const int start = static_cast<int>(x.size()), n = static_cast<int>(lp.x.size());
@@ -550,17 +228,13 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
     }
     MLC_CHECK(p.tr.dimension() == 2,
               "mesh_domain: the boundary points are collinear; the domain has no area");
-    // The loop constraints, which alone bound the domain (interior lines are constraints too).
-    std::set<std::pair<VertexHandle, VertexHandle>> loop_edge;
-    for (std::size_t k = 0; k < x.size(); ++k) {
-        loop_edge.emplace(p.vh[k], p.vh[p.next[k]]);
-        loop_edge.emplace(p.vh[p.next[k]], p.vh[k]);
-    }
-    auto is_border = [&](FaceHandle f, int i) {
-        return f->is_constrained(i) &&
-               loop_edge.count({f->vertex(CDT::ccw(i)), f->vertex(CDT::cw(i))}) > 0;
-    };
-    // Interior lines: open polylines, their ends inside the domain or at a loop point.
+    return x;
+}
+
+/// Interior lines: open polylines, their ends inside the domain or at a loop point, inserted as
+/// constraints. Returns each line's vertices.
+std::vector<std::vector<VertexHandle>> insert_lines(const std::vector<LoopPoints>& lines,
+                                                    Meshed& p) {
     std::vector<std::vector<VertexHandle>> line_vh(lines.size());
     std::map<VertexHandle, int> line_of; // vertex -> line it belongs to
     for (std::size_t l = 0; l < lines.size(); ++l) {
@@ -598,8 +272,24 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
             }
         }
     }
+    return line_vh;
+}
 
-    // Nesting level of each face: number of constraints crossed from the infinite face.
+/// Marks the faces of the domain (nesting level 1 = inside the outer loop, outside every hole),
+/// the nesting level of a face being the number of loop constraints crossed from the infinite
+/// face (interior lines are constraints too, but do not bound the domain), and checks its
+/// orientation and area against the loops'.
+void mark_domain(const std::vector<LoopPoints>& loops, const std::vector<SegmentGeometry>& segs,
+                 std::size_t n_points, Meshed& p) {
+    std::set<std::pair<VertexHandle, VertexHandle>> loop_edge;
+    for (std::size_t k = 0; k < n_points; ++k) {
+        loop_edge.emplace(p.vh[k], p.vh[p.next[k]]);
+        loop_edge.emplace(p.vh[p.next[k]], p.vh[k]);
+    }
+    auto is_border = [&](FaceHandle f, int i) {
+        return f->is_constrained(i) &&
+               loop_edge.count({f->vertex(CDT::ccw(i)), f->vertex(CDT::cw(i))}) > 0;
+    };
     std::unordered_map<FaceHandle, int> level;
     std::queue<FaceHandle> border;
     auto flood = [&](FaceHandle start, int index) {
@@ -648,7 +338,11 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
     MLC_CHECK(std::abs(area - expected) <= 1e-8 * signed_area(loops[0].x),
               "mesh_domain: the meshed area " << area << " differs from outer minus hole areas "
                                               << expected << "; every hole must lie inside loop 0");
+}
 
+/// Every piece of an interior line has domain faces on both sides.
+void check_lines_inside(const std::vector<LoopPoints>& lines,
+                        const std::vector<std::vector<VertexHandle>>& line_vh, const Meshed& p) {
     for (std::size_t l = 0; l < lines.size(); ++l)
         for (std::size_t k = 0; k + 1 < line_vh[l].size(); ++k) {
             FaceHandle f;
@@ -662,48 +356,38 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
                                            << lines[l].x[k].transpose()
                                            << "; interior lines must lie inside it");
         }
+}
 
+/// Refines the marked domain with the size-field criteria. refine_mesh() step by step (the same
+/// insertions in the same order), so a stop request is seen: a step inserts one point, a few
+/// microseconds.
+void run_mesher(const SizeFunction& h, Meshed& p, const StopPoll& stop) {
     SizeFieldCriteria criteria(shape_bound, h);
     CGAL::Delaunay_mesher_2<CDT, SizeFieldCriteria> mesher(p.tr, criteria);
     mesher.init(true); // keep our domain marks
-    // refine_mesh() step by step (the same insertions in the same order), so a stop request is
-    // seen: a step inserts one point, a few microseconds.
     for (std::uint64_t step = 1; mesher.try_one_step_refine_mesh(); ++step)
         if (stop && step % 2048 == 0 && stop())
             throw Interrupted("meshing stopped on request after " +
                               std::to_string(p.tr.number_of_vertices()) + " vertices");
+}
 
-    // Walk each input chord along the constrained edges that replaced it.
+/// Inserts the boundary, checks and marks the domain, and refines it; then walks each input
+/// chord (boundary and interior lines) along the constrained edges that replaced it.
+void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<SegmentGeometry>& segs,
+                   const std::vector<LoopPoints>& lines, const SizeFunction& h, Meshed& p,
+                   const StopPoll& stop) {
+    const std::vector<Vec2> x = insert_boundary(loops, segs, p);
+    const std::vector<std::vector<VertexHandle>> line_vh = insert_lines(lines, p);
+    mark_domain(loops, segs, x.size(), p);
+    check_lines_inside(lines, line_vh, p);
+    run_mesher(h, p, stop);
     p.added.assign(x.size(), {});
     for (std::size_t k = 0; k < x.size(); ++k) {
         const VertexHandle target = p.vh[p.next[k]];
-        const Vec2 dir = (x[p.next[k]] - x[k]).normalized();
-        VertexHandle cur = p.vh[k], prev;
-        for (std::size_t step = 0; cur != target; ++step) {
-            MLC_CHECK(step < p.tr.number_of_vertices(),
-                      "mesh_domain: internal error: lost the boundary chord at " << x[k]);
-            VertexHandle best;
-            double best_cos = 0.5;
-            auto ec = p.tr.incident_edges(cur), done = ec;
-            do {
-                if (!p.tr.is_constrained(*ec)) continue;
-                const FaceHandle f = ec->first;
-                VertexHandle n = f->vertex(CDT::ccw(ec->second));
-                if (n == cur) n = f->vertex(CDT::cw(ec->second));
-                if (n == prev || p.tr.is_infinite(n)) continue;
-                const double c = (to_vec(n->point()) - to_vec(cur->point())).normalized().dot(dir);
-                if (c > best_cos) {
-                    best_cos = c;
-                    best = n;
-                }
-            } while (++ec != done);
-            MLC_CHECK(best != VertexHandle(),
-                      "mesh_domain: internal error: boundary chord at " << x[k] << " is broken");
-            p.sub_edges.push_back({cur, best, p.seg[k]});
-            if (best != target && best->info().input < 0) p.added[k].push_back(best);
-            prev = cur;
-            cur = best;
-        }
+        walk_chord(p.tr, p.vh[k], target, x[k], x[p.next[k]], [&](VertexHandle a, VertexHandle b) {
+            p.sub_edges.push_back({a, b, p.seg[k]});
+            if (b != target && b->info().input < 0) p.added[k].push_back(b);
+        });
     }
     for (std::size_t l = 0; l < lines.size(); ++l)
         for (std::size_t k = 0; k + 1 < line_vh[l].size(); ++k)

@@ -2,6 +2,7 @@
 // Gmsh .msh reader: a strict line-by-line parser of the ASCII formats 2.2 and 4.1 that collects
 // nodes and elements, then selects triangles and boundary lines.
 #include "mesh/io/gmsh.hpp"
+#include "mesh/io/gmsh_parse.hpp"
 #include "mesh/topology.hpp"
 
 #include "core/check.hpp"
@@ -21,12 +22,7 @@ namespace mlc::mesh {
 
 namespace {
 
-/// What the reader needs to know about a Gmsh element type.
-struct ElementType {
-    int dim = -1;
-    int n_nodes = 0;
-    const char* name = "";
-};
+using gmsh_io::ElementType;
 
 /// Gmsh element types (gmsh.info, "MSH file format"); dim -1 for an unknown type.
 ElementType element_type(int type) {
@@ -102,22 +98,7 @@ ElementType element_type(int type) {
     }
 }
 
-/// Everything read from the file, before selection. Elements are stored flat: element e has
-/// nodes node_ids[node_begin[e] .. node_begin[e+1]) and physical tags
-/// phys[phys_begin[e] .. phys_begin[e+1]).
-struct MshData {
-    std::vector<std::int64_t> node_id;
-    std::vector<Eigen::Vector3d> node_x;
-    std::vector<int> node_line;
-    std::vector<int> elem_type, elem_line;
-    std::vector<std::size_t> node_begin{0}, phys_begin{0};
-    std::vector<std::int64_t> node_ids;
-    std::vector<int> phys;
-    std::map<std::pair<int, int>, std::string> names;            // (dim, physical tag) -> name
-    std::map<std::pair<int, int>, std::vector<int>> entity_phys; // 4.1: (dim, entity) -> tags
-
-    std::size_t n_elements() const { return elem_type.size(); }
-};
+using gmsh_io::MshData;
 
 /// Line-by-line reader that knows where it is, for error messages.
 class Reader {
@@ -460,72 +441,79 @@ std::uint64_t edge_key(int a, int b) {
     return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
 }
 
-} // namespace
+/// The file's nodes by id, with the messages' prefix `where`.
+class NodeLookup {
+public:
+    NodeLookup(const MshData& d, const std::string& where) : d_(d), where_(where) {
+        index_.reserve(d.node_id.size());
+        for (std::size_t i = 0; i < d.node_id.size(); ++i)
+            MLC_CHECK(index_.emplace(d.node_id[i], static_cast<int>(i)).second,
+                      where << ":" << d.node_line[i] << ": node id " << d.node_id[i]
+                            << " appears twice");
+    }
+    /// The file's index of node k of element e.
+    int operator()(std::size_t e, std::size_t k) const {
+        const std::int64_t id = d_.node_ids[d_.node_begin[e] + k];
+        auto it = index_.find(id);
+        MLC_CHECK(it != index_.end(), where_ << ":" << d_.elem_line[e]
+                                             << ": element refers to node id " << id
+                                             << ", which is not in $Nodes");
+        return it->second;
+    }
 
-Mesh read_gmsh(const std::filesystem::path& file, const std::string& surface) {
-    return read_gmsh_text(read_file(file), file, surface);
+private:
+    const MshData& d_;
+    const std::string& where_;
+    std::unordered_map<std::int64_t, int> index_;
+};
+
+/// The physical surface named `surface` (or "tagN" for an unnamed surface N); 0 for all.
+int wanted_surface(const MshData& d, const std::string& surface, const std::string& where) {
+    if (surface.empty()) return 0;
+    int wanted = 0;
+    std::set<int> surfaces;
+    for (std::size_t e = 0; e < d.n_elements(); ++e)
+        if (element_type(d.elem_type[e]).dim == 2)
+            for (std::size_t k = d.phys_begin[e]; k < d.phys_begin[e + 1]; ++k)
+                surfaces.insert(d.phys[k]);
+    bool found = false;
+    for (const auto& [key, name] : d.names)
+        if (key.first == 2 && name == surface) {
+            wanted = key.second;
+            found = true;
+        }
+    for (int s : surfaces)
+        if (!found && surface == "tag" + std::to_string(s) && !d.names.count({2, s})) {
+            wanted = s;
+            found = true;
+        }
+    if (!found) {
+        std::ostringstream known;
+        for (int s : surfaces) {
+            auto it = d.names.find({2, s});
+            known << " '" << (it == d.names.end() ? "tag" + std::to_string(s) : it->second) << "'";
+        }
+        MLC_CHECK(false, where << ": no physical surface '" << surface << "'; the file has:"
+                               << (surfaces.empty() ? " none" : "") << known.str());
+    }
+    return wanted;
 }
 
-Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
-                    const std::string& surface) {
-    const MshData d = parse(file, text);
-    const std::string where = "read_gmsh: " + file.string();
+/// The selected triangles (in node indices of the file) and the candidate boundary lines.
+struct Selection {
+    std::vector<std::array<int, 3>> tris;
+    std::vector<int> tri_phys;
+    std::vector<std::size_t> tri_element, lines;
+};
 
-    std::unordered_map<std::int64_t, int> node_index;
-    node_index.reserve(d.node_id.size());
-    for (std::size_t i = 0; i < d.node_id.size(); ++i)
-        MLC_CHECK(node_index.emplace(d.node_id[i], static_cast<int>(i)).second,
-                  where << ":" << d.node_line[i] << ": node id " << d.node_id[i]
-                        << " appears twice");
-
-    // Which physical surface is wanted.
-    int wanted = 0;
-    if (!surface.empty()) {
-        std::set<int> surfaces;
-        for (std::size_t e = 0; e < d.n_elements(); ++e)
-            if (element_type(d.elem_type[e]).dim == 2)
-                for (std::size_t k = d.phys_begin[e]; k < d.phys_begin[e + 1]; ++k)
-                    surfaces.insert(d.phys[k]);
-        bool found = false;
-        for (const auto& [key, name] : d.names)
-            if (key.first == 2 && name == surface) {
-                wanted = key.second;
-                found = true;
-            }
-        for (int s : surfaces)
-            if (!found && surface == "tag" + std::to_string(s) && !d.names.count({2, s})) {
-                wanted = s;
-                found = true;
-            }
-        if (!found) {
-            std::ostringstream known;
-            for (int s : surfaces) {
-                auto it = d.names.find({2, s});
-                known << " '" << (it == d.names.end() ? "tag" + std::to_string(s) : it->second)
-                      << "'";
-            }
-            MLC_CHECK(false, where << ": no physical surface '" << surface << "'; the file has:"
-                                   << (surfaces.empty() ? " none" : "") << known.str());
-        }
-    }
+Selection select_elements(const MshData& d, const NodeLookup& node, const std::string& surface,
+                          int wanted, const std::string& where) {
     auto has_phys = [&](std::size_t e, int p) {
         for (std::size_t k = d.phys_begin[e]; k < d.phys_begin[e + 1]; ++k)
             if (d.phys[k] == p) return true;
         return false;
     };
-    auto node = [&](std::size_t e, std::size_t k) {
-        const std::int64_t id = d.node_ids[d.node_begin[e] + k];
-        auto it = node_index.find(id);
-        MLC_CHECK(it != node_index.end(), where << ":" << d.elem_line[e]
-                                                << ": element refers to node id " << id
-                                                << ", which is not in $Nodes");
-        return it->second;
-    };
-
-    // Selected triangles (in node indices of the file) and candidate boundary lines.
-    std::vector<std::array<int, 3>> tris;
-    std::vector<int> tri_phys;
-    std::vector<std::size_t> tri_element, lines;
+    Selection s;
     for (std::size_t e = 0; e < d.n_elements(); ++e) {
         const int type = d.elem_type[e];
         const ElementType et = element_type(type);
@@ -534,25 +522,30 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
         // All elements of dimension >= 1 but 2-node lines, or the wanted surface's elements.
         const bool selected =
             surface.empty() ? et.dim >= 1 && type != 1 : et.dim == 2 && has_phys(e, wanted);
-        if (type == 1 && d.phys_begin[e + 1] > d.phys_begin[e]) lines.push_back(e);
+        if (type == 1 && d.phys_begin[e + 1] > d.phys_begin[e]) s.lines.push_back(e);
         if (!selected) continue;
         MLC_CHECK(type == 2, where << ":" << d.elem_line[e] << ": element type " << type << " ("
                                    << et.name
                                    << ") is not supported; only 3-node triangles (type 2) and "
                                       "2-node lines (type 1) are read (set Gmsh's "
                                       "Mesh.ElementOrder = 1 and do not recombine)");
-        tris.push_back({node(e, 0), node(e, 1), node(e, 2)});
-        tri_element.push_back(e);
-        tri_phys.push_back(d.phys_begin[e + 1] > d.phys_begin[e] ? d.phys[d.phys_begin[e]] : 0);
+        s.tris.push_back({node(e, 0), node(e, 1), node(e, 2)});
+        s.tri_element.push_back(e);
+        s.tri_phys.push_back(d.phys_begin[e + 1] > d.phys_begin[e] ? d.phys[d.phys_begin[e]] : 0);
     }
-    MLC_CHECK(!tris.empty(),
+    MLC_CHECK(!s.tris.empty(),
               where << ": no 3-node triangles found"
                     << (surface.empty() ? "" : " in physical surface '" + surface + "'"));
+    return s;
+}
 
-    // Keep the used nodes, in file order; orient triangles counter-clockwise.
+/// The used nodes, in file order (new_index: file index -> vertex, or -1), and the triangles
+/// oriented counter-clockwise.
+Mesh build_triangles(const MshData& d, const Selection& s, const std::string& where,
+                     std::vector<int>& new_index) {
     Mesh m;
-    std::vector<int> new_index(d.node_id.size(), -1);
-    for (const auto& t : tris)
+    new_index.assign(d.node_id.size(), -1);
+    for (const auto& t : s.tris)
         for (int v : t)
             new_index[v] = 0;
     for (std::size_t i = 0; i < new_index.size(); ++i)
@@ -565,12 +558,12 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
         MLC_CHECK(new_index[i] < 0 || std::abs(d.node_x[i].z()) <= 1e-10 * diam,
                   where << ":" << d.node_line[i] << ": node " << d.node_id[i] << " has z = "
                         << d.node_x[i].z() << "; only planar meshes in the plane z = 0 are read");
-    for (std::size_t i = 0; i < tris.size(); ++i) {
-        std::array<int, 3> t = {new_index[tris[i][0]], new_index[tris[i][1]],
-                                new_index[tris[i][2]]};
+    for (std::size_t i = 0; i < s.tris.size(); ++i) {
+        std::array<int, 3> t = {new_index[s.tris[i][0]], new_index[s.tris[i][1]],
+                                new_index[s.tris[i][2]]};
         const Vec2 &a = m.vertices[t[0]], &b = m.vertices[t[1]], &c = m.vertices[t[2]];
         const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-        const std::size_t e = tri_element[i];
+        const std::size_t e = s.tri_element[i];
         MLC_CHECK(std::abs(area2) > 2e-14 * diam * diam,
                   where << ":" << d.elem_line[e] << ": degenerate triangle (nodes "
                         << d.node_ids[d.node_begin[e]] << ", " << d.node_ids[d.node_begin[e] + 1]
@@ -578,14 +571,19 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
         if (area2 < 0) std::swap(t[1], t[2]);
         m.triangles.push_back(t);
     }
-    if (std::any_of(tri_phys.begin(), tri_phys.end(), [](int p) { return p != 0; }))
-        m.attribute = tri_phys;
+    if (std::any_of(s.tri_phys.begin(), s.tri_phys.end(), [](int p) { return p != 0; }))
+        m.attribute = s.tri_phys;
+    return m;
+}
 
-    // The triangles of every vertex, in triangle order: a line element (a, b) lies on the
-    // triangles that hold both, with the direction it has in the first of them.
+/// The tagged line elements: boundary edges (on one triangle) and interior lines (on two). The
+/// triangles of every vertex, in triangle order: a line element (a, b) lies on the triangles that
+/// hold both, with the direction it has in the first of them.
+void tag_lines(const MshData& d, const Selection& s, const NodeLookup& node,
+               const std::vector<int>& new_index, Mesh& m) {
     const VertexTriangles vtri = vertex_triangles(m);
     std::set<std::uint64_t> tagged;
-    for (std::size_t e : lines) {
+    for (std::size_t e : s.lines) {
         const int a = new_index[node(e, 0)], b = new_index[node(e, 1)];
         if (a < 0 || b < 0) continue;
         const auto on = vtri.on_edge(m, a, b); // its direction in the first triangle holding it
@@ -608,10 +606,44 @@ Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
         // An edge of two selected triangles is a tagged interior line.
         (count == 1 ? m.boundary : m.lines).push_back(be);
     }
+}
+
+} // namespace
+
+namespace gmsh_io {
+
+ElementType msh_element_type(int type) {
+    return element_type(type);
+}
+
+std::string read_msh_file(const std::filesystem::path& file) {
+    return read_file(file);
+}
+
+MshData parse_msh(const std::filesystem::path& file, std::string text) {
+    return parse(file, std::move(text));
+}
+
+} // namespace gmsh_io
+
+Mesh read_gmsh(const std::filesystem::path& file, const std::string& surface) {
+    return read_gmsh_text(read_file(file), file, surface);
+}
+
+Mesh read_gmsh_text(const std::string& text, const std::filesystem::path& file,
+                    const std::string& surface) {
+    const MshData d = parse(file, text);
+    const std::string where = "read_gmsh: " + file.string();
+    const NodeLookup node(d, where);
+    const int wanted = wanted_surface(d, surface, where);
+    const Selection s = select_elements(d, node, surface, wanted, where);
+    std::vector<int> new_index; // the file's node index -> vertex, or -1
+    Mesh m = build_triangles(d, s, where, new_index);
+    tag_lines(d, s, node, new_index, m);
     // Defects of the mesh name the file, and each triangle its element's line and node ids.
     try {
         check_quality(m, [&](int t) {
-            const std::size_t e = tri_element[static_cast<std::size_t>(t)];
+            const std::size_t e = s.tri_element[static_cast<std::size_t>(t)];
             return "triangle " + std::to_string(t) + " (the element on line " +
                    std::to_string(d.elem_line[e]) + ", nodes " +
                    std::to_string(d.node_ids[d.node_begin[e]]) + " " +

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
-"""The scene keys of issue 16 from Python: the Scene reads them through the C++ parser, exposes
-the supports with their activity per load step and the mesh's tags (boundary and interior lines),
-and solves the built-in scenes that use them."""
+"""The scene keys of transformed and tagged scenes from Python: the Scene reads them through the
+C++ parser, exposes the supports with their activity per load step and the mesh's tags (boundary
+and interior lines), and solves the built-in scenes that use them."""
 import json
 
 import pytest

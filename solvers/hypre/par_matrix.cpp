@@ -362,6 +362,20 @@ void add_offdiagonal(const Impl& m, const Vector& ghost, Vector& y, double sign)
 }
 } // namespace
 
+void ParMatrix::apply(const Vector& x, Vector& y, const LinearOperator& diag) const {
+    const Impl& m = *impl_;
+    MLC_CHECK(m.view, "ParMatrix::apply with a diagonal-block operator: only for a matrix on "
+                      "RowBlocks");
+    MLC_CHECK(x.size() == m.n_cols && diag.rows() == m.n && diag.cols() == m.n_cols,
+              "ParMatrix::apply: x has "
+                  << x.size() << " entries, the diagonal block's operator is " << diag.rows()
+                  << " x " << diag.cols() << ", the matrix " << m.n << " x " << m.n_cols);
+    hypre_ParCSRCommHandle* h = start_halo(m, x, m.ghost);
+    diag.apply(x, y);
+    hypre_ParCSRCommHandleDestroy(h);
+    add_offdiagonal(m, m.ghost, y, 1.0);
+}
+
 void ParMatrix::apply(const Vector& x, Vector& y) const {
     const Impl& m = *impl_;
     MLC_CHECK(x.size() == m.n_cols, "ParMatrix::apply: x has " << x.size() << " entries for "

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file A square matrix distributed by rows over the processes of a Communicator, held once as
 /// hypre's ParCSR matrix (per process a diagonal and an off-diagonal block; hypre exchanges the
-/// halo of a mat-vec), built and refreshed through hypre's IJ interface (issue 12, item 3).
+/// halo of a mat-vec), built and refreshed through hypre's IJ interface.
 /// Compiled only with MLC_WITH_HYPRE (MLC_HAVE_HYPRE defined); without it the constructor throws
 /// InvalidInput saying so. hypre and MPI stay in the .cpp.
 #pragma once
@@ -61,20 +61,20 @@ public:
               int n_cols);
     /// Collective. A ParCSR matrix on `blocks`' arrays, not a copy: hypre reads blocks.diag and
     /// blocks.offd where they are, so values written into them later are the matrix's (what the
-    /// smoother of a process's diagonal block and the Newton assembly write into; issue 12,
-    /// "one copy of each operator"). `blocks` must outlive this object and keep its patterns.
-    /// The row and column partitions follow the blocks in rank order, as above. update_values()
-    /// throws InvalidInput on such a matrix (write into the blocks).
+    /// smoother of a process's diagonal block and the Newton assembly write into: one copy of each
+    /// operator). `blocks` must outlive this object and keep its patterns. The row and column
+    /// partitions follow the blocks in rank order, as above. update_values() throws InvalidInput on
+    /// such a matrix (write into the blocks).
     ParMatrix(const Communicator& comm, RowBlocks& blocks);
     ~ParMatrix() override;
     ParMatrix(const ParMatrix&) = delete;
     ParMatrix& operator=(const ParMatrix&) = delete;
 
     std::int64_t first_row() const;
-    int n_rows() const;            ///< owned rows
+    int n_rows() const;             ///< owned rows
     std::int64_t first_col() const; ///< first owned column (first_row() when square)
     int n_cols() const;             ///< owned columns (n_rows() when square)
-    std::int64_t n_global() const; ///< rows over all processes
+    std::int64_t n_global() const;  ///< rows over all processes
     /// hypre's HYPRE_ParCSRMatrix of this matrix (as void*, so that hypre stays out of this
     /// header), for hypre's own solvers (solvers/hypre/ only). Owned by this object. A matrix
     /// built from RowBlocks keeps Eigen's column order in its diagonal block (the diagonal entry
@@ -90,6 +90,10 @@ public:
     /// overwritten). The entries of x owned elsewhere come from their processes (hypre's halo
     /// exchange). Allocates nothing when y has the size already.
     void apply(const Vector& x, Vector& y) const override;
+    /// Collective: y = A x as apply() does, with the diagonal block's product computed by
+    /// `diag` (an operator of the same values, e.g. a structured kernel of a smoother that holds
+    /// them) while the halo exchange is under way. Only for a matrix built on RowBlocks.
+    void apply(const Vector& x, Vector& y, const LinearOperator& diag) const;
     /// Collective: y = A^T x on the owned entries (x of size n_rows(), y of n_cols(); hypre's
     /// transposed ParCSR mat-vec).
     void apply_transpose(const Vector& x, Vector& y) const override;

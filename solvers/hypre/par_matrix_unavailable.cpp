@@ -57,6 +57,9 @@ void ParMatrix::ghost_values(const Vector&, Vector&) const {
 void ParMatrix::subtract_offdiagonal(const Vector&, Vector&) const {
     unavailable();
 }
+void ParMatrix::apply(const Vector&, Vector&, const LinearOperator&) const {
+    unavailable();
+}
 void ParMatrix::update_values(const std::vector<double>&) {
     unavailable();
 }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
-// `study error-vs-time` (issue 15 item 6): the multilevel rows exist (coarse-to-fine and cold
+// `study error-vs-time`: the multilevel rows exist (coarse-to-fine and cold
 // mg from level 1, mgr where hypre is built in), converge, and their error against the level-3
 // reference falls with the level; the other configurations are left out by --only.
-#include "apps/study_error_vs_time.hpp"
+#include "studies/error_vs_time.hpp"
 #include "core/check.hpp"
 #include "levels/resources.hpp"
 #include "scene/scene.hpp"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Hertz contact (benchmarks.md `hertz`): half-width and pressure against the closed form.
-#include "apps/closed_form.hpp"
+#include "run/closed_form.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
 

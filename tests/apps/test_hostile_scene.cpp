@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Hostile input (issue 7): scenes that once crashed, hung or invoked undefined behaviour in the
+// Hostile input: scenes that once crashed, hung or invoked undefined behaviour in the
 // parser (found while fuzzing it with tests/fuzz, or by review). Each is a data file in
 // tests/data/hostile/ (the Python tests read the same files, python/tests/test_hostile.py) whose
 // comment line "# expect: invalid[: text]" or "# expect: valid: N triangles" says what parsing it
@@ -8,8 +8,8 @@
 // "# expect: not converged: text" (the run fails, exit 2, and its diagnosis contains the text) or
 // "# expect: solves: text" (the run converges and its report contains the text: a warning or a
 // check said not applicable); they are solved as `mlcontact run` solves them.
-#include "apps/output.hpp"
-#include "apps/run.hpp"
+#include "run/output.hpp"
+#include "run/run.hpp"
 #include "core/check.hpp"
 #include "scene/scene.hpp"
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // --pc mgr (hypre MGR) in a run gives the exact solver's contact answer, and `bench newton`
 // writes one record per Newton system of the finest level with finite values.
-#include "apps/bench.hpp"
+#include "bench/bench.hpp"
 #include "core/check.hpp"
 #include "levels/checks.hpp"
 #include "levels/solve.hpp"

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // The preconditioner registry is the one list of names: the CLI help, `mlcontact
 // preconditioners`, the study's and the bench's lists and the driver's choice all agree with it.
-#include "apps/bench.hpp"
-#include "apps/preconditioners.hpp"
-#include "apps/study_preconditioners.hpp"
+#include "bench/bench.hpp"
+#include "run/preconditioners.hpp"
+#include "studies/preconditioners.hpp"
 #include "core/check.hpp"
 #include "levels/resources.hpp"
 #include "scene/scene.hpp"

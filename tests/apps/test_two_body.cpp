@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Two-body contact (node on node, node on facet) on the benchmark scenes patch, patch_matching,
 // mindlin and dovetail, the ring scene calumet, and the scene keys of two-body pairs.
-#include "apps/output.hpp"
-#include "apps/study_accuracy.hpp"
+#include "run/output.hpp"
+#include "studies/accuracy.hpp"
 #include "core/check.hpp"
 #include "levels/checks.hpp"
 #include "levels/solve.hpp"

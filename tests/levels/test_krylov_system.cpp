@@ -192,7 +192,7 @@ TEST(JacobianAssembler, IsKPlusTheContactTangentsAndReassemblesInPlace) {
 }
 
 TEST(KrylovSystem, ElementsRestrictedToTheFirstUnknownsSumToTheLeadingBlock) {
-    // EBE on one process's diagonal block (issue 13): the elements restricted to the unknowns
+    // EBE on one process's diagonal block: the elements restricted to the unknowns
     // [0, n) sum to J's leading n x n block, for any n; elements with none of them are dropped.
     TwoLevels& t = two_levels();
     std::vector<smoothers::ElementMatrix> all = elastic_element_matrices(t.fine);

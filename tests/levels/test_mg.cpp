@@ -236,9 +236,7 @@ TEST(MultilevelPreconditioner, TheExactFallbackSolvesWhatTheMultigridCannot) {
 TEST(MultilevelPreconditioner, TheDampedTwoBodyDefaultSolvesTheDovetail) {
     // The default's Krylov + mg with a two-body pair (BiCGStab + mg:omega=0.8,pre=0,post=2, levels/
     // resources.hpp): the same solution as the exact schur on dovetail level 2 (56 181
-    // unknowns), with few BiCGStab iterations per Newton step (on level 4: 20 against 85
-    // undamped with V(0,2), 27 against 55 with V(1,1); README "Choosing the Newton-system
-    // solver" and "The default cycle: V(0,2) with BiCGStab").
+    // unknowns), with few BiCGStab iterations per Newton step (docs/results/default-cycle.md).
     auto p = scene::load_scene("dovetail");
     p.levels = 2;
     p.load_steps = 2;
@@ -344,8 +342,8 @@ TEST(AlgebraicMultigrid, SolvesHertzGmshAtLevel0LikeSchur) {
 
 TEST(AlgebraicMultigrid, IsAskedForOnASingleLevelAndEstimated) {
     // The square exported from level 2: 8 512 unknowns on level 0, rigid obstacle only. The
-    // default stays the exact schur on a single level (measured faster there: README "mg on a
-    // mesh without levels"); --pc mg builds the aggregation hierarchy.
+    // default stays the exact schur on a single level (faster there:
+    // docs/results/solver-choice.md); --pc mg builds the aggregation hierarchy.
     const Problem p = exported_square(2);
     EXPECT_EQ(plan_solver(p, {}).spec.method, solvers::Method::schur);
     SolverRequest asked;

@@ -305,9 +305,8 @@ TEST(MemoryLimit, IsPositiveAndNamesItsSource) {
 }
 
 TEST(MemoryEstimate, SquareLevel7WithMgFitsIn24GiB) {
-    // Issue 15: `bench square --levels 7` (8.4 million unknowns, mg coarse-to-fine) must not be
-    // refused on a 24 GiB machine. Level 6 measured 2487 MiB peak (README); the estimate for
-    // level 7 scales about 4x, far below 24 GiB, and above the measured level 6.
+    // `bench square --levels 7` (8.4 million unknowns, mg coarse-to-fine) must not be refused on
+    // a 24 GiB machine: the estimate for level 7 scales about 4x from level 6, far below 24 GiB.
     auto p = scene::load_scene("square");
     p.levels = 7;
     const auto sizes = levels::predict_level_sizes(p);

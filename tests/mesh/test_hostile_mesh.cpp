@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Hostile input (issue 7): inputs that once crashed, hung or invoked undefined behaviour in the
+// Hostile input: inputs that once crashed, hung or invoked undefined behaviour in the
 // mesh code (found while fuzzing with tests/fuzz, or by review) now get an InvalidInput, or are
 // checked in reasonable time when they are valid.
 #include "core/check.hpp"

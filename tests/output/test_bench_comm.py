@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""`mlcontact bench comm` (issue 13 item 4): the PMPI library counts what the distributed mg sends,
+"""`mlcontact bench comm`: the PMPI library counts what the distributed mg sends,
 and the counts follow the V-cycle's pattern in closed form:
 - on 2 processes each has one neighbour, so a mat-vec sends 1 message, and a V-cycle from level
   p + j sends 4 j (per distributed level: the halo after the pre-sweep, R = T^T, T, the halo

@@ -1,10 +1,10 @@
 # SPDX-License-Identifier: MIT
-"""`mlcontact run` on several processes (issue 12): mpirun -np 2 and 3 give the one-process
+"""`mlcontact run` on several processes: mpirun -np 2 and 3 give the one-process
 answer (displacements and multipliers to 1e-8 relative, the same status at every contact node)
 with the Newton and Krylov tolerances at 1e-12; solution.pvtu opens in VTK's own parallel reader
 (python3-vtk9) as one mesh whose displacements are the one-process solution.vtu's; summary.json
 records the processes; what has no distributed form is refused with a message. `bench elastic`
-on two processes solves the one-process bench's elastic block. Two-body scenes (issue 13): patch
+on two processes solves the one-process bench's elastic block. Two-body scenes: patch
 and dovetail on 2 and 3 processes give the one-process answer with the interface cut.
 
 Run by ctest as `/usr/bin/python3 -m pytest`; MLCONTACT is the driver, MPIEXEC the launcher.
@@ -184,10 +184,11 @@ def test_a_preconditioner_of_the_matrix_alone_runs_on_each_process_block(tmp_pat
 
 def ebe_on_processes(tmp_path, np_):
     # EBE (C1) from each process's elements restricted to its owned unknowns, coloured within the
-    # process, Jacobi across the cuts (issue 13): the one-process answer on np_ processes.
+    # process, Jacobi across the cuts: the one-process answer on np_ processes.
     f = scene_file(tmp_path, "square")
     out1 = tmp_path / "one"
-    # BiCGStab: CGS with EBE on 2 processes stalls at 5000 iterations here (README).
+    # BiCGStab: CGS with EBE on 2 processes stalls at 5000 iterations here
+    # (docs/parallel.md, "Other preconditioners").
     p1 = subprocess.run([MLCONTACT, "run", str(f), "--levels", "2", "--pc", "ebe",
                          "--krylov", "bicgstab", "--linear-tol", "1e-12", "--quiet",
                          "--out", str(out1)],
@@ -211,7 +212,7 @@ def test_ebe_runs_on_each_process_block(tmp_path):
     (["--linear", "schur"], "--linear schur has no distributed form"),
     (["--pc", "sorcf"], "'sorcf' has no distributed form"),
     (["--cold"], "--cold is one process only"),
-    (["--pc", "mg:precision=single"], "mg:precision=single has no distributed form"),
+    (["--pc", "mg:coarse=galerkin"], "mg:coarse=galerkin has no distributed form"),
     (["--partition-level", "3"], "--partition-level must lie in [0, 2] for --levels 3"),
 ])
 def test_what_has_no_distributed_form_is_refused_once(tmp_path, args, message):

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The parallel VTU output (issue 12, item 5) read by VTK's own parallel reader: write_pvtu
+"""The parallel VTU output read by VTK's own parallel reader: write_pvtu
 (tests/output/write_pvtu.cpp) run alone and under mpirun -np 2 and 3 writes solution.pvtu and
 one piece per process; vtkXMLPUnstructuredGridReader (Debian python3-vtk9) opens it as one mesh
 with the serial mesh's triangles and vertices and the fields' closed forms.

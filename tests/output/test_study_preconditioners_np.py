@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""`mlcontact study preconditioners --np-list` (issue 13, item 2): the table has one row per
+"""`mlcontact study preconditioners --np-list`: the table has one row per
 preconditioner, level and process count, every cell converged, level l distributed exactly when
 N > 1, and its N = 1 column is what a plain one-process `mlcontact run` of the same cell reports
 (Krylov iterations per Newton step, mean from summary.json and max from iterations.csv). What

@@ -32,12 +32,12 @@ def run(cmd, **kw):
 run([cmake, "--install", build, "--prefix", prefix])
 inc = os.path.join(prefix, "include")
 assert sorted(os.listdir(inc)) == ["mlcontact"], f"include/ holds {os.listdir(inc)}, expected mlcontact/ only"
-for folder in ["core", "mesh", "fem", "contact", "transfer", "smoothers", "solvers", "levels", "scene", "apps"]:
+for folder in ["core", "mesh", "fem", "contact", "transfer", "smoothers", "solvers", "levels", "scene", "run", "studies", "bench"]:
     assert os.path.isdir(os.path.join(inc, "mlcontact", folder)), folder
     assert os.path.exists(os.path.join(prefix, "lib", f"libmlc_{folder}.a")), folder
 solve_hpp = open(os.path.join(inc, "mlcontact", "levels", "solve.hpp")).read()
 assert '#include "mlcontact/core/timer.hpp"' in solve_hpp, "own includes not prefixed"
-assert not re.search(r'#include "(core|mesh|fem|contact|transfer|smoothers|solvers|levels|scene|apps)/', solve_hpp)
+assert not re.search(r'#include "(core|mesh|fem|contact|transfer|smoothers|solvers|levels|scene|run|studies|bench)/', solve_hpp)
 cfg = os.path.join(prefix, "lib", "cmake", "mlcontact")
 for f in ["mlcontactConfig.cmake", "mlcontactConfigVersion.cmake", "mlcontactTargets.cmake"]:
     assert os.path.exists(os.path.join(cfg, f)), f

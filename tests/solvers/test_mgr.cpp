@@ -49,17 +49,18 @@ std::vector<CapturedSystem> square_systems(int level, std::vector<int>& function
     p.levels = level;
     std::vector<CapturedSystem> systems;
     levels::SolveOptions so;
-    so.wrap_system_solver = [&](int l, const levels::Level& L,
-                                std::unique_ptr<levels::NewtonSystemSolver> s)
-        -> std::unique_ptr<levels::NewtonSystemSolver> {
-        if (l != level) return s;
-        functions.assign(static_cast<size_t>(L.n_unknowns()), solvers::kMultiplierFunction);
-        for (int v = 0; v < L.dofs.n_vertices(); ++v)
-            for (int c = 0; c < 2; ++c)
-                if (const int i = L.dofs.u_dof(v, c); i >= 0) functions[static_cast<size_t>(i)] = c;
-        return std::make_unique<Capture>(std::move(s), L, systems);
-    };
-    const auto r = levels::solve(p, so);
+    levels::SolverWrapper wrap(
+        [&](int l, const levels::Level& L, std::unique_ptr<levels::NewtonSystemSolver> s)
+            -> std::unique_ptr<levels::NewtonSystemSolver> {
+            if (l != level) return s;
+            functions.assign(static_cast<size_t>(L.n_unknowns()), solvers::kMultiplierFunction);
+            for (int v = 0; v < L.dofs.n_vertices(); ++v)
+                for (int c = 0; c < 2; ++c)
+                    if (const int i = L.dofs.u_dof(v, c); i >= 0)
+                        functions[static_cast<size_t>(i)] = c;
+            return std::make_unique<Capture>(std::move(s), L, systems);
+        });
+    const auto r = levels::solve(p, so, &wrap);
     EXPECT_TRUE(r.converged) << r.failure;
     return systems;
 }

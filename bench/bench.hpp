@@ -1,0 +1,121 @@
+// SPDX-License-Identifier: MIT
+/// @file `mlcontact bench`: scaling benchmarks of the multilevel preconditioner.
+///
+/// - `bench square`: the full coarse-to-fine solve of a scene (all levels, all load steps) with
+///   each requested Newton-system solver; per level: unknowns, Jacobian nonzeros, Newton steps,
+///   Krylov iterations per Newton step, Jacobian assembly, preconditioner setup and solve seconds,
+///   and per run the wall time and peak resident memory (getrusage ru_maxrss). Beside it the
+///   bandwidth account: the compulsory bytes of every counted pass (core/traffic.hpp) of each
+///   level's Newton solves by kind, their time and GB/s, a STREAM copy/triad measured by the same
+///   binary after the first solver's runs, the time of one CSR mat-vec of the finest Jacobian
+///   (same threads) and a fine Newton step in those mat-vecs; and per level the RSS growth of
+///   building its solver and running its first Newton solve, per unknown.
+/// - `bench elastic`: the elastic block alone (K on the free displacement unknowns of the finest
+///   level, right-hand side the full load) solved to the same relative tolerance by hypre
+///   BoomerAMG-PCG and by our geometric V-cycle (vertex-block Gauss–Seidel, P / P^T, sparse LU
+///   on level 0) inside CG and GMRES, side by side in one run. Under mpirun with N > 1 processes:
+///   bench/distributed.hpp (bench_elastic_distributed).
+/// - `bench newton`: the Newton systems of the finest level, captured from a real coarse-to-fine
+///   run (one per Newton step, through levels::SolveObserver::wrap_system_solver), each solved
+///   from zero to the same relative tolerance by our Krylov method with `mg` as the run uses it
+///   (at each requested thread count), with hypre MGR (solvers/hypre/mgr.hpp) and with
+///   BoomerAMG on the whole Jacobian (the naive choice), both at one thread through our
+///   Preconditioner interface (hypre has no CGS), and MGR inside hypre's own FlexGMRES;
+///   per system: statuses, setup and solve seconds,
+///   iterations and the true relative residual ||b - J x|| / ||b|| computed here.
+/// All print a table and write JSON.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace mlc::apps {
+
+/// Options of `bench square`.
+struct BenchSquareOptions {
+    std::string scene = "square";
+    int levels = 3; ///< finest level L (levels 0..L are all solved)
+    /// "schur", "lu", "default" (the run's default mg and Krylov method above the crossover:
+    /// levels::kMgDefaultOneBody or kMgDefaultTwoBody with levels::kMgDefaultKrylov), or Krylov
+    /// preconditioner specs.
+    std::vector<std::string> pcs = {"default"};
+    /// Krylov method for the preconditioner specs; unset: CGS, and for "default" the run's.
+    std::optional<std::string> krylov;
+    /// Order of the unknowns, "hilbert" or "lattice" (levels::Problem::numbering); unset:
+    /// bench_numbering.
+    std::optional<std::string> numbering;
+    double rel_tol = 1e-8; ///< Krylov relative tolerance
+    int max_iter = 5000;   ///< Krylov iterations per Newton step
+    int repeat = 1;        ///< runs per solver; times are medians over them
+    /// Linear load steps taken at the extrapolated state (levels::SolveOptions::extrapolate, the
+    /// run's default); off by default here, so that every load step's Newton is measured.
+    bool extrapolate = false;
+    std::filesystem::path out; ///< JSON file (default out/bench/square_L<L>.json)
+    /// STREAM (core/traffic.hpp) array length in doubles, and its repetitions (best taken).
+    std::size_t stream_doubles = std::size_t(1) << 25;
+    int stream_repeats = 5;
+};
+
+/// The Krylov method and preconditioner spec `bench square` runs for the entry `pc` of
+/// opt.pcs on a problem with (`two_body`) or without a two-body pair: "default" is the run's
+/// default above the crossover (with the lattice sweep, levels::kMgDefaultLatticeOption, when
+/// `lattice`: the levels numbered by lattices and the finest at least
+/// levels::kMgDefaultLatticeLevel), anything else `pc` itself with opt.krylov (CGS if unset).
+struct BenchSolver {
+    std::string krylov, pc;
+};
+BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
+                         bool lattice = false);
+
+/// The numbering of a single-process `bench square`: opt.numbering if set, else "lattice" when
+/// every solver is the default one and the finest level is at least
+/// levels::kMgDefaultLatticeLevel (the numbering the run's default takes there) or one of them
+/// names the lattice sweep (mg:...,smoother=lattice), else "hilbert" (the named preconditioners
+/// keep the numbering they always had).
+std::string bench_numbering(const BenchSquareOptions& opt);
+
+/// Runs the benchmark (see the file comment); returns the exit code (0: every run converged).
+int bench_square(const BenchSquareOptions& opt, std::ostream& os);
+
+/// Options of `bench elastic`.
+struct BenchElasticOptions {
+    std::string scene = "square";
+    int levels = 3;        ///< the elastic block of level L
+    double rel_tol = 1e-8; ///< relative tolerance of every solve
+    int max_iter = 1000;   ///< iterations of every solve
+    int repeat = 1;        ///< runs per solver; times are medians over them
+    /// JSON file (default out/bench/elastic_<scene>_L<L>.json; on N > 1 processes
+    /// out/bench/elastic_<scene>_L<L>_np<N>.json)
+    std::filesystem::path out;
+};
+
+/// Runs the benchmark (see the file comment); returns the exit code (0: every solve converged).
+int bench_elastic(const BenchElasticOptions& opt, std::ostream& os);
+
+/// Options of `bench newton`.
+struct BenchNewtonOptions {
+    std::string scene = "square";
+    int levels = 3;          ///< the finest level L (>= 1; levels 0..L are solved)
+    std::string pc = "mg";   ///< our preconditioner spec (the run's)
+    std::string mgr = "mgr"; ///< the hypre MGR spec (registry options, e.g. "mgr:theta=0.5")
+    bool amg = true;         ///< also BoomerAMG on the whole Jacobian
+    /// Also MGR inside hypre's own FlexGMRES(50) ("mgr+fgmres"), as hypre users run it (hypre
+    /// has no CGS), at 1 thread.
+    bool hypre_gmres = true;
+    std::string krylov = "cgs";        ///< Krylov method of every solve
+    double rel_tol = 1e-8;             ///< relative tolerance of every solve
+    int max_iter = 1000;               ///< iterations per solve (slow solves are cut short earlier)
+    int repeat = 1;                    ///< runs per thread count; times are medians over them
+    std::vector<int> threads = {1, 2}; ///< thread counts for our pc (hypre: the 1-thread runs)
+    std::filesystem::path out;         ///< JSON file (default out/bench/newton_<scene>_L<L>.json)
+};
+
+/// Runs the benchmark (see the file comment); returns the exit code (0: every mg and MGR solve
+/// reached the tolerance, 2 otherwise).
+int bench_newton(const BenchNewtonOptions& opt, std::ostream& os);
+
+} // namespace mlc::apps

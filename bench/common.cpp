@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: MIT
+// What the benches share.
+#include "bench/common.hpp"
+
+#include "contact/element.hpp"
+#include "core/check.hpp"
+#include "core/memory.hpp"
+
+#include <algorithm>
+#include <iomanip>
+#include <set>
+
+namespace mlc::apps {
+
+double peak_rss_mib() {
+    return peak_rss_bytes() / (1024.0 * 1024.0);
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string json_string(const std::string& s) {
+    std::string out = "\"";
+    for (char c : s) {
+        if (c == '"' || c == '\\') out += '\\';
+        out += c;
+    }
+    return out + "\"";
+}
+
+// The JSON a bench writes: `given`, or out/bench/<prefix><scene>_L<levels>.json.
+std::filesystem::path bench_json_path(const std::string& given, const std::string& prefix,
+                                      const std::string& scene, int levels) {
+    if (!given.empty()) return given;
+    return "out/bench/" + prefix + scene + "_L" + std::to_string(levels) + ".json";
+}
+
+AtomicOfstream open_json(const std::filesystem::path& file) {
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+    AtomicOfstream f(file);
+    MLC_CHECK(f.good(), "cannot write " << file.string());
+    f << std::setprecision(6);
+    return f;
+}
+
+// Nonzeros of the Jacobian pattern of a level: K plus the contact tangent entries outside it.
+long jacobian_nonzeros(const levels::Level& L) {
+    const SparseMatrix& K = L.elastic.K;
+    std::set<std::pair<int, int>> extra;
+    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+    for (size_t e = 0; e < L.contacts.size(); ++e)
+        contact::for_each_tangent_entry(
+            L.contacts[e], I, L.dofs, L.lambda_dof[e], [&](int row, int col, double) {
+                const int* b = K.innerIndexPtr() + K.outerIndexPtr()[row];
+                const int* en = K.innerIndexPtr() + K.outerIndexPtr()[row + 1];
+                if (!std::binary_search(b, en, col)) extra.emplace(row, col);
+            });
+    return static_cast<long>(K.nonZeros()) + static_cast<long>(extra.size());
+}
+
+} // namespace mlc::apps

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+/// @file The distributed multigrid: the V-cycle of solvers/vcycle.hpp (the one-process
+/// multigrid's) over the distributed levels of a run on several processes
+/// (levels/distributed.hpp). On each level the operator of its converged statuses (rediscretized,
+/// as mg does on one process; its Newton system's on the finest) as a ParCSR matrix, whose halo
+/// exchange gives the residuals; the smoother of each process's diagonal block, the other
+/// processes' unknowns held at their values (Jacobi across the cuts): mg:smoother=lattice's sweep
+/// where the level is numbered by lattices (the macro triangles a process owns whole), else
+/// vertex-block Gauss-Seidel, in double or (mg:precision=single) single precision; T a ParCSR
+/// matrix, R = T^T. On level p the gathered coarse solve: the residual gathered on every process
+/// and solved by the sparse LU of level p's Jacobian at its converged statuses.
+#pragma once
+
+#include "core/communicator.hpp"
+#include "levels/distributed.hpp"
+#include "levels/solve.hpp"
+#include "solvers/hypre/par_matrix.hpp"
+#include "solvers/mg.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mlc::levels {
+
+/// The distributed multigrid over the levels of a distributed run and the Newton systems of its
+/// levels 1..m (levels[k] is level p + k; levels[0], level p, is the gathered coarse level).
+/// Collective calls throughout (every process calls them in the same order).
+class DistributedMultigrid {
+public:
+    /// `levels`, `transfers` (transfers[k - 1]: levels[k - 1] -> levels[k]) and `comm` must outlive
+    /// it. spec: the Krylov method, tolerance and iteration limit of solve().
+    DistributedMultigrid(const std::vector<DistributedLevel>& levels,
+                         const std::vector<DistributedTransfer>& transfers,
+                         const Communicator& comm, LinearSolverSpec spec,
+                         solvers::MultigridParams mg);
+    ~DistributedMultigrid();
+    /// The coarse solve: level p (the whole level, on every process) at the status matrices M
+    /// (one per contact element of level_p; none without contact), factored by sparse LU.
+    void set_coarse(const Level& level_p, const std::vector<Eigen::Matrix2d>& M);
+    /// Level k's operator J_k = K_k + contact tangents at M (one per contact element of the
+    /// part), assembled in place, and its smoother set up; nothing when M is the last call's on
+    /// every process.
+    void prepare(size_t k, const std::vector<Eigen::Matrix2d>& M);
+    /// J_k(M) dx = b on the owned unknowns by the Krylov method preconditioned by one V-cycle
+    /// from level k, to max(forcing, spec.rel_tol).
+    SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+                      double forcing);
+    /// J_k as prepared last (a ParCSR view of its blocks).
+    const solvers::ParMatrix& matrix(size_t k) const;
+    /// One V-cycle from level k as a Preconditioner of J_k (borrows this object).
+    std::unique_ptr<Preconditioner> preconditioner(size_t k) const;
+    /// e.g. "cgs + distributed mg(pre=1,post=1,omega=1)".
+    std::string name() const;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The V-cycle parameters of spec.pc ("mg[:pre=N,post=N,omega=W]"). Throws InvalidInput when
+/// spec is not a Krylov method with mg (naming what has no distributed form).
+solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec);
+
+/// The solver of levels 0..p of a distributed run (solved on every process by levels::solve):
+/// `spec` itself, but without mg:smoother=lattice when p is below the first level the lattice
+/// sweep applies to (those levels are swept by vertex blocks either way).
+LinearSolverSpec serial_levels_spec(const LinearSolverSpec& spec, int partition_level);
+
+} // namespace mlc::levels

@@ -1,0 +1,221 @@
+// SPDX-License-Identifier: MIT
+/// @file The pieces of the scene parser (scene.cpp reads the sections in order, mesh_tables.cpp a
+/// body's mesh table, contacts.cpp the contact pairs, recover_levels.cpp the levels of a refined
+/// Gmsh file): the Reader with its typed getters, and what the pieces share. Internal to mlc_scene.
+#pragma once
+
+#include "core/check.hpp"
+#include "levels/problem.hpp"
+#include "mesh/mesh.hpp"
+#include "scene/scene.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <span>
+#include <sstream>
+#include <string>
+#include <toml++/toml.h>
+#include <vector>
+
+namespace mlc::scene::detail {
+
+const std::map<std::string, std::string>& builtin_scenes(); // generated
+const std::map<std::string, std::string>& builtin_files();  // generated: scenes/*.msh
+
+constexpr int kMaxLevels = 12; // [scene].levels and the levels a Gmsh mesh is read with
+
+/// Parsing context: the origin for messages and typed getters that fail with file:line.
+class Reader {
+public:
+    explicit Reader(std::string origin, StopPoll stop = {})
+        : origin_(std::move(origin)), stop_(std::move(stop)) {}
+
+    [[noreturn]] void fail(const toml::node* n, const std::string& msg) const {
+        std::ostringstream os;
+        os << origin_;
+        if (n && n->source().begin.line > 0) os << ":" << n->source().begin.line;
+        os << ": " << msg;
+        throw InvalidInput(os.str());
+    }
+
+    void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
+                    const std::string& where) const {
+        check_keys(t, std::span<const std::string_view>(allowed.begin(), allowed.size()), where);
+    }
+    void check_keys(const toml::table& t, std::span<const std::string_view> allowed,
+                    const std::string& where) const {
+        for (auto&& [k, v] : t) {
+            bool ok = false;
+            for (auto a : allowed)
+                ok = ok || k.str() == a;
+            if (!ok) {
+                std::string list;
+                for (auto a : allowed)
+                    list += (list.empty() ? "" : ", ") + std::string(a);
+                std::ostringstream os;
+                os << origin_ << ":" << k.source().begin.line << ": unknown key '" << k.str()
+                   << "' in " << where << " (allowed: " << list << ")";
+                throw InvalidInput(os.str());
+            }
+        }
+    }
+
+    const toml::node* need(const toml::table& t, std::string_view key,
+                           const std::string& where) const {
+        const toml::node* n = t.get(key);
+        if (!n) fail(&t, "missing key '" + std::string(key) + "' in " + where);
+        return n;
+    }
+
+    double number(const toml::node* n, const std::string& what) const {
+        if (auto d = n->value_exact<double>()) return finite(*d, n, what);
+        if (auto i = n->value_exact<int64_t>()) return static_cast<double>(*i);
+        fail(n, what + " must be a number, found " + type_name(n));
+    }
+    double number(const toml::table& t, std::string_view key, const std::string& where) const {
+        return number(need(t, key, where), where + "." + std::string(key));
+    }
+    double number_or(const toml::table& t, std::string_view key, double dflt,
+                     const std::string& where) const {
+        const toml::node* n = t.get(key);
+        return n ? number(n, where + "." + std::string(key)) : dflt;
+    }
+    std::optional<double> optional_number(const toml::table& t, std::string_view key,
+                                          const std::string& where) const {
+        const toml::node* n = t.get(key);
+        if (!n) return std::nullopt;
+        return number(n, where + "." + std::string(key));
+    }
+    int integer(const toml::node* n, const std::string& what) const {
+        if (auto i = n->value_exact<int64_t>()) {
+            if (*i < -1000000000 || *i > 1000000000) fail(n, what + " is out of range");
+            return static_cast<int>(*i);
+        }
+        fail(n, what + " must be an integer, found " + type_name(n));
+    }
+    int integer_or(const toml::table& t, std::string_view key, int dflt,
+                   const std::string& where) const {
+        const toml::node* n = t.get(key);
+        return n ? integer(n, where + "." + std::string(key)) : dflt;
+    }
+    std::string string(const toml::node* n, const std::string& what) const {
+        if (auto s = n->value_exact<std::string>()) return *s;
+        fail(n, what + " must be a string, found " + type_name(n));
+    }
+    std::string string(const toml::table& t, std::string_view key, const std::string& where) const {
+        return string(need(t, key, where), where + "." + std::string(key));
+    }
+    std::string string_or(const toml::table& t, std::string_view key, std::string dflt,
+                          const std::string& where) const {
+        const toml::node* n = t.get(key);
+        return n ? string(n, where + "." + std::string(key)) : dflt;
+    }
+    bool boolean_or(const toml::table& t, std::string_view key, bool dflt,
+                    const std::string& where) const {
+        const toml::node* n = t.get(key);
+        if (!n) return dflt;
+        if (auto b = n->value_exact<bool>()) return *b;
+        fail(n, where + "." + std::string(key) + " must be true or false, found " + type_name(n));
+    }
+    Vec2 vec2(const toml::node* n, const std::string& what) const {
+        const toml::array* a = n->as_array();
+        if (!a || a->size() != 2) fail(n, what + " must be an array of two numbers [x, y]");
+        return {number(a->get(0), what + "[0]"), number(a->get(1), what + "[1]")};
+    }
+    Vec2 vec2(const toml::table& t, std::string_view key, const std::string& where) const {
+        return vec2(need(t, key, where), where + "." + std::string(key));
+    }
+    /// A non-empty array of numbers.
+    std::vector<double> numbers(const toml::node* n, const std::string& what) const {
+        const toml::array* a = n->as_array();
+        if (!a || a->empty()) fail(n, what + " must be a non-empty array of numbers");
+        std::vector<double> out;
+        for (size_t i = 0; i < a->size(); ++i)
+            out.push_back(number(a->get(i), what + "[" + std::to_string(i) + "]"));
+        return out;
+    }
+    const toml::table& table(const toml::node* n, const std::string& what) const {
+        const toml::table* t = n->as_table();
+        if (!t) fail(n, what + " must be a table, found " + type_name(n));
+        return *t;
+    }
+    /// An array of tables ([[name]]) or a single table; empty when absent.
+    std::vector<const toml::table*> tables(const toml::table& t, std::string_view key,
+                                           const std::string& where) const {
+        std::vector<const toml::table*> out;
+        const toml::node* n = t.get(key);
+        if (!n) return out;
+        if (const toml::array* a = n->as_array()) {
+            for (const auto& e : *a)
+                out.push_back(&table(&e, where + "." + std::string(key)));
+        } else {
+            out.push_back(&table(n, where + "." + std::string(key)));
+        }
+        return out;
+    }
+    const std::string& origin() const { return origin_; }
+    /// What the meshing of a domain polls (may be empty).
+    const StopPoll& stop() const { return stop_; }
+
+private:
+    double finite(double d, const toml::node* n, const std::string& what) const {
+        if (!std::isfinite(d)) fail(n, what + " must be finite");
+        return d;
+    }
+    static std::string type_name(const toml::node* n) {
+        switch (n->type()) {
+        case toml::node_type::string:
+            return "a string";
+        case toml::node_type::integer:
+            return "an integer";
+        case toml::node_type::floating_point:
+            return "a number";
+        case toml::node_type::boolean:
+            return "a boolean";
+        case toml::node_type::array:
+            return "an array";
+        case toml::node_type::table:
+            return "a table";
+        default:
+            return "a date/time";
+        }
+    }
+    std::string origin_;
+    StopPoll stop_;
+};
+
+/// Wraps a library InvalidInput with the scene position of the entry that caused it.
+template <class F> auto at(const Reader& rd, const toml::node* n, F&& f) {
+    try {
+        return f();
+    } catch (const InvalidInput& e) {
+        rd.fail(n, e.what());
+    }
+}
+
+/// A body's mesh table: built in its own frame, mirrored (mirror_x), moved (transform), then the
+/// arcs of a Gmsh mesh declared (in the global frame). mesh_tables.cpp.
+mesh::Mesh parse_mesh(const Reader& rd, const toml::table& t, const std::string& where,
+                      const std::filesystem::path& base_dir);
+
+/// Fails unless `tag` names boundary edges of `m` (or, with boundary_only false, also a tagged
+/// interior line, Mesh::lines); the message points at t[key] (or at t) and lists the known tags.
+void check_tag(const Reader& rd, const mesh::Mesh& m, const toml::table& t, const std::string& tag,
+               const std::string& where, bool boundary_only = true, const char* key = "tag");
+
+/// The [[contact]] pairs of the scene, appended to p.contacts (the bodies and their mesh read).
+/// contacts.cpp.
+void parse_contacts(const Reader& rd, const toml::table& root, levels::Problem& p);
+
+/// A Gmsh mesh that is a uniform 1->4 refinement (Gmsh's RefineMesh, `gmsh -refine`, `mlcontact
+//// show --msh-level`) is read as a coarse ancestor and the levels between: coarse-to-fine Newton
+//// and the multigrid then have the hierarchy a built-in scene has. The ancestors are found by
+//// mesh::unrefine (its vertices within tol of the file's: exact for a file written with 17
+//// digits; tol also allows the rounding of coordinates far from the origin); the coarsest one on
+//// which the scene's level 0 builds (its support points are vertices, every contact pair finds
+//// contactor nodes, matching node pairs match) becomes mesh0. Called on a parsed, valid problem.
+void recover_levels(levels::Problem& p);
+
+} // namespace mlc::scene::detail

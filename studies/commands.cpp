@@ -1,0 +1,166 @@
+// SPDX-License-Identifier: MIT
+// The studies' subcommands: their options and what runs them.
+#include "studies/commands.hpp"
+
+#include "run/preconditioners.hpp"
+#include "scene/scene.hpp"
+#include "studies/accuracy.hpp"
+#include "studies/error_vs_time.hpp"
+#include "studies/extremes.hpp"
+#include "studies/preconditioners.hpp"
+#include "studies/status_transfer.hpp"
+
+#include <memory>
+
+namespace mlc::apps {
+
+namespace {
+
+Action add_status_transfer(CLI::App& st) {
+    struct Args {
+        StatusTransferOptions o;
+        std::string scene = "square", out, q = "paper";
+    };
+    auto a = std::make_shared<Args>();
+    st.add_option("scene", a->scene, "scene file or built-in name (default square)");
+    st.add_option("--levels,-l", a->o.levels, "finest level (default 3)");
+    st.add_option("--out,-o", a->out, "output folder (default out/<scene>/status_transfer)");
+    st.add_option("--q-rule", a->q, "multiplier interpolation: paper (default) or conservative")
+        ->check(CLI::IsMember({"paper", "conservative"}));
+    st.add_flag("--increment", a->o.increment,
+                "warm start = own previous state + interpolated coarse increment");
+    st.add_flag("!--no-plot", a->o.plot, "do not draw the PNG");
+    return [a](const Launch& at) {
+        a->o.out = a->out;
+        a->o.q_rule = a->q == "paper" ? transfer::QRule::paper : transfer::QRule::conservative;
+        return study_status_transfer(scene::load_scene(a->scene), a->o, at.os);
+    };
+}
+
+Action add_extremes(CLI::App& ex) {
+    struct Args {
+        ExtremesOptions o;
+        std::string out;
+    };
+    auto a = std::make_shared<Args>();
+    ex.add_option("--levels,-l", a->o.levels, "finest level of every case (default 2)");
+    ex.add_option("--seconds", a->o.seconds_per_case, "time bound per case (default 120)");
+    ex.add_option("--only", a->o.only, "run only cases whose name contains this text");
+    ex.add_option("--out,-o", a->out, "output folder (default out/studies/extremes)");
+    ex.add_option("--linear", a->o.linear,
+                  "Newton-system solver of every case: schur, lu or krylov (default: each "
+                  "solver the run default may choose, one table each)")
+        ->check(CLI::IsMember({"schur", "lu", "krylov"}));
+    ex.add_option("--krylov", a->o.krylov, "Krylov method (implies a Krylov solve)");
+    ex.add_option("--pc", a->o.pc, pc_option_help("preconditioner (implies a Krylov solve)"));
+    ex.add_option("--linear-tol", a->o.linear_rel_tol,
+                  "relative tolerance of each Krylov solve (implies a Krylov solve)");
+    return [a](const Launch& at) {
+        a->o.out = a->out;
+        return study_extremes(a->o, at.os);
+    };
+}
+
+Action add_error_vs_time(CLI::App& ev) {
+    struct Args {
+        ErrorVsTimeOptions o;
+        std::string scene = "square", out;
+    };
+    auto a = std::make_shared<Args>();
+    ev.add_option("scene", a->scene, "scene file or built-in name (default square)");
+    ev.add_option("--levels,-l", a->o.max_level, "configurations on levels 0..L (default 3)");
+    ev.add_option("--ilu-levels", a->o.ilu_max_level,
+                  "the ILU(0) configurations only up to this level (default 3)");
+    ev.add_option("--only", a->o.only,
+                  "run only the configurations whose name contains this text (e.g. mg)");
+    ev.add_option("--out,-o", a->out, "output folder (default out/studies/<scene>_error_vs_time)");
+    ev.add_flag("!--no-plot", a->o.plot, "do not draw the PNG");
+    return [a](const Launch& at) {
+        a->o.out = a->out;
+        return study_error_vs_time(scene::load_scene(a->scene), a->o, at.os);
+    };
+}
+
+Action add_preconditioners(CLI::App& ps) {
+    struct Args {
+        PreconditionerStudyOptions o;
+        std::string scene = "square", out;
+    };
+    auto a = std::make_shared<Args>();
+    ps.add_option("scene", a->scene, "scene file or built-in name (default square)");
+    ps.add_option("--levels,-l", a->o.levels, "finest level (default 2)");
+    ps.add_option("--mu", a->o.mu, "friction coefficients (list)")->delimiter(',');
+    ps.add_option("--r", a->o.r_over_E, "penalty factors r/E (list)")->delimiter(',');
+    ps.add_option(
+        "--pc", a->o.pcs,
+        pc_option_help("preconditioners (list; default diag ilu:0 cf sorcf ebe ebe:variant=c5)"));
+    ps.add_option("--krylov", a->o.krylovs, "Krylov methods (list; default cgs)")->delimiter(',');
+    ps.add_option("--steps", a->o.load_steps, "load steps (default: the scene's)");
+    ps.add_option("--tol", a->o.rel_tol, "Krylov relative tolerance (default 1e-8)");
+    ps.add_option("--max-iter", a->o.max_iter, "Krylov iterations per Newton step (default 5000)");
+    ps.add_option("--seconds", a->o.seconds_per_run, "time bound per combination (default 600)");
+    ps.add_option("--out,-o", a->out, "output folder");
+    ps.add_flag("!--no-plot", a->o.plot, "do not draw the PNG");
+    auto* np = ps.add_option("--np-list", a->o.np_list,
+                             "process counts (list, e.g. 1,2,4): run each cell as `mlcontact "
+                             "run` on N processes (mpiexec -n N for N > 1) and tabulate the "
+                             "Krylov iterations per Newton step by N (default --pc diag "
+                             "ilu:0 ebe mg)")
+                   ->delimiter(',');
+    ps.add_option("--mpiexec", a->o.mpiexec,
+                  "with --np-list: the MPI launcher (default mpiexec or mpirun on PATH, with "
+                  "--oversubscribe for Open MPI)")
+        ->needs(np);
+    return [a, &ps](const Launch& at) {
+        a->o.out = a->out;
+        if (!a->o.np_list.empty()) {
+            a->o.scene_arg = a->scene;
+            if (ps.count("--pc") == 0) a->o.pcs = {"diag", "ilu:0", "ebe", "mg"};
+            return study_preconditioners_np(scene::load_scene(a->scene), a->o, at.os);
+        }
+        return study_preconditioners(scene::load_scene(a->scene), a->o, at.os);
+    };
+}
+
+Action add_accuracy(CLI::App& ac) {
+    struct Args {
+        AccuracyOptions o;
+        std::string scene = "hertz", out;
+    };
+    auto a = std::make_shared<Args>();
+    ac.add_option("scene", a->scene, "scene file or built-in name (default hertz)");
+    ac.add_option("--levels,-l", a->o.levels, "levels 0..L (default 3)");
+    ac.add_option("--out,-o", a->out, "output folder (default out/<scene>/accuracy)");
+    ac.add_flag("!--no-plot", a->o.plot, "do not draw the PNG");
+    ac.add_flag("!--no-compare", a->o.compare_integration,
+                "node-on-facet scenes: do not also solve with the other integration variants");
+    return [a](const Launch& at) {
+        a->o.out = a->out;
+        return study_accuracy(scene::load_scene(a->scene), a->o, at.os);
+    };
+}
+
+} // namespace
+
+std::vector<Command> study_commands() {
+    return {
+        {.name = "status-transfer",
+         .usage = "predicted vs converged statuses and Newton iterations, coarse-to-fine vs "
+                  "cold, per level",
+         .add = add_status_transfer},
+        {.name = "extremes",
+         .usage = "stiff and extreme cases, each bounded in time",
+         .add = add_extremes},
+        {.name = "error-vs-time",
+         .usage = "error against wall time over levels and solvers",
+         .add = add_error_vs_time},
+        {.name = "preconditioners",
+         .usage = "Krylov iterations and times per Newton step per preconditioner",
+         .add = add_preconditioners},
+        {.name = "accuracy",
+         .usage = "closed-form errors per level and observed orders (hertz, mindlin, patch)",
+         .add = add_accuracy},
+    };
+}
+
+} // namespace mlc::apps
