@@ -49,7 +49,8 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     p.levels = opt.levels;
     p.validate();
     const BenchSolver solver = bench_solver(opt, opt.pcs.front(), levels::has_two_body_pair(p));
-    levels::number_for(p, solver.pc); // mg:smoother=lattice: each part numbered by lattices
+    if (solvers::parse_pc(solver.pc).lattice_numbering())
+        p.numbering = levels::Problem::Numbering::lattice; // each part numbered by lattices
     parallel::set_num_threads(1);
     const int np = comm.size();
     const int plevel = levels::partition_level(p.mesh0.n_triangles(), p.levels, np);

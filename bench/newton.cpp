@@ -397,7 +397,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     for (int t : opt.threads)
         MLC_CHECK(t >= 1 && t <= 256, "bench newton: --threads must be in 1..256, found " << t);
     check_preconditioner_names({opt.pc, opt.mgr});
-    MLC_CHECK(solvers::find_preconditioner(opt.mgr)->name == "mgr",
+    MLC_CHECK(solvers::parse_pc(opt.mgr).entry->name == "mgr",
               "bench newton: --mgr must be an mgr spec (mgr[:options]), found '" << opt.mgr << "'");
     MLC_CHECK(solvers::have_hypre(),
               "bench newton compares with hypre MGR and BoomerAMG: this build has "
@@ -405,7 +405,6 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
     (void)solvers::parse_krylov(opt.krylov);
     levels::Problem problem = scene::load_scene(opt.scene);
     problem.levels = opt.levels;
-    levels::number_for(problem, opt.pc); // a lattice sweep on levels numbered for it
     // Thread counts: 1 first (hypre's runs), then the others as given.
     std::vector<int> threads{1};
     for (int t : opt.threads)
@@ -436,9 +435,9 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
             const NewtonBenchPass pass{t, t == 1, t == 1 && rep == 0};
             levels::SolveOptions so;
             so.coarse_to_fine = true;
-            so.linear = {.method = "krylov",
-                         .krylov = opt.krylov,
-                         .pc = opt.pc,
+            so.linear = {.method = solvers::Method::krylov,
+                         .krylov = solvers::parse_krylov(opt.krylov),
+                         .pc = solvers::parse_pc(opt.pc),
                          .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
             levels::SolverWrapper wrap([&](int level, const levels::Level& L,
@@ -459,7 +458,7 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
             if (unknowns == 0) {
                 unknowns = r.finest().n_unknowns();
                 nonzeros = jacobian_nonzeros(r.finest());
-                run_solver = r.steps.empty() ? "" : r.solver.spec.pc;
+                run_solver = r.steps.empty() ? "" : r.solver.spec.pc.text();
             }
             if (&into == &rows) continue;
             // Later runs: the same systems (same sequence) add their samples.

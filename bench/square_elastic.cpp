@@ -328,9 +328,9 @@ void print_square_tables(std::ostream& os, const std::string& bw_table,
 BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
                          bool lattice) {
     if (pc != "default") return {opt.krylov.value_or("cgs"), pc};
-    return {
-        opt.krylov.value_or(levels::kMgDefaultKrylov),
-        levels::default_mg_spec(two_body, lattice && opt.levels >= levels::kMgDefaultLatticeLevel)};
+    return {opt.krylov.value_or(std::string(solvers::to_string(levels::kMgDefaultKrylov))),
+            levels::default_mg(two_body, lattice && opt.levels >= levels::kMgDefaultLatticeLevel)
+                .text()};
 }
 
 std::string bench_numbering(const BenchSquareOptions& opt) {
@@ -339,7 +339,10 @@ std::string bench_numbering(const BenchSquareOptions& opt) {
                                          [](const std::string& pc) { return pc == "default"; });
     const bool named_lattice =
         std::any_of(opt.pcs.begin(), opt.pcs.end(),
-                    [](const std::string& pc) { return levels::wants_lattice_sweep(pc); });
+                    [](const std::string& pc) {
+                        return pc != "default" && pc != "schur" && pc != "lu" &&
+                               solvers::parse_pc(pc).lattice_numbering();
+                    });
     return named_lattice || (all_default && opt.levels >= levels::kMgDefaultLatticeLevel)
                ? "lattice"
                : "hilbert";
@@ -386,11 +389,11 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         so.extrapolate = opt.extrapolate;
         const BenchSolver solver = bench_solver(opt, pc, two_body, lattice);
         if (pc == "schur" || pc == "lu")
-            so.linear.method = pc;
+            so.linear.method = solvers::parse_method(pc);
         else
-            so.linear = {.method = "krylov",
-                         .krylov = solver.krylov,
-                         .pc = solver.pc,
+            so.linear = {.method = solvers::Method::krylov,
+                         .krylov = solvers::parse_krylov(solver.krylov),
+                         .pc = solvers::parse_pc(solver.pc),
                          .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
         std::vector<SquareRow> rows;

@@ -26,8 +26,8 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
          LinearSolverSpec spec, solvers::MultigridParams mg)
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
-          use_mg_(solvers::parse_preconditioner_spec(spec_.pc).name == "mg"),
-          use_ebe_(solvers::parse_preconditioner_spec(spec_.pc).name == "ebe"), op_(levels.size()) {
+          use_mg_(spec_.pc.name() == "mg"), use_ebe_(spec_.pc.entry->element_matrices),
+          op_(levels.size()) {
         for (size_t k = 1; k < levels.size(); ++k) {
             build_jacobian(k);
             transfer_.emplace_back(*transfers[k - 1].T);
@@ -173,7 +173,7 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         const LatticeProduct lattice_product(o);
         const LinearOperator& A =
             o.lattice ? static_cast<const LinearOperator&>(lattice_product) : *o.J;
-        SolveResult r = solvers::solve(solvers::parse_krylov(spec_.krylov), A, pc, b, dx, kp);
+        SolveResult r = solvers::solve(spec_.krylov, A, pc, b, dx, kp);
         r.setup_seconds = t1 - t0;
         r.solve_seconds = wall_seconds() - t1;
         return r;
@@ -202,7 +202,9 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
 
     std::string name() const {
         std::ostringstream os;
-        if (!use_mg_) return spec_.krylov + " + " + spec_.pc + " on each process's diagonal block";
+        if (!use_mg_)
+            return std::string(solvers::to_string(spec_.krylov)) + " + " + spec_.pc.text() +
+                   " on each process's diagonal block";
         os << spec_.krylov << " + distributed mg(pre=" << mg_.pre_sweeps
            << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega;
         if (mg_.precision == Precision::float32) os << ",precision=single";
@@ -525,67 +527,40 @@ std::string DistributedMultigrid::name() const {
 }
 
 solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
-    MLC_CHECK(spec.method == "krylov",
+    MLC_CHECK(spec.method == solvers::Method::krylov,
               "on several processes the Newton systems are solved by a Krylov method with mg "
               "(--linear krylov --pc mg); '"
                   << spec.method
                   << "' has no distributed form (schur, lu, cf and sorcf need the "
                      "whole level on one process)");
-    const auto ps = solvers::parse_preconditioner_spec(spec.pc);
-    solvers::MultigridParams p;
-    if (ps.name != "mg") {
-        // A preconditioner of the matrix alone runs on each process's diagonal block.
-        const solvers::PreconditionerEntry* e = solvers::find_preconditioner(spec.pc);
-        MLC_CHECK(e && (!e->level_aware || e->name == "ebe"),
-                  "on several processes the preconditioner is mg, ebe, or one that needs the "
-                  "matrix alone (diag, ilu, sor, ...) on each process's diagonal block; '"
-                      << spec.pc
-                      << "' has no distributed form (cf, sorcf and mgr need the whole level: "
-                         "run it on one process)");
-        // Its options checked here, on every process (ebe: on no elements, not set up).
+    const solvers::PcSpec& pc = spec.pc;
+    const std::string why = pc.distributed();
+    MLC_CHECK(why.empty(), why);
+    if (pc.name() != "mg") {
+        // A preconditioner of the matrix alone (or ebe) runs on each process's diagonal block;
+        // its options checked here, on every process (ebe: on no elements, not set up).
         static const std::vector<smoothers::ElementMatrix> none;
         solvers::LevelData d;
         d.elements = [] { return &none; };
-        solvers::make_preconditioner(spec.pc, e->level_aware ? &d : nullptr);
-        return p;
+        solvers::make_preconditioner(pc, pc.entry->level_aware ? &d : nullptr);
+        return {};
     }
-    solvers::SpecOptions o(ps);
-    p.pre_sweeps = o.get_int("pre", p.pre_sweeps);
-    p.post_sweeps = o.get_int("post", p.post_sweeps);
-    p.omega = o.get_double("omega", p.omega);
-    const std::string coarse = o.get_string("coarse", "rediscretize");
-    MLC_CHECK(coarse == "rediscretize",
-              "mg:coarse=" << coarse
-                           << " has no distributed form; on several processes mg rediscretizes "
-                              "(coarse=rediscretize)");
-    // Per process on its diagonal block, as one process smooths its level.
-    const std::string precision = o.get_string("precision", "double");
-    MLC_CHECK(precision == "double" || precision == "single",
-              "option precision=" << precision << " of mg: valid double, single");
-    p.precision = precision == "single" ? Precision::float32 : Precision::float64;
-    const std::string smoother = o.get_string("smoother", "block");
-    MLC_CHECK(smoother == "block" || smoother == "lattice",
-              "option smoother=" << smoother << " of mg: valid block, lattice");
-    p.smoother = smoother == "lattice" ? solvers::MultigridParams::Smoother::lattice
-                                       : solvers::MultigridParams::Smoother::block;
-    o.finish();
+    // Per process on its diagonal block, as one process smooths its level (block or lattice
+    // sweeps, double or single precision).
+    const solvers::MultigridParams p = pc.get<solvers::MgOptions>().cycle();
     p.validate();
     return p;
 }
 
 LinearSolverSpec serial_levels_spec(const LinearSolverSpec& spec, int partition_level) {
     LinearSolverSpec s = spec;
-    if (spec.method != "krylov" || partition_level >= kMgDefaultLatticeLevel) return s;
-    auto ps = solvers::parse_preconditioner_spec(spec.pc);
-    const auto it = ps.options.find("smoother");
-    if (ps.name != "mg" || it == ps.options.end() || it->second != "lattice") return s;
-    ps.options.erase(it);
-    s.pc = ps.name;
-    char sep = ':';
-    for (const auto& [key, value] : ps.options) {
-        s.pc += sep + key + "=" + value;
-        sep = ',';
-    }
+    if (spec.method != solvers::Method::krylov || partition_level >= kMgDefaultLatticeLevel ||
+        spec.pc.name() != "mg")
+        return s;
+    solvers::MgOptions m = spec.pc.get<solvers::MgOptions>();
+    if (m.smoother != solvers::MultigridParams::Smoother::lattice) return s;
+    m.smoother = solvers::MultigridParams::Smoother::block;
+    s.pc.options = m;
     return s;
 }
 

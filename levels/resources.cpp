@@ -140,10 +140,17 @@ SolverPlan plan_distributed(const Problem& problem, const SolverRequest& req, in
     if (req.rel_tol) s.rel_tol = *req.rel_tol;
     const std::string why = s.pc.distributed();
     MLC_CHECK(why.empty(), why);
-    MLC_CHECK(!req.numbering || *req.numbering == Problem::Numbering::hilbert,
-              "the lattice numbering has no distributed form: on several processes each "
-              "process numbers its unknowns along a Hilbert curve (drop --numbering lattice)");
-    s.numbering = Problem::Numbering::hilbert;
+    if (s.pc.lattice_numbering()) {
+        // mg:smoother=lattice: each part numbered by lattices, as on one process.
+        s.numbering = req.numbering;
+        s.numbering = hierarchy_numbering(problem, s);
+    } else {
+        MLC_CHECK(!req.numbering || *req.numbering == Problem::Numbering::hilbert,
+                  "the lattice numbering has no distributed form without a lattice sweep: on "
+                  "several processes each process numbers its unknowns along a Hilbert curve "
+                  "(drop --numbering lattice)");
+        s.numbering = Problem::Numbering::hilbert;
+    }
     c.reason = req.pc ? "Krylov solve with --pc " + s.pc.text() + " as requested"
                       : "on " + std::to_string(processes) +
                             " processes: BiCGStab + distributed multilevel mg (V(0,2) cycle" +

@@ -110,7 +110,8 @@ struct SolverPlan {
 /// On several processes (`processes` > 1): always a Krylov method, BiCGStab + the default mg
 /// (never schur); a named `pc` takes CGS, BiCGStab with a two-body pair; a method or
 /// preconditioner without a distributed form (PreconditionerEntry::distributed) is refused
-/// naming the alternative; the levels keep the Hilbert numbering.
+/// naming the alternative; the levels keep the Hilbert numbering unless the preconditioner
+/// sweeps by lattices (mg:smoother=lattice: each process's part numbered by lattices).
 ///
 /// A preconditioner that sweeps by lattices numbers the levels for it (spec.numbering lattice)
 /// and is refused below level 4 or with numbering hilbert requested; one that needs the level

@@ -11,8 +11,8 @@ namespace mlc::python {
 namespace {
 
 // Convergence, the mesh, the solution and the contact state.
-void bind_result_solution(ResultClass& c) {
-    c.def_property_readonly(
+void bind_result_solution(ResultClass& cls) {
+    cls.def_property_readonly(
          "converged", [](const Result& r) { return r.run.converged; },
          "whether every load step converged on every level")
         .def_property_readonly(
@@ -143,8 +143,8 @@ void bind_result_solution(ResultClass& c) {
 }
 
 // The contact boundary, resultants, per-step reports, checks, timings and solver.
-void bind_result_reports(ResultClass& c) {
-    c.def_property_readonly(
+void bind_result_reports(ResultClass& cls) {
+    cls.def_property_readonly(
          "boundary_edges",
          [](const Result& r) {
              const auto& b = r.run.finest().mesh.boundary;
@@ -232,9 +232,9 @@ void bind_result_reports(ResultClass& c) {
             [](const Result& r) {
                 const auto& sp = r.run.solver.spec;
                 py::dict d;
-                d["method"] = sp.method;
-                d["krylov"] = sp.krylov;
-                d["pc"] = sp.pc;
+                d["method"] = std::string(solvers::to_string(sp.method));
+                d["krylov"] = std::string(solvers::to_string(sp.krylov));
+                d["pc"] = sp.pc.text();
                 d["rel_tol"] = sp.rel_tol;
                 d["automatic"] = r.run.solver.automatic;
                 d["numbering"] = std::string(levels::to_string(r.problem.numbering));
@@ -246,8 +246,8 @@ void bind_result_reports(ResultClass& c) {
 }
 
 // The state of one step, the closed forms, the report and the files.
-void bind_result_methods(ResultClass& c) {
-    c.def(
+void bind_result_methods(ResultClass& cls) {
+    cls.def(
          "step_state",
          [](const Result& r, int k) {
              const auto& st = r.run.step_nodes;

@@ -36,7 +36,7 @@ std::shared_ptr<Result> solve(const Scene& scene, std::optional<int> levels,
     auto res = std::make_shared<Result>();
     res->problem = scene.problem;
     apps::apply_overrides(res->problem, opt);
-    levels::SolverChoice choice;
+    levels::SolverPlan choice;
     levels::SolveOptions so = apps::run_solve_options(res->problem, opt, choice);
     so.keep_step_states = keep_steps;
     // Ctrl-C: Python's handler only sets a flag while the GIL is released; it is run here,

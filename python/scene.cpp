@@ -10,8 +10,8 @@ namespace mlc::python {
 namespace {
 
 // Where a scene comes from, copies, and what it is.
-void bind_scene_sources(SceneClass& c) {
-    c.def_static(
+void bind_scene_sources(SceneClass& cls) {
+    cls.def_static(
          "builtin",
          [](const std::string& name) {
              const std::string text = scene::builtin_scene_text(name);
@@ -90,8 +90,8 @@ void bind_scene_sources(SceneClass& c) {
 }
 
 // The settings of a scene that can be set.
-void bind_scene_settings(SceneClass& c) {
-    c.def_property(
+void bind_scene_settings(SceneClass& cls) {
+    cls.def_property(
          "levels", [](const Scene& s) { return s.problem.levels - s.problem.recovered_levels; },
          [](Scene& s, int v) {
              const int k = s.problem.recovered_levels;
@@ -171,8 +171,8 @@ void bind_scene_settings(SceneClass& c) {
 }
 
 // Its supports, tags and materials, and the edits of one pair or body.
-void bind_scene_parts(SceneClass& c) {
-    c.def_property_readonly(
+void bind_scene_parts(SceneClass& cls) {
+    cls.def_property_readonly(
          "supports",
          [](const Scene& s) {
              py::list out;

@@ -78,7 +78,7 @@ TEST(ErrorVsTime, MultilevelRowsConvergeAndTheirErrorFallsWithTheLevel) {
 }
 
 // The grid's default row is the run's default above the crossover on every level: the block
-// sweep up to level 3, the lattice sweep from level 4 (what choose_solver picks with no solver
+// sweep up to level 3, the lattice sweep from level 4 (what plan_solver picks with no solver
 // flag), with a one-body and a two-body scene.
 TEST(ErrorVsTime, TheDefaultRowRunsTheRunsDefaultOnEveryLevel) {
     // patch (two bodies, crossover 10 000 unknowns) is below it up to level 3.

@@ -136,7 +136,7 @@ levels::Level held_node(double kn, double fn, double mu, double r, bool pin) {
 } // namespace
 
 TEST(HeldComponents, ANodeHeldTangentiallyIsSolvedExactlyWithLambdaTZero) {
-    for (const std::string solver : {"lu", "schur"}) {
+    for (const solvers::Method solver : {solvers::Method::lu, solvers::Method::schur}) {
         const auto L = held_node(20.0, -2.0, 0.5, 3.0, true);
         ASSERT_EQ(L.contacts[0].pinned, kT);
         levels::ContactNewton newton(L, {},

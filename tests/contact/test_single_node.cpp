@@ -41,7 +41,7 @@ struct Solved {
 };
 
 Solved solve_single(double kt, double kn, Vec2 f, double mu, double r,
-                    const std::string& solver = "schur") {
+                    solvers::Method solver = solvers::Method::schur) {
     const auto L = single_node(kt, kn, f, mu, r);
     levels::ContactNewton newton(L, {}, levels::make_newton_system_solver(L, {.method = solver}));
     Vector x = Vector::Zero(L.n_unknowns());
@@ -74,8 +74,8 @@ TEST(SingleNode, SlipsForward) {
 
 TEST(SingleNode, AssembledLUAndCondensedSolversAgree) {
     for (Vec2 f : {Vec2(0.9, -2.0), Vec2(3.0, -2.0), Vec2(-3.0, -2.0), Vec2(1.0, 2.0)}) {
-        const auto a = solve_single(10.0, 20.0, f, 0.5, 3.0, "lu");
-        const auto b = solve_single(10.0, 20.0, f, 0.5, 3.0, "schur");
+        const auto a = solve_single(10.0, 20.0, f, 0.5, 3.0, solvers::Method::lu);
+        const auto b = solve_single(10.0, 20.0, f, 0.5, 3.0, solvers::Method::schur);
         EXPECT_EQ(a.status, b.status);
         EXPECT_EQ(a.iterations, b.iterations);
         EXPECT_NEAR((a.u - b.u).norm(), 0.0, 1e-14);

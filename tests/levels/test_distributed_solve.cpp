@@ -241,7 +241,9 @@ TEST(DistributedSolve, LatticeSweepOnEachProcessIsTheOneProcessAnswer) {
     EXPECT_EQ(comm.sum(static_cast<int>(rows->macros())),
               comm.sum(static_cast<int>(lattice_macros)));
     EXPECT_GE(comm.sum(static_cast<int>(lattice_macros)), 16);
-    if (comm.size() == 1) EXPECT_EQ(lattice_macros, 32);
+    if (comm.size() == 1) {
+        EXPECT_EQ(lattice_macros, 32);
+    }
     // The level below keeps the Hilbert numbering and the vertex-block sweep.
     EXPECT_EQ(d.levels[d.levels.size() - 2].local.lattice, nullptr);
 }

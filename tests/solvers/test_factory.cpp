@@ -91,10 +91,11 @@ TEST(Factory, EveryRegistryEntryRoundTripsThroughItsText) {
         EXPECT_EQ(def.text(), e.name);
         EXPECT_EQ(parse_pc(def.text()), def) << e.name;
         const std::vector<PcKey> keys = e.keys();
-        if (!e.positional_key.empty())
+        if (!e.positional_key.empty()) {
             EXPECT_TRUE(std::any_of(keys.begin(), keys.end(), [&](const PcKey& k) {
                 return k.name == e.positional_key;
             })) << e.name;
+        }
         for (const PcKey& k : keys) {
             EXPECT_NE(usage.find(k.name + "=" + k.placeholder), std::string::npos)
                 << usage << " lacks " << k.name;
@@ -156,7 +157,9 @@ TEST(Factory, MethodNamesReadBack) {
 }
 
 TEST(Factory, RegisteringRefusesAnEntryWithoutParserOrUsage) {
-    PreconditionerEntry e{.name = "toy-without-fields", .summary = "a toy"};
+    PreconditionerEntry e;
+    e.name = "toy-without-fields";
+    e.summary = "a toy";
     e.build = [](const PcOptions&, const LevelData*) -> std::unique_ptr<Preconditioner> {
         return std::make_unique<IdentityPreconditioner>();
     };
