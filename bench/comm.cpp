@@ -166,12 +166,11 @@ int bench_comm(const BenchCommOptions& opt, const Communicator& comm, std::ostre
     const size_t m = dl.size() - 1;
     MLC_CHECK(m >= 1, "bench comm: no distributed level above the partition level");
 
-    const levels::LinearSolverSpec spec{
-        .method = solvers::Method::krylov,
-        .krylov = solvers::Krylov::cgs,
-        .pc = solvers::parse_pc("mg"),
-        .rel_tol = opt.rel_tol,
-        .max_iter = 1000};
+    const levels::LinearSolverSpec spec{.method = solvers::Method::krylov,
+                                        .krylov = solvers::Krylov::cgs,
+                                        .pc = solvers::parse_pc("mg"),
+                                        .rel_tol = opt.rel_tol,
+                                        .max_iter = 1000};
     levels::DistributedMultigrid mg(dl, h->transfers, comm, spec,
                                     levels::distributed_mg_params(spec));
     mg.set_coarse(h->level_p, {});

@@ -441,8 +441,8 @@ int bench_newton(const BenchNewtonOptions& opt, std::ostream& os) {
                          .rel_tol = opt.rel_tol,
                          .max_iter = opt.max_iter};
             levels::SolverWrapper wrap([&](int level, const levels::Level& L,
-                                        std::unique_ptr<levels::NewtonSystemSolver> s)
-                -> std::unique_ptr<levels::NewtonSystemSolver> {
+                                           std::unique_ptr<levels::NewtonSystemSolver> s)
+                                           -> std::unique_ptr<levels::NewtonSystemSolver> {
                 if (level == opt.levels)
                     return std::make_unique<NewtonSystemRecorder>(std::move(s), L, opt, pass,
                                                                   &coarse, into);

@@ -338,11 +338,10 @@ std::string bench_numbering(const BenchSquareOptions& opt) {
     const bool all_default = std::all_of(opt.pcs.begin(), opt.pcs.end(),
                                          [](const std::string& pc) { return pc == "default"; });
     const bool named_lattice =
-        std::any_of(opt.pcs.begin(), opt.pcs.end(),
-                    [](const std::string& pc) {
-                        return pc != "default" && pc != "schur" && pc != "lu" &&
-                               solvers::parse_pc(pc).lattice_numbering();
-                    });
+        std::any_of(opt.pcs.begin(), opt.pcs.end(), [](const std::string& pc) {
+            return pc != "default" && pc != "schur" && pc != "lu" &&
+                   solvers::parse_pc(pc).lattice_numbering();
+        });
     return named_lattice || (all_default && opt.levels >= levels::kMgDefaultLatticeLevel)
                ? "lattice"
                : "hilbert";
@@ -409,8 +408,8 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
             const double rss_before_run = current_rss_bytes();
             double rss_prev = -1;
             levels::SolverWrapper wrap([&](int level, const levels::Level&,
-                                        std::unique_ptr<levels::NewtonSystemSolver> sys)
-                -> std::unique_ptr<levels::NewtonSystemSolver> {
+                                           std::unique_ptr<levels::NewtonSystemSolver> sys)
+                                           -> std::unique_ptr<levels::NewtonSystemSolver> {
                 MLC_CHECK(level >= 0 && level <= opt.levels, "bench square: level " << level);
                 // The first solver handed over: its construction is counted with the
                 // hierarchy (both happen before the first hand-over).

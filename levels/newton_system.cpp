@@ -429,7 +429,8 @@ std::unique_ptr<NewtonSystemSolver> make_newton_system_solver(const Level& level
                                                               const LevelBelow* below) {
     spec.validate();
     if (spec.method == solvers::Method::schur) return make_schur_system_solver(level);
-    if (spec.method == solvers::Method::lu) return make_assembled_system_solver(level, make_sparse_lu_solver());
+    if (spec.method == solvers::Method::lu)
+        return make_assembled_system_solver(level, make_sparse_lu_solver());
     return make_krylov_system_solver(level, spec, below);
 }
 

@@ -133,9 +133,8 @@ SolverPlan plan_distributed(const Problem& problem, const SolverRequest& req, in
     s.method = solvers::Method::krylov;
     // The default (BiCGStab + V(0,2) mg) when no preconditioner is named; a named one keeps
     // the Krylov method it always had there (CGS, BiCGStab with a two-body pair).
-    s.krylov = req.krylov.value_or(req.pc ? (two_body ? solvers::Krylov::bicgstab
-                                                      : solvers::Krylov::cgs)
-                                          : kMgDefaultKrylov);
+    s.krylov = req.krylov.value_or(
+        req.pc ? (two_body ? solvers::Krylov::bicgstab : solvers::Krylov::cgs) : kMgDefaultKrylov);
     s.pc = req.pc.value_or(default_mg(two_body));
     if (req.rel_tol) s.rel_tol = *req.rel_tol;
     const std::string why = s.pc.distributed();
@@ -191,8 +190,8 @@ void plan_by_size(const Problem& problem, const SolverRequest& req,
     LinearSolverSpec& s = c.spec;
     c.automatic = true;
     const bool has_levels = problem.levels >= 1;
-    const double n = known_sizes ? known_sizes->back().unknowns
-                                 : predict_level_sizes(problem).back().unknowns;
+    const double n =
+        known_sizes ? known_sizes->back().unknowns : predict_level_sizes(problem).back().unknowns;
     const double crossover = mg_crossover_unknowns(problem);
     std::ostringstream os;
     os << std::setprecision(3);
@@ -202,12 +201,12 @@ void plan_by_size(const Problem& problem, const SolverRequest& req,
         if (!req.krylov) s.krylov = kMgDefaultKrylov;
         // Levels 4 and finer swept by lattices, numbered for it (not when the request keeps
         // the Hilbert numbering).
-        const bool lattice = problem.levels >= kMgDefaultLatticeLevel &&
-                             req.numbering.value_or(Problem::Numbering::lattice) ==
-                                 Problem::Numbering::lattice;
+        const bool lattice =
+            problem.levels >= kMgDefaultLatticeLevel &&
+            req.numbering.value_or(Problem::Numbering::lattice) == Problem::Numbering::lattice;
         s.pc = default_mg(two_body, lattice);
-        os << "default: " << n << " unknowns on the finest level exceed the crossover "
-           << crossover << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
+        os << "default: " << n << " unknowns on the finest level exceed the crossover " << crossover
+           << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
            << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles" : "")
            << (lattice ? "; levels 4 and finer numbered and swept macro triangle by macro "
                          "triangle, --numbering hilbert for the block sweep)"

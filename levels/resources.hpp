@@ -37,16 +37,16 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem);
 /// Finest-level unknowns above which the default Newton-system solver is Krylov + mg (BiCGStab +
 /// the V(0,2) cycle) rather than the exact `schur`, with rigid obstacles only and with a two-body
 /// pair: where the two take about the same time with OpenBLAS behind CHOLMOD, mg's memory no
-/// larger than schur's wherever it is chosen (docs/solver-guide.md).
+/// larger than schur's wherever it is chosen (docs/solver-guide.md#solver-default).
 inline constexpr double kMgCrossoverOneBody = 2000;
 inline constexpr double kMgCrossoverTwoBody = 10000;
 
 /// The preconditioner the driver takes for `mg` when nobody named one: a V(0,2) cycle (no
 /// pre-smoothing, two backward sweeps after the coarse correction), which needs fewer bytes per
-/// Newton step than V(1,1) for the same or fewer Krylov iterations (docs/solver-guide.md); with
-/// a two-body pair the sweeps are also damped (omega = 0.8), which needs fewer BiCGStab
-/// iterations there; with rigid obstacles only they are not (the square's iterations grow with
-/// omega = 0.8). Their canonical text, as reports print it.
+/// Newton step than V(1,1) for the same or fewer Krylov iterations
+/// (docs/solver-guide.md#solver-why-default); with a two-body pair the sweeps are also damped
+/// (omega = 0.8), which needs fewer BiCGStab iterations there; with rigid obstacles only they are
+/// not (the square's iterations grow with omega = 0.8). Their canonical text, as reports print it.
 inline constexpr const char* kMgDefaultOneBody = "mg:pre=0,post=2";
 inline constexpr const char* kMgDefaultTwoBody = "mg:omega=0.8,pre=0,post=2";
 /// The Krylov method the driver takes with its default mg (the V(0,2) cycle is not symmetric,

@@ -44,9 +44,9 @@ Problem numbered_at_step(const Problem& problem, int step, const LinearSolverSpe
 }
 
 /// The checks before anything is built: the problem and the solver are valid, the levels are
-/// numbered as the solver needs them (a lattice sweep: by macro triangles), and the run's estimated peak memory fits in what the process may
-/// use (throws InvalidInput naming both). Fills the solver, the predicted sizes and the memory
-/// figures of `res`.
+/// numbered as the solver needs them (a lattice sweep: by macro triangles), and the run's estimated
+/// peak memory fits in what the process may use (throws InvalidInput naming both). Fills the
+/// solver, the predicted sizes and the memory figures of `res`.
 void check_before_building(const Problem& problem, const SolveOptions& options, RunResult& res) {
     problem.validate();
     options.linear.validate();
@@ -277,7 +277,8 @@ LoadStepping::LoadStepping(const Problem& problem, const SolveOptions& options,
     // Supports released or taken up between load steps (Support::active) change which components
     // are unknowns: the hierarchy, its solvers and Newton drivers are then rebuilt for the new
     // step's supports (Problem::at_step), and the state carried over through the nodal values.
-    res.hierarchy = build_hierarchy(numbered_at_step(problem, 1, res.solver.spec), options.q_rule, &res.timings);
+    res.hierarchy = build_hierarchy(numbered_at_step(problem, 1, res.solver.spec), options.q_rule,
+                                    &res.timings);
     const auto& levels = res.hierarchy.levels;
     res.warnings = initial_gap_warnings(problem, levels.front());
     n_levels_ = res.hierarchy.n_levels();
@@ -370,8 +371,8 @@ void LoadStepping::change_supports(int step) {
     {
         ScopedTimer t(&res_.timings, "setup/supports_changed");
         try {
-            res_.hierarchy =
-                build_hierarchy(numbered_at_step(problem_, step, res_.solver.spec), options_.q_rule, &res_.timings);
+            res_.hierarchy = build_hierarchy(numbered_at_step(problem_, step, res_.solver.spec),
+                                             options_.q_rule, &res_.timings);
         } catch (const InvalidInput& e) {
             throw InvalidInput("load step " + std::to_string(step) +
                                ", with the supports active from this step on: " + e.what());

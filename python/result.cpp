@@ -13,8 +13,8 @@ namespace {
 // Convergence, the mesh, the solution and the contact state.
 void bind_result_solution(ResultClass& cls) {
     cls.def_property_readonly(
-         "converged", [](const Result& r) { return r.run.converged; },
-         "whether every load step converged on every level")
+           "converged", [](const Result& r) { return r.run.converged; },
+           "whether every load step converged on every level")
         .def_property_readonly(
             "failure", [](const Result& r) { return r.run.failure; },
             "the diagnosis of the step that did not converge (empty when converged)")
@@ -145,17 +145,17 @@ void bind_result_solution(ResultClass& cls) {
 // The contact boundary, resultants, per-step reports, checks, timings and solver.
 void bind_result_reports(ResultClass& cls) {
     cls.def_property_readonly(
-         "boundary_edges",
-         [](const Result& r) {
-             const auto& b = r.run.finest().mesh.boundary;
-             py::array_t<int> a({static_cast<py::ssize_t>(b.size()), py::ssize_t{2}});
-             for (size_t i = 0; i < b.size(); ++i) {
-                 a.mutable_at(i, 0) = b[i].v0;
-                 a.mutable_at(i, 1) = b[i].v1;
-             }
-             return a;
-         },
-         "(e, 2) boundary edges of the finest mesh (a copy)")
+           "boundary_edges",
+           [](const Result& r) {
+               const auto& b = r.run.finest().mesh.boundary;
+               py::array_t<int> a({static_cast<py::ssize_t>(b.size()), py::ssize_t{2}});
+               for (size_t i = 0; i < b.size(); ++i) {
+                   a.mutable_at(i, 0) = b[i].v0;
+                   a.mutable_at(i, 1) = b[i].v1;
+               }
+               return a;
+           },
+           "(e, 2) boundary edges of the finest mesh (a copy)")
         .def_property_readonly(
             "contact_pair_names",
             [](const Result& r) {
@@ -248,42 +248,42 @@ void bind_result_reports(ResultClass& cls) {
 // The state of one step, the closed forms, the report and the files.
 void bind_result_methods(ResultClass& cls) {
     cls.def(
-         "step_state",
-         [](const Result& r, int k) {
-             const auto& st = r.run.step_nodes;
-             // The contact states of every step are always kept, the displacements only with
-             // keep_steps: both must hold step k.
-             if (r.run.step_u_full.size() < st.size() || st.empty())
-                 throw InvalidInput("step_state needs the states of every load step, which "
-                                    "this result did not keep: solve it with "
-                                    "mlcontact.solve(scene, ..., keep_steps=True)");
-             if (k < 1 || k > static_cast<int>(st.size()))
-                 throw InvalidInput("step must lie in [1, " + std::to_string(st.size()) +
-                                    "] (the load steps completed), found " + std::to_string(k));
-             const auto& n = st[static_cast<size_t>(k - 1)];
-             const Vector& u = r.run.step_u_full[static_cast<size_t>(k - 1)];
-             py::array_t<double> x({static_cast<py::ssize_t>(n.size()), py::ssize_t{2}});
-             py::array_t<double> lt(static_cast<py::ssize_t>(n.size())),
-                 ln(static_cast<py::ssize_t>(n.size()));
-             std::vector<contact::Status> s;
-             for (size_t i = 0; i < n.size(); ++i) {
-                 x.mutable_at(i, 0) = n[i].x.x();
-                 x.mutable_at(i, 1) = n[i].x.y();
-                 lt.mutable_at(i) = n[i].lambda_t;
-                 ln.mutable_at(i) = n[i].lambda_n;
-                 s.push_back(n[i].status);
-             }
-             py::array_t<double> ua({u.size() / 2, Index{2}});
-             std::copy(u.data(), u.data() + u.size(), ua.mutable_data());
-             py::dict d;
-             d["contact_x"] = x;
-             d["lambda_t"] = lt;
-             d["lambda_n"] = ln;
-             d["status"] = status_array(s);
-             d["displacement"] = ua;
-             return d;
-         },
-         py::arg("step"), "State after load step k (1-based; copies), with keep_steps=True")
+           "step_state",
+           [](const Result& r, int k) {
+               const auto& st = r.run.step_nodes;
+               // The contact states of every step are always kept, the displacements only with
+               // keep_steps: both must hold step k.
+               if (r.run.step_u_full.size() < st.size() || st.empty())
+                   throw InvalidInput("step_state needs the states of every load step, which "
+                                      "this result did not keep: solve it with "
+                                      "mlcontact.solve(scene, ..., keep_steps=True)");
+               if (k < 1 || k > static_cast<int>(st.size()))
+                   throw InvalidInput("step must lie in [1, " + std::to_string(st.size()) +
+                                      "] (the load steps completed), found " + std::to_string(k));
+               const auto& n = st[static_cast<size_t>(k - 1)];
+               const Vector& u = r.run.step_u_full[static_cast<size_t>(k - 1)];
+               py::array_t<double> x({static_cast<py::ssize_t>(n.size()), py::ssize_t{2}});
+               py::array_t<double> lt(static_cast<py::ssize_t>(n.size())),
+                   ln(static_cast<py::ssize_t>(n.size()));
+               std::vector<contact::Status> s;
+               for (size_t i = 0; i < n.size(); ++i) {
+                   x.mutable_at(i, 0) = n[i].x.x();
+                   x.mutable_at(i, 1) = n[i].x.y();
+                   lt.mutable_at(i) = n[i].lambda_t;
+                   ln.mutable_at(i) = n[i].lambda_n;
+                   s.push_back(n[i].status);
+               }
+               py::array_t<double> ua({u.size() / 2, Index{2}});
+               std::copy(u.data(), u.data() + u.size(), ua.mutable_data());
+               py::dict d;
+               d["contact_x"] = x;
+               d["lambda_t"] = lt;
+               d["lambda_n"] = ln;
+               d["status"] = status_array(s);
+               d["displacement"] = ua;
+               return d;
+           },
+           py::arg("step"), "State after load step k (1-based; copies), with keep_steps=True")
         .def(
             "accuracy",
             [](const Result& r) {

@@ -12,19 +12,19 @@ namespace {
 // Where a scene comes from, copies, and what it is.
 void bind_scene_sources(SceneClass& cls) {
     cls.def_static(
-         "builtin",
-         [](const std::string& name) {
-             const std::string text = scene::builtin_scene_text(name);
-             if (text.empty()) {
-                 std::string list;
-                 for (const auto& n : scene::builtin_scene_names())
-                     list += (list.empty() ? "" : ", ") + n;
-                 throw InvalidInput("no built-in scene named '" + name + "' (built-in: " + list +
-                                    ")");
-             }
-             return std::make_shared<Scene>(Scene{scene::load_scene(name), "builtin:" + name});
-         },
-         py::arg("name"), "A built-in scene (Scene.builtin_names())")
+           "builtin",
+           [](const std::string& name) {
+               const std::string text = scene::builtin_scene_text(name);
+               if (text.empty()) {
+                   std::string list;
+                   for (const auto& n : scene::builtin_scene_names())
+                       list += (list.empty() ? "" : ", ") + n;
+                   throw InvalidInput("no built-in scene named '" + name + "' (built-in: " + list +
+                                      ")");
+               }
+               return std::make_shared<Scene>(Scene{scene::load_scene(name), "builtin:" + name});
+           },
+           py::arg("name"), "A built-in scene (Scene.builtin_names())")
         .def_static(
             "from_file",
             [](const std::string& path) {
@@ -92,16 +92,16 @@ void bind_scene_sources(SceneClass& cls) {
 // The settings of a scene that can be set.
 void bind_scene_settings(SceneClass& cls) {
     cls.def_property(
-         "levels", [](const Scene& s) { return s.problem.levels - s.problem.recovered_levels; },
-         [](Scene& s, int v) {
-             const int k = s.problem.recovered_levels;
-             if (v < 0 || v > 12 - k)
-                 throw InvalidInput("levels: [scene].levels must lie in [0, " +
-                                    std::to_string(12 - k) + "], found " + std::to_string(v));
-             set_checked(s, "levels", [&](levels::Problem& p) { p.levels = k + v; });
-         },
-         "number of 1->4 refinements of the scene's mesh ([scene].levels, 0..12; of the "
-         "file's mesh when its levels were recovered, see recovered_levels)")
+           "levels", [](const Scene& s) { return s.problem.levels - s.problem.recovered_levels; },
+           [](Scene& s, int v) {
+               const int k = s.problem.recovered_levels;
+               if (v < 0 || v > 12 - k)
+                   throw InvalidInput("levels: [scene].levels must lie in [0, " +
+                                      std::to_string(12 - k) + "], found " + std::to_string(v));
+               set_checked(s, "levels", [&](levels::Problem& p) { p.levels = k + v; });
+           },
+           "number of 1->4 refinements of the scene's mesh ([scene].levels, 0..12; of the "
+           "file's mesh when its levels were recovered, see recovered_levels)")
         .def_property(
             "load_steps", [](const Scene& s) { return s.problem.load_steps; },
             [](Scene& s, int v) {
@@ -173,35 +173,35 @@ void bind_scene_settings(SceneClass& cls) {
 // Its supports, tags and materials, and the edits of one pair or body.
 void bind_scene_parts(SceneClass& cls) {
     cls.def_property_readonly(
-         "supports",
-         [](const Scene& s) {
-             py::list out;
-             for (const auto& sp : s.problem.supports) {
-                 py::dict d;
-                 d["tag"] = sp.tag;
-                 d["point"] = sp.point ? py::object(py::make_tuple(sp.point->x(), sp.point->y()))
-                                       : py::object(py::none());
-                 for (int c = 0; c < 2; ++c) {
-                     const auto& full = c == 0 ? sp.ux : sp.uy;
-                     const auto& path = c == 0 ? sp.ux_path : sp.uy_path;
-                     const char* key = c == 0 ? "ux" : "uy";
-                     if (!full)
-                         d[key] = py::none();
-                     else if (path.empty())
-                         d[key] = *full;
-                     else
-                         d[key] = path;
-                 }
-                 py::list active;
-                 for (int k = 1; k <= s.problem.load_steps; ++k)
-                     active.append(s.problem.support_active(sp, k));
-                 d["active"] = active;
-                 out.append(d);
-             }
-             return out;
-         },
-         "the supports (copies): tag or point, ux, uy (a number, a list per path point or "
-         "None) and active, whether it holds in each load step ([[support]].active)")
+           "supports",
+           [](const Scene& s) {
+               py::list out;
+               for (const auto& sp : s.problem.supports) {
+                   py::dict d;
+                   d["tag"] = sp.tag;
+                   d["point"] = sp.point ? py::object(py::make_tuple(sp.point->x(), sp.point->y()))
+                                         : py::object(py::none());
+                   for (int c = 0; c < 2; ++c) {
+                       const auto& full = c == 0 ? sp.ux : sp.uy;
+                       const auto& path = c == 0 ? sp.ux_path : sp.uy_path;
+                       const char* key = c == 0 ? "ux" : "uy";
+                       if (!full)
+                           d[key] = py::none();
+                       else if (path.empty())
+                           d[key] = *full;
+                       else
+                           d[key] = path;
+                   }
+                   py::list active;
+                   for (int k = 1; k <= s.problem.load_steps; ++k)
+                       active.append(s.problem.support_active(sp, k));
+                   d["active"] = active;
+                   out.append(d);
+               }
+               return out;
+           },
+           "the supports (copies): tag or point, ux, uy (a number, a list per path point or "
+           "None) and active, whether it holds in each load step ([[support]].active)")
         .def_property_readonly(
             "mesh_tags",
             [](const Scene& s) {

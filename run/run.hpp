@@ -46,9 +46,9 @@ struct RunOptions {
     bool every_level = false;   ///< also a VTU series + collection per coarser level
     bool plot = false;          ///< draw contact.png (scripts/plot_contact.py)
     bool progress_eta = false;  ///< progress lines with the time left (stdout is a terminal)
-    /// Polled by the solve (levels::SolveObserver::stop_requested); when it is set, the run stops after the
-    /// current Newton iteration, writes the files of the completed steps and returns 128 +
-    /// stop_signal() (run/interrupt.hpp). Null: never stops.
+    /// Polled by the solve (levels::SolveObserver::stop_requested); when it is set, the run stops
+    /// after the current Newton iteration, writes the files of the completed steps and returns 128
+    /// + stop_signal() (run/interrupt.hpp). Null: never stops.
     const std::atomic<bool>* stop = nullptr;
     /// Several processes: the partition level (levels::partition_level when unset). A flag
     /// that cannot take effect on one process: refused there.

@@ -4,9 +4,9 @@
 /// and solution.pvtu (one piece per process), contact.csv and summary.json written once.
 #pragma once
 
-#include "run/run.hpp"
 #include "core/communicator.hpp"
 #include "levels/newton_system.hpp"
+#include "run/run.hpp"
 
 #include <ostream>
 

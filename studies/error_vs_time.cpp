@@ -2,12 +2,12 @@
 // Work-precision study (issue: error against run time).
 #include "studies/error_vs_time.hpp"
 
-#include "run/closed_form.hpp"
-#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 #include "levels/solve.hpp"
+#include "run/closed_form.hpp"
+#include "run/plot_script.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -40,20 +40,23 @@ std::vector<Config> configurations(const levels::Problem& problem) {
     // sweep on levels numbered by lattices: `lattice_from`), `--pc mg` (CGS + V(1,1), an
     // earlier default) and hypre's MGR with `--pc mgr`, to the run's default linear
     // tolerance.
-    const levels::LinearSolverSpec def{
-        .method = solvers::Method::krylov,
-        .krylov = levels::kMgDefaultKrylov,
-        .pc = levels::default_mg(levels::has_two_body_pair(problem)),
-        .rel_tol = 1e-10};
+    const levels::LinearSolverSpec def{.method = solvers::Method::krylov,
+                                       .krylov = levels::kMgDefaultKrylov,
+                                       .pc = levels::default_mg(levels::has_two_body_pair(problem)),
+                                       .rel_tol = 1e-10};
     c.push_back(
         {"c2f default bicgstab+mg", true, def, 1e-10, F::mg, levels::kMgDefaultLatticeLevel});
-    const levels::LinearSolverSpec mg{
-        .method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .rel_tol = 1e-10};
+    const levels::LinearSolverSpec mg{.method = solvers::Method::krylov,
+                                      .krylov = solvers::Krylov::cgs,
+                                      .pc = solvers::parse_pc("mg"),
+                                      .rel_tol = 1e-10};
     c.push_back({"c2f cgs+mg", true, mg, 1e-10, F::mg});
     c.push_back({"cold cgs+mg", false, mg, 1e-10, F::mg});
 #if defined(MLC_HAVE_HYPRE)
-    const levels::LinearSolverSpec mgr{
-        .method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mgr"), .rel_tol = 1e-10};
+    const levels::LinearSolverSpec mgr{.method = solvers::Method::krylov,
+                                       .krylov = solvers::Krylov::cgs,
+                                       .pc = solvers::parse_pc("mgr"),
+                                       .rel_tol = 1e-10};
     c.push_back({"c2f cgs+mgr", true, mgr, 1e-10, F::exact});
 #endif
     c.push_back({"c2f schur", true, {}, 1e-10});
@@ -63,17 +66,26 @@ std::vector<Config> configurations(const levels::Problem& problem) {
     c.push_back({"cold lu", false, {.method = solvers::Method::lu}, 1e-10});
     c.push_back({"c2f gmres+ilu0 1e-8",
                  true,
-                 {.method = solvers::Method::krylov, .krylov = solvers::Krylov::gmres, .pc = solvers::parse_pc("ilu:0"), .rel_tol = 1e-8},
+                 {.method = solvers::Method::krylov,
+                  .krylov = solvers::Krylov::gmres,
+                  .pc = solvers::parse_pc("ilu:0"),
+                  .rel_tol = 1e-8},
                  1e-8,
                  F::ilu});
     c.push_back({"cold gmres+ilu0 1e-8",
                  false,
-                 {.method = solvers::Method::krylov, .krylov = solvers::Krylov::gmres, .pc = solvers::parse_pc("ilu:0"), .rel_tol = 1e-8},
+                 {.method = solvers::Method::krylov,
+                  .krylov = solvers::Krylov::gmres,
+                  .pc = solvers::parse_pc("ilu:0"),
+                  .rel_tol = 1e-8},
                  1e-8,
                  F::ilu});
     c.push_back({"c2f cgs+ilu0 1e-6",
                  true,
-                 {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("ilu:0"), .rel_tol = 1e-6},
+                 {.method = solvers::Method::krylov,
+                  .krylov = solvers::Krylov::cgs,
+                  .pc = solvers::parse_pc("ilu:0"),
+                  .rel_tol = 1e-6},
                  1e-6,
                  F::ilu});
     return c;
@@ -223,9 +235,9 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
     for (const auto& c : configurations(problem)) {
         if (!opt.only.empty() && c.name.find(opt.only) == std::string::npos) continue;
         // mg needs a level below; the lattice sweep (smoother=lattice) levels 4 and finer.
-        const int lo = c.linear.pc.lattice_numbering() ? levels::kMgDefaultLatticeLevel
-                       : c.family == Config::Family::mg         ? 1
-                                                                : 0;
+        const int lo = c.linear.pc.lattice_numbering()  ? levels::kMgDefaultLatticeLevel
+                       : c.family == Config::Family::mg ? 1
+                                                        : 0;
         const int hi = c.family == Config::Family::ilu ? std::min(opt.max_level, opt.ilu_max_level)
                                                        : opt.max_level;
         for (int l = lo; l <= hi; ++l) {

@@ -419,9 +419,9 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
             // level 4 on both with the lattice sweep, on levels numbered for it.
             const bool lattice = opt.levels >= levels::kMgDefaultLatticeLevel;
             for (const bool two_body : {false, true})
-                solvers.push_back(levels::plan_solver(
-                    sq, {.krylov = levels::kMgDefaultKrylov,
-                         .pc = levels::default_mg(two_body, lattice)}));
+                solvers.push_back(
+                    levels::plan_solver(sq, {.krylov = levels::kMgDefaultKrylov,
+                                             .pc = levels::default_mg(two_body, lattice)}));
         }
     }
     os << "stability study: square-based cases on levels 0.." << opt.levels << " (coarse-to-fine), "

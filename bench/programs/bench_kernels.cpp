@@ -249,7 +249,10 @@ int main(int argc, char** argv) {
     pr.load_steps = 1;
     if (lattice_numbering) pr.numbering = levels::Problem::Numbering::lattice;
     levels::SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::bicgstab, .pc = solvers::parse_pc(pc), .rel_tol = 1e-8};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::bicgstab,
+                 .pc = solvers::parse_pc(pc),
+                 .rel_tol = 1e-8};
     std::map<std::string, Stat> out;
     Index n = 0;
     levels::SolverWrapper wrap(

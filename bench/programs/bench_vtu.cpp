@@ -4,11 +4,11 @@
 // Solves the scene once on the given level (the run's default solver), then writes the final
 // state's solution.vtu REPEAT times in each format, alternating, and prints one JSON object:
 // sizes in bytes, write times in seconds (median and all), and the ratios.
-#include "run/output.hpp"
 #include "core/check.hpp"
 #include "core/memory.hpp"
 #include "core/timer.hpp"
 #include "levels/solve.hpp"
+#include "run/output.hpp"
 #include "scene/scene.hpp"
 
 #include <algorithm>

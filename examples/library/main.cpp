@@ -2,10 +2,10 @@
 // Solves a scene with the installed mlcontact library, as `mlcontact run SCENE --levels L` does,
 // and prints the resultant contact force of every contact pair.
 //   contact_resultant [SCENE [LEVELS]]     (default: square, the scene's levels)
-#include <mlcontact/run/run.hpp>
 #include <mlcontact/core/check.hpp>
 #include <mlcontact/levels/checks.hpp>
 #include <mlcontact/levels/solve.hpp>
+#include <mlcontact/run/run.hpp>
 #include <mlcontact/scene/scene.hpp>
 
 #include <cstdio>

@@ -2,11 +2,11 @@
 // `study error-vs-time`: the multilevel rows exist (coarse-to-fine and cold
 // mg from level 1, mgr where hypre is built in), converge, and their error against the level-3
 // reference falls with the level; the other configurations are left out by --only.
-#include "studies/error_vs_time.hpp"
 #include "core/check.hpp"
 #include "levels/resources.hpp"
 #include "scene/scene.hpp"
 #include "solvers/hypre/boomeramg.hpp"
+#include "studies/error_vs_time.hpp"
 
 #include <gtest/gtest.h>
 

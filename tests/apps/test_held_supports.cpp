@@ -3,10 +3,10 @@
 // the matching multiplier is pinned to zero on every level, the Newton systems stay regular, and
 // the assembled LU, the multigrid without fallback and the cold start give one answer; a scene
 // whose support and contact frame share a direction only in part is refused.
-#include "run/run.hpp"
 #include "core/check.hpp"
 #include "levels/checks.hpp"
 #include "levels/solve.hpp"
+#include "run/run.hpp"
 #include "scene/scene.hpp"
 #include "tests/common/scene_text.hpp"
 

@@ -8,9 +8,9 @@
 // "# expect: not converged: text" (the run fails, exit 2, and its diagnosis contains the text) or
 // "# expect: solves: text" (the run converges and its report contains the text: a warning or a
 // check said not applicable); they are solved as `mlcontact run` solves them.
+#include "core/check.hpp"
 #include "run/output.hpp"
 #include "run/run.hpp"
-#include "core/check.hpp"
 #include "scene/scene.hpp"
 
 #include <gtest/gtest.h>

@@ -24,7 +24,9 @@ TEST(MGRRun, SquareLevel2GivesTheSchurAnswer) {
     levels::SolveOptions exact;
     exact.linear.method = solvers::Method::schur;
     levels::SolveOptions mgr;
-    mgr.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mgr")};
+    mgr.linear = {.method = solvers::Method::krylov,
+                  .krylov = solvers::Krylov::cgs,
+                  .pc = solvers::parse_pc("mgr")};
     const auto a = levels::solve(p, exact);
     const auto b = levels::solve(p, mgr);
     ASSERT_TRUE(a.converged) << a.failure;
@@ -55,7 +57,10 @@ TEST(BenchNewton, OneRecordPerNewtonSystemWithFiniteValues) {
     auto p = scene::load_scene("square");
     p.levels = 1;
     levels::SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .rel_tol = 1e-8};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc("mg"),
+                 .rel_tol = 1e-8};
     const auto r = levels::solve(p, so);
     ASSERT_TRUE(r.converged) << r.failure;
     int systems = 0;

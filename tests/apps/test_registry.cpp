@@ -2,13 +2,13 @@
 // The preconditioner registry is the one list of names: the CLI help, `mlcontact
 // preconditioners`, the study's and the bench's lists and the driver's choice all agree with it.
 #include "bench/bench.hpp"
-#include "run/preconditioners.hpp"
-#include "studies/preconditioners.hpp"
 #include "core/check.hpp"
 #include "levels/resources.hpp"
+#include "run/preconditioners.hpp"
 #include "scene/scene.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/hypre/boomeramg.hpp"
+#include "studies/preconditioners.hpp"
 
 #include <gtest/gtest.h>
 

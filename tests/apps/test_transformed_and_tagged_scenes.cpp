@@ -2,13 +2,13 @@
 // Scenes a researcher can write: transformed meshes, tags on interior and mirror
 // lines, arcs on Gmsh meshes, supports with per-step activity, and the built-in scenes that use
 // them (hertz_gmsh, axis_release, incline), each against its closed form or an identity.
-#include "run/closed_form.hpp"
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 #include "levels/checks.hpp"
 #include "levels/solve.hpp"
 #include "mesh/io/gmsh.hpp"
 #include "mesh/transform.hpp"
+#include "run/closed_form.hpp"
 #include "scene/scene.hpp"
 #include "tests/common/scene_text.hpp"
 

@@ -64,7 +64,10 @@ expect_same_answer(const std::string& scene, int levels, int p, const std::strin
     prob.numbering = numbering;
     prob.newton.rel_tol = 1e-12;
     levels::SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = 1e-12};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::parse_krylov(krylov),
+                 .pc = solvers::parse_pc(pc),
+                 .rel_tol = 1e-12};
     const levels::RunResult one = levels::solve(prob, so);
     levels::DistributedRunResult d = levels::solve_distributed(prob, so, comm, p);
     EXPECT_TRUE(one.converged) << one.failure;
@@ -261,11 +264,14 @@ TEST(DistributedSolve, RefusesWhatHasNoDistributedForm) {
     levels::SolveOptions so;
     so.linear.method = solvers::Method::schur;
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg:coarse=galerkin")};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc("mg:coarse=galerkin")};
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
     so.linear.pc = solvers::parse_pc("mg:coarse=aggregation");
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
-    so.linear.pc = solvers::parse_pc("mg:smoother=lattice,precision=single"); // not on one process either
+    so.linear.pc =
+        solvers::parse_pc("mg:smoother=lattice,precision=single"); // not on one process either
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);
     so.linear.pc = solvers::parse_pc("sorcf");
     EXPECT_THROW(levels::solve_distributed(prob, so, comm, 1), InvalidInput);

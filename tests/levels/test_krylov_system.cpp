@@ -42,8 +42,9 @@ struct TwoLevels {
         transfer =
             transfer::build_transfer(fine.mesh, coarse.dofs, fine.dofs,
                                      levels::contact_nodes(coarse), levels::contact_nodes(fine));
-        ContactNewton newton_c(coarse, problem.newton,
-                               make_newton_system_solver(coarse, {.method = solvers::Method::schur}));
+        ContactNewton newton_c(
+            coarse, problem.newton,
+            make_newton_system_solver(coarse, {.method = solvers::Method::schur}));
         Vector x = Vector::Zero(coarse.n_unknowns());
         Vector u_prev = Vector::Zero(2 * coarse.mesh.n_vertices()), u_full;
         const int N = problem.load_steps;
@@ -96,7 +97,10 @@ struct Outcome {
 Outcome solve_with(const std::string& krylov, const std::string& pc, double rel_tol = 1e-9) {
     TwoLevels& t = two_levels();
     const LevelBelow below = t.below();
-    LinearSolverSpec spec{.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = rel_tol};
+    LinearSolverSpec spec{.method = solvers::Method::krylov,
+                          .krylov = solvers::parse_krylov(krylov),
+                          .pc = solvers::parse_pc(pc),
+                          .rel_tol = rel_tol};
     auto solver = make_newton_system_solver(t.fine, spec, &below);
     solver->set_coarse_statuses(t.coarse_M);
     Outcome o;
@@ -274,16 +278,21 @@ TEST(KrylovSystem, LevelAwarePreconditionersCheckTheirInput) {
             << e.what();
     }
     const LevelBelow empty;
-    EXPECT_THROW(make_newton_system_solver(t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("sorcf")}, &empty),
-                 InvalidInput);
+    EXPECT_THROW(
+        make_newton_system_solver(
+            t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("sorcf")}, &empty),
+        InvalidInput);
     const LevelBelow ctx = t.below();
     for (const std::string pc : {"cf:inner=ilu", "cf:scale=half", "cf:coarse=amg", "cf:omega=1",
                                  "sorcf:block=2", "sorcf:omega=2", "ebe:variant=c2", "ebe:omega=1"})
-        EXPECT_THROW(make_newton_system_solver(t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc(pc)}, &ctx),
-                     InvalidInput)
+        EXPECT_THROW(
+            make_newton_system_solver(
+                t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc(pc)}, &ctx),
+            InvalidInput)
             << pc;
     // EBE needs no coarse level.
-    EXPECT_NO_THROW(make_newton_system_solver(t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("ebe")}, nullptr));
+    EXPECT_NO_THROW(make_newton_system_solver(
+        t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("ebe")}, nullptr));
 }
 
 TEST(KrylovSystem, TheCoarseStatusesArePassedByTheDriver) {
@@ -292,7 +301,8 @@ TEST(KrylovSystem, TheCoarseStatusesArePassedByTheDriver) {
     TwoLevels& t = two_levels();
     const LevelBelow below = t.below();
     auto solver = make_newton_system_solver(
-        t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("cf"), .rel_tol = 1e-9}, &below);
+        t.fine, {.method = solvers::Method::krylov, .pc = solvers::parse_pc("cf"), .rel_tol = 1e-9},
+        &below);
     Vector dx;
     EXPECT_THROW(solver->solve(t.fine_M, t.b, dx), InvalidInput);
     EXPECT_THROW(solver->set_coarse_statuses({Eigen::Matrix2d::Identity()}), InvalidInput);

@@ -42,13 +42,21 @@ RunResult run_square(int levels, const std::string& krylov, const std::string& p
     p.levels = levels;
     if (load_steps > 0) p.load_steps = load_steps;
     SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = 1e-8, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::parse_krylov(krylov),
+                 .pc = solvers::parse_pc(pc),
+                 .rel_tol = 1e-8,
+                 .max_iter = 200};
     return solve(p, so);
 }
 
 RunResult run_square_problem(const Problem& p) {
     SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .rel_tol = 1e-8, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc("mg"),
+                 .rel_tol = 1e-8,
+                 .max_iter = 200};
     return solve(p, so);
 }
 
@@ -99,7 +107,9 @@ TEST(MultilevelPreconditioner, NeedsTheLevelBelowAndValidOptions) {
     SolveOptions so;
     // On a single level mg builds its aggregation hierarchy; the geometric coarse operators
     // need the level below.
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg:coarse=galerkin")};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc("mg:coarse=galerkin")};
     EXPECT_THROW(solve(p, so), InvalidInput);
     so.linear.pc = solvers::parse_pc("mg:coarse=rediscretize");
     EXPECT_THROW(solve(p, so), InvalidInput);
@@ -108,8 +118,8 @@ TEST(MultilevelPreconditioner, NeedsTheLevelBelowAndValidOptions) {
     p.levels = 1;
     so.linear.pc = solvers::parse_pc("mg:pre=0,post=0");
     EXPECT_THROW(solve(p, so), InvalidInput);
-    so.linear.pc = solvers::parse_pc("mg:sweeps=2");
-    EXPECT_THROW(solve(p, so), InvalidInput);
+    // Refused where the spec is read, before anything is built.
+    EXPECT_THROW((void)solvers::parse_pc("mg:sweeps=2"), InvalidInput);
 }
 
 TEST(InexactNewton, ForcingTermsSaveKrylovIterationsAndGiveTheSameSolution) {
@@ -164,8 +174,8 @@ TEST(MultilevelPreconditioner, GalerkinCoarseOperatorsConvergeLikeRediscretizati
     EXPECT_LT((gal.x - ref.x).norm(), 1e-8 * ref.x.norm());
     for (int m : max_iterations(gal))
         EXPECT_LE(m, 12);
-    so.linear.pc = solvers::parse_pc("mg:coarse=algebraic");
-    EXPECT_THROW(solve(p, so), InvalidInput);
+    // Refused where the spec is read, before anything is built.
+    EXPECT_THROW((void)solvers::parse_pc("mg:coarse=algebraic"), InvalidInput);
 }
 
 TEST(MultilevelPreconditioner, StiffContactBlocksOfLargeRAreSmoothed_Slow) {
@@ -201,7 +211,10 @@ TEST(MultilevelPreconditioner, TheExactFallbackSolvesWhatTheMultigridCannot) {
     const RunResult ref = solve(p, exact);
     ASSERT_TRUE(ref.converged) << ref.failure;
     SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg"), .max_iter = 100};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc("mg"),
+                 .max_iter = 100};
     const RunResult fails = solve(p, so);
     EXPECT_FALSE(fails.converged);
     EXPECT_NE(fails.failure.find("linear solve failed"), std::string::npos) << fails.failure;
@@ -219,7 +232,9 @@ TEST(MultilevelPreconditioner, TheExactFallbackSolvesWhatTheMultigridCannot) {
     auto q = scene::load_scene("square");
     q.levels = 2;
     SolveOptions plain;
-    plain.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg")};
+    plain.linear = {.method = solvers::Method::krylov,
+                    .krylov = solvers::Krylov::cgs,
+                    .pc = solvers::parse_pc("mg")};
     SolveOptions with = plain;
     with.exact_fallback = true;
     const RunResult a = solve(q, plain), b = solve(q, with);
@@ -301,7 +316,11 @@ void expect_algebraic_mg_solves_like_schur(const Problem& p, const RunResult& re
     ASSERT_EQ(p.levels, 0);
     ASSERT_TRUE(ref.converged);
     SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::parse_krylov(krylov), .pc = solvers::parse_pc(pc), .rel_tol = 1e-10, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::parse_krylov(krylov),
+                 .pc = solvers::parse_pc(pc),
+                 .rel_tol = 1e-10,
+                 .max_iter = 200};
     const RunResult r = solve(p, so);
     ASSERT_TRUE(r.converged) << r.failure;
     int worst = 0;

@@ -26,8 +26,11 @@ RunResult run(const std::string& scene, int levels, const std::string& pc, int l
     if (load_steps > 0) p.load_steps = load_steps;
     p.numbering = Problem::Numbering::lattice;
     SolveOptions so;
-    so.linear = {
-        .method = solvers::Method::krylov, .krylov = solvers::Krylov::bicgstab, .pc = solvers::parse_pc(pc), .rel_tol = 1e-8, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::bicgstab,
+                 .pc = solvers::parse_pc(pc),
+                 .rel_tol = 1e-8,
+                 .max_iter = 200};
     return solve(p, so);
 }
 

@@ -26,7 +26,11 @@ Run run(const std::string& scene, int levels, const std::string& pc) {
     auto p = scene::load_scene(scene);
     p.levels = levels;
     SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc(pc), .rel_tol = 1e-8, .max_iter = 200};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc(pc),
+                 .rel_tol = 1e-8,
+                 .max_iter = 200};
     const traffic::Account a0 = traffic::snapshot();
     Run r{solve(p, so), {}};
     r.bytes = traffic::snapshot() - a0;

@@ -83,7 +83,9 @@ TEST(RContinuation, CoarseToFineWithTheMultigridAtHugeR) {
     // and leaves the Krylov solves of level 1 at the scene's r.
     const Problem p = square_with_r(1e5, 1);
     SolveOptions so;
-    so.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg")};
+    so.linear = {.method = solvers::Method::krylov,
+                 .krylov = solvers::Krylov::cgs,
+                 .pc = solvers::parse_pc("mg")};
     so.exact_fallback = true;
     so.r_continuation = true;
     const RunResult r = solve(p, so);
@@ -106,7 +108,9 @@ TEST(RContinuation, ChangesNothingWhereNewtonConverges) {
     auto p = scene::load_scene("square");
     p.levels = 2;
     SolveOptions plain;
-    plain.linear = {.method = solvers::Method::krylov, .krylov = solvers::Krylov::cgs, .pc = solvers::parse_pc("mg")};
+    plain.linear = {.method = solvers::Method::krylov,
+                    .krylov = solvers::Krylov::cgs,
+                    .pc = solvers::parse_pc("mg")};
     SolveOptions with = plain;
     with.r_continuation = true;
     const RunResult a = solve(p, plain), b = solve(p, with);

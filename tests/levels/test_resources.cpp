@@ -99,8 +99,9 @@ TEST(ChooseSolver, LinearKrylovUsesTheDefaultMgOnEveryMesh) {
     EXPECT_NE(one.reason.find("aggregation hierarchy"), std::string::npos) << one.reason;
     auto dt = scene::load_scene("dovetail");
     dt.levels = 0;
-    EXPECT_EQ(levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.pc.text(),
-              "mg:omega=0.8,pre=0,post=2");
+    EXPECT_EQ(
+        levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.pc.text(),
+        "mg:omega=0.8,pre=0,post=2");
 }
 
 TEST(ChooseSolver, AKrylovOptionBesideADirectSolverIsAnError) {
@@ -141,9 +142,9 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
                 EXPECT_EQ(c.spec.method, solvers::Method::krylov);
                 // From level 4 on with the lattice sweep (the test below).
                 EXPECT_EQ(c.spec.pc.text(), std::string(crossover == levels::kMgCrossoverTwoBody
-                                                     ? "mg:omega=0.8,pre=0,post=2"
-                                                     : "mg:pre=0,post=2") +
-                                         (L >= 4 ? ",smoother=lattice" : ""));
+                                                            ? "mg:omega=0.8,pre=0,post=2"
+                                                            : "mg:pre=0,post=2") +
+                                                (L >= 4 ? ",smoother=lattice" : ""));
                 EXPECT_EQ(c.lattice_numbering(), L >= 4);
                 EXPECT_EQ(c.spec.krylov, solvers::Krylov::bicgstab);
             } else {
@@ -188,13 +189,16 @@ TEST(ChooseSolver, TheDefaultPicksBySizeAtTheCrossover) {
     EXPECT_EQ(levels::plan_solver(dt, {}).spec.krylov, solvers::Krylov::bicgstab);
     EXPECT_NE(levels::plan_solver(dt, {}).reason.find("BiCGStab + mg:omega=0.8,pre=0,post=2"),
               std::string::npos);
-    EXPECT_EQ(levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.pc.text(),
-              "mg:omega=0.8,pre=0,post=2");
+    EXPECT_EQ(
+        levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.pc.text(),
+        "mg:omega=0.8,pre=0,post=2");
     EXPECT_EQ(levels::plan_solver(dt, request(std::string("krylov"), {}, {}, {}, {})).spec.krylov,
               solvers::Krylov::bicgstab);
     // A named preconditioner is taken as given, with CGS unless a method is named.
-    EXPECT_EQ(levels::plan_solver(dt, request({}, {}, std::string("mg"), {}, {})).spec.pc.text(), "mg");
-    EXPECT_EQ(levels::plan_solver(dt, request({}, {}, std::string("mg"), {}, {})).spec.krylov, solvers::Krylov::cgs);
+    EXPECT_EQ(levels::plan_solver(dt, request({}, {}, std::string("mg"), {}, {})).spec.pc.text(),
+              "mg");
+    EXPECT_EQ(levels::plan_solver(dt, request({}, {}, std::string("mg"), {}, {})).spec.krylov,
+              solvers::Krylov::cgs);
     sq.levels = 3;
     EXPECT_EQ(levels::plan_solver(sq, {}).spec.krylov, solvers::Krylov::bicgstab);
     EXPECT_NE(levels::plan_solver(sq, {}).reason.find("BiCGStab + mg:pre=0,post=2"),
@@ -340,7 +344,8 @@ TEST(ChooseSolver, TheDefaultSweepsByLatticesFromLevel4UnlessNumberingHilbertIsA
     EXPECT_TRUE(h.automatic);
     EXPECT_FALSE(h.lattice_numbering());
     EXPECT_EQ(h.spec.pc.text(), "mg:pre=0,post=2");
-    const auto named = levels::plan_solver(p, request({}, {}, std::string("mg:pre=0,post=2"), {}, {}));
+    const auto named =
+        levels::plan_solver(p, request({}, {}, std::string("mg:pre=0,post=2"), {}, {}));
     EXPECT_FALSE(named.lattice_numbering());
     const auto krylov = levels::plan_solver(p, request(std::string("krylov"), {}, {}, {}, {}));
     EXPECT_FALSE(krylov.lattice_numbering());

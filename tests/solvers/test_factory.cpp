@@ -132,19 +132,21 @@ TEST(Factory, CapabilitiesAreDeclaredOnTheEntry) {
     EXPECT_TRUE(parse_pc("mg:smoother=lattice").lattice_numbering());
     EXPECT_FALSE(parse_pc("mg").lattice_numbering());
     EXPECT_FALSE(parse_pc("ilu").lattice_numbering());
-    // On several processes: mg's rediscretized V-cycle with any sweeps, the matrix-alone
-    // preconditioners and ebe; not the coarse/fine ones, mgr, or mg's other options.
-    for (const char* ok : {"mg", "mg:omega=0.8,pre=0,post=2", "mg:coarse=rediscretize", "ilu:1",
-                           "diag", "sor", "ebe", "none"})
+    // On several processes: mg's rediscretized V-cycle with block or lattice sweeps in double or
+    // single precision, the matrix-alone preconditioners and ebe; not the coarse/fine ones, mgr,
+    // mg's algebraic hierarchy, or lattice sweeps in single precision.
+    for (const char* ok :
+         {"mg", "mg:omega=0.8,pre=0,post=2", "mg:coarse=rediscretize", "ilu:1", "diag", "sor",
+          "ebe", "none", "mg:precision=single", "mg:smoother=lattice"})
         EXPECT_EQ(parse_pc(ok).distributed(), "") << ok;
-    for (const char* no : {"cf", "sorcf", "mgr", "mg:coarse=galerkin", "mg:precision=single",
-                           "mg:smoother=lattice", "mg:csize=100"})
+    for (const char* no : {"cf", "sorcf", "mgr", "mg:coarse=galerkin", "mg:csize=100",
+                           "mg:smoother=lattice,precision=single"})
         EXPECT_NE(parse_pc(no).distributed(), "") << no;
     EXPECT_NE(parse_pc("sorcf").distributed().find("'sorcf' has no distributed form"),
               std::string::npos);
-    EXPECT_NE(parse_pc("mg:precision=single")
+    EXPECT_NE(parse_pc("mg:coarse=galerkin")
                   .distributed()
-                  .find("mg:precision=single has no distributed form"),
+                  .find("mg:coarse=galerkin has no distributed form"),
               std::string::npos);
 }
 

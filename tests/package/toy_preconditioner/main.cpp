@@ -37,7 +37,7 @@ private:
 #define REQUIRE(cond)                                                                              \
     do {                                                                                           \
         if (!(cond)) {                                                                             \
-            std::fprintf(stderr, "toy: failed: %s (line %d)\n", #cond, __LINE__);                 \
+            std::fprintf(stderr, "toy: failed: %s (line %d)\n", #cond, __LINE__);                  \
             return 1;                                                                              \
         }                                                                                          \
     } while (0)
@@ -77,8 +77,8 @@ int main() {
         try {
             (void)levels::plan_solver(p, {.pc = spec}, 2);
         } catch (const InvalidInput& e) {
-            refused = std::string(e.what()).find("'toy' has no distributed form") !=
-                      std::string::npos;
+            refused =
+                std::string(e.what()).find("'toy' has no distributed form") != std::string::npos;
         }
         REQUIRE(refused);
 
