@@ -26,6 +26,8 @@
 /// All print a table and write JSON.
 #pragma once
 
+#include "levels/resources.hpp"
+
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -60,16 +62,17 @@ struct BenchSquareOptions {
     int stream_repeats = 5;
 };
 
-/// The Krylov method and preconditioner spec `bench square` runs for the entry `pc` of
-/// opt.pcs on a problem with (`two_body`) or without a two-body pair: "default" is the run's
-/// default above the crossover (with the lattice sweep, levels::kMgDefaultLatticeOption, when
-/// `lattice`: the levels numbered by lattices and the finest at least
-/// levels::kMgDefaultLatticeLevel), anything else `pc` itself with opt.krylov (CGS if unset).
-struct BenchSolver {
-    std::string krylov, pc;
-};
-BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
-                         bool lattice = false);
+/// The solver `bench square` runs for the entry `pc` of opt.pcs ("default", "schur", "lu" or a
+/// preconditioner spec), planned by levels::plan_solver for `problem` (whose numbering is the
+/// bench's, bench_numbering) on `processes`: "default" is the run's Krylov default (BiCGStab +
+/// the V(0,2) mg, damped with a two-body pair, the lattice sweep from
+/// levels::kMgDefaultLatticeLevel on levels numbered by lattices) whatever the size; a spec
+/// runs with opt.krylov (CGS if unset); opt.rel_tol and opt.max_iter bound each Krylov solve.
+levels::SolverPlan bench_plan(const BenchSquareOptions& opt, const std::string& pc,
+                              const levels::Problem& problem, int processes = 1);
+
+/// "krylov + pc" of a plan (the method name for schur and lu), for tables and JSON.
+std::string bench_label(const levels::SolverPlan& plan);
 
 /// The numbering of a single-process `bench square`: opt.numbering if set, else "lattice" when
 /// every solver is the default one and the finest level is at least

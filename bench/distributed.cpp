@@ -37,33 +37,24 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 8,
               "bench square: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench square: --repeat must be >= 1, found " << opt.repeat);
-    MLC_CHECK(opt.pcs.size() == 1 &&
-                  (opt.pcs.front() == "default" || opt.pcs.front().rfind("mg", 0) == 0),
-              "bench square on several processes runs mg alone (--pc default or "
-              "mg[:options]); the other preconditioners have no distributed form");
-    MLC_CHECK(!opt.numbering || *opt.numbering == "hilbert",
-              "bench square on several processes numbers each process's unknowns along a Hilbert "
-              "curve; the lattice numbering has no distributed form (drop --numbering "
-                  << *opt.numbering << ")");
+    MLC_CHECK(opt.pcs.size() == 1,
+              "bench square on several processes runs one solver at a time (--pc default or "
+              "one preconditioner with a distributed form), found " << opt.pcs.size());
     levels::Problem p = scene::load_scene(opt.scene);
     p.levels = opt.levels;
     p.validate();
-    const BenchSolver solver = bench_solver(opt, opt.pcs.front(), levels::has_two_body_pair(p));
-    if (solvers::parse_pc(solver.pc).lattice_numbering())
-        p.numbering = levels::Problem::Numbering::lattice; // each part numbered by lattices
+    // The plan numbers the levels (by lattices for a lattice sweep, else along a Hilbert curve).
+    const levels::SolverPlan plan = bench_plan(opt, opt.pcs.front(), p, comm.size());
+    p.numbering = plan.numbering();
     parallel::set_num_threads(1);
     const int np = comm.size();
     const int plevel = levels::partition_level(p.mesh0.n_triangles(), p.levels, np);
     levels::SolveOptions so;
     so.coarse_to_fine = true;
-    so.linear = {.method = solvers::Method::krylov,
-                 .krylov = solvers::parse_krylov(solver.krylov),
-                 .pc = solvers::parse_pc(solver.pc),
-                 .rel_tol = opt.rel_tol,
-                 .max_iter = opt.max_iter};
+    so.linear = plan.spec;
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
        << p.load_steps << " load steps, " << np << " processes (one thread each), partition level "
-       << plevel << ", Krylov " << solver.krylov << " + distributed " << solver.pc << " rel_tol "
+       << plevel << ", Krylov " << plan.spec.krylov << " + distributed " << plan.spec.pc << " rel_tol "
        << opt.rel_tol << ", times are medians of " << opt.repeat << " run(s)\n";
     std::vector<double> walls;
     levels::DistributedRunResult last;
@@ -144,7 +135,7 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
             js << std::setprecision(9) << "{\n  \"scene\": \"" << opt.scene
                << "\",\n  \"levels\": " << opt.levels << ",\n  \"processes\": " << np
                << ",\n  \"threads_per_process\": 1,\n  \"partition_level\": " << plevel
-               << ",\n  \"krylov\": \"" << solver.krylov << "\",\n  \"pc\": \"" << solver.pc
+               << ",\n  \"krylov\": \"" << plan.spec.krylov << "\",\n  \"pc\": \"" << plan.spec.pc
                << "\",\n  \"rel_tol\": " << opt.rel_tol << ",\n  \"repeat\": " << opt.repeat
                << ",\n  \"wall_seconds\": " << wall << ",\n  \"wall_seconds_runs\": [";
             for (size_t i = 0; i < walls.size(); ++i)

@@ -148,7 +148,7 @@ double matrix_seconds(const traffic::Account& a) {
 /// The JSON file's head and the table's header; `def`: the default solver when one is benched.
 void print_square_header(std::ostream& os, std::ostream& js, const BenchSquareOptions& opt,
                          int load_steps, const std::string& krylov_label,
-                         const std::string& numbering, const BenchSolver* def) {
+                         const std::string& numbering, const levels::SolverPlan* def) {
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"levels\": " << opt.levels
        << ",\n  \"krylov\": " << json_string(krylov_label) << ",\n  \"rel_tol\": " << opt.rel_tol
        << ",\n  \"repeat\": " << opt.repeat << ",\n  \"numbering\": " << json_string(numbering)
@@ -157,7 +157,7 @@ void print_square_header(std::ostream& os, std::ostream& js, const BenchSquareOp
        << load_steps << " load steps, Krylov " << krylov_label << " rel_tol " << opt.rel_tol
        << ", times are medians of " << opt.repeat << " run(s)\n";
     if (def)
-        os << "default = " << def->krylov << " + " << def->pc
+        os << "default = " << bench_label(*def)
            << " (the run's default above the crossover)\n";
     os << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
        << std::setw(11) << "nonzeros" << std::setw(7) << "newton" << std::setw(10) << "its/newt"
@@ -325,12 +325,34 @@ void print_square_tables(std::ostream& os, const std::string& bw_table,
 
 } // namespace
 
-BenchSolver bench_solver(const BenchSquareOptions& opt, const std::string& pc, bool two_body,
-                         bool lattice) {
-    if (pc != "default") return {opt.krylov.value_or("cgs"), pc};
-    return {opt.krylov.value_or(std::string(solvers::to_string(levels::kMgDefaultKrylov))),
-            levels::default_mg(two_body, lattice && opt.levels >= levels::kMgDefaultLatticeLevel)
-                .text()};
+levels::SolverPlan bench_plan(const BenchSquareOptions& opt, const std::string& pc,
+                              const levels::Problem& problem, int processes) {
+    levels::SolverRequest req;
+    if (pc == "schur" || pc == "lu") {
+        req.linear = solvers::parse_method(pc);
+        return levels::plan_solver(problem, req, processes);
+    }
+    if (opt.krylov) req.krylov = solvers::parse_krylov(*opt.krylov);
+    req.rel_tol = opt.rel_tol;
+    if (processes == 1)
+        req.numbering = problem.numbering;
+    else if (opt.numbering)
+        req.numbering = levels::parse_numbering(*opt.numbering, "bench square: --numbering");
+    levels::SolverPlan plan;
+    if (pc == "default") {
+        plan = levels::plan_default_mg(problem, req, processes);
+    } else {
+        req.pc = solvers::parse_pc(pc);
+        plan = levels::plan_solver(problem, req, processes);
+    }
+    plan.spec.max_iter = opt.max_iter;
+    return plan;
+}
+
+std::string bench_label(const levels::SolverPlan& plan) {
+    const levels::LinearSolverSpec& s = plan.spec;
+    if (s.method != solvers::Method::krylov) return std::string(solvers::to_string(s.method));
+    return std::string(solvers::to_string(s.krylov)) + " + " + s.pc.text();
 }
 
 std::string bench_numbering(const BenchSquareOptions& opt) {
@@ -360,13 +382,12 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
     base.levels = opt.levels;
     const std::string numbering = bench_numbering(opt);
     base.numbering = levels::parse_numbering(numbering, "bench square: --numbering");
-    const bool lattice = base.numbering == levels::Problem::Numbering::lattice;
-    const bool two_body = levels::has_two_body_pair(base);
-    const BenchSolver def = bench_solver(opt, "default", two_body, lattice);
+    const levels::SolverPlan def = bench_plan(opt, "default", base);
+    const std::string def_krylov(solvers::to_string(def.spec.krylov));
     const std::string named_krylov = opt.krylov.value_or("cgs");
     std::string krylov_label = named_krylov;
     if (named.size() != opt.pcs.size())
-        krylov_label = named.empty() ? def.krylov : named_krylov + " (default: " + def.krylov + ")";
+        krylov_label = named.empty() ? def_krylov : named_krylov + " (default: " + def_krylov + ")";
     const std::filesystem::path out = bench_json_path(opt.out, "", opt.scene, opt.levels);
     AtomicOfstream js = open_json(out);
     print_square_header(os, js, opt, base.load_steps, krylov_label, numbering,
@@ -386,15 +407,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
         levels::SolveOptions so;
         so.coarse_to_fine = true;
         so.extrapolate = opt.extrapolate;
-        const BenchSolver solver = bench_solver(opt, pc, two_body, lattice);
-        if (pc == "schur" || pc == "lu")
-            so.linear.method = solvers::parse_method(pc);
-        else
-            so.linear = {.method = solvers::Method::krylov,
-                         .krylov = solvers::parse_krylov(solver.krylov),
-                         .pc = solvers::parse_pc(solver.pc),
-                         .rel_tol = opt.rel_tol,
-                         .max_iter = opt.max_iter};
+        so.linear = bench_plan(opt, pc, base).spec;
         std::vector<SquareRow> rows;
         std::vector<double> walls;
         double estimate_mib = 0;

@@ -135,7 +135,12 @@ SolverPlan plan_distributed(const Problem& problem, const SolverRequest& req, in
     // the Krylov method it always had there (CGS, BiCGStab with a two-body pair).
     s.krylov = req.krylov.value_or(
         req.pc ? (two_body ? solvers::Krylov::bicgstab : solvers::Krylov::cgs) : kMgDefaultKrylov);
-    s.pc = req.pc.value_or(default_mg(two_body));
+    // The default sweeps levels 4 and finer by lattices from a finest level of
+    // kMgDistributedLatticeLevel on (not when the request keeps the Hilbert numbering).
+    const bool lattice =
+        problem.levels >= kMgDistributedLatticeLevel &&
+        req.numbering.value_or(Problem::Numbering::lattice) == Problem::Numbering::lattice;
+    s.pc = req.pc.value_or(default_mg(two_body, lattice));
     if (req.rel_tol) s.rel_tol = *req.rel_tol;
     const std::string why = s.pc.distributed();
     MLC_CHECK(why.empty(), why);
@@ -153,7 +158,12 @@ SolverPlan plan_distributed(const Problem& problem, const SolverRequest& req, in
     c.reason = req.pc ? "Krylov solve with --pc " + s.pc.text() + " as requested"
                       : "on " + std::to_string(processes) +
                             " processes: BiCGStab + distributed multilevel mg (V(0,2) cycle" +
-                            (two_body ? ", damped with a two-body pair)" : ")");
+                            (two_body ? ", damped with a two-body pair" : "") +
+                            (s.pc.lattice_numbering()
+                                 ? "; levels 4 and finer numbered and swept macro triangle by "
+                                   "macro triangle on each process, --numbering hilbert for the "
+                                   "block sweep)"
+                                 : ")");
     s.validate();
     return c;
 }
@@ -184,6 +194,27 @@ void plan_krylov(const Problem& problem, const SolverRequest& req, SolverPlan& c
                " (V(0,2) cycle)" + (two_body ? ", damped (omega = 0.8) with a two-body pair" : "");
 }
 
+// BiCGStab (unless the request names a Krylov method) + the default mg, as above the crossover.
+void plan_mg_default(const Problem& problem, const SolverRequest& req, SolverPlan& c) {
+    LinearSolverSpec& s = c.spec;
+    s.method = solvers::Method::krylov;
+    const bool two_body = has_two_body_pair(problem);
+    if (!req.krylov) s.krylov = kMgDefaultKrylov;
+    // Levels 4 and finer swept by lattices, numbered for it (not when the request keeps the
+    // Hilbert numbering).
+    const bool lattice =
+        problem.levels >= kMgDefaultLatticeLevel &&
+        req.numbering.value_or(Problem::Numbering::lattice) == Problem::Numbering::lattice;
+    s.pc = default_mg(two_body, lattice);
+    std::ostringstream os;
+    os << "BiCGStab + " << s.pc << " (faster and smaller than schur there"
+       << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles" : "")
+       << (lattice ? "; levels 4 and finer numbered and swept macro triangle by macro "
+                     "triangle, --numbering hilbert for the block sweep)"
+                   : ")");
+    c.reason = os.str();
+}
+
 // Nothing asked for: schur up to the crossover, BiCGStab + the default mg above it.
 void plan_by_size(const Problem& problem, const SolverRequest& req,
                   const std::vector<LevelSize>* known_sizes, SolverPlan& c) {
@@ -196,21 +227,9 @@ void plan_by_size(const Problem& problem, const SolverRequest& req,
     std::ostringstream os;
     os << std::setprecision(3);
     if (has_levels && n > crossover) {
-        s.method = solvers::Method::krylov;
-        const bool two_body = has_two_body_pair(problem);
-        if (!req.krylov) s.krylov = kMgDefaultKrylov;
-        // Levels 4 and finer swept by lattices, numbered for it (not when the request keeps
-        // the Hilbert numbering).
-        const bool lattice =
-            problem.levels >= kMgDefaultLatticeLevel &&
-            req.numbering.value_or(Problem::Numbering::lattice) == Problem::Numbering::lattice;
-        s.pc = default_mg(two_body, lattice);
+        plan_mg_default(problem, req, c);
         os << "default: " << n << " unknowns on the finest level exceed the crossover " << crossover
-           << ": BiCGStab + " << s.pc << " (faster and smaller than schur there"
-           << (two_body ? "; with a two-body pair damped sweeps need fewer V-cycles" : "")
-           << (lattice ? "; levels 4 and finer numbered and swept macro triangle by macro "
-                         "triangle, --numbering hilbert for the block sweep)"
-                       : ")");
+           << ": " << c.reason;
     } else {
         s.method = solvers::Method::schur;
         if (!has_levels && n > crossover)
@@ -242,6 +261,22 @@ SolverPlan plan_solver(const Problem& problem, const SolverRequest& req, int pro
     } else {
         plan_by_size(problem, req, known_sizes, c);
     }
+    s.numbering = req.numbering;
+    s.numbering = hierarchy_numbering(problem, s);
+    s.validate();
+    return c;
+}
+
+SolverPlan plan_default_mg(const Problem& problem, const SolverRequest& req, int processes) {
+    MLC_CHECK(!req.linear && !req.pc,
+              "plan_default_mg: the request names a method or a preconditioner");
+    if (processes > 1) return plan_solver(problem, req, processes);
+    SolverPlan c;
+    LinearSolverSpec& s = c.spec;
+    if (req.krylov) s.krylov = *req.krylov;
+    if (req.rel_tol) s.rel_tol = *req.rel_tol;
+    plan_mg_default(problem, req, c);
+    c.reason = "the default above the crossover: " + c.reason;
     s.numbering = req.numbering;
     s.numbering = hierarchy_numbering(problem, s);
     s.validate();

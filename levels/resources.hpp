@@ -64,6 +64,11 @@ bool has_two_body_pair(const Problem& problem);
 /// level-0 edge: solvers::kMinLatticeSubdivisions).
 inline constexpr int kMgDefaultLatticeLevel = 4;
 
+/// The finest level from which the default mg sweeps by lattices on several processes (each
+/// process its own level-0 triangles). Level 4 keeps the block sweep there: its values would move
+/// by about 1e-11 against the block sweep's.
+inline constexpr int kMgDistributedLatticeLevel = 5;
+
 /// The default mg: kMgDefaultTwoBody with a two-body pair, else kMgDefaultOneBody; with
 /// `lattice`, the lattice sweep of levels 4 and finer (smoother=lattice) too.
 solvers::PcSpec default_mg(bool two_body, bool lattice = false);
@@ -108,7 +113,8 @@ struct SolverPlan {
 /// next to `linear schur` or `linear lu` contradicts it and throws InvalidInput saying so.
 ///
 /// On several processes (`processes` > 1): always a Krylov method, BiCGStab + the default mg
-/// (never schur); a named `pc` takes CGS, BiCGStab with a two-body pair; a method or
+/// (never schur; from level kMgDistributedLatticeLevel on with the lattice sweep on each
+/// process's part numbered for it, unless the request names numbering hilbert); a named `pc` takes CGS, BiCGStab with a two-body pair; a method or
 /// preconditioner without a distributed form (PreconditionerEntry::distributed) is refused
 /// naming the alternative; the levels keep the Hilbert numbering unless the preconditioner
 /// sweeps by lattices (mg:smoother=lattice: each process's part numbered by lattices).
@@ -119,6 +125,13 @@ struct SolverPlan {
 /// has it already (it builds level 0).
 SolverPlan plan_solver(const Problem& problem, const SolverRequest& request, int processes = 1,
                        const std::vector<LevelSize>* sizes = nullptr);
+
+/// The plan the default takes above the crossover whatever the size (BiCGStab unless
+/// `request.krylov` says otherwise, the default mg, the lattice sweep where the default takes
+/// it): what `bench square` and the studies call "default". `request` names no method and no
+/// preconditioner.
+SolverPlan plan_default_mg(const Problem& problem, const SolverRequest& request,
+                           int processes = 1);
 
 /// The numbering the hierarchy of a solve with `spec` is built with: spec.numbering when set,
 /// else lattice when its preconditioner sweeps by lattices, else the problem's. Throws

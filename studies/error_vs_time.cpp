@@ -27,9 +27,9 @@ struct Config {
     /// What bounds the levels it runs on: none (0..L), ILU(0) (0..min(L, ilu_max_level)) or the
     /// multigrid (1..L: it needs a level below).
     enum class Family { exact, ilu, mg } family = Family::exact;
-    /// The run's default: from this level on its pc gains kMgDefaultLatticeOption (the lattice
-    /// sweep, on levels numbered for it), as the planner's default does; 0 = never.
-    int lattice_from = 0;
+    /// The run's default above the crossover on every level, planned per level by
+    /// levels::plan_default_mg (the lattice sweep from level 4 on, on levels numbered for it).
+    bool planned_default = false;
 };
 
 std::vector<Config> configurations(const levels::Problem& problem) {
@@ -37,7 +37,7 @@ std::vector<Config> configurations(const levels::Problem& problem) {
     using F = Config::Family;
     // The multilevel solvers: the run's default above the crossover (BiCGStab + mg's V(0,2)
     // cycle, damped with a two-body pair; from level kMgDefaultLatticeLevel on with the lattice
-    // sweep on levels numbered by lattices: `lattice_from`), `--pc mg` (CGS + V(1,1), an
+    // sweep on levels numbered by lattices: `planned_default`), `--pc mg` (CGS + V(1,1), an
     // earlier default) and hypre's MGR with `--pc mgr`, to the run's default linear
     // tolerance.
     const levels::LinearSolverSpec def{.method = solvers::Method::krylov,
@@ -45,7 +45,7 @@ std::vector<Config> configurations(const levels::Problem& problem) {
                                        .pc = levels::default_mg(levels::has_two_body_pair(problem)),
                                        .rel_tol = 1e-10};
     c.push_back(
-        {"c2f default bicgstab+mg", true, def, 1e-10, F::mg, levels::kMgDefaultLatticeLevel});
+        {"c2f default bicgstab+mg", true, def, 1e-10, F::mg, true});
     const levels::LinearSolverSpec mg{.method = solvers::Method::krylov,
                                       .krylov = solvers::Krylov::cgs,
                                       .pc = solvers::parse_pc("mg"),
@@ -92,12 +92,11 @@ std::vector<Config> configurations(const levels::Problem& problem) {
 }
 
 /// The linear solver a configuration runs on level `level`.
-levels::LinearSolverSpec linear_for(const Config& c, int level) {
-    levels::LinearSolverSpec s = c.linear;
-    if (c.lattice_from > 0 && level >= c.lattice_from)
-        std::get<solvers::MgOptions>(s.pc.options).smoother =
-            solvers::MultigridParams::Smoother::lattice;
-    return s;
+levels::LinearSolverSpec linear_for(const Config& c, const levels::Problem& problem, int level) {
+    if (!c.planned_default) return c.linear;
+    levels::Problem p = problem;
+    p.levels = level;
+    return levels::plan_default_mg(p, {.rel_tol = c.linear.rel_tol}).spec;
 }
 
 /// Prolongates a full nodal vector from level l to level L of a hierarchy (P_nodal chain).
@@ -189,7 +188,7 @@ Errors errors_against(const levels::RunResult& ref, int l, const levels::RunResu
 std::string error_vs_time_pc(const levels::Problem& problem, const std::string& configuration,
                              int level) {
     for (const auto& c : configurations(problem))
-        if (c.name == configuration) return linear_for(c, level).pc.text();
+        if (c.name == configuration) return linear_for(c, problem, level).pc.text();
     throw InvalidInput("study error-vs-time has no configuration named '" + configuration + "'");
 }
 
@@ -246,7 +245,7 @@ int study_error_vs_time(const levels::Problem& problem_in, const ErrorVsTimeOpti
             p.newton.rel_tol = c.newton_tol;
             levels::SolveOptions so;
             so.coarse_to_fine = c.coarse_to_fine;
-            so.linear = linear_for(c, l);
+            so.linear = linear_for(c, p, l);
             const double t0 = wall_seconds();
             levels::RunResult r;
             try {

@@ -128,18 +128,36 @@ TEST(Registry, HelpStudyBenchAndDriverAgreeWithIt) {
     // The bench's default is the run's default pair, whose mg spec is registered too.
     const apps::BenchSquareOptions bench_defaults;
     EXPECT_EQ(bench_defaults.pcs, std::vector<std::string>{"default"});
-    for (const bool two_body : {false, true}) {
-        const apps::BenchSolver d = apps::bench_solver(bench_defaults, "default", two_body);
-        EXPECT_EQ(d.krylov, solvers::to_string(levels::kMgDefaultKrylov));
-        EXPECT_EQ(d.pc, two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody);
-        EXPECT_NO_THROW(solvers::parse_pc(d.pc)) << d.pc;
+    // "default" is the run's default above the crossover whatever the size, planned by
+    // plan_default_mg: on square level 2 (below the crossover) and on dovetail (two bodies).
+    for (const char* scene_name : {"square", "dovetail"}) {
+        levels::Problem p = scene::load_scene(scene_name);
+        p.levels = 2;
+        const bool two_body = levels::has_two_body_pair(p);
+        const levels::SolverPlan d = apps::bench_plan(bench_defaults, "default", p);
+        EXPECT_EQ(d.spec.method, solvers::Method::krylov) << scene_name;
+        EXPECT_EQ(d.spec.krylov, levels::kMgDefaultKrylov) << scene_name;
+        EXPECT_EQ(d.spec.pc.text(),
+                  two_body ? levels::kMgDefaultTwoBody : levels::kMgDefaultOneBody)
+            << scene_name;
+        EXPECT_EQ(apps::bench_label(d), "bicgstab + " + d.spec.pc.text());
     }
+    levels::Problem sq = scene::load_scene("square");
+    sq.levels = 2;
     // A named preconditioner without --krylov keeps CGS; --krylov applies to both.
-    EXPECT_EQ(apps::bench_solver(bench_defaults, "mg", false).krylov, "cgs");
+    EXPECT_EQ(apps::bench_plan(bench_defaults, "mg", sq).spec.krylov, solvers::Krylov::cgs);
     apps::BenchSquareOptions gmres;
     gmres.krylov = "gmres";
-    EXPECT_EQ(apps::bench_solver(gmres, "mg", false).krylov, "gmres");
-    EXPECT_EQ(apps::bench_solver(gmres, "default", true).krylov, "gmres");
+    EXPECT_EQ(apps::bench_plan(gmres, "mg", sq).spec.krylov, solvers::Krylov::gmres);
+    EXPECT_EQ(apps::bench_plan(gmres, "default", sq).spec.krylov, solvers::Krylov::gmres);
+    EXPECT_EQ(apps::bench_plan(gmres, "schur", sq).spec.method, solvers::Method::schur);
+    EXPECT_EQ(apps::bench_label(apps::bench_plan(gmres, "lu", sq)), "lu");
+    // From level 4 on the default sweeps by lattices on levels numbered for it.
+    sq.levels = 4;
+    sq.numbering = levels::Problem::Numbering::lattice;
+    const levels::SolverPlan d4 = apps::bench_plan(bench_defaults, "default", sq);
+    EXPECT_TRUE(d4.lattice_numbering());
+    EXPECT_EQ(d4.spec.pc.text(), "mg:pre=0,post=2,smoother=lattice");
     std::vector<std::string> all;
     for (const auto& e : reg)
         all.push_back(e.name);
