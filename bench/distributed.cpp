@@ -39,7 +39,8 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     MLC_CHECK(opt.repeat >= 1, "bench square: --repeat must be >= 1, found " << opt.repeat);
     MLC_CHECK(opt.pcs.size() == 1,
               "bench square on several processes runs one solver at a time (--pc default or "
-              "one preconditioner with a distributed form), found " << opt.pcs.size());
+              "one preconditioner with a distributed form), found "
+                  << opt.pcs.size());
     levels::Problem p = scene::load_scene(opt.scene);
     p.levels = opt.levels;
     p.validate();
@@ -54,8 +55,8 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     so.linear = plan.spec;
     os << "bench " << opt.scene << ": levels 0.." << opt.levels << ", coarse-to-fine, "
        << p.load_steps << " load steps, " << np << " processes (one thread each), partition level "
-       << plevel << ", Krylov " << plan.spec.krylov << " + distributed " << plan.spec.pc << " rel_tol "
-       << opt.rel_tol << ", times are medians of " << opt.repeat << " run(s)\n";
+       << plevel << ", Krylov " << plan.spec.krylov << " + distributed " << plan.spec.pc
+       << " rel_tol " << opt.rel_tol << ", times are medians of " << opt.repeat << " run(s)\n";
     std::vector<double> walls;
     levels::DistributedRunResult last;
     for (int rep = 0; rep < opt.repeat; ++rep) {

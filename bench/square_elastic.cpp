@@ -157,8 +157,7 @@ void print_square_header(std::ostream& os, std::ostream& js, const BenchSquareOp
        << load_steps << " load steps, Krylov " << krylov_label << " rel_tol " << opt.rel_tol
        << ", times are medians of " << opt.repeat << " run(s)\n";
     if (def)
-        os << "default = " << bench_label(*def)
-           << " (the run's default above the crossover)\n";
+        os << "default = " << bench_label(*def) << " (the run's default above the crossover)\n";
     os << std::setw(14) << "solver" << std::setw(6) << "level" << std::setw(10) << "unknowns"
        << std::setw(11) << "nonzeros" << std::setw(7) << "newton" << std::setw(10) << "its/newt"
        << std::setw(6) << "max" << std::setw(10) << "asm s" << std::setw(10) << "setup s"

@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 namespace mlc::levels {
@@ -112,10 +113,14 @@ void build_distributed_levels(const Problem& problem, const SolveOptions& option
     for (int l = 0; l < p; ++l)
         mp = mesh::refine(mp);
     {
-        ScopedTimer t(&res.timings, "setup/distribute");
+        // The partition and the refined parts, then each part's levels (as "setup/levels" of
+        // one process: numbering, assembly, contact elements).
+        std::optional<ScopedTimer> t1(std::in_place, &res.timings, "setup/distribute");
         auto dh =
             mesh::distribute(mp, problem.levels - p, comm, {}, contact_ghost_reach(problem, mp));
         mp = mesh::Mesh{};
+        t1.reset();
+        ScopedTimer t2(&res.timings, "setup/levels");
         for (auto& lv : dh.levels)
             res.levels.push_back(build_distributed_level(problem, std::move(lv), comm));
     }

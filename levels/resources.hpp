@@ -114,10 +114,11 @@ struct SolverPlan {
 ///
 /// On several processes (`processes` > 1): always a Krylov method, BiCGStab + the default mg
 /// (never schur; from level kMgDistributedLatticeLevel on with the lattice sweep on each
-/// process's part numbered for it, unless the request names numbering hilbert); a named `pc` takes CGS, BiCGStab with a two-body pair; a method or
-/// preconditioner without a distributed form (PreconditionerEntry::distributed) is refused
-/// naming the alternative; the levels keep the Hilbert numbering unless the preconditioner
-/// sweeps by lattices (mg:smoother=lattice: each process's part numbered by lattices).
+/// process's part numbered for it, unless the request names numbering hilbert); a named `pc` takes
+/// CGS, BiCGStab with a two-body pair; a method or preconditioner without a distributed form
+/// (PreconditionerEntry::distributed) is refused naming the alternative; the levels keep the
+/// Hilbert numbering unless the preconditioner sweeps by lattices (mg:smoother=lattice: each
+/// process's part numbered by lattices).
 ///
 /// A preconditioner that sweeps by lattices numbers the levels for it (spec.numbering lattice)
 /// and is refused below level 4 or with numbering hilbert requested; one that needs the level
@@ -130,8 +131,7 @@ SolverPlan plan_solver(const Problem& problem, const SolverRequest& request, int
 /// `request.krylov` says otherwise, the default mg, the lattice sweep where the default takes
 /// it): what `bench square` and the studies call "default". `request` names no method and no
 /// preconditioner.
-SolverPlan plan_default_mg(const Problem& problem, const SolverRequest& request,
-                           int processes = 1);
+SolverPlan plan_default_mg(const Problem& problem, const SolverRequest& request, int processes = 1);
 
 /// The numbering the hierarchy of a solve with `spec` is built with: spec.numbering when set,
 /// else lattice when its preconditioner sweeps by lattices, else the problem's. Throws

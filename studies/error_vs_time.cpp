@@ -44,8 +44,7 @@ std::vector<Config> configurations(const levels::Problem& problem) {
                                        .krylov = levels::kMgDefaultKrylov,
                                        .pc = levels::default_mg(levels::has_two_body_pair(problem)),
                                        .rel_tol = 1e-10};
-    c.push_back(
-        {"c2f default bicgstab+mg", true, def, 1e-10, F::mg, true});
+    c.push_back({"c2f default bicgstab+mg", true, def, 1e-10, F::mg, true});
     const levels::LinearSolverSpec mg{.method = solvers::Method::krylov,
                                       .krylov = solvers::Krylov::cgs,
                                       .pc = solvers::parse_pc("mg"),

@@ -362,3 +362,37 @@ TEST(ChooseSolver, TheDefaultSweepsByLatticesFromLevel4UnlessNumberingHilbertIsA
     EXPECT_FALSE(three.lattice_numbering());
     EXPECT_EQ(three.spec.pc.text(), "mg:pre=0,post=2");
 }
+
+TEST(PlanSolver, SeveralProcessesSweepByLatticesFromLevel5UnlessNumberingHilbertIsAsked) {
+    // On several processes the default is BiCGStab + the V(0,2) mg at any size (never schur):
+    // the block sweep on the Hilbert numbering up to level 4, the lattice sweep on each part
+    // numbered for it from level 5 on; numbering hilbert keeps the block sweep. A named
+    // preconditioner takes CGS, BiCGStab with a two-body pair; a direct method is refused.
+    auto p = scene::load_scene("square");
+    for (const int level : {2, 4, 5, 6}) {
+        p.levels = level;
+        const auto d = levels::plan_solver(p, {}, 2);
+        EXPECT_FALSE(d.automatic) << level;
+        EXPECT_EQ(d.spec.method, solvers::Method::krylov) << level;
+        EXPECT_EQ(d.spec.krylov, solvers::Krylov::bicgstab) << level;
+        EXPECT_EQ(d.lattice_numbering(), level >= levels::kMgDistributedLatticeLevel) << level;
+        EXPECT_EQ(d.spec.pc.text(),
+                  level >= 5 ? "mg:pre=0,post=2,smoother=lattice" : "mg:pre=0,post=2")
+            << level;
+        const auto h = levels::plan_solver(p, request({}, {}, {}, {}, std::string("hilbert")), 2);
+        EXPECT_FALSE(h.lattice_numbering()) << level;
+        EXPECT_EQ(h.spec.pc.text(), "mg:pre=0,post=2") << level;
+    }
+    EXPECT_EQ(levels::plan_solver(p, request({}, {}, std::string("ilu:1"), {}, {}), 3).spec.krylov,
+              solvers::Krylov::cgs);
+    EXPECT_THROW(levels::plan_solver(p, request(std::string("schur"), {}, {}, {}, {}), 2),
+                 InvalidInput);
+    EXPECT_THROW(levels::plan_solver(p, request({}, {}, std::string("cf"), {}, {}), 2),
+                 InvalidInput);
+    auto dt = scene::load_scene("dovetail");
+    dt.levels = 5;
+    const auto t = levels::plan_solver(dt, request({}, {}, std::string("mg"), {}, {}), 2);
+    EXPECT_EQ(t.spec.krylov, solvers::Krylov::bicgstab);
+    EXPECT_EQ(levels::plan_solver(dt, {}, 2).spec.pc.text(),
+              "mg:omega=0.8,pre=0,post=2,smoother=lattice");
+}
