@@ -197,19 +197,46 @@ solvers::RowBlocks DistributedLevel::row_blocks(const SparseMatrix& A) const {
         offd_col[static_cast<size_t>(ghost_cols[j])] = static_cast<int>(j);
         b.col_map.push_back(global_dof[static_cast<size_t>(ghost_cols[j])]);
     }
-    std::vector<Eigen::Triplet<double>> td, to;
-    for (int i = 0; i < n; ++i)
-        for (SparseMatrix::InnerIterator it(A, i); it; ++it)
-            if (it.col() < n)
-                td.emplace_back(i, it.col(), it.value());
-            else
-                to.emplace_back(i, offd_col[static_cast<size_t>(it.col())], it.value());
+    // Both blocks written row by row in place (A's rows hold each column once): the owned
+    // columns in A's order, the ghost columns sorted by their place in col_map.
     b.diag.resize(n, n);
-    b.diag.setFromTriplets(td.begin(), td.end());
-    b.diag.makeCompressed();
     b.offd.resize(n, static_cast<Index>(ghost_cols.size()));
-    b.offd.setFromTriplets(to.begin(), to.end());
-    b.offd.makeCompressed();
+    int* d_outer = b.diag.outerIndexPtr();
+    int* o_outer = b.offd.outerIndexPtr();
+    d_outer[0] = o_outer[0] = 0;
+    for (int i = 0; i < n; ++i) {
+        int nd = 0, no = 0;
+        for (SparseMatrix::InnerIterator it(A, i); it; ++it)
+            (it.col() < n ? nd : no) += 1;
+        d_outer[i + 1] = d_outer[i] + nd;
+        o_outer[i + 1] = o_outer[i] + no;
+    }
+    b.diag.resizeNonZeros(d_outer[n]);
+    b.offd.resizeNonZeros(o_outer[n]);
+    int* d_inner = b.diag.innerIndexPtr();
+    double* d_val = b.diag.valuePtr();
+    int* o_inner = b.offd.innerIndexPtr();
+    double* o_val = b.offd.valuePtr();
+    std::vector<std::pair<int, double>> row_offd;
+    for (int i = 0; i < n; ++i) {
+        int kd = d_outer[i];
+        row_offd.clear();
+        for (SparseMatrix::InnerIterator it(A, i); it; ++it) {
+            if (it.col() < n) {
+                d_inner[kd] = static_cast<int>(it.col());
+                d_val[kd++] = it.value();
+            } else {
+                row_offd.emplace_back(offd_col[static_cast<size_t>(it.col())], it.value());
+            }
+        }
+        std::sort(row_offd.begin(), row_offd.end(),
+                  [](const auto& x, const auto& y) { return x.first < y.first; });
+        int ko = o_outer[i];
+        for (const auto& [c, v] : row_offd) {
+            o_inner[ko] = c;
+            o_val[ko++] = v;
+        }
+    }
     return b;
 }
 

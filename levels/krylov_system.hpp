@@ -82,10 +82,10 @@ solvers::AggregationInput aggregation_input(const Level& level);
 std::vector<smoothers::ElementMatrix> elastic_element_matrices(const Level& level);
 
 /// The element matrices restricted to the unknowns [0, n) (EBE on one process's diagonal block,
-/// issue 13): each element keeps the rows and columns of its unknowns below n (a principal
-/// submatrix, in the element's order), and an element with none of them is dropped. The
-/// restricted elements of all the elements around the unknowns [0, n) sum to the block of those
-/// unknowns of the matrix the whole elements sum to.
+/// docs/parallel.md#parallel-preconditioners): each element keeps the rows and columns of its
+/// unknowns below n (a principal submatrix, in the element's order), and an element with none of
+/// them is dropped. The restricted elements of all the elements around the unknowns [0, n) sum to
+/// the block of those unknowns of the matrix the whole elements sum to.
 void restrict_elements(std::vector<smoothers::ElementMatrix>& elements, Index n);
 
 /// The contact element tangent of element e of `level` for the status matrix M (formulation.md

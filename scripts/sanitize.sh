@@ -56,19 +56,23 @@ built=$(date +%s)
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 out=$dir/ctest.log
-# Whole-run tests that take over 20 s under the sanitizers are left to the Release suite: every
+# Whole-run tests that take over 15 s under the sanitizers are left to the Release suite: every
 # new scene coarse-to-fine, the multilevel rows of error-vs-time, Mindlin's partial slip, the
 # aggregation-mg runs on the exported square, the level-3 size predictions, the level-independence
 # of the V-cycle, BiCGStab over the threads, the coarse-to-fine square and increment transfer, the
 # damped two-body default on the dovetail, the lattice transfer products, the lattice and
-# single-precision multigrids against their references, the recovered levels and the held corner.
+# single-precision multigrids against their references, the recovered levels, the held corner and
+# the held Hertz half model, the coarse/fine variants of the Krylov system, mg inside each Krylov
+# method and its exact fallback, and the dovetail on levels 0-2.
 # What they run is covered here by the unit tests of the same code (levels, solvers, contact,
 # smoothers, transfer, the hierarchy tests); this keeps .ci/run well under 40 minutes
 # (docs/testing.md#testing-hostile).
 heavy="^(NewScenes\.CoarseToFineNewtonAndMgSolveEveryNewScene|ErrorVsTime\.MultilevelRowsConvergeAndTheirErrorFallsWithTheLevel|Mindlin\.PartialSlipStickZoneMatchesCattaneoMindlin|AlgebraicMultigrid\.SolvesTheSquareExportedFromLevel2LikeSchur|PredictLevelSizes\.RefinementCountsAreExactAndUnknownsClose"
 heavy+="|Multigrid\.VCycleIsLevelIndependentAsCGPreconditioner|Krylov\.BicgstabOverTheThreadsIsTheWholeVectorIterationBitForBit|CoarseToFine\.SquareMatchesColdStartWithHalfTheNewtonIterations|MultilevelPreconditioner\.TheDampedTwoBodyDefaultSolvesTheDovetail"
 heavy+="|LatticeTransfer\.TAndRThroughTheLatticeAreTheirCsrProductsBitForBit|LatticeMultigrid\.SquareLevel4LikeTheBlockSmoother|SinglePrecisionMultigrid\.SquareLevel3LikeDouble|CoarseToFine\.IncrementTransferGivesTheSameSolutionAndPredictsAtLeastAsWell"
-heavy+="|RecoveredLevels\.TheExportedSquareSolvesAsTheRefinedSquareDoes|HeldSupports\.SquareWithItsContactCornerHeldInUxSolvesAlikeByEverySolver)$"
+heavy+="|RecoveredLevels\.TheExportedSquareSolvesAsTheRefinedSquareDoes|HeldSupports\.SquareWithItsContactCornerHeldInUxSolvesAlikeByEverySolver"
+heavy+="|KrylovSystem\.CoarseFineVariantsSolveTheFineSystem|MultilevelPreconditioner\.WorksInsideCgsBicgstabAndGmres|MultilevelPreconditioner\.TheExactFallbackSolvesWhatTheMultigridCannot"
+heavy+="|HeldSupports\.FrictionalHertzHalfModelCarriesTheLoadAndSolvesAlikeByEverySolver|Dovetail\.EquilibriumMirrorSymmetryAndCoulombOnLevels0To2)$"
 if ctest --test-dir "$dir" -LE "^(slow|cli)$" -E "$heavy" -j"$jobs" --output-on-failure > "$out" 2>&1; then
   n=$(grep -oE "out of [0-9]+" "$out" | tail -n 1 | grep -oE "[0-9]+")
   echo "sanitize: ${n:-?} tests passed under address+undefined ($cxx, build-asan;" \

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 /// @file Block Jacobi across processes: a preconditioner of each process's diagonal block of a
 /// row-distributed matrix (ParMatrix), so that a process smooths with its own rows and columns
-/// and treats the couplings to other processes' unknowns as a Jacobi method does (issue 12,
-/// item 3: "block Gauss-Seidel inside each process and Jacobi across process cuts", as the threads
-/// of core/parallel.hpp do with their chunks). No hypre: the block is cut from DistributedRows.
+/// and treats the couplings to other processes' unknowns as a Jacobi method does
+/// (docs/parallel.md#parallel-how: block Gauss-Seidel inside each process and Jacobi across process
+/// cuts, as the threads of core/parallel.hpp do with their chunks). No hypre: the block is cut from
+/// DistributedRows.
 #pragma once
 
 #include "core/linear_operator.hpp"

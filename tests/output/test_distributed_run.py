@@ -244,7 +244,7 @@ def expect_interface_cut(dist, stdout, np_):
 
 @pytest.mark.parametrize("scene,levels,plevel", [("patch", 2, 0), ("dovetail", 1, 0)])
 def test_a_two_body_scene_gives_the_one_process_answer(tmp_path, scene, levels, plevel):
-    """Issue 13 item 5: two bodies, node on facet, the interface cut by the partition; np 2 and
+    """Two bodies, node on facet, the interface cut by the partition; np 2 and
     3 run with the two-body default (BiCGStab + mg:omega=0.8,pre=0,post=2, chosen without
     asking)."""
     f = scene_file(tmp_path, scene)
@@ -322,7 +322,7 @@ def test_bench_elastic_on_two_processes_solves_the_one_process_block(tmp_path):
 
 @pytest.mark.parametrize("scene,levels", [("square", 4), ("hertz", 3)])
 def test_ladder_one_to_four_processes_agree(tmp_path, scene, levels):
-    """Issue 12's judged case (ctest label slow: `ctest -L slow -R ladder`): N = 2, 3, 4 against
+    """The ladder (ctest label slow: `ctest -L slow -R ladder`): N = 2, 3, 4 against
     one process on square level 4 and hertz level 3, to 1e-8 with tolerances 1e-12."""
     f = scene_file(tmp_path, scene)
     serial, _ = run(tmp_path, f, levels, 1)
@@ -333,7 +333,7 @@ def test_ladder_one_to_four_processes_agree(tmp_path, scene, levels):
 
 @pytest.mark.parametrize("scene", ["dovetail", "patch"])
 def test_ladder_two_bodies_one_to_four_processes_agree(tmp_path, scene):
-    """Issue 13's judged case: dovetail and patch level 2, N = 2, 3, 4 against one process
+    """Two bodies: dovetail and patch level 2, N = 2, 3, 4 against one process
     (BiCGStab + mg:omega=0.8), tolerances 1e-12, with the default partition level and with
     every level distributed (--partition-level 0); the interface cut by the partition."""
     f = scene_file(tmp_path, scene)
