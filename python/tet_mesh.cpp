@@ -41,8 +41,41 @@ std::vector<mesh::Field> fields_of(const py::dict& data, const char* kind) {
     return out;
 }
 
-// Where a mesh comes from: the box, a Gmsh file, refinement.
+/// A mesh from arrays (n, 3) points, (m, 4) tetrahedra and optionally (m,) attributes; indices
+/// and shapes are checked here, the geometry by check().
+std::shared_ptr<TetMesh> from_arrays(
+    const py::array_t<double, py::array::c_style | py::array::forcecast>& points,
+    const py::array_t<int, py::array::c_style | py::array::forcecast>& tets,
+    const std::optional<py::array_t<int, py::array::c_style | py::array::forcecast>>& attributes) {
+    if (points.ndim() != 2 || points.shape(1) != 3)
+        throw InvalidInput("TetMesh: points must have shape (n, 3)");
+    if (tets.ndim() != 2 || tets.shape(1) != 4)
+        throw InvalidInput("TetMesh: tetrahedra must have shape (m, 4)");
+    auto m = std::make_shared<TetMesh>();
+    for (py::ssize_t i = 0; i < points.shape(0); ++i)
+        m->vertices.emplace_back(points.at(i, 0), points.at(i, 1), points.at(i, 2));
+    for (py::ssize_t t = 0; t < tets.shape(0); ++t)
+        m->tetrahedra.push_back({tets.at(t, 0), tets.at(t, 1), tets.at(t, 2), tets.at(t, 3)});
+    if (attributes) {
+        if (attributes->ndim() != 1 || attributes->shape(0) != tets.shape(0))
+            throw InvalidInput("TetMesh: attributes must have shape (m,), one per tetrahedron");
+        m->attribute.assign(attributes->data(), attributes->data() + attributes->size());
+    }
+    for (std::size_t t = 0; t < m->tetrahedra.size(); ++t)
+        for (int v : m->tetrahedra[t])
+            if (v < 0 || v >= m->n_vertices())
+                throw InvalidInput("TetMesh: tetrahedron " + std::to_string(t) +
+                                   " refers to vertex " + std::to_string(v) + " but there are " +
+                                   std::to_string(m->n_vertices()) + " points");
+    return m;
+}
+
+// Where a mesh comes from: arrays, the box, a Gmsh file, refinement.
 void bind_tet_sources(TetMeshClass& cls) {
+    cls.def(py::init(&from_arrays), py::arg("points"), py::arg("tetrahedra"),
+            py::arg("attributes") = py::none(),
+            "A mesh from (n, 3) points, (m, 4) vertex indices and optionally (m,) bodies, "
+            "without boundary tags; check() checks it");
     cls.def_static(
            "box",
            [](const std::array<double, 3>& corner, const std::array<double, 3>& size,

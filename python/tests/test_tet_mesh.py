@@ -193,3 +193,23 @@ def test_pvd_series_of_steps(tmp):
     assert [(float(d.get("timestep")), d.get("file")) for d in sets] == steps
     for s, (_, name) in enumerate(steps):
         assert np.array_equal(read_vtu(tmp / name)["displacement"][:, 2], -0.1 * s * m.points[:, 2])
+
+
+def test_check_names_the_bad_element():
+    box = mlcontact.TetMesh.box((0, 0, 0), (1, 1, 1), (1, 1, 1))
+    same = mlcontact.TetMesh(box.points, box.tetrahedra, attributes=np.arange(6))
+    same.check()
+    assert np.array_equal(same.tetrahedra, box.tetrahedra) and list(same.attributes) == list(range(6))
+    flat = box.tetrahedra.copy()
+    flat[4] = (0, 1, 2, 3)  # four corners of the bottom face
+    with pytest.raises(ValueError, match=r"flat tetrahedron: tetrahedron 4 \(vertices 0, 1, 2, 3 at "
+                       r"\(0, 0, 0\), \(1, 0, 0\), \(0, 1, 0\), \(1, 1, 0\)\) has volume 0"):
+        mlcontact.TetMesh(box.points, flat).check()
+    three = mlcontact.TetMesh([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (0.2, 0.2, 2),
+                               (0, 0, -1)], [(0, 1, 2, 3), (0, 1, 2, 4), (0, 1, 2, 5)])
+    with pytest.raises(ValueError, match=r"a face shared by 3 tetrahedra: the face \(0, 1, 2\)"):
+        three.check()
+    with pytest.raises(ValueError, match="tetrahedron 1 refers to vertex 9 but there are 4 points"):
+        mlcontact.TetMesh(box.points[:4], [(0, 1, 2, 3), (0, 1, 2, 9)])
+    with pytest.raises(ValueError, match=r"points must have shape \(n, 3\)"):
+        mlcontact.TetMesh(np.zeros((4, 2)), [(0, 1, 2, 3)])
