@@ -125,5 +125,7 @@ void bind_scene(py::module_& m);
 void bind_result(py::module_& m);
 /// solve() and the studies.
 void bind_run(py::module_& m);
+/// The class TetMesh and write_pvd.
+void bind_tet_mesh(py::module_& m);
 
 } // namespace mlc::python

@@ -27,4 +27,5 @@ PYBIND11_MODULE(_core, m) {
     python::bind_scene(m);
     python::bind_result(m);
     python::bind_run(m);
+    python::bind_tet_mesh(m);
 }

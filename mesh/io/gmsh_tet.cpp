@@ -51,6 +51,32 @@ std::string element_text(const MshData& d, std::size_t e) {
     return os.str();
 }
 
+/// Physical volumes are bodies: either every selected tetrahedron is in one, or none is (then
+/// all are body 0). Names the first tetrahedron in none.
+void check_every_tetrahedron_has_a_volume(const MshData& d, const std::vector<int>& tet_phys,
+                                          const std::vector<std::size_t>& tet_element,
+                                          const std::string& where) {
+    const auto in_volume = [](int p) { return p != 0; };
+    const std::size_t in =
+        static_cast<std::size_t>(std::count_if(tet_phys.begin(), tet_phys.end(), in_volume));
+    if (in == 0 || in == tet_phys.size()) return;
+    const std::size_t i =
+        static_cast<std::size_t>(std::find(tet_phys.begin(), tet_phys.end(), 0) - tet_phys.begin());
+    std::set<int> volumes(tet_phys.begin(), tet_phys.end());
+    volumes.erase(0);
+    std::ostringstream known;
+    for (int v : volumes) {
+        auto it = d.names.find({3, v});
+        known << " '" << (it == d.names.end() ? "tag" + std::to_string(v) : it->second) << "'";
+    }
+    MLC_CHECK(false, where << ":" << d.elem_line[tet_element[i]] << ": tetrahedron " << i << " ("
+                           << element_text(d, tet_element[i]) << ") is in no physical volume, but "
+                           << in << " of the " << tet_phys.size() << " tetrahedra are (in"
+                           << known.str()
+                           << "); a physical volume is a body: put every volume of the model "
+                              "in a Physical Volume, or select one volume by name");
+}
+
 /// Tagged triangles of the file that are boundary faces of m become its BoundaryFaces.
 void add_boundary_faces(TetMesh& m, const MshData& d, const std::vector<std::size_t>& triangles,
                         const std::vector<int>& new_index,
@@ -180,6 +206,7 @@ TetMesh read_gmsh_tet_text(const std::string& text, const std::filesystem::path&
                            "or if the file lists every tetrahedron the other way, swap two of "
                            "the nodes of each");
     }
+    check_every_tetrahedron_has_a_volume(d, tet_phys, tet_element, where);
     if (std::any_of(tet_phys.begin(), tet_phys.end(), [](int p) { return p != 0; }))
         m.attribute = tet_phys;
     add_boundary_faces(m, d, triangles, new_index, node_index);

@@ -20,7 +20,9 @@ namespace mlc::mesh {
 /// - Vertices: only those used by the selected tetrahedra, renumbered 0.. in the file's node
 ///   order.
 /// - Bodies: TetMesh::attribute is the (first) physical volume tag of each tetrahedron, or empty
-///   when the tetrahedra carry no physical volume.
+///   when the tetrahedra carry no physical volume. Either every selected tetrahedron is in a
+///   physical volume or none is: a file with both is refused, naming the first tetrahedron in
+///   none.
 /// - Boundary: every 3-node triangle (type 2) in a physical surface that is a boundary face of
 ///   the selected tetrahedra becomes a BoundaryFace tagged with the physical name ("tag<N>" if
 ///   unnamed), turned so that its normal points out of the body. Triangles that are faces of

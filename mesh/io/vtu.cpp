@@ -3,6 +3,8 @@
 // buffer with std::to_chars into a temporary file that is renamed into place.
 #include "mesh/io/vtu.hpp"
 
+#include "mesh/io/vtu_grid.hpp"
+
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/stop.hpp"
@@ -313,9 +315,17 @@ void put_appended_refs(BufferedFile& out, const std::vector<AppendedArray>& arra
     }
 }
 
-void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
-                      const std::vector<Field>& point_fields,
-                      const std::vector<Field>& cell_fields) {
+} // namespace
+
+namespace detail {
+
+void check_vtu_fields(const std::vector<Field>& fields, const char* kind, const char* entity,
+                      std::size_t n_entities) {
+    check_fields(fields, kind, entity, n_entities);
+}
+
+void write_vtu_grid(const std::filesystem::path& file, VtuGrid grid,
+                    const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields) {
     static_assert(sizeof(double) == 8);
     {
         const std::uint16_t one = 1;
@@ -323,7 +333,7 @@ void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
         std::memcpy(&first, &one, 1);
         MLC_CHECK(first == 1, "write_vtu: binary output is written little endian only");
     }
-    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    const std::size_t nv = grid.xyz.size() / 3, nt = grid.types.size();
     // Order in the file: point fields, cell fields, points, connectivity, offsets, types.
     std::vector<std::string> attributes;
     std::vector<RawArray> raws;
@@ -333,30 +343,15 @@ void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
             attributes.push_back(std::move(a));
             raws.push_back({std::move(bytes), true});
         }
-    {
-        std::vector<double> xyz(3 * nv, 0.0);
-        for (std::size_t v = 0; v < nv; ++v) {
-            xyz[3 * v] = m.vertices[v].x();
-            xyz[3 * v + 1] = m.vertices[v].y();
-        }
-        attributes.emplace_back("type=\"Float64\" NumberOfComponents=\"3\"");
-        raws.push_back({raw_bytes(xyz)});
-    }
-    {
-        std::vector<std::int32_t> conn(3 * nt);
-        std::vector<std::int64_t> offsets(nt);
-        for (std::size_t t = 0; t < nt; ++t) {
-            for (std::size_t k = 0; k < 3; ++k)
-                conn[3 * t + k] = m.triangles[t][k];
-            offsets[t] = static_cast<std::int64_t>(3 * (t + 1));
-        }
-        attributes.emplace_back("type=\"Int32\" Name=\"connectivity\"");
-        raws.push_back({raw_bytes(conn)});
-        attributes.emplace_back("type=\"Int64\" Name=\"offsets\"");
-        raws.push_back({raw_bytes(offsets)});
-        attributes.emplace_back("type=\"UInt8\" Name=\"types\"");
-        raws.push_back({std::vector<unsigned char>(nt, 5)});
-    }
+    attributes.emplace_back("type=\"Float64\" NumberOfComponents=\"3\"");
+    raws.push_back({raw_bytes(grid.xyz)});
+    attributes.emplace_back("type=\"Int32\" Name=\"connectivity\"");
+    raws.push_back({raw_bytes(grid.connectivity)});
+    attributes.emplace_back("type=\"Int64\" Name=\"offsets\"");
+    raws.push_back({raw_bytes(grid.offsets)});
+    attributes.emplace_back("type=\"UInt8\" Name=\"types\"");
+    raws.push_back({raw_bytes(grid.types)});
+    grid = VtuGrid{};
     std::vector<AppendedArray> arrays(raws.size());
     {
         auto encoded = zlib_encode(raws);
@@ -395,6 +390,32 @@ void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
         out.put("\n  </AppendedData>\n"
                 "</VTKFile>\n");
     });
+}
+
+} // namespace detail
+
+namespace {
+
+/// The triangles of a 2D mesh as a VtuGrid (points (x, y, 0), VTK_TRIANGLE).
+void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
+                      const std::vector<Field>& point_fields,
+                      const std::vector<Field>& cell_fields) {
+    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    detail::VtuGrid grid;
+    grid.xyz.assign(3 * nv, 0.0);
+    for (std::size_t v = 0; v < nv; ++v) {
+        grid.xyz[3 * v] = m.vertices[v].x();
+        grid.xyz[3 * v + 1] = m.vertices[v].y();
+    }
+    grid.connectivity.resize(3 * nt);
+    grid.offsets.resize(nt);
+    for (std::size_t t = 0; t < nt; ++t) {
+        for (std::size_t k = 0; k < 3; ++k)
+            grid.connectivity[3 * t + k] = m.triangles[t][k];
+        grid.offsets[t] = static_cast<std::int64_t>(3 * (t + 1));
+    }
+    grid.types.assign(nt, detail::kVtkTriangle);
+    detail::write_vtu_grid(file, std::move(grid), point_fields, cell_fields);
 }
 
 } // namespace

@@ -25,7 +25,7 @@ import tempfile as _tempfile
 import numpy as _np
 
 from . import _core
-from ._core import Result, Scene, SolverBreakdown
+from ._core import Result, Scene, SolverBreakdown, TetMesh, write_pvd
 
 __version__ = _core.__version__
 SolverBreakdown.__doc__ = """A numerical breakdown during solve(): a NaN or Inf, or a singular Newton
@@ -35,7 +35,7 @@ system (a RuntimeError; the driver exits 3 for the same condition)."""
 STATUS_NAMES = tuple(_core.status_names)
 GAP, STICK, SLIP_FORWARD, SLIP_BACKWARD = range(4)
 
-__all__ = ["Scene", "Result", "solve", "NotConverged", "SolverBreakdown", "UnknownKey", "BadType",
+__all__ = ["Scene", "Result", "TetMesh", "write_pvd", "solve", "NotConverged", "SolverBreakdown", "UnknownKey", "BadType",
            "study_status_transfer", "study_accuracy", "tractions", "STATUS_NAMES", "__version__"]
 
 
