@@ -7,8 +7,9 @@
 
 namespace mlc::fem {
 
-DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<int>& n_extra,
-               const std::vector<int>& order) {
+template <int dim>
+BasicDofMap<dim>::BasicDofMap(const std::vector<std::array<bool, dim>>& fixed,
+                              const std::vector<int>& n_extra, const std::vector<int>& order) {
     MLC_CHECK(fixed.size() == n_extra.size(),
               "DofMap: " << fixed.size() << " fixed flags for " << n_extra.size() << " vertices");
     const size_t nv = fixed.size();
@@ -27,7 +28,7 @@ DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<
     int next = 0;
     for (size_t pos = 0; pos < nv; ++pos) {
         const size_t v = order.empty() ? pos : static_cast<size_t>(order[pos]);
-        for (size_t c = 0; c < 2; ++c) {
+        for (size_t c = 0; c < dim; ++c) {
             if (fixed[v][c]) {
                 u_dof_[v][c] = -1;
             } else {
@@ -37,7 +38,7 @@ DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<
                 ++n_u_;
             }
         }
-        MLC_CHECK(n_extra[v] >= 0 && n_extra[v] <= 2,
+        MLC_CHECK(n_extra[v] >= 0 && n_extra[v] <= dim,
                   "DofMap: vertex " << v << " asks for " << n_extra[v] << " extra unknowns");
         if (n_extra[v] > 0) {
             extra_[v] = next;
@@ -51,18 +52,22 @@ DofMap::DofMap(const std::vector<std::array<bool, 2>>& fixed, const std::vector<
     n_dofs_ = next;
 }
 
-void DofMap::expand(const Vector& x, const Vector& u_fixed, Vector& u_full) const {
+template <int dim>
+void BasicDofMap<dim>::expand(const Vector& x, const Vector& u_fixed, Vector& u_full) const {
     const int nv = n_vertices();
-    u_full.resize(2 * nv);
+    u_full.resize(dim * nv);
     // The vertices over the threads (the Newton residual expands every iterate).
     parallel::for_rows(
         static_cast<size_t>(nv), parallel::kTouchRowsPerChunk / 2, [&](size_t b, size_t e) {
             for (auto v = static_cast<int>(b); v < static_cast<int>(e); ++v)
-                for (int c = 0; c < 2; ++c) {
+                for (int c = 0; c < dim; ++c) {
                     const int d = u_dof_[static_cast<size_t>(v)][static_cast<size_t>(c)];
-                    u_full[2 * v + c] = d >= 0 ? x[d] : u_fixed[2 * v + c];
+                    u_full[dim * v + c] = d >= 0 ? x[d] : u_fixed[dim * v + c];
                 }
         });
 }
+
+template class BasicDofMap<2>;
+template class BasicDofMap<3>;
 
 } // namespace mlc::fem
