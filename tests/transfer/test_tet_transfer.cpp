@@ -4,6 +4,7 @@
 // unknowns, on levels 0..3 of a Kuhn box and of a Gmsh mesh.
 #include "mesh/io/gmsh_tet.hpp"
 #include "mesh/tet_refine.hpp"
+#include "tests/common/random.hpp"
 #include "tests/mesh/tet_test_meshes.hpp"
 #include "transfer/tet_transfer.hpp"
 
@@ -56,12 +57,7 @@ Vector linear_field(const TetMesh& m, const Vec3& grad, double c) {
 }
 
 Vector random_field(int n, unsigned seed) {
-    std::mt19937 gen(seed);
-    std::uniform_real_distribution<double> d(-1.0, 1.0);
-    Vector u(n);
-    for (int i = 0; i < n; ++i)
-        u[i] = d(gen);
-    return u;
+    return testutil::random_vector(n, seed);
 }
 
 /// The coarse P1 field u evaluated at every fine vertex, through the barycentric coordinates of
