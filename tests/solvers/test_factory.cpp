@@ -47,7 +47,8 @@ TEST(Factory, ParsesOptionsIntoTheirStruct) {
     EXPECT_EQ(parse_pc("ilu:4").get<IluOptions>().k, 4);
     EXPECT_EQ(parse_pc("ilu:k=4"), parse_pc("ilu:4"));
     EXPECT_EQ(parse_pc(" MG : post=2 , pre=0 ").text(), "mg:pre=0,post=2");
-    const MgOptions& m = parse_pc("mg:omega=0.8,pre=0,post=2,smoother=lattice").get<MgOptions>();
+    const PcSpec mg = parse_pc("mg:omega=0.8,pre=0,post=2,smoother=lattice");
+    const MgOptions& m = mg.get<MgOptions>();
     EXPECT_EQ(m.omega, 0.8);
     EXPECT_EQ(m.pre, 0);
     EXPECT_EQ(m.post, 2);

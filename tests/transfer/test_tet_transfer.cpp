@@ -229,8 +229,14 @@ TEST(TetTransfer, RefusesSupportsThatDoNotNestAndBadNumberings) {
     auto ff = std::vector<std::array<bool, 3>>(static_cast<size_t>(fine.n_vertices()),
                                                {false, false, false});
     fc[5][1] = true; // uy of coarse vertex 5 prescribed on the coarse level only
-    const auto [uc, nc] = number(fc, true);
-    const auto [uf, nf] = number(ff, true);
+    // Named copies, not structured bindings: clang 14 (the sanitizer build) refuses to capture
+    // structured bindings in a lambda.
+    const auto coarse_numbering = number(fc, true);
+    const auto fine_numbering = number(ff, true);
+    const auto& uc = coarse_numbering.first;
+    const int nc = coarse_numbering.second;
+    const auto& uf = fine_numbering.first;
+    const int nf = fine_numbering.second;
     tmesh::expect_invalid([&] { restrict_to_unknowns(P, 3, uc, nc, uf, nf); },
                           {"component 1 of coarse vertex 5", "supports must nest"});
     auto twice = uf;
