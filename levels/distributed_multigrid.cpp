@@ -21,6 +21,57 @@
 namespace mlc::levels {
 
 /// The Newton systems of the distributed levels and their multigrid (distributed_solve.hpp).
+namespace {
+/// The pattern of J's diagonal block, K's (`Kd`, compressed, sorted rows) merged row by row
+/// with the contact entries of the owned rows (`centries`: (row, column), row -1 for a row
+/// owned elsewhere, columns >= n in the off-diagonal block), into `J` (zero values, sorted
+/// rows: the pattern setFromTriplets would give, without sorting K's entries again).
+/// Returns the position in J of every entry of Kd, in Kd's order.
+std::vector<int> merge_diagonal_pattern(const SparseMatrix& Kd,
+                                        const std::vector<std::pair<int, int>>& centries,
+                                        SparseMatrix& J) {
+    const int n = static_cast<int>(Kd.rows());
+    std::vector<std::pair<int, int>> dc;
+    for (const auto& [r, c] : centries)
+        if (r >= 0 && c < n) dc.emplace_back(r, c);
+    std::sort(dc.begin(), dc.end());
+    dc.erase(std::unique(dc.begin(), dc.end()), dc.end());
+    const int* ko = Kd.outerIndexPtr();
+    const int* ki = Kd.innerIndexPtr();
+    J.resize(n, n);
+    int* jo = J.outerIndexPtr();
+    jo[0] = 0;
+    size_t q = 0;
+    for (int i = 0; i < n; ++i) {
+        int count = ko[i + 1] - ko[i];
+        for (; q < dc.size() && dc[q].first == i; ++q)
+            count += !std::binary_search(ki + ko[i], ki + ko[i + 1], dc[q].second);
+        jo[i + 1] = jo[i] + count;
+    }
+    J.resizeNonZeros(jo[n]);
+    int* ji = J.innerIndexPtr();
+    std::fill_n(J.valuePtr(), jo[n], 0.0);
+    std::vector<int> kpos(static_cast<size_t>(ko[n]));
+    q = 0;
+    for (int i = 0; i < n; ++i) {
+        int a = ko[i], out = jo[i];
+        while (a < ko[i + 1] || (q < dc.size() && dc[q].first == i)) {
+            const bool from_k = a < ko[i + 1];
+            const bool from_c = q < dc.size() && dc[q].first == i;
+            if (from_k && (!from_c || ki[a] <= dc[q].second)) {
+                if (from_c && ki[a] == dc[q].second) ++q;
+                kpos[static_cast<size_t>(a)] = out;
+                ji[out++] = ki[a++];
+            } else {
+                ji[out++] = dc[q++].second;
+            }
+        }
+        MLC_ASSERT(out == jo[i + 1], "merged row of the wrong length");
+    }
+    return kpos;
+}
+} // namespace
+
 struct DistributedMultigrid::Impl final : solvers::VCycle {
     Impl(const std::vector<DistributedLevel>& levels,
          const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
@@ -368,21 +419,12 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
             MLC_ASSERT(it != col_map.end() && *it == g, "an off-diagonal column is not mapped");
             return static_cast<int>(it - col_map.begin());
         };
-        std::vector<Eigen::Triplet<double>> trip;
-        trip.reserve(static_cast<size_t>(Kb.diag.nonZeros()) + centries.size());
-        for (int i = 0; i < n; ++i)
-            for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
-                trip.emplace_back(i, it.col(), 0.0);
-        for (auto [r, c] : centries)
-            if (r >= 0 && c < n) trip.emplace_back(r, c, 0.0);
-        B.diag.resize(n, n);
-        B.diag.setFromTriplets(trip.begin(), trip.end());
-        B.diag.makeCompressed();
+        o.kpos = merge_diagonal_pattern(Kb.diag, centries, B.diag);
         if (!offd_grows) {
             B.offd = Kb.offd;
             B.col_map = Kb.col_map;
         } else {
-            trip.clear();
+            std::vector<Eigen::Triplet<double>> trip;
             for (int i = 0; i < n; ++i)
                 for (SparseMatrix::InnerIterator it(Kb.offd, i); it; ++it)
                     trip.emplace_back(i, offd_col(Kb.col_map[static_cast<size_t>(it.col())]), 0.0);
@@ -394,7 +436,6 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
             B.offd.makeCompressed();
             B.col_map = col_map;
         }
-        trip = {};
         auto position = [](const SparseMatrix& A, int row, int col) {
             const int* begin = A.innerIndexPtr() + A.outerIndexPtr()[row];
             const int* end = A.innerIndexPtr() + A.outerIndexPtr()[row + 1];
@@ -402,10 +443,6 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
             MLC_ASSERT(it != end && *it == col, "Jacobian pattern misses an entry");
             return static_cast<int>(it - A.innerIndexPtr());
         };
-        o.kpos.reserve(static_cast<size_t>(Kb.diag.nonZeros()));
-        for (int i = 0; i < n; ++i)
-            for (SparseMatrix::InnerIterator it(Kb.diag, i); it; ++it)
-                o.kpos.push_back(position(B.diag, i, static_cast<int>(it.col())));
         if (offd_grows)
             for (int i = 0; i < n; ++i)
                 for (SparseMatrix::InnerIterator it(Kb.offd, i); it; ++it)

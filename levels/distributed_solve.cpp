@@ -110,8 +110,11 @@ solvers::MultigridParams check_distributable(const Problem& problem, const Solve
 void build_distributed_levels(const Problem& problem, const SolveOptions& options,
                               const Communicator& comm, int p, DistributedRunResult& res) {
     mesh::Mesh mp = problem.mesh0;
-    for (int l = 0; l < p; ++l)
-        mp = mesh::refine(mp);
+    {
+        ScopedTimer t(&res.timings, "setup/refine");
+        for (int l = 0; l < p; ++l)
+            mp = mesh::refine(mp);
+    }
     {
         // The partition and the refined parts, then each part's levels (as "setup/levels" of
         // one process: numbering, assembly, contact elements).
@@ -368,6 +371,7 @@ void DistributedSteps::accept_level(size_t k, double s, const Vector& xo) {
     D.ghosts.update(Lk.dofs, x_[k]);
     Lk.dofs.expand(x_[k], Lk.u_fixed_at(s), u_now_[k]);
     if (k < m_) {
+        ScopedTimer t(&res_.timings, "distributed/prepare_level");
         Vector R;
         std::vector<Eigen::Matrix2d> converged;
         newton_[k]->residual(s, u_prev_[k], xo, R, nullptr, &converged, nullptr);
@@ -416,7 +420,11 @@ DistributedRunResult solve_distributed(const Problem& problem, const SolveOption
     res.partition_level = p;
     res.mg = check_distributable(problem, options, comm, p);
     build_distributed_levels(problem, options, comm, p, res);
+    // The distributed multigrid (each level's ParCSR Jacobian and transfer) and the Newton
+    // solvers, as one process's "setup/linear_solver".
+    std::optional<ScopedTimer> t_solver(std::in_place, &res.timings, "setup/linear_solver");
     DistributedSteps steps(problem, options, comm, p, observer, res);
+    t_solver.reset();
     // Levels 0..p on every process alike, each converged step of level p continued on the
     // distributed levels; a distributed level that fails stops the serial solve.
     DistributedObserver serial_observer(steps, observer, comm.rank() == 0);
