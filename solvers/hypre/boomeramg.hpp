@@ -42,10 +42,11 @@ struct BoomerAMGParams {
 };
 
 /// The settings for 3D linear elasticity (interleaved x, y, z per vertex): num_functions 3,
-/// nodal coarsening (norm 4, nodal_diag 1), the rigid-body modes as interpolation vectors (GM
-/// variant 2, Q truncated to 4 entries per row, smoothed once, one refinement step), strong
-/// threshold 0.5 (hypre's value for 3D), HMIS, extended+i interpolation truncated to 4,
-/// l1-symmetric hybrid Gauss-Seidel.
+/// nodal coarsening (norm 4, nodal_diag 1), interpolation vectors (the rotational rigid-body
+/// modes; GM variant 2, Q truncated to 4 entries per row, smoothed once, one refinement step),
+/// strong threshold 0.5 (hypre's value for 3D), one level of aggressive coarsening (without it
+/// the interpolation vectors raise the memory of the AMG hierarchy about threefold), HMIS,
+/// extended+i interpolation truncated to 4, l1-symmetric hybrid Gauss-Seidel.
 BoomerAMGParams boomeramg_elasticity3d();
 
 /// Threads hypre's kernels run on: OpenMP's maximum when hypre was built with OpenMP, else 1.

@@ -49,6 +49,7 @@ BoomerAMGParams boomeramg_elasticity3d() {
     p.interp_vec_q_max = 4;
     p.smooth_interp_vectors = 1;
     p.interp_refine = 1;
+    p.agg_num_levels = 1;
     return p;
 }
 int hypre_threads() {
