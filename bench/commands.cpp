@@ -61,13 +61,16 @@ Action add_elastic(CLI::App& bel) {
     };
     auto a = std::make_shared<Args>();
     bel.add_option("scene", a->o.scene, "scene file or built-in name (default square)");
-    bel.add_option("--levels,-l", a->o.levels, "level of the elastic block (default 3)");
+    auto* levels = bel.add_option("--levels,-l", a->o.levels,
+                                  "level of the elastic block (default 3; a 3D scene: its "
+                                  "[scene].levels)");
     bel.add_option("--tol", a->o.rel_tol, "relative tolerance of every solve (default 1e-8)");
     bel.add_option("--max-iter", a->o.max_iter, "iterations of every solve (default 1000)");
     bel.add_option("--repeat", a->o.repeat, "runs per solver, times are medians (default 1)");
     bel.add_option("--out,-o", a->out, "JSON file (default out/bench/elastic_<scene>_L<L>.json)");
-    return [a](const Launch& at) {
+    return [a, levels](const Launch& at) {
         a->o.out = a->out;
+        a->o.levels_from_scene = levels->count() == 0;
         if (at.distributed) return bench_elastic_distributed(a->o, comm::world(), at.os);
         return bench_elastic(a->o, at.os);
     };

@@ -17,6 +17,7 @@
 #include "levels/newton_system.hpp"
 #include "levels/solve.hpp"
 #include "scene/scene.hpp"
+#include "scene/scene3.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
 #include "solvers/hypre/boomeramg.hpp"
@@ -516,6 +517,7 @@ struct ElasticResult {
 } // namespace
 
 int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
+    if (scene::scene_dimension(opt.scene) == 3) return bench_elastic3d(opt, os);
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 8,
               "bench elastic: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench elastic: --repeat must be >= 1, found " << opt.repeat);

@@ -218,4 +218,9 @@ void parse_contacts(const Reader& rd, const toml::table& root, levels::Problem& 
 //// contactor nodes, matching node pairs match) becomes mesh0. Called on a parsed, valid problem.
 void recover_levels(levels::Problem& p);
 
+/// A 2D parse of a scene whose [scene] table (`scene_table`) states a dimension: 3 is refused
+/// naming what runs 3D scenes, anything but 2 is refused, and `dimension = 2` is removed from
+/// the table (a 2D scene may state it). scene3.cpp.
+void refuse_3d_scene(const Reader& rd, const toml::table& root, toml::table& scene_table);
+
 } // namespace mlc::scene::detail

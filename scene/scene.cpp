@@ -294,6 +294,7 @@ levels::Problem parse_scene(const std::string& text, const std::string& origin,
     std::array<std::string_view, kSections.size()> keys;
     for (size_t i = 0; i < kSections.size(); ++i)
         keys[i] = kSections[i].key;
+    if (toml::table* st = root["scene"].as_table()) detail::refuse_3d_scene(rd, root, *st);
     rd.check_keys(root, keys, "the scene");
     SceneParse sp{rd, base_dir, {}};
     for (const Section& s : kSections)

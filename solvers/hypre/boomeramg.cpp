@@ -12,8 +12,12 @@
 #include <HYPRE.h>
 #include <HYPRE_krylov.h>
 #include <HYPRE_parcsr_ls.h>
+#include <_hypre_parcsr_ls.h> // SetSmoothInterpVectors, SetInterpRefine
 #include <_hypre_parcsr_mv.h>
 #include <mpi.h>
+#ifdef HYPRE_USING_OPENMP
+#include <omp.h>
+#endif
 
 #include <cmath>
 #include <cstdlib>
@@ -30,13 +34,47 @@ void BoomerAMGParams::validate() const {
               "BoomerAMG: strong_threshold must be in (0, 1), found " << strong_threshold);
     MLC_CHECK(p_max_elmts >= 0, "BoomerAMG: p_max_elmts must be >= 0, found " << p_max_elmts);
     MLC_CHECK(agg_num_levels >= 0, "BoomerAMG: agg_num_levels must be >= 0, found " << agg_num_levels);
+    MLC_CHECK(interp_vec_variant >= 0 && interp_vec_variant <= 3,
+              "BoomerAMG: interp_vec_variant must be in 0..3, found " << interp_vec_variant);
+    MLC_CHECK(interp_vec_variant == 0 || nodal > 0,
+              "BoomerAMG: interpolation vectors need nodal coarsening (nodal >= 1)");
+    MLC_CHECK(nodal_diag >= 0 && interp_vec_q_max >= 0 && smooth_interp_vectors >= 0 &&
+                  interp_refine >= 0,
+              "BoomerAMG: nodal_diag, interp_vec_q_max, smooth_interp_vectors and interp_refine "
+              "must be >= 0");
+}
+
+BoomerAMGParams boomeramg_elasticity3d() {
+    BoomerAMGParams p;
+    p.num_functions = 3;
+    p.nodal = 4;
+    p.nodal_diag = 1;
+    p.strong_threshold = 0.5;
+    p.interp_vec_variant = 2;
+    p.interp_vec_q_max = 4;
+    p.smooth_interp_vectors = 1;
+    p.interp_refine = 1;
+    p.agg_num_levels = 1;
+    return p;
+}
+
+int hypre_threads() {
+#ifdef HYPRE_USING_OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
 }
 
 std::ostream& operator<<(std::ostream& os, const BoomerAMGParams& p) {
     return os << "BoomerAMGParams{num_functions=" << p.num_functions << ", nodal=" << p.nodal
               << ", strong_threshold=" << p.strong_threshold << ", coarsen_type=" << p.coarsen_type
               << ", interp_type=" << p.interp_type << ", p_max_elmts=" << p.p_max_elmts
-              << ", relax_type=" << p.relax_type << ", agg_num_levels=" << p.agg_num_levels << "}";
+              << ", relax_type=" << p.relax_type << ", agg_num_levels=" << p.agg_num_levels
+              << ", nodal_diag=" << p.nodal_diag << ", interp_vec_variant=" << p.interp_vec_variant
+              << ", interp_vec_q_max=" << p.interp_vec_q_max
+              << ", smooth_interp_vectors=" << p.smooth_interp_vectors
+              << ", interp_refine=" << p.interp_refine << "}";
 }
 
 bool have_hypre() { return true; }
@@ -133,6 +171,14 @@ HYPRE_Solver create_boomeramg(const BoomerAMGParams& p, bool as_preconditioner,
         HYPRE_BoomerAMGSetDofFunc(amg, f);
     }
     if (p.nodal > 0) HYPRE_BoomerAMGSetNodal(amg, p.nodal);
+    if (p.nodal_diag > 0) HYPRE_BoomerAMGSetNodalDiag(amg, p.nodal_diag);
+    if (p.interp_vec_variant > 0) {
+        HYPRE_BoomerAMGSetInterpVecVariant(amg, p.interp_vec_variant);
+        if (p.interp_vec_q_max > 0) HYPRE_BoomerAMGSetInterpVecQMax(amg, p.interp_vec_q_max);
+        if (p.smooth_interp_vectors > 0)
+            HYPRE_BoomerAMGSetSmoothInterpVectors(amg, p.smooth_interp_vectors);
+        if (p.interp_refine > 0) HYPRE_BoomerAMGSetInterpRefine(amg, p.interp_refine);
+    }
     HYPRE_BoomerAMGSetStrongThreshold(amg, p.strong_threshold);
     HYPRE_BoomerAMGSetCoarsenType(amg, p.coarsen_type);
     HYPRE_BoomerAMGSetInterpType(amg, p.interp_type);
@@ -195,9 +241,45 @@ std::string BoomerAMGPreconditioner::name() const {
     return os.str();
 }
 
+namespace {
+
+/// Near-null-space vectors in hypre, alive until destroyed (after the AMG that reads them).
+struct InterpVectors {
+    std::vector<HYPRE_IJVector> ij;
+    std::vector<HYPRE_ParVector> par;
+    InterpVectors(const std::vector<Vector>& v, const std::vector<HYPRE_BigInt>& rows) {
+        const auto n = static_cast<HYPRE_Int>(rows.size());
+        for (const Vector& x : v) {
+            MLC_CHECK(x.size() == n, "BoomerAMG: an interpolation vector has "
+                                         << x.size() << " entries for " << n << " unknowns");
+            HYPRE_IJVector iv = nullptr;
+            HYPRE_IJVectorCreate(MPI_COMM_SELF, 0, n - 1, &iv);
+            HYPRE_IJVectorSetObjectType(iv, HYPRE_PARCSR);
+            HYPRE_IJVectorInitialize(iv);
+            HYPRE_IJVectorSetValues(iv, n, rows.data(), x.data());
+            HYPRE_IJVectorAssemble(iv);
+            HYPRE_ParVector pv = nullptr;
+            HYPRE_IJVectorGetObject(iv, reinterpret_cast<void**>(&pv));
+            ij.push_back(iv);
+            par.push_back(pv);
+        }
+    }
+    ~InterpVectors() {
+        for (HYPRE_IJVector v : ij)
+            HYPRE_IJVectorDestroy(v);
+    }
+    InterpVectors(const InterpVectors&) = delete;
+    InterpVectors& operator=(const InterpVectors&) = delete;
+};
+
+} // namespace
+
 SolveResult boomeramg_pcg(const SparseMatrix& A, const Vector& b, Vector& x, double rel_tol,
                           int max_iter, const BoomerAMGParams& params,
-                          const std::vector<int>& dof_func) {
+                          const std::vector<int>& dof_func,
+                          const std::vector<Vector>& interp_vectors) {
+    MLC_CHECK(interp_vectors.empty() || params.interp_vec_variant > 0,
+              "boomeramg_pcg: interpolation vectors given but params.interp_vec_variant is 0");
     params.validate();
     smoothers::check_setup_matrix(A, "boomeramg_pcg");
     smoothers::check_size(b, A.rows(), "boomeramg_pcg", "b");
@@ -211,7 +293,11 @@ SolveResult boomeramg_pcg(const SparseMatrix& A, const Vector& b, Vector& x, dou
     res.initial_residual = r.norm();
     const double t0 = wall_seconds();
     BoomerAMGPreconditioner::Impl h(A);
+    const InterpVectors iv(interp_vectors, h.rows);
     h.create_amg(params, true, dof_func);
+    if (!iv.par.empty())
+        HYPRE_BoomerAMGSetInterpVectors(h.amg, static_cast<HYPRE_Int>(iv.par.size()),
+                                        const_cast<HYPRE_ParVector*>(iv.par.data()));
     h.set_vector(h.ij_b, b);
     h.set_vector(h.ij_x, x);
     HYPRE_Solver pcg = nullptr;

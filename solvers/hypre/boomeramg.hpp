@@ -31,8 +31,26 @@ struct BoomerAMGParams {
     int p_max_elmts = 4;          ///< SetPMaxElmts: interpolation truncation (0: none)
     int relax_type = 8;           ///< SetRelaxType: 8 l1-symmetric hybrid Gauss–Seidel
     int agg_num_levels = 0;       ///< SetAggNumLevels: aggressive coarsening levels
+    /// Elasticity options (hypre's settings for systems with near-null-space vectors; 0 leaves
+    /// hypre's default and is what the 2D elastic block runs with):
+    int nodal_diag = 0;            ///< SetNodalDiag: diagonal of the nodal strength matrix
+    int interp_vec_variant = 0;    ///< SetInterpVecVariant: 1, 2 (GM), 3 (LN); needs nodal
+    int interp_vec_q_max = 0;      ///< SetInterpVecQMax: entries per row of the added Q
+    int smooth_interp_vectors = 0; ///< SetSmoothInterpVectors: 1 smooths the vectors
+    int interp_refine = 0;         ///< SetInterpRefine: steps of interpolation refinement
     void validate() const;
 };
+
+/// The settings for 3D linear elasticity (interleaved x, y, z per vertex): num_functions 3,
+/// nodal coarsening (norm 4, nodal_diag 1), interpolation vectors (the rotational rigid-body
+/// modes; GM variant 2, Q truncated to 4 entries per row, smoothed once, one refinement step),
+/// strong threshold 0.5 (hypre's value for 3D), one level of aggressive coarsening (without it
+/// the interpolation vectors raise the memory of the AMG hierarchy about threefold), HMIS,
+/// extended+i interpolation truncated to 4, l1-symmetric hybrid Gauss-Seidel.
+BoomerAMGParams boomeramg_elasticity3d();
+
+/// Threads hypre's kernels run on: OpenMP's maximum when hypre was built with OpenMP, else 1.
+int hypre_threads();
 
 std::ostream& operator<<(std::ostream& os, const BoomerAMGParams& p);
 
@@ -73,9 +91,12 @@ private:
 /// Returns iterations, residuals and the setup (AMG hierarchy) and solve seconds separately.
 /// x holds the initial guess on entry (resized to zero if empty).
 /// `dof_func`: as BoomerAMGPreconditioner::set_dof_func (empty: interleaved).
+/// `interp_vectors`: the near-null-space vectors (rigid-body modes, A.rows() entries each) for
+/// HYPRE_BoomerAMGSetInterpVectors; needs params.interp_vec_variant > 0 and params.nodal > 0.
 SolveResult boomeramg_pcg(const SparseMatrix& A, const Vector& b, Vector& x, double rel_tol,
                           int max_iter, const BoomerAMGParams& params = {},
-                          const std::vector<int>& dof_func = {});
+                          const std::vector<int>& dof_func = {},
+                          const std::vector<Vector>& interp_vectors = {});
 
 /// Collective (every process of A's communicator): hypre's ParCSR PCG preconditioned by BoomerAMG
 /// on the distributed A x = b to ||b - A x|| <= rel_tol ||b|| (two-norm, over all processes),

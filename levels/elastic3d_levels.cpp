@@ -1,0 +1,315 @@
+// SPDX-License-Identifier: MIT
+// 3D elastic levels: sizes and memory predicted from level 0, the levels and transfers, and the
+// multigrid on them.
+#include "levels/elastic3d_levels.hpp"
+
+#include "core/check.hpp"
+#include "fem/elastic3d.hpp"
+#include "mesh/tet_refine.hpp"
+#include "transfer/tet_transfer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace mlc::levels {
+
+namespace {
+
+/// The support's vertices on mesh m (a tagged face's, or the point's level-0 vertex).
+std::vector<int> support_vertices(const ElasticProblem3& p, const Support3& s,
+                                  const mesh::TetMesh& m) {
+    if (!s.tag.empty()) return fem::face_vertices(m, m.tag(s.tag));
+    return {p.mesh0.nearest_vertex(*s.point)};
+}
+
+/// Relative distance under which a support point is a vertex.
+constexpr double kPointTol = 1e-9;
+
+} // namespace
+
+void ElasticProblem3::validate() const {
+    MLC_CHECK(!bodies.empty(), "the 3D problem has no body");
+    MLC_CHECK(levels >= 0 && levels <= kMaxLevels3,
+              "levels must lie in [0, " << kMaxLevels3 << "], found " << levels);
+    MLC_CHECK(mesh0.n_tetrahedra() > 0, "the 3D problem's mesh has no tetrahedra");
+    for (size_t t = 0; t < mesh0.attribute.size(); ++t)
+        MLC_CHECK(mesh0.attribute[t] >= 0 && mesh0.attribute[t] < static_cast<int>(bodies.size()),
+                  "tetrahedron " << t << " belongs to body " << mesh0.attribute[t] << ", but "
+                                 << bodies.size() << " bodies are given");
+    for (const Body3& b : bodies) {
+        b.material.validate();
+        MLC_CHECK(b.material.plane == fem::Plane::strain,
+                  "body '" << b.name << "': plane stress is a 2D reduction");
+        MLC_CHECK(b.body_force.allFinite(), "body '" << b.name << "': body force not finite");
+    }
+    for (const FaceLoad3& l : loads) {
+        MLC_CHECK(mesh0.find_tag(l.tag) && mesh0.is_boundary_tag(mesh0.tag(l.tag)),
+                  "load: no boundary face carries the tag '" << l.tag << "'");
+        MLC_CHECK(std::isfinite(l.pressure) && l.traction.allFinite(),
+                  "load on '" << l.tag << "' is not finite");
+    }
+    for (const Support3& s : supports) {
+        MLC_CHECK(s.u[0] || s.u[1] || s.u[2], "a support fixes nothing: give ux, uy and/or uz");
+        MLC_CHECK(s.tag.empty() != !s.point, "a support takes a tag or a point");
+        if (!s.tag.empty()) {
+            MLC_CHECK(mesh0.find_tag(s.tag) && mesh0.is_boundary_tag(mesh0.tag(s.tag)),
+                      "support: no boundary face carries the tag '" << s.tag << "'");
+        } else {
+            const int v = mesh0.nearest_vertex(*s.point);
+            const double d = (mesh0.vertices[static_cast<size_t>(v)] - *s.point).norm();
+            MLC_CHECK(d <= kPointTol * mesh0.diameter(),
+                      "support point (" << s.point->x() << ", " << s.point->y() << ", "
+                                        << s.point->z()
+                                        << ") is no vertex of the level-0 mesh (the nearest "
+                                           "vertex lies "
+                                        << d << " away)");
+        }
+    }
+}
+
+// ------------------------------------------------------------------------------------------
+
+std::vector<int> ElasticLevel3::vertex_of_dof() const {
+    std::vector<int> out(static_cast<size_t>(dofs.n_dofs()));
+    for (Index i = 0; i < dofs.n_dofs(); ++i)
+        out[static_cast<size_t>(i)] = dofs.vertex_of(i);
+    return out;
+}
+
+ElasticLevel3 build_elastic_level3(const ElasticProblem3& p, mesh::TetMesh m) {
+    ElasticLevel3 L;
+    std::vector<fem::VertexSupport> vs;
+    for (const Support3& s : p.supports) {
+        fem::VertexSupport v;
+        v.vertices = support_vertices(p, s, m);
+        for (int c = 0; c < 3; ++c) {
+            v.components[static_cast<size_t>(c)] = s.u[static_cast<size_t>(c)].has_value();
+            v.value[c] = s.u[static_cast<size_t>(c)].value_or(0.0);
+        }
+        vs.push_back(std::move(v));
+    }
+    fem::Supports3 sup = fem::collect_supports(m, vs);
+    L.dofs = fem::DofMap3(sup.fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
+    L.u_fixed = std::move(sup.u_fixed);
+    std::vector<fem::Traction3> tr;
+    for (const FaceLoad3& l : p.loads)
+        tr.push_back({m.tag(l.tag), l.pressure, l.traction});
+    std::vector<Vec3> bf;
+    std::vector<fem::Material> mats;
+    bool any_force = false;
+    for (const Body3& b : p.bodies) {
+        bf.push_back(b.body_force);
+        mats.push_back(b.material);
+        any_force = any_force || !b.body_force.isZero(0.0);
+    }
+    const Vector F = fem::nodal_loads(m, tr, any_force ? bf : std::vector<Vec3>{});
+    L.system = fem::assemble_elastic(m, mats, L.dofs, F, L.u_fixed);
+    L.mesh = std::move(m);
+    return L;
+}
+
+ElasticHierarchy3 build_elastic_hierarchy3(const ElasticProblem3& p, int levels) {
+    p.validate();
+    MLC_CHECK(levels >= 0 && levels <= kMaxLevels3,
+              "levels must lie in [0, " << kMaxLevels3 << "], found " << levels);
+    ElasticHierarchy3 h;
+    h.levels.push_back(build_elastic_level3(p, p.mesh0));
+    h.T.emplace_back();
+    h.R.emplace_back();
+    for (int l = 1; l <= levels; ++l) {
+        mesh::TetMesh fine = mesh::refine(h.levels.back().mesh);
+        mesh::check_refined_quality(fine);
+        const SparseMatrix Pv = transfer::tet_vertex_prolongation(fine);
+        ElasticLevel3 L = build_elastic_level3(p, std::move(fine));
+        const ElasticLevel3& C = h.levels.back();
+        SparseMatrix T = transfer::restrict_to_unknowns(
+            Pv, 3, transfer::vertex_unknowns(C.dofs, 3), static_cast<int>(C.dofs.n_dofs()),
+            transfer::vertex_unknowns(L.dofs, 3), static_cast<int>(L.dofs.n_dofs()));
+        h.R.emplace_back(T.transpose());
+        h.T.push_back(std::move(T));
+        h.levels.push_back(std::move(L));
+    }
+    return h;
+}
+
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h,
+                                                       solvers::MultigridParams params) {
+    MLC_CHECK(h.levels.size() >= 2,
+              "the 3D multigrid needs at least two levels (levels >= 1), found "
+                  << h.levels.size());
+    MLC_CHECK(params.smoother != solvers::MultigridParams::Smoother::lattice,
+              "mg:smoother=lattice sweeps the lattices of 2D macro triangles (2D-only); a 3D "
+              "hierarchy is swept by vertex blocks (smoother=block)");
+    const size_t n = h.levels.size();
+    std::vector<solvers::MultigridLevelData> data(n);
+    for (size_t l = 0; l < n; ++l) {
+        if (l > 0) {
+            data[l].T = &h.T[l];
+            data[l].R = &h.R[l];
+        }
+        data[l].block_starts = solvers::vertex_block_starts(h.levels[l].vertex_of_dof());
+    }
+    auto mg = std::make_unique<solvers::Multigrid>(std::move(data), params);
+    for (size_t l = 0; l + 1 < n; ++l)
+        mg->set_operator(static_cast<int>(l), h.levels[l].system.K);
+    mg->setup(h.levels[n - 1].system.K);
+    return mg;
+}
+
+std::vector<Vector> rigid_body_modes3(const ElasticLevel3& L) {
+    const mesh::TetMesh& m = L.mesh;
+    Vec3 lo = m.vertices.front(), hi = m.vertices.front();
+    for (const Vec3& x : m.vertices) {
+        lo = lo.cwiseMin(x);
+        hi = hi.cwiseMax(x);
+    }
+    const Vec3 c = 0.5 * (lo + hi);
+    std::vector<Vector> modes(6, Vector::Zero(L.dofs.n_dofs()));
+    for (int v = 0; v < m.n_vertices(); ++v) {
+        const Vec3 r = m.vertices[static_cast<size_t>(v)] - c;
+        for (int k = 0; k < 3; ++k) {
+            // Rotation about axis k: e_k x r.
+            const Vec3 rot = Vec3::Unit(k).cross(r);
+            for (int comp = 0; comp < 3; ++comp) {
+                const int d = L.dofs.u_dof(v, comp);
+                if (d < 0) continue;
+                modes[static_cast<size_t>(k)][d] = comp == k ? 1.0 : 0.0;
+                modes[static_cast<size_t>(3 + k)][d] = rot[comp];
+            }
+        }
+    }
+    return modes;
+}
+
+// ------------------------------------------------------------------------------------------
+// Sizes and memory.
+
+namespace {
+
+/// Bytes per unit, fitted on the peak resident memory of `bench elastic` on box3d (levels 3
+/// and 4) and rounded up.
+constexpr double kBaseline3 = 16.0 * (1 << 20);
+// The hierarchy: per nonzero of K (its CSR) and per unknown (the DofMap3, loads, the two
+// transfers T and R, mesh arrays per vertex folded in).
+constexpr double kHierarchyPerNonzero3 = 12.5;
+constexpr double kHierarchyPerUnknown3 = 150.0;
+// The multigrid over all levels: smoother data and work vectors per unknown and nonzero.
+constexpr double kMgPerNonzero3 = 5.0;
+constexpr double kMgPerUnknown3 = 50.0;
+// BoomerAMG-PCG on the finest level (solvers::boomeramg_elasticity3d): hypre's copy of K and its
+// AMG hierarchy.
+constexpr double kAmgPerNonzero3 = 40.0;
+constexpr double kAmgPerUnknown3 = 0.0;
+
+} // namespace
+
+namespace {
+
+/// Fixed components on level l: per component, the vertices of the faces whose tags hold it
+/// (V' = V + E, E' = 2 E + 3 F, F' = 4 F over those faces), and the point supports' vertices
+/// (kept by refinement) off them.
+std::vector<double> predict_fixed_components(const ElasticProblem3& p, int levels) {
+    std::vector<double> fixed(static_cast<size_t>(levels) + 1, 0.0);
+    for (int c = 0; c < 3; ++c) {
+        std::set<int> tags;
+        std::set<int> points;
+        for (const Support3& s : p.supports) {
+            if (!s.u[static_cast<size_t>(c)]) continue;
+            if (!s.tag.empty())
+                tags.insert(p.mesh0.tag(s.tag));
+            else
+                points.insert(p.mesh0.nearest_vertex(*s.point));
+        }
+        std::set<std::array<int, 3>> faces;
+        std::set<std::pair<int, int>> edges;
+        std::set<int> verts;
+        for (const mesh::BoundaryFace& f : p.mesh0.boundary) {
+            if (!tags.count(f.tag)) continue;
+            std::array<int, 3> k = f.v;
+            std::sort(k.begin(), k.end());
+            if (!faces.insert(k).second) continue;
+            edges.insert({k[0], k[1]});
+            edges.insert({k[0], k[2]});
+            edges.insert({k[1], k[2]});
+            verts.insert(k.begin(), k.end());
+        }
+        double off = 0;
+        for (int v : points)
+            off += verts.count(v) ? 0.0 : 1.0;
+        double V = static_cast<double>(verts.size()), E = static_cast<double>(edges.size()),
+               F = static_cast<double>(faces.size());
+        for (int l = 0; l <= levels; ++l) {
+            fixed[static_cast<size_t>(l)] += V + off;
+            const double V1 = V + E, E1 = 2 * E + 3 * F, F1 = 4 * F;
+            V = V1;
+            E = E1;
+            F = F1;
+        }
+    }
+    return fixed;
+}
+
+} // namespace
+
+std::vector<ElasticLevelSize3> predict_elastic3_sizes(const ElasticProblem3& p, int levels) {
+    MLC_CHECK(levels >= 0 && levels <= kMaxLevels3,
+              "levels must lie in [0, " << kMaxLevels3 << "], found " << levels);
+    const std::vector<mesh::TetLevelSize> ms = mesh::predict_tet_level_sizes(p.mesh0, levels);
+    const ElasticLevel3 L0 = build_elastic_level3(p, p.mesh0);
+    const std::vector<double> fixed = predict_fixed_components(p, levels);
+    const double V0 = ms[0].vertices, E0 = ms[0].edges;
+    // The nonzeros the fixed components remove, per fixed component (level 0's ratio).
+    const double deficit0 = 9 * (V0 + 2 * E0) - static_cast<double>(L0.system.K.nonZeros());
+    const double per_fixed = fixed[0] > 0 ? deficit0 / fixed[0] : 0.0;
+    std::vector<ElasticLevelSize3> out;
+    for (const mesh::TetLevelSize& s : ms) {
+        ElasticLevelSize3 e;
+        e.level = s.level;
+        e.vertices = s.vertices;
+        e.edges = s.edges;
+        e.tetrahedra = s.tetrahedra;
+        const double f = fixed[static_cast<size_t>(s.level)];
+        e.unknowns = std::max(0.0, 3 * s.vertices - f);
+        e.k_nonzeros = std::max(0.0, 9 * (s.vertices + 2 * s.edges) - per_fixed * f);
+        out.push_back(e);
+    }
+    out[0].unknowns = static_cast<double>(L0.dofs.n_dofs());
+    out[0].k_nonzeros = static_cast<double>(L0.system.K.nonZeros());
+    return out;
+}
+
+ElasticMemory3 estimate_elastic3_memory(const std::vector<ElasticLevelSize3>& sizes) {
+    MLC_CHECK(!sizes.empty(), "estimate_elastic3_memory: no levels");
+    ElasticMemory3 e;
+    e.baseline_bytes = kBaseline3;
+    for (const ElasticLevelSize3& s : sizes) {
+        e.hierarchy_bytes +=
+            kHierarchyPerNonzero3 * s.k_nonzeros + kHierarchyPerUnknown3 * s.unknowns;
+        e.mg_bytes += kMgPerNonzero3 * s.k_nonzeros + kMgPerUnknown3 * s.unknowns;
+    }
+    // The coarse LU of level 0 (a small multiple of its nonzeros).
+    e.mg_bytes += 120.0 * sizes.front().k_nonzeros;
+    const ElasticLevelSize3& f = sizes.back();
+    e.amg_bytes = kAmgPerNonzero3 * f.k_nonzeros + kAmgPerUnknown3 * f.unknowns;
+    return e;
+}
+
+void check_elastic3_fits(const ElasticMemory3& e, const MemoryLimit& limit,
+                         const std::vector<ElasticLevelSize3>& sizes) {
+    if (e.bytes() <= limit.bytes) return;
+    const ElasticLevelSize3& f = sizes.back();
+    std::ostringstream os;
+    os << std::setprecision(3) << "the 3D elastic bench needs an estimated "
+       << format_bytes(e.bytes()) << " (finest level " << f.level << ": " << f.unknowns
+       << " unknowns, " << f.k_nonzeros << " nonzeros of K; multigrid " << format_bytes(e.mg_peak())
+       << ", BoomerAMG-PCG " << format_bytes(e.amg_peak()) << ") but this process may use "
+       << format_bytes(std::max(0.0, limit.bytes)) << " (" << limit.source
+       << "): use fewer --levels";
+    throw InvalidInput(os.str());
+}
+
+} // namespace mlc::levels

@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: MIT
+/// @file 3D linear elasticity over a hierarchy of tetrahedral levels: the problem a 3D scene
+/// describes (scene/scene3.hpp), its level sizes and memory predicted before anything is built,
+/// the levels (mesh refined 1->8, DofMap3, stiffness on the free unknowns, the P transfers
+/// restricted to the unknowns) and the geometric multigrid on them (solvers::Multigrid with
+/// rediscretized operators and 3 x 3 vertex blocks).
+#pragma once
+
+#include "core/types.hpp"
+#include "fem/assembly.hpp"
+#include "fem/dof_map.hpp"
+#include "fem/elasticity.hpp"
+#include "levels/resources.hpp"
+#include "mesh/tet_mesh.hpp"
+#include "solvers/mg.hpp"
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mlc::levels {
+
+using mesh::Vec3;
+
+/// One body of a 3D problem: the tetrahedra whose attribute is its index.
+struct Body3 {
+    std::string name;
+    fem::Material material;         ///< plane strain (the 3D law; no plane reduction)
+    Vec3 body_force = Vec3::Zero(); ///< per unit volume
+};
+
+/// A uniform pressure (positive pushing into the body) and traction (per unit area) on the
+/// boundary faces with a tag.
+struct FaceLoad3 {
+    std::string tag;
+    double pressure = 0.0;
+    Vec3 traction = Vec3::Zero();
+};
+
+/// Prescribed displacement components on the faces with a tag, or at a vertex of level 0 (a
+/// point; refinement keeps its index). Unset components are free.
+struct Support3 {
+    std::string tag;                          ///< a boundary tag, or empty for a point support
+    std::optional<Vec3> point;                ///< a level-0 vertex (for a point support)
+    std::array<std::optional<double>, 3> u{}; ///< ux, uy, uz
+};
+
+/// A 3D elastic problem: the level-0 mesh (attribute = body index), bodies, loads and supports,
+/// and the finest level.
+struct ElasticProblem3 {
+    std::string name, description, units;
+    mesh::TetMesh mesh0;
+    std::vector<Body3> bodies;
+    std::vector<FaceLoad3> loads;
+    std::vector<Support3> supports;
+    int levels = 0;
+    /// Throws InvalidInput naming the first defect: no body, an attribute without a body, a bad
+    /// material, a tag no boundary face carries, a point that is no level-0 vertex, a support
+    /// that fixes nothing, levels outside 0..12.
+    void validate() const;
+};
+
+/// Largest finest level of a 3D problem.
+inline constexpr int kMaxLevels3 = 12;
+
+/// Predicted size of one 3D elastic level.
+struct ElasticLevelSize3 {
+    int level = 0;
+    double vertices = 0, edges = 0, tetrahedra = 0;
+    double unknowns = 0;   ///< free displacement components
+    double k_nonzeros = 0; ///< of K on the unknowns
+};
+
+/// Sizes of levels 0..levels from the level-0 mesh alone (mesh::predict_tet_level_sizes; level
+/// 0's DofMap3 and stiffness counted). Unknowns are 3 V less the fixed components, exact: per
+/// component the vertices of the supported faces refine as V' = V + E, E' = 2 E + 3 F,
+/// F' = 4 F, and point supports stay. The nonzeros of K are 9 (V + 2 E) less level 0's deficit
+/// per fixed component times the fixed components.
+std::vector<ElasticLevelSize3> predict_elastic3_sizes(const ElasticProblem3& p, int levels);
+
+/// Estimated peak resident memory of `bench elastic` on a 3D problem: the hierarchy (meshes,
+/// DofMaps, K, loads, transfers of every level), then either solver beside it: the multigrid
+/// (its smoothers, work vectors, the coarse factor) or BoomerAMG-PCG (hypre's copy of K and its
+/// AMG hierarchy); the peak is the hierarchy and the larger of the two.
+struct ElasticMemory3 {
+    double hierarchy_bytes = 0, mg_bytes = 0, amg_bytes = 0;
+    double baseline_bytes = 0;
+    double mg_peak() const { return baseline_bytes + hierarchy_bytes + mg_bytes; }
+    double amg_peak() const { return baseline_bytes + hierarchy_bytes + amg_bytes; }
+    double bytes() const { return std::max(mg_peak(), amg_peak()); }
+};
+ElasticMemory3 estimate_elastic3_memory(const std::vector<ElasticLevelSize3>& sizes);
+
+/// Throws InvalidInput when `e` does not fit in `limit`: the finest level, its unknowns, the
+/// estimate and the limit, and the fix (fewer levels).
+void check_elastic3_fits(const ElasticMemory3& e, const MemoryLimit& limit,
+                         const std::vector<ElasticLevelSize3>& sizes);
+
+/// One level: its mesh, numbering (free components interleaved by vertex), the prescribed
+/// values (3 per vertex) and the assembled system (K on the unknowns, f for the full load).
+struct ElasticLevel3 {
+    mesh::TetMesh mesh;
+    fem::DofMap3 dofs;
+    Vector u_fixed;
+    fem::ElasticSystem system;
+    /// Vertex of each unknown (the smoother's 3 x 3 blocks).
+    std::vector<int> vertex_of_dof() const;
+};
+
+/// Builds one level on mesh `m` (supports, loads, assembly).
+ElasticLevel3 build_elastic_level3(const ElasticProblem3& p, mesh::TetMesh m);
+
+/// Levels 0..L (coarsest first) and the transfers between them: T[l] (l >= 1) the linear
+/// interpolation from level l-1 to level l on the free unknowns (transfer::restrict_to_unknowns
+/// of the vertex prolongation), R[l] = T[l]^T; T[0], R[0] empty.
+struct ElasticHierarchy3 {
+    std::vector<ElasticLevel3> levels;
+    std::vector<SparseMatrix> T, R;
+    const ElasticLevel3& finest() const { return levels.back(); }
+};
+
+/// Refines p.mesh0 `levels` times (mesh::refine) and builds every level and transfer.
+ElasticHierarchy3 build_elastic_hierarchy3(const ElasticProblem3& p, int levels);
+
+/// The geometric multigrid on a hierarchy of at least two levels: rediscretized operators (each
+/// level's K), smoother blocks of the 3 components of a vertex, T and R of the hierarchy
+/// (borrowed: `h` must outlive it), sparse LU on level 0. With the default params, a symmetric
+/// V(1,1) cycle (forward pre-sweep, backward post-sweep) that preconditions CG. The lattice
+/// smoother is 2D-only and refused (InvalidInput).
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h,
+                                                       solvers::MultigridParams params = {});
+
+/// The rigid-body modes of a level on its unknowns: the translations along x, y, z and the
+/// rotations about the x, y, z axes through the centre of the mesh's bounding box (6 vectors).
+std::vector<Vector> rigid_body_modes3(const ElasticLevel3& L);
+
+} // namespace mlc::levels

@@ -1,0 +1,347 @@
+// SPDX-License-Identifier: MIT
+// 3D scenes ([scene] dimension = 3): a box or a Gmsh tetrahedral mesh, bodies, face loads and
+// supports, read with the Reader of the 2D scenes; keys of 2D scenes are refused as 2D-only.
+#include "scene/scene3.hpp"
+
+#include "core/check.hpp"
+#include "mesh/io/gmsh_tet.hpp"
+#include "mesh/tet_mesh.hpp"
+#include "scene/reader.hpp"
+
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace mlc::scene {
+
+namespace {
+
+using detail::at;
+using detail::Reader;
+using levels::ElasticProblem3;
+using mesh::Vec3;
+
+/// Fails on the first key of `t` that is one of `two_d` (keys of 2D scenes), naming it.
+void refuse_2d_only(const Reader& rd, const toml::table& t,
+                    std::initializer_list<std::string_view> two_d, const std::string& where,
+                    const std::string& why = "") {
+    for (auto&& [k, v] : t)
+        for (auto key : two_d)
+            if (k.str() == key) {
+                const std::string name =
+                    where.empty() ? std::string(key) : where + "." + std::string(key);
+                rd.fail(&v, name + " is 2D-only: a 3D scene ([scene] dimension = 3) has no " +
+                                std::string(key) + (why.empty() ? "" : " (" + why + ")"));
+            }
+}
+
+Vec3 vec3(const Reader& rd, const toml::node* n, const std::string& what) {
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 3) rd.fail(n, what + " must be an array of three numbers [x, y, z]");
+    return {rd.number(a->get(0), what + "[0]"), rd.number(a->get(1), what + "[1]"),
+            rd.number(a->get(2), what + "[2]")};
+}
+Vec3 vec3(const Reader& rd, const toml::table& t, std::string_view key, const std::string& w) {
+    return vec3(rd, rd.need(t, key, w), w + "." + std::string(key));
+}
+
+/// The boundary tags of m, for messages.
+std::string known_tags(const mesh::TetMesh& m) {
+    std::string s;
+    for (const auto& [name, id] : m.tag_names)
+        if (m.is_boundary_tag(id)) s += (s.empty() ? "" : ", ") + name;
+    return s.empty() ? "none" : s;
+}
+
+void check_tag3(const Reader& rd, const mesh::TetMesh& m, const toml::table& t,
+                const std::string& tag, const std::string& w) {
+    const auto id = m.find_tag(tag);
+    if (!id || !m.is_boundary_tag(*id))
+        rd.fail(t.get("tag"),
+                w + ": unknown boundary tag '" + tag + "' (the mesh has: " + known_tags(m) + ")");
+}
+
+/// [scene]: name, description, units, dimension, levels.
+void read_scene3_table(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
+    const toml::table& s = rd.table(rd.need(root, "scene", "the scene"), "[scene]");
+    refuse_2d_only(rd, s, {"plane", "load_steps", "recover_levels"}, "[scene]");
+    rd.check_keys(s, {"name", "description", "units", "dimension", "levels"}, "[scene]");
+    p.name = rd.string(s, "name", "[scene]");
+    p.description = rd.string_or(s, "description", "", "[scene]");
+    p.units = rd.string_or(s, "units", "", "[scene]");
+    p.levels = rd.integer_or(s, "levels", 0, "[scene]");
+    if (p.levels < 0 || p.levels > levels::kMaxLevels3)
+        rd.fail(s.get("levels"), "[scene].levels must lie in [0, 12]");
+}
+
+/// `type = "box"`: a structured box of Kuhn-split cubes, faces tagged xmin .. zmax.
+mesh::TetMesh read_box(const Reader& rd, const toml::table& t, const std::string& w) {
+    refuse_2d_only(rd, t, {"diagonal", "transform", "mirror_x", "arcs"}, w);
+    rd.check_keys(t, {"type", "corner", "size", "divisions"}, w);
+    const Vec3 corner = vec3(rd, t, "corner", w);
+    const Vec3 size = vec3(rd, t, "size", w);
+    if (!(size.minCoeff() > 0)) rd.fail(t.get("size"), w + ".size must be positive");
+    const toml::node* dn = rd.need(t, "divisions", w);
+    const toml::array* da = dn->as_array();
+    if (!da || da->size() != 3) rd.fail(dn, w + ".divisions must be [nx, ny, nz]");
+    int n[3];
+    for (int k = 0; k < 3; ++k) {
+        n[k] = rd.integer(da->get(static_cast<size_t>(k)),
+                          w + ".divisions[" + std::to_string(k) + "]");
+        if (n[k] < 1 || n[k] > 1000) rd.fail(dn, w + ".divisions must be between 1 and 1000");
+    }
+    return at(rd, &t, [&] { return mesh::structured_box(corner, size, n[0], n[1], n[2]); });
+}
+
+/// The text of a Gmsh file of a body (a built-in scene's compiled in), and its name.
+std::pair<std::string, std::string> gmsh_text(const Reader& rd, const toml::table& t,
+                                              const std::string& w,
+                                              const std::filesystem::path& base_dir) {
+    std::filesystem::path file = rd.string(t, "file", w);
+    if (rd.origin().rfind("builtin:", 0) == 0 && file.is_relative() && base_dir.empty()) {
+        const std::string text = builtin_file_text(file.string());
+        if (!text.empty()) return {text, "builtin:" + file.string()};
+    }
+    if (file.is_relative() && !base_dir.empty()) file = base_dir / file;
+    std::ifstream in(file);
+    if (!in) rd.fail(t.get("file"), w + ".file: cannot read '" + file.string() + "'");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return {ss.str(), file.string()};
+}
+
+/// The bodies' meshes: one box, or the physical volumes of one Gmsh file (a body each).
+void read_bodies3(const Reader& rd, const toml::table& root, const std::filesystem::path& base,
+                  ElasticProblem3& p) {
+    const auto bodies = rd.tables(root, "body", "the scene");
+    if (bodies.empty()) rd.fail(&root, "the scene defines no [[body]]");
+    std::string file_text, file_name;
+    std::map<int, int> body_of_volume; // physical volume tag -> body index
+    for (size_t i = 0; i < bodies.size(); ++i) {
+        const toml::table& b = *bodies[i];
+        const std::string w = "[[body]] " + std::to_string(i + 1);
+        refuse_2d_only(rd, b, {"tags"}, w);
+        rd.check_keys(b, {"name", "E", "nu", "body_force", "mesh"}, w);
+        levels::Body3 body;
+        body.name = rd.string_or(b, "name", "body" + std::to_string(i + 1), w);
+        body.material.E = rd.number(b, "E", w);
+        body.material.nu = rd.number(b, "nu", w);
+        at(rd, b.get("E"), [&] {
+            body.material.validate();
+            return 0;
+        });
+        if (b.get("body_force")) body.body_force = vec3(rd, b, "body_force", w);
+        const std::string mw = w + ".mesh";
+        const toml::table& mt = rd.table(rd.need(b, "mesh", w), mw);
+        const std::string type = rd.string(mt, "type", mw);
+        if (type == "rectangle" || type == "domain")
+            rd.fail(mt.get("type"), mw + ".type \"" + type +
+                                        "\" is 2D-only: a 3D body's mesh is \"box\" or \"gmsh\"");
+        if (type == "box") {
+            if (bodies.size() > 1)
+                rd.fail(mt.get("type"), mw + ": a box is one body; several bodies are the "
+                                             "physical volumes of one Gmsh file");
+            p.mesh0 = read_box(rd, mt, mw);
+        } else if (type == "gmsh") {
+            refuse_2d_only(rd, mt, {"surface", "transform", "arcs"}, mw,
+                           "a 3D body selects a physical volume with `volume`");
+            rd.check_keys(mt, {"type", "file", "volume"}, mw);
+            const auto file = gmsh_text(rd, mt, mw, base);
+            std::string text = file.first, name = file.second;
+            if (!file_name.empty() && name != file_name)
+                rd.fail(mt.get("file"), mw +
+                                            ".file: the bodies of a 3D scene are the physical "
+                                            "volumes of one Gmsh file ('" +
+                                            file_name + "')");
+            const std::string volume = rd.string_or(mt, "volume", "", mw);
+            if (volume.empty() && bodies.size() > 1)
+                rd.fail(&mt, mw + " needs a volume: with several bodies, each is a physical "
+                                  "volume of the file");
+            if (!volume.empty()) {
+                const mesh::TetMesh part = at(rd, mt.get("volume"), [&] {
+                    return mesh::read_gmsh_tet_text(text, name, volume);
+                });
+                body_of_volume[part.attribute.at(0)] = static_cast<int>(i);
+            }
+            file_text = std::move(text);
+            file_name = std::move(name);
+        } else {
+            rd.fail(mt.get("type"),
+                    mw + ".type must be \"box\" or \"gmsh\", found \"" + type + "\"");
+        }
+        p.bodies.push_back(body);
+    }
+    if (file_name.empty()) return;
+    p.mesh0 = at(rd, &root, [&] { return mesh::read_gmsh_tet_text(file_text, file_name, ""); });
+    if (body_of_volume.empty()) {
+        p.mesh0.attribute.clear();
+        return;
+    }
+    for (int& a : p.mesh0.attribute) {
+        const auto it = body_of_volume.find(a);
+        if (it == body_of_volume.end())
+            rd.fail(bodies[0], "[[body]]: the tetrahedra of physical volume tag " +
+                                   std::to_string(a) + " of '" + file_name +
+                                   "' belong to no body: give a [[body]] with its volume");
+        a = it->second;
+    }
+}
+
+/// [[load]]: pressure and/or traction on a boundary tag.
+void read_loads3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
+    for (const toml::table* lt : rd.tables(root, "load", "the scene")) {
+        const std::string w = "[[load]]";
+        refuse_2d_only(rd, *lt, {"factors"}, w, "its load is applied at once");
+        rd.check_keys(*lt, {"tag", "pressure", "traction"}, w);
+        levels::FaceLoad3 ld;
+        ld.tag = rd.string(*lt, "tag", w);
+        check_tag3(rd, p.mesh0, *lt, ld.tag, w);
+        ld.pressure = rd.number_or(*lt, "pressure", 0.0, w);
+        if (lt->get("traction")) ld.traction = vec3(rd, *lt, "traction", w);
+        if (!lt->get("pressure") && !lt->get("traction"))
+            rd.fail(lt, w + " needs a pressure or a traction");
+        p.loads.push_back(ld);
+    }
+}
+
+/// [[support]]: a tag or a point, and ux, uy and/or uz.
+void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
+    for (const toml::table* st : rd.tables(root, "support", "the scene")) {
+        const std::string w = "[[support]]";
+        refuse_2d_only(rd, *st, {"active"}, w, "its supports hold throughout");
+        rd.check_keys(*st, {"tag", "point", "ux", "uy", "uz"}, w);
+        levels::Support3 s;
+        if (st->get("tag") && st->get("point"))
+            rd.fail(st, w + " takes a tag or a point, not both");
+        if (st->get("tag")) {
+            s.tag = rd.string(*st, "tag", w);
+            check_tag3(rd, p.mesh0, *st, s.tag, w);
+        } else if (st->get("point")) {
+            s.point = vec3(rd, *st, "point", w);
+        } else {
+            rd.fail(st, w + " needs a tag or a point");
+        }
+        const char* keys[3] = {"ux", "uy", "uz"};
+        for (int c = 0; c < 3; ++c) {
+            const toml::node* n = st->get(keys[c]);
+            if (!n) continue;
+            if (n->is_array())
+                rd.fail(n, w + "." + keys[c] +
+                               " must be a number: a list of values per load step is 2D-only");
+            s.u[static_cast<size_t>(c)] = rd.number(n, w + "." + keys[c]);
+        }
+        if (!s.u[0] && !s.u[1] && !s.u[2]) rd.fail(st, w + " fixes nothing: give ux, uy and/or uz");
+        if (s.point)
+            at(rd, st->get("point"), [&] {
+                levels::ElasticProblem3 probe;
+                probe.mesh0 = p.mesh0;
+                probe.bodies = p.bodies;
+                probe.supports = {s};
+                probe.validate();
+                return 0;
+            });
+        p.supports.push_back(s);
+    }
+}
+
+std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    MLC_CHECK(in.good(), "cannot read scene file '" << path.string() << "'");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+} // namespace
+
+namespace detail {
+
+void refuse_3d_scene(const Reader& rd, const toml::table& root, toml::table& scene_table) {
+    const toml::node* d = scene_table.get("dimension");
+    if (!d) return;
+    const int dim = rd.integer(d, "[scene].dimension");
+    if (dim == 3)
+        rd.fail(d, "this is a 3D scene ([scene].dimension = 3): 3D scenes run with `mlcontact "
+                   "bench elastic` only (run, the studies, show --msh-level and the Python "
+                   "module solve 2D scenes)");
+    if (dim != 2) rd.fail(d, "[scene].dimension must be 2 or 3, found " + std::to_string(dim));
+    (void)root;
+    scene_table.erase("dimension");
+}
+
+} // namespace detail
+
+int scene_text_dimension(const std::string& text) {
+    try {
+        const toml::table root = toml::parse(text);
+        if (const auto d = root["scene"]["dimension"].value_exact<int64_t>(); d && *d == 3)
+            return 3;
+    } catch (const toml::parse_error&) {
+    }
+    return 2;
+}
+
+int scene_dimension(const std::string& name_or_path) {
+    const std::filesystem::path path(name_or_path);
+    const bool looks_like_file = path.extension() == ".toml" || path.has_parent_path();
+    if (!looks_like_file || !std::filesystem::exists(path)) {
+        const std::string text = builtin_scene_text(name_or_path);
+        if (!text.empty()) return scene_text_dimension(text);
+    }
+    if (!std::filesystem::is_regular_file(path)) return 2;
+    std::ifstream in(path);
+    if (!in) return 2;
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return scene_text_dimension(ss.str());
+}
+
+levels::ElasticProblem3 parse_scene3(const std::string& text, const std::string& origin,
+                                     const std::filesystem::path& base_dir) {
+    Reader rd(origin);
+    toml::table root;
+    try {
+        root = toml::parse(text, origin);
+    } catch (const toml::parse_error& e) {
+        std::ostringstream os;
+        os << origin << ":" << e.source().begin.line << ": malformed TOML: " << e.description();
+        throw InvalidInput(os.str());
+    }
+    if (const toml::table* s = root["scene"].as_table()) {
+        const toml::node* d = s->get("dimension");
+        if (!d) rd.fail(s, "[scene].dimension = 3 is missing: this is no 3D scene");
+        if (rd.integer(d, "[scene].dimension") != 3)
+            rd.fail(d, "[scene].dimension of a 3D scene must be 3");
+    }
+    refuse_2d_only(rd, root, {"contact", "newton"}, "",
+                   "3D contact is not available yet; the 3D elastic problem is linear");
+    rd.check_keys(root, {"scene", "body", "load", "support"}, "the scene");
+    ElasticProblem3 p;
+    read_scene3_table(rd, root, p);
+    read_bodies3(rd, root, base_dir, p);
+    read_loads3(rd, root, p);
+    read_supports3(rd, root, p);
+    at(rd, &root, [&] {
+        p.validate();
+        return 0;
+    });
+    return p;
+}
+
+levels::ElasticProblem3 load_scene3(const std::string& name_or_path) {
+    const std::filesystem::path path(name_or_path);
+    const bool looks_like_file = path.extension() == ".toml" || path.has_parent_path();
+    if (!looks_like_file || !std::filesystem::exists(path)) {
+        const std::string text = builtin_scene_text(name_or_path);
+        if (!text.empty()) return parse_scene3(text, "builtin:" + name_or_path, {});
+    }
+    if (!std::filesystem::exists(path))
+        throw InvalidInput("scene '" + name_or_path +
+                           "' is neither a readable file nor a built-in scene");
+    MLC_CHECK(std::filesystem::is_regular_file(path),
+              "scene '" << name_or_path << "' is not a regular file");
+    return parse_scene3(read_text(path), path.string(), path.parent_path());
+}
+
+} // namespace mlc::scene

@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: MIT
+/// @file 3D scene files (TOML, `[scene] dimension = 3`) -> levels::ElasticProblem3, validated as
+/// strictly as the 2D scenes (scene/scene.hpp): unknown keys, wrong types and out-of-range values
+/// are refused with the file, line and key, and a key that only makes sense in 2D with a message
+/// saying so. 3D scenes run with `mlcontact bench elastic`; scene::parse_scene refuses them.
+#pragma once
+
+#include "levels/elastic3d_levels.hpp"
+
+#include <filesystem>
+#include <string>
+
+namespace mlc::scene {
+
+/// The dimension a scene text declares: [scene].dimension when it is the integer 3, else 2
+/// (also for malformed TOML, which the parsers then report).
+int scene_text_dimension(const std::string& text);
+
+/// The dimension of a scene by file path or built-in name (as load_scene finds it); 2 when
+/// there is no such scene (load_scene then reports it).
+int scene_dimension(const std::string& name_or_path);
+
+/// Parses a 3D scene from TOML text (`origin` and `base_dir` as for parse_scene). Throws
+/// InvalidInput with "origin:line: message" on any defect.
+levels::ElasticProblem3 parse_scene3(const std::string& text, const std::string& origin,
+                                     const std::filesystem::path& base_dir = {});
+
+/// Loads a 3D scene by file path or built-in name (as load_scene).
+levels::ElasticProblem3 load_scene3(const std::string& name_or_path);
+
+} // namespace mlc::scene
