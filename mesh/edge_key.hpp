@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 /// @file The key of an unoriented edge (its two vertices, smaller first, in 64 bits), shared by
-/// refinement (mesh.cpp) and the conformity checks (mesh_checks.cpp). Internal to mlc_mesh.
+/// refinement of triangles (mesh.cpp) and tetrahedra (tet_refine.cpp), the conformity checks
+/// (mesh_checks.cpp) and the CGAL mesher. Internal to mlc_mesh.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Bey's 1->8 refinement of a tetrahedral mesh and the predicted sizes of its levels.
 #include "mesh/tet_refine.hpp"
+#include "mesh/edge_key.hpp"
 
 #include "core/check.hpp"
 
@@ -14,12 +15,6 @@ namespace mlc::mesh {
 
 namespace {
 
-std::uint64_t edge_key(int a, int b) {
-    if (a > b) std::swap(a, b);
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
-           static_cast<std::uint32_t>(b);
-}
-
 /// Splits the boundary faces of `coarse` into fine (whose vertices are in place) and moves the
 /// midpoints of edges of curved faces onto their surfaces. Returns for each new vertex the
 /// coarse boundary face whose surface moved it, or -1.
@@ -30,9 +25,10 @@ std::vector<int> refine_boundary(const TetMesh& coarse, const TetEdges& edges, T
     std::unordered_map<std::uint64_t, int> midpoint;
     midpoint.reserve(edges.edges.size());
     for (size_t e = 0; e < edges.edges.size(); ++e)
-        midpoint.emplace(edge_key(edges.edges[e][0], edges.edges[e][1]), n0 + static_cast<int>(e));
+        midpoint.emplace(detail::edge_key(edges.edges[e][0], edges.edges[e][1]),
+                         n0 + static_cast<int>(e));
     auto mid = [&](int a, int b) {
-        const auto it = midpoint.find(edge_key(a, b));
+        const auto it = midpoint.find(detail::edge_key(a, b));
         MLC_CHECK(it != midpoint.end(),
                   "boundary face edge (" << a << ", " << b << ") is not an edge of a tetrahedron");
         return it->second;

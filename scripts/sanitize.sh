@@ -63,7 +63,8 @@ out=$dir/ctest.log
 # damped two-body default on the dovetail, the lattice transfer products, the lattice and
 # single-precision multigrids against their references, the recovered levels, the held corner and
 # the held Hertz half model, the coarse/fine variants of the Krylov system, mg inside each Krylov
-# method and its exact fallback, and the dovetail on levels 0-2.
+# method and its exact fallback, the dovetail on levels 0-2, and the 3D manufactured solution over
+# levels 0-3.
 # What they run is covered here by the unit tests of the same code (levels, solvers, contact,
 # smoothers, transfer, the hierarchy tests); this keeps .ci/run well under 40 minutes
 # (docs/testing.md#testing-hostile).
@@ -72,7 +73,8 @@ heavy+="|Multigrid\.VCycleIsLevelIndependentAsCGPreconditioner|Krylov\.BicgstabO
 heavy+="|LatticeTransfer\.TAndRThroughTheLatticeAreTheirCsrProductsBitForBit|LatticeMultigrid\.SquareLevel4LikeTheBlockSmoother|SinglePrecisionMultigrid\.SquareLevel3LikeDouble|CoarseToFine\.IncrementTransferGivesTheSameSolutionAndPredictsAtLeastAsWell"
 heavy+="|RecoveredLevels\.TheExportedSquareSolvesAsTheRefinedSquareDoes|HeldSupports\.SquareWithItsContactCornerHeldInUxSolvesAlikeByEverySolver"
 heavy+="|KrylovSystem\.CoarseFineVariantsSolveTheFineSystem|MultilevelPreconditioner\.WorksInsideCgsBicgstabAndGmres|MultilevelPreconditioner\.TheExactFallbackSolvesWhatTheMultigridCannot"
-heavy+="|HeldSupports\.FrictionalHertzHalfModelCarriesTheLoadAndSolvesAlikeByEverySolver|Dovetail\.EquilibriumMirrorSymmetryAndCoulombOnLevels0To2)$"
+heavy+="|HeldSupports\.FrictionalHertzHalfModelCarriesTheLoadAndSolvesAlikeByEverySolver|Dovetail\.EquilibriumMirrorSymmetryAndCoulombOnLevels0To2"
+heavy+="|Elastic3dConvergence\.ManufacturedSolutionOrderOneInEnergyTwoInL2)$"
 if ctest --test-dir "$dir" -LE "^(slow|cli)$" -E "$heavy" -j"$jobs" --output-on-failure > "$out" 2>&1; then
   n=$(grep -oE "out of [0-9]+" "$out" | tail -n 1 | grep -oE "[0-9]+")
   echo "sanitize: ${n:-?} tests passed under address+undefined ($cxx, build-asan;" \

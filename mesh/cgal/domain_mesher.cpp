@@ -5,6 +5,7 @@
 
 #include "core/check.hpp"
 #include "mesh/cgal/domain_detail.hpp"
+#include "mesh/edge_key.hpp"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
@@ -397,11 +398,6 @@ void refine_domain(const std::vector<LoopPoints>& loops, const std::vector<Segme
                        });
 }
 
-std::uint64_t edge_key(int a, int b) {
-    if (a > b) std::swap(a, b);
-    return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
-}
-
 } // namespace
 
 MeshPrediction predict_mesh_size(const std::vector<std::vector<Segment>>& loops,
@@ -606,9 +602,9 @@ Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField
         be.v1 = f->vertex(CDT::cw(i))->info().id;
         be.tag = tag_of[e.seg];
         be.curve = g.circle;
-        MLC_CHECK(!seen[edge_key(be.v0, be.v1)],
+        MLC_CHECK(!seen[detail::edge_key(be.v0, be.v1)],
                   "mesh_domain: internal error: boundary edge listed twice");
-        seen[edge_key(be.v0, be.v1)] = true;
+        seen[detail::edge_key(be.v0, be.v1)] = true;
         out.boundary.push_back(be);
     }
     for (const SubEdge& e : result.line_sub_edges)
