@@ -44,20 +44,6 @@ void BoomerAMGParams::validate() const {
               "must be >= 0");
 }
 
-BoomerAMGParams boomeramg_elasticity3d() {
-    BoomerAMGParams p;
-    p.num_functions = 3;
-    p.nodal = 4;
-    p.nodal_diag = 1;
-    p.strong_threshold = 0.5;
-    p.interp_vec_variant = 2;
-    p.interp_vec_q_max = 4;
-    p.smooth_interp_vectors = 1;
-    p.interp_refine = 1;
-    p.agg_num_levels = 1;
-    return p;
-}
-
 int hypre_threads() {
 #ifdef HYPRE_USING_OPENMP
     return omp_get_max_threads();

@@ -47,7 +47,19 @@ struct BoomerAMGParams {
 /// strong threshold 0.5 (hypre's value for 3D), one level of aggressive coarsening (without it
 /// the interpolation vectors raise the memory of the AMG hierarchy about threefold), HMIS,
 /// extended+i interpolation truncated to 4, l1-symmetric hybrid Gauss-Seidel.
-BoomerAMGParams boomeramg_elasticity3d();
+inline BoomerAMGParams boomeramg_elasticity3d() {
+    BoomerAMGParams p;
+    p.num_functions = 3;
+    p.nodal = 4;
+    p.nodal_diag = 1;
+    p.strong_threshold = 0.5;
+    p.interp_vec_variant = 2;
+    p.interp_vec_q_max = 4;
+    p.smooth_interp_vectors = 1;
+    p.interp_refine = 1;
+    p.agg_num_levels = 1;
+    return p;
+}
 
 /// Threads hypre's kernels run on: OpenMP's maximum when hypre was built with OpenMP, else 1.
 int hypre_threads();
