@@ -33,6 +33,14 @@ struct Run3 {
     double peak_rss_mib = 0; ///< peak resident memory of the process after this solver
     double estimate_mib = 0; ///< its predicted peak (hierarchy + this solver)
     double x_norm = 0;
+    /// One repetition's figures.
+    void add(double setup_seconds, const SolveResult& s) {
+        setup.push_back(setup_seconds);
+        solve.push_back(s.solve_seconds);
+        iterations = s.iterations;
+        relative_residual = s.relative_residual;
+        converged = s.converged;
+    }
 };
 
 constexpr double kMiB = 1024.0 * 1024.0;
@@ -52,11 +60,7 @@ Run3 run_mg(const levels::ElasticHierarchy3& h, const Vector& b, const BenchElas
         kp.rel_tol = opt.rel_tol;
         kp.max_iter = opt.max_iter;
         const SolveResult s = solvers::cg(MatrixOperator(K, MatVec::unrolled), *mg, b, x, kp);
-        r.setup.push_back(t1 - t0);
-        r.solve.push_back(s.solve_seconds);
-        r.iterations = s.iterations;
-        r.relative_residual = s.relative_residual;
-        r.converged = s.converged;
+        r.add(t1 - t0, s);
     }
     r.x_norm = x.norm();
     return r;
@@ -75,11 +79,7 @@ Run3 run_amg(const levels::ElasticHierarchy3& h, const Vector& b, const BenchEla
         x = Vector::Zero(K.rows());
         const SolveResult s = solvers::boomeramg_pcg(K, b, x, opt.rel_tol, opt.max_iter,
                                                      solvers::boomeramg_elasticity3d(), {}, modes);
-        r.setup.push_back(s.setup_seconds);
-        r.solve.push_back(s.solve_seconds);
-        r.iterations = s.iterations;
-        r.relative_residual = s.relative_residual;
-        r.converged = s.converged;
+        r.add(s.setup_seconds, s);
     }
     r.x_norm = x.norm();
     return r;

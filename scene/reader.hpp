@@ -223,4 +223,16 @@ void recover_levels(levels::Problem& p);
 /// the table (a 2D scene may state it). scene3.cpp.
 void refuse_3d_scene(const Reader& rd, const toml::table& root, toml::table& scene_table);
 
+/// The TOML table of a scene's text; malformed TOML throws InvalidInput "origin:line: malformed
+/// TOML: ...".
+inline toml::table parse_toml(const std::string& text, const std::string& origin) {
+    try {
+        return toml::parse(text, origin);
+    } catch (const toml::parse_error& e) {
+        std::ostringstream os;
+        os << origin << ":" << e.source().begin.line << ": malformed TOML: " << e.description();
+        throw InvalidInput(os.str());
+    }
+}
+
 } // namespace mlc::scene::detail

@@ -283,14 +283,7 @@ constexpr std::array<Section, 6> kSections{{
 levels::Problem parse_scene(const std::string& text, const std::string& origin,
                             const std::filesystem::path& base_dir, const StopPoll& stop) {
     Reader rd(origin, stop);
-    toml::table root;
-    try {
-        root = toml::parse(text, origin);
-    } catch (const toml::parse_error& e) {
-        std::ostringstream os;
-        os << origin << ":" << e.source().begin.line << ": malformed TOML: " << e.description();
-        throw InvalidInput(os.str());
-    }
+    toml::table root = detail::parse_toml(text, origin);
     std::array<std::string_view, kSections.size()> keys;
     for (size_t i = 0; i < kSections.size(); ++i)
         keys[i] = kSections[i].key;

@@ -300,14 +300,7 @@ int scene_dimension(const std::string& name_or_path) {
 levels::ElasticProblem3 parse_scene3(const std::string& text, const std::string& origin,
                                      const std::filesystem::path& base_dir) {
     Reader rd(origin);
-    toml::table root;
-    try {
-        root = toml::parse(text, origin);
-    } catch (const toml::parse_error& e) {
-        std::ostringstream os;
-        os << origin << ":" << e.source().begin.line << ": malformed TOML: " << e.description();
-        throw InvalidInput(os.str());
-    }
+    toml::table root = detail::parse_toml(text, origin);
     if (const toml::table* s = root["scene"].as_table()) {
         const toml::node* d = s->get("dimension");
         if (!d) rd.fail(s, "[scene].dimension = 3 is missing: this is no 3D scene");
