@@ -143,8 +143,9 @@ TEST(HeldSupports, OnlyTheContactCornerHeldInUxIsPinned) {
     // axis_release's axis node has a free target (the block), hertz is frictionless (lambda_n
     // alone, along the free u_y).
     for (const auto& name : scene::builtin_scene_names())
-        if (scene::scene_dimension(name) == 2) // 3D scenes have no contact
+        if (scene::scene_dimension(name) == 2) { // 3D scenes have no contact
             EXPECT_TRUE(pinned_of(scene::load_scene(name), 0).empty()) << name;
+        }
     EXPECT_TRUE(pinned_of(scene::load_scene("square"), 1).empty());
     const auto hf = pinned_of(scene::load_scene(data_file("hertz_friction.toml")), 1);
     ASSERT_EQ(hf.size(), 1u);

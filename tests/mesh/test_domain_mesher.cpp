@@ -3,6 +3,7 @@
 #include "core/check.hpp"
 #include "mesh/cgal/domain_mesher.hpp"
 #include "mesh/mesh.hpp"
+#include "tests/mesh/measures.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,13 +19,6 @@ using namespace mlc::mesh;
 namespace {
 
 constexpr double pi = std::numbers::pi;
-
-double total_area(const Mesh& m) {
-    double a = 0;
-    for (int t = 0; t < m.n_triangles(); ++t)
-        a += m.signed_area(t);
-    return a;
-}
 
 double edge_length(const Mesh& m, const BoundaryEdge& e) {
     return (m.vertices[e.v1] - m.vertices[e.v0]).norm();
@@ -109,7 +103,7 @@ SizeField quarter_disc_size() {
 
 TEST(DomainMesher, UnitSquareHasExactAreaAndTaggedSides) {
     const Mesh m = mesh_domain({unit_square()}, SizeField{.max_size = 0.1});
-    EXPECT_NEAR(total_area(m), 1.0, 1e-13);
+    EXPECT_NEAR(mesh::testing::total_area(m), 1.0, 1e-13);
     ASSERT_EQ(m.tag_names.size(), 4u);
     const auto len = boundary_length_per_tag(m);
     for (const std::string name : {"bottom", "right", "top", "left"}) {
@@ -157,7 +151,7 @@ TEST(DomainMesher, QuarterDiscKeepsArcVerticesOnCircleAndGradesSize) {
     EXPECT_GT(len.at("arc"), pi / 2 - 1e-3);
 
     // Inscribed polygon: area below pi/4 by at most the circular segments cut off.
-    const double area = total_area(m);
+    const double area = mesh::testing::total_area(m);
     const double bound = sagitta_area_bound(m, 0);
     EXPECT_LE(area, pi / 4 + 1e-13);
     EXPECT_GE(area, pi / 4 - bound);
@@ -209,8 +203,8 @@ TEST(DomainMesher, RingHoleIsEmpty) {
     const double exact = pi * (20 * 20 - 15 * 15);
     const double outer_loss = sagitta_area_bound(m, outer_curve);
     const double hole_loss = sagitta_area_bound(m, 1 - outer_curve);
-    EXPECT_GE(total_area(m), exact - outer_loss);
-    EXPECT_LE(total_area(m), exact + hole_loss);
+    EXPECT_GE(mesh::testing::total_area(m), exact - outer_loss);
+    EXPECT_LE(mesh::testing::total_area(m), exact + hole_loss);
     EXPECT_LT(outer_loss + hole_loss, 1e-2 * exact);
     EXPECT_NEAR(boundary_length_per_tag(m).at("inner"), 2 * pi * 15, 0.02);
     EXPECT_NEAR(boundary_length_per_tag(m).at("outer"), 2 * pi * 20, 0.02);
@@ -220,8 +214,8 @@ TEST(DomainMesher, RingHoleIsEmpty) {
     const Mesh m2 = mesh_domain({outer, ccw_hole}, SizeField{.max_size = 1.0});
     expect_consistent_boundary(m2);
     const int outer2 = m2.boundary[0].curve;
-    EXPECT_GE(total_area(m2), exact - sagitta_area_bound(m2, outer2));
-    EXPECT_LE(total_area(m2), exact + sagitta_area_bound(m2, 1 - outer2));
+    EXPECT_GE(mesh::testing::total_area(m2), exact - sagitta_area_bound(m2, outer2));
+    EXPECT_LE(mesh::testing::total_area(m2), exact + sagitta_area_bound(m2, 1 - outer2));
 }
 
 TEST(DomainMesher, ConcaveArcStaysOnCircle) {
@@ -242,8 +236,8 @@ TEST(DomainMesher, ConcaveArcStaysOnCircle) {
         EXPECT_NEAR((m.vertices[v] - c).norm(), r, 1e-12);
     // Chords of a concave arc cut into the circle's disc: the polygon has a little more area.
     const double exact = 1 - r * r / 2 * (theta - std::sin(theta));
-    EXPECT_GE(total_area(m), exact);
-    EXPECT_LE(total_area(m), exact + sagitta_area_bound(m, 0));
+    EXPECT_GE(mesh::testing::total_area(m), exact);
+    EXPECT_LE(mesh::testing::total_area(m), exact + sagitta_area_bound(m, 0));
 }
 
 TEST(DomainMesher, ManyFocusPointsFollowSizeField) {
@@ -257,7 +251,7 @@ TEST(DomainMesher, ManyFocusPointsFollowSizeField) {
                                        Segment::line({0.6, 0.4}, {0.4, 0.4}, "hole")};
     const Mesh m = mesh_domain({unit_square(), hole}, size);
     expect_consistent_boundary(m);
-    EXPECT_NEAR(total_area(m), 1.0 - 0.04, 1e-13);
+    EXPECT_NEAR(mesh::testing::total_area(m), 1.0 - 0.04, 1e-13);
     EXPECT_NEAR(boundary_length_per_tag(m).at("hole"), 0.8, 1e-13);
     for (const auto& t : m.triangles)
         for (int i = 0; i < 3; ++i) {
@@ -278,8 +272,8 @@ TEST(DomainMesher, RefinementKeepsArcVerticesOnCircle) {
     EXPECT_EQ(arc_vertices.size(), 2 * coarse.vertices_with_tag(coarse.tag("arc")).size() - 1);
     for (int v : arc_vertices)
         EXPECT_NEAR((fine.vertices[v] - Vec2(0, 1)).norm(), 1.0, 1e-12) << "vertex " << v;
-    EXPECT_GT(total_area(fine), total_area(coarse));
-    EXPECT_LE(total_area(fine), pi / 4);
+    EXPECT_GT(mesh::testing::total_area(fine), mesh::testing::total_area(coarse));
+    EXPECT_LE(mesh::testing::total_area(fine), pi / 4);
 }
 
 TEST(DomainMesher, SizeFieldFormula) {
@@ -425,5 +419,5 @@ TEST(DomainMesherSlow, LargeMeshIsValid) {
     expect_consistent_boundary(m);
     for (int v : m.vertices_with_tag(m.tag("arc")))
         EXPECT_NEAR((m.vertices[v] - Vec2(0, 1)).norm(), 1.0, 1e-12);
-    EXPECT_NEAR(total_area(m), pi / 4, sagitta_area_bound(m, 0));
+    EXPECT_NEAR(mesh::testing::total_area(m), pi / 4, sagitta_area_bound(m, 0));
 }

@@ -4,6 +4,9 @@
 #include "mesh/io/gmsh.hpp"
 #include "mesh/mesh.hpp"
 
+#include "tests/common/files.hpp"
+#include "tests/mesh/measures.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -22,23 +25,9 @@ fs::path data(const std::string& name) {
     return fs::path(MLC_TEST_DATA_DIR) / name;
 }
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-/// Directory of the running test (tests may run in parallel processes).
-fs::path scratch_path() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    return fs::path(::testing::TempDir()) /
-           ("mlc_gmsh_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-}
-
 /// Writes `text` to a file in the running test's directory (removed by the fixture).
 fs::path scratch_file(const std::string& text, const std::string& name = "mesh.msh") {
-    const fs::path dir = scratch_path();
+    const fs::path dir = testutil::scratch_path("mlc_gmsh");
     fs::create_directories(dir);
     std::ofstream(dir / name) << text;
     return dir / name;
@@ -50,13 +39,6 @@ std::string replace(std::string s, const std::string& from, const std::string& t
     EXPECT_NE(at, std::string::npos) << from;
     if (at != std::string::npos) s.replace(at, from.size(), to);
     return s;
-}
-
-double total_area(const Mesh& m) {
-    double a = 0;
-    for (int t = 0; t < m.n_triangles(); ++t)
-        a += m.signed_area(t);
-    return a;
 }
 
 /// The boundary edges as (from, to) coordinate pairs with their tag names.
@@ -80,7 +62,7 @@ void expect_unit_square(const Mesh& m) {
     ASSERT_EQ(m.n_triangles(), 4);
     for (int t = 0; t < 4; ++t)
         EXPECT_DOUBLE_EQ(m.signed_area(t), 0.25) << "triangle " << t;
-    EXPECT_DOUBLE_EQ(total_area(m), 1.0);
+    EXPECT_DOUBLE_EQ(mesh::testing::total_area(m), 1.0);
     // Two clockwise triangles in the file were re-oriented, keeping their first vertex.
     EXPECT_EQ(m.triangles[1], (std::array<int, 3>{1, 2, 4}));
     EXPECT_EQ(m.triangles[3], (std::array<int, 3>{3, 0, 4}));
@@ -113,7 +95,7 @@ void expect_error(const std::string& text, const std::vector<std::string>& parts
 
 class Gmsh : public ::testing::Test {
 protected:
-    void TearDown() override { fs::remove_all(scratch_path()); }
+    void TearDown() override { fs::remove_all(testutil::scratch_path("mlc_gmsh")); }
 };
 
 TEST_F(Gmsh, ReadsFormat22) {
@@ -131,7 +113,7 @@ TEST_F(Gmsh, SelectsPhysicalSurface) {
     const Mesh lower = read_gmsh(data("two_bodies_v22.msh"), "lower");
     ASSERT_EQ(lower.n_vertices(), 4);
     ASSERT_EQ(lower.n_triangles(), 2);
-    EXPECT_DOUBLE_EQ(total_area(lower), 1.0);
+    EXPECT_DOUBLE_EQ(mesh::testing::total_area(lower), 1.0);
     const std::set<std::tuple<double, double, double, double, std::string>> lower_edges = {
         {0, 0, 1, 0, "bottom"}, {1, 1, 0, 1, "contact_lower"}};
     EXPECT_EQ(boundary_set(lower), lower_edges);
@@ -139,7 +121,7 @@ TEST_F(Gmsh, SelectsPhysicalSurface) {
     const Mesh upper = read_gmsh(data("two_bodies_v22.msh"), "upper");
     ASSERT_EQ(upper.n_vertices(), 4);
     ASSERT_EQ(upper.n_triangles(), 2);
-    EXPECT_DOUBLE_EQ(total_area(upper), 1.0);
+    EXPECT_DOUBLE_EQ(mesh::testing::total_area(upper), 1.0);
     for (const Vec2& v : upper.vertices)
         EXPECT_GE(v.y(), 1.1);
     const std::set<std::tuple<double, double, double, double, std::string>> upper_edges = {
@@ -153,20 +135,20 @@ TEST_F(Gmsh, SelectsPhysicalSurface) {
     EXPECT_EQ(both.n_vertices(), 8);
     EXPECT_EQ(both.attribute, (std::vector<int>{10, 10, 11, 11}));
     EXPECT_EQ(both.boundary.size(), 4u);
-    EXPECT_DOUBLE_EQ(total_area(both), 2.0);
+    EXPECT_DOUBLE_EQ(mesh::testing::total_area(both), 2.0);
 
-    expect_error(slurp(data("two_bodies_v22.msh")),
+    expect_error(testutil::slurp(data("two_bodies_v22.msh")),
                  {"no physical surface 'middle'", "'lower'", "'upper'"}, "middle");
     // An unnamed physical surface is selected as "tag<N>".
-    const std::string unnamed =
-        replace(slurp(data("two_bodies_v22.msh")), "2 11 \"upper\"\n", "2 12 \"other\"\n");
+    const std::string unnamed = replace(testutil::slurp(data("two_bodies_v22.msh")),
+                                        "2 11 \"upper\"\n", "2 12 \"other\"\n");
     const Mesh by_tag = read_gmsh(scratch_file(unnamed), "tag11");
     EXPECT_EQ(by_tag.n_triangles(), 2);
     EXPECT_GE(by_tag.vertices[0].y(), 1.1);
 }
 
 TEST_F(Gmsh, UnsupportedElementsThrowNamingType) {
-    const std::string v22 = slurp(data("square_v22.msh"));
+    const std::string v22 = testutil::slurp(data("square_v22.msh"));
     // A 6-node triangle in the selection.
     expect_error(replace(v22, "9 2 2 3 1 40 50 10", "9 9 2 3 1 40 50 10 10 20 30"),
                  {"mesh.msh:29:", "element type 9", "6-node triangle"});
@@ -177,7 +159,7 @@ TEST_F(Gmsh, UnsupportedElementsThrowNamingType) {
     expect_error(replace(v22, "9 2 2 3 1 40 50 10", "9 4 2 3 1 40 50 10 20"),
                  {"element type 4", "tetrahedron"});
     // ... but elements outside the selected surface are ignored.
-    const std::string two = slurp(data("two_bodies_v22.msh"));
+    const std::string two = testutil::slurp(data("two_bodies_v22.msh"));
     const std::string quad_upper = replace(two, "8 2 2 11 2 5 8 7", "8 3 2 11 2 5 6 7 8");
     EXPECT_EQ(read_gmsh(scratch_file(quad_upper), "lower").n_triangles(), 2);
     expect_error(quad_upper, {"element type 3"}, "upper");
@@ -187,8 +169,8 @@ TEST_F(Gmsh, UnsupportedElementsThrowNamingType) {
 }
 
 TEST_F(Gmsh, MalformedFilesThrowNamingLine) {
-    const std::string v22 = slurp(data("square_v22.msh"));
-    const std::string v41 = slurp(data("square_v41.msh"));
+    const std::string v22 = testutil::slurp(data("square_v22.msh"));
+    const std::string v41 = testutil::slurp(data("square_v41.msh"));
     // Truncated inside $Nodes / at the end / inside $Entities.
     expect_error(v22.substr(0, v22.find("40 0 1 0")), {":14:", "unexpected end of file in $Nodes"});
     expect_error(v22.substr(0, v22.find("$EndElements")), {"unexpected end of file"});
@@ -241,7 +223,7 @@ TEST_F(Gmsh, MalformedFilesThrowNamingLine) {
 }
 
 TEST_F(Gmsh, SkipsUnknownSectionsAndBlankLines) {
-    std::string v41 = slurp(data("square_v41.msh"));
+    std::string v41 = testutil::slurp(data("square_v41.msh"));
     v41 = replace(v41, "$Nodes", "$Comments\n$Nodes is not a section here\n$EndComments\n\n$Nodes");
     v41 = replace(v41, "$EndElements\n", "$EndElements\n$NodeData\n1\n\"u\"\n$EndNodeData\n\n");
     // Windows line ends.

@@ -15,8 +15,6 @@ using namespace mlc::mesh;
 
 namespace {
 
-constexpr double pi = std::numbers::pi;
-
 std::vector<std::vector<Segment>> square(double side) {
     return {{Segment::line({0, 0}, {side, 0}, "bottom"),
              Segment::line({side, 0}, {side, side}, "right"),
@@ -25,7 +23,7 @@ std::vector<std::vector<Segment>> square(double side) {
 }
 
 /// The hertz scene's quarter disc: the arc from (0, 0) to (1, 1) about (0, 1), the top, the axis.
-std::vector<std::vector<Segment>> quarter_disc() {
+std::vector<std::vector<Segment>> quarter_disc_loops() {
     return {{Segment::arc({0, 0}, {1, 1}, {0, 1}, true, "surface"),
              Segment::line({1, 1}, {0, 1}, "top"), Segment::line({0, 1}, {0, 0}, "axis")}};
 }
@@ -43,14 +41,15 @@ SizeField field(double max_size, double min_size, std::vector<Vec2> focus, doubl
 
 TEST(MeshPrediction, AreasAreExact) {
     EXPECT_NEAR(predict_mesh_size(square(2), field(0.1, 0, {}, 0.25)).area, 4.0, 1e-14);
-    EXPECT_NEAR(predict_mesh_size(quarter_disc(), field(0.1, 0, {}, 0.25)).area, pi / 4, 1e-14);
+    EXPECT_NEAR(predict_mesh_size(quarter_disc_loops(), field(0.1, 0, {}, 0.25)).area,
+                std::numbers::pi / 4, 1e-14);
     // A square with a round hole: 4 - pi r^2.
     auto loops = square(2);
     loops.push_back({Segment::arc({1.5, 1}, {1.5, 1}, {1, 1}, false, "hole")});
     const MeshPrediction p = predict_mesh_size(loops, field(0.1, 0, {}, 0.25));
-    EXPECT_NEAR(p.area, 4 - pi * 0.25, 1e-13);
+    EXPECT_NEAR(p.area, 4 - std::numbers::pi * 0.25, 1e-13);
     // Uniform: the integral is A / h^2 exactly.
-    EXPECT_NEAR(p.integral, (4 - pi * 0.25) / 0.01, 1e-9);
+    EXPECT_NEAR(p.integral, (4 - std::numbers::pi * 0.25) / 0.01, 1e-9);
     EXPECT_DOUBLE_EQ(p.triangles, kTrianglesPerUnitIntegral * p.integral);
 }
 
@@ -59,11 +58,13 @@ TEST(MeshPrediction, GradedIntegralAgainstItsClosedForm) {
     // whole disc adds 2 pi / g^2 (ln(M / m) - 1 + m / M) to A / M^2.
     const double M = 1, m = 0.01, g = 0.5;
     const SizeField f = field(M, m, {{50, 50}}, g);
-    const double closed = 1e4 / (M * M) + 2 * pi / (g * g) * (std::log(M / m) - 1 + m / M);
+    const double closed =
+        1e4 / (M * M) + 2 * std::numbers::pi / (g * g) * (std::log(M / m) - 1 + m / M);
     EXPECT_NEAR(predict_mesh_size(square(100), f).integral, closed, 2e-3 * closed);
     // At a corner of the square a quarter of the disc is inside.
     const SizeField corner = field(M, m, {{0, 0}}, g);
-    const double quarter = 1e4 / (M * M) + 0.25 * 2 * pi / (g * g) * (std::log(M / m) - 1 + m / M);
+    const double quarter =
+        1e4 / (M * M) + 0.25 * 2 * std::numbers::pi / (g * g) * (std::log(M / m) - 1 + m / M);
     EXPECT_NEAR(predict_mesh_size(square(100), corner).integral, quarter, 2e-3 * quarter);
 }
 
@@ -75,8 +76,8 @@ TEST(MeshPrediction, AtOrAboveTheMeshedCountAndWithinOneAndAHalfTimesIt) {
     const std::vector<Case> cases = {
         {square(1), field(0.05, 0, {}, 0.25)},
         {square(1), field(0.1, 0.005, {{0.5, 0}}, 0.25)},
-        {quarter_disc(), field(0.1, 0.004, {{0, 0}}, 0.12)}, // the hertz scene
-        {quarter_disc(), field(0.02, 0, {}, 0.25)},
+        {quarter_disc_loops(), field(0.1, 0.004, {{0, 0}}, 0.12)}, // the hertz scene
+        {quarter_disc_loops(), field(0.02, 0, {}, 0.25)},
         {{{Segment::arc({1, 0}, {1, 0}, {0, 0}, true, "circle")}},
          field(0.1, 0.01, {{0, 0}, {0.5, 0}}, 0.3)},
     };
@@ -94,7 +95,7 @@ TEST(MeshPrediction, BadGeometryIsRefusedAsByTheMesher) {
 }
 
 TEST(MeshStop, APollThatSaysStopThrowsInterruptedAndOneThatNeverDoesChangesNothing) {
-    const auto loops = quarter_disc();
+    const auto loops = quarter_disc_loops();
     const SizeField size = field(0.01, 0.002, {{0, 0}}, 0.2);
     int polls = 0;
     EXPECT_THROW(mesh_domain(loops, size, {}, [&] { return ++polls == 3; }), Interrupted);

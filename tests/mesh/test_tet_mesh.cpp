@@ -4,6 +4,7 @@
 #include "core/check.hpp"
 #include "mesh/io/gmsh_tet.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "tests/mesh/measures.hpp"
 #include "tests/mesh/tet_test_meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -20,13 +21,6 @@ using namespace mlc::mesh;
 using namespace mlc::mesh::testing;
 
 namespace {
-
-double total_volume(const TetMesh& m) {
-    double v = 0;
-    for (int t = 0; t < m.n_tetrahedra(); ++t)
-        v += std::abs(m.signed_volume(t));
-    return v;
-}
 
 /// The union of two meshes, with vertices at equal coordinates merged.
 TetMesh merge(const TetMesh& a, const TetMesh& b) {
@@ -68,7 +62,7 @@ TEST(TetBox, CountsTagsAndKuhnPaths) {
     EXPECT_EQ(m.n_vertices(), 4 * 5 * 3);
     EXPECT_EQ(m.n_tetrahedra(), 6 * 3 * 4 * 2);
     EXPECT_EQ(m.boundary.size(), 4u * (3 * 4 + 4 * 2 + 2 * 3));
-    EXPECT_NEAR(total_volume(m), 6.0, 1e-13);
+    EXPECT_NEAR(mesh::testing::total_volume(m), 6.0, 1e-13);
     EXPECT_EQ(m.vertices[(2 * 5 + 3) * 4 + 1], corner + Vec3(1, 1.5, 1)); // vertex (1, 3, 2)
     // Every tetrahedron runs along a Kuhn path: three steps along three different axes.
     const Vec3 h(1, 0.5, 0.5);

@@ -4,6 +4,7 @@
 // element are refused.
 #include "mesh/tet_mesh.hpp"
 #include "mesh/tet_refine.hpp"
+#include "tests/mesh/measures.hpp"
 #include "tests/mesh/tet_test_meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -16,13 +17,6 @@ using namespace mlc::mesh;
 using namespace mlc::mesh::testing;
 
 namespace {
-
-double total_volume(const TetMesh& m) {
-    double v = 0;
-    for (int t = 0; t < m.n_tetrahedra(); ++t)
-        v += std::abs(m.signed_volume(t));
-    return v;
-}
 
 /// Appends the face (a, b, c) tagged `tag`, its normal turned away from vertex `inside`.
 void add_face(TetMesh& m, std::array<int, 3> v, int inside, int tag) {
@@ -66,7 +60,7 @@ TEST(TetSurface, NewVerticesGoOntoTheSphere) {
     for (const auto& f : m.boundary)
         EXPECT_EQ(f.surface, 0);
     const std::vector<TetLevelSize> sizes = predict_tet_level_sizes(m, 3);
-    std::vector<double> error{4 * std::numbers::pi / 3 - total_volume(m)};
+    std::vector<double> error{4 * std::numbers::pi / 3 - mesh::testing::total_volume(m)};
     for (int l = 1; l <= 3; ++l) {
         m = refine(m);
         EXPECT_NO_THROW(check_quality(m)) << "level " << l;
@@ -74,7 +68,7 @@ TEST(TetSurface, NewVerticesGoOntoTheSphere) {
         EXPECT_EQ(m.n_vertices(), sizes[l].vertices);
         for (const auto& f : m.boundary)
             EXPECT_EQ(f.surface, 0);
-        error.push_back(4 * std::numbers::pi / 3 - total_volume(m));
+        error.push_back(4 * std::numbers::pi / 3 - mesh::testing::total_volume(m));
         // The volume grows towards the ball's, its error falling about fourfold per level once
         // the octahedron's (a coarse start) has been refined away.
         EXPECT_GT(error[l], 0);
@@ -104,7 +98,7 @@ TEST(TetSurface, NewVerticesGoOntoTheCylinder) {
             EXPECT_EQ(m.vertices[v].z(), 1.0);
     }
     // 32 sides around a circle on level 2: the polygon's area 16 sin(2 pi / 32).
-    EXPECT_NEAR(total_volume(m), 16 * std::sin(2 * std::numbers::pi / 32), 1e-13);
+    EXPECT_NEAR(mesh::testing::total_volume(m), 16 * std::sin(2 * std::numbers::pi / 32), 1e-13);
 }
 
 TEST(TetSurface, RefusesABadDeclarationOrAnInvertingMove) {

@@ -5,6 +5,9 @@
 #include "mesh/io/vtu.hpp"
 #include "mesh/mesh.hpp"
 
+#include "tests/common/files.hpp"
+#include "tests/mesh/vtu_read.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -23,21 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Directory of the running test (tests may run in parallel processes).
-fs::path scratch_path() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    return fs::path(::testing::TempDir()) /
-           ("mlc_vtu_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-}
-
-/// A fresh, empty directory for the running test; the fixture removes it afterwards.
-fs::path scratch_dir() {
-    const fs::path dir = scratch_path();
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
 /// The names in a folder that are temporaries (written by a writer and not renamed).
 std::vector<std::string> temporaries(const fs::path& dir) {
     std::vector<std::string> out;
@@ -45,22 +33,6 @@ std::vector<std::string> temporaries(const fs::path& dir) {
         if (e.path().filename().string().ends_with(".tmp"))
             out.push_back(e.path().filename().string());
     return out;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-/// Value of the first attribute `name="..."` after position `from`.
-std::string attribute(const std::string& xml, const std::string& name, std::size_t from = 0) {
-    const std::string key = " " + name + "=\"";
-    const std::size_t a = xml.find(key, from);
-    if (a == std::string::npos) return "";
-    const std::size_t b = xml.find('"', a + key.size());
-    return xml.substr(a + key.size(), b - a - key.size());
 }
 
 /// Numbers of a DataArray: the one whose opening tag contains `marker` (e.g. Name="u"), or,
@@ -96,11 +68,11 @@ void expect_close(double expected, double found, const std::string& what) {
 
 class Vtu : public ::testing::Test {
 protected:
-    void TearDown() override { fs::remove_all(scratch_path()); }
+    void TearDown() override { fs::remove_all(testutil::scratch_path("mlc_vtu")); }
 };
 
 TEST_F(Vtu, RoundTripsMeshAndFields) {
-    const fs::path file = scratch_dir() / "out.vtu";
+    const fs::path file = testutil::scratch_dir("mlc_vtu") / "out.vtu";
     const Mesh m = small_mesh();
     Field u{"displacement", 2, {}};
     for (int i = 0; i < 4; ++i) {
@@ -113,11 +85,11 @@ TEST_F(Vtu, RoundTripsMeshAndFields) {
     ASSERT_TRUE(fs::exists(file));
     EXPECT_TRUE(temporaries(file.parent_path()).empty());
 
-    const std::string xml = slurp(file);
+    const std::string xml = testutil::slurp(file);
     EXPECT_EQ(xml.rfind("<?xml", 0), 0u);
     EXPECT_NE(xml.find("type=\"UnstructuredGrid\""), std::string::npos);
-    EXPECT_EQ(attribute(xml, "NumberOfPoints"), "4");
-    EXPECT_EQ(attribute(xml, "NumberOfCells"), "2");
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfPoints"), "4");
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), "2");
 
     const auto points = data_array(xml, "<Points>");
     ASSERT_EQ(points.size(), 12u);
@@ -135,7 +107,7 @@ TEST_F(Vtu, RoundTripsMeshAndFields) {
     const std::size_t u_at = xml.find("Name=\"displacement\"");
     EXPECT_LT(point_data, u_at);
     EXPECT_LT(u_at, xml.find("</PointData>"));
-    EXPECT_EQ(attribute(xml, "NumberOfComponents", u_at), "3");
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfComponents", u_at), "3");
     const auto uu = data_array(xml, "Name=\"displacement\"");
     ASSERT_EQ(uu.size(), 12u);
     for (int v = 0; v < 4; ++v) {
@@ -154,47 +126,8 @@ TEST_F(Vtu, RoundTripsMeshAndFields) {
     EXPECT_EQ(data_array(xml, "Name=\"stress &lt;xx&gt;\""), s.values);
 }
 
-namespace {
-
-/// The decoded bytes of an appended, zlib-compressed array (header_type UInt64) of a binary VTU,
-/// found by the `marker` in its DataArray tag; empty (and a test failure) if anything is off.
-std::vector<unsigned char> appended_array(const std::string& xml, const std::string& marker) {
-    std::size_t at = xml.find(marker);
-    EXPECT_NE(at, std::string::npos) << marker;
-    if (at == std::string::npos) return {};
-    if (marker.back() == '>') at = xml.find("<DataArray", at);
-    EXPECT_EQ(attribute(xml, "format", at), "appended");
-    const std::size_t offset = std::stoull(attribute(xml, "offset", at));
-    const std::size_t data = xml.find('_', xml.find("<AppendedData encoding=\"raw\">")) + 1;
-    const auto* p = reinterpret_cast<const unsigned char*>(xml.data()) + data + offset;
-    std::uint64_t head[3];
-    std::memcpy(head, p, sizeof head);
-    const std::uint64_t n_blocks = head[0], block = head[1], last = head[2];
-    std::vector<std::uint64_t> sizes(n_blocks);
-    std::memcpy(sizes.data(), p + sizeof head, n_blocks * 8);
-    const unsigned char* blocks = p + sizeof head + n_blocks * 8;
-    std::vector<unsigned char> out;
-    for (std::uint64_t b = 0; b < n_blocks; ++b) {
-        uLongf n = (b + 1 == n_blocks && last != 0) ? last : block;
-        std::vector<unsigned char> chunk(n);
-        EXPECT_EQ(uncompress(chunk.data(), &n, blocks, sizes[b]), Z_OK);
-        chunk.resize(n);
-        out.insert(out.end(), chunk.begin(), chunk.end());
-        blocks += sizes[b];
-    }
-    return out;
-}
-
-template <class T> std::vector<T> as(const std::vector<unsigned char>& bytes) {
-    std::vector<T> v(bytes.size() / sizeof(T));
-    std::memcpy(v.data(), bytes.data(), v.size() * sizeof(T));
-    return v;
-}
-
-} // namespace
-
 TEST_F(Vtu, BinaryHoldsTheSameArraysBitForBit) {
-    const fs::path dir = scratch_dir();
+    const fs::path dir = testutil::scratch_dir("mlc_vtu");
     // Large enough for several 1 MiB compression blocks: 90601 points (2.2 MB of coordinates),
     // 180000 triangles (a 4.3 MB stress field), none a whole number of blocks.
     const Mesh m = structured_rectangle(Vec2(0, 0), Vec2(2, 1), 300, 300);
@@ -211,43 +144,46 @@ TEST_F(Vtu, BinaryHoldsTheSameArraysBitForBit) {
     write_vtu(dir / "b.vtu", m, {u}, {s, zero});
     write_vtu(dir / "a.vtu", m, {u}, {s, zero}, VtuFormat::ascii);
     EXPECT_TRUE(temporaries(dir).empty());
-    const std::string xml = slurp(dir / "b.vtu");
+    const std::string xml = testutil::slurp(dir / "b.vtu");
     EXPECT_NE(xml.find("header_type=\"UInt64\""), std::string::npos);
     EXPECT_NE(xml.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
-    EXPECT_EQ(attribute(xml, "NumberOfPoints"), std::to_string(nv));
-    EXPECT_EQ(attribute(xml, "NumberOfCells"), std::to_string(nt));
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfPoints"), std::to_string(nv));
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), std::to_string(nt));
     EXPECT_LT(fs::file_size(dir / "b.vtu"), fs::file_size(dir / "a.vtu"));
 
-    const auto points = as<double>(appended_array(xml, "<Points>"));
+    const auto points = testutil::as<double>(testutil::appended_array(xml, "<Points>"));
     ASSERT_EQ(points.size(), 3 * nv);
     for (std::size_t v = 0; v < nv; v += 37) {
         EXPECT_EQ(points[3 * v], m.vertices[v].x());
         EXPECT_EQ(points[3 * v + 1], m.vertices[v].y());
         EXPECT_EQ(points[3 * v + 2], 0.0);
     }
-    const auto uu = as<double>(appended_array(xml, "Name=\"displacement\""));
+    const auto uu = testutil::as<double>(testutil::appended_array(xml, "Name=\"displacement\""));
     ASSERT_EQ(uu.size(), 3 * nv);
     for (std::size_t v = 0; v < nv; ++v) {
         ASSERT_EQ(uu[3 * v], u.values[2 * v]) << v;
         ASSERT_EQ(uu[3 * v + 1], u.values[2 * v + 1]) << v;
         ASSERT_EQ(uu[3 * v + 2], 0.0) << v;
     }
-    EXPECT_EQ(as<double>(appended_array(xml, "Name=\"stress &lt;xx&gt;\"")), s.values);
-    EXPECT_EQ(as<double>(appended_array(xml, "Name=\"zero\"")), zero.values);
-    const auto conn = as<std::int32_t>(appended_array(xml, "Name=\"connectivity\""));
+    EXPECT_EQ(testutil::as<double>(testutil::appended_array(xml, "Name=\"stress &lt;xx&gt;\"")),
+              s.values);
+    EXPECT_EQ(testutil::as<double>(testutil::appended_array(xml, "Name=\"zero\"")), zero.values);
+    const auto conn =
+        testutil::as<std::int32_t>(testutil::appended_array(xml, "Name=\"connectivity\""));
     ASSERT_EQ(conn.size(), 3 * nt);
     for (std::size_t t = 0; t < nt; ++t)
         for (int k = 0; k < 3; ++k)
             ASSERT_EQ(conn[3 * t + k], m.triangles[t][k]);
-    const auto offsets = as<std::int64_t>(appended_array(xml, "Name=\"offsets\""));
+    const auto offsets =
+        testutil::as<std::int64_t>(testutil::appended_array(xml, "Name=\"offsets\""));
     ASSERT_EQ(offsets.size(), nt);
     EXPECT_EQ(offsets.front(), 3);
     EXPECT_EQ(offsets.back(), static_cast<std::int64_t>(3 * nt));
-    EXPECT_EQ(appended_array(xml, "Name=\"types\""), std::vector<unsigned char>(nt, 5));
+    EXPECT_EQ(testutil::appended_array(xml, "Name=\"types\""), std::vector<unsigned char>(nt, 5));
 }
 
 TEST_F(Vtu, NonFiniteValueThrowsAndLeavesNoFile) {
-    const fs::path dir = scratch_dir();
+    const fs::path dir = testutil::scratch_dir("mlc_vtu");
     const fs::path file = dir / "bad.vtu";
     const Mesh m = small_mesh();
     Field u{"u", 2, std::vector<double>(8, 1.0)};
@@ -276,7 +212,7 @@ TEST_F(Vtu, NonFiniteValueThrowsAndLeavesNoFile) {
 }
 
 TEST_F(Vtu, InconsistentSizesThrow) {
-    const fs::path dir = scratch_dir();
+    const fs::path dir = testutil::scratch_dir("mlc_vtu");
     const fs::path file = dir / "bad.vtu";
     const Mesh m = small_mesh();
     EXPECT_THROW(write_vtu(file, m, {Field{"u", 2, std::vector<double>(7, 0.0)}}, {}),
@@ -298,16 +234,16 @@ TEST_F(Vtu, InconsistentSizesThrow) {
 }
 
 TEST_F(Vtu, OverwritesAndWritesLargerMeshes) {
-    const fs::path file = scratch_dir() / "grid.vtu";
+    const fs::path file = testutil::scratch_dir("mlc_vtu") / "grid.vtu";
     const Mesh m = structured_rectangle(Vec2(0, 0), Vec2(2, 1), 40, 20);
     write_vtu(file, small_mesh(), {}, {});
     std::vector<double> x(m.vertices.size());
     for (std::size_t v = 0; v < x.size(); ++v)
         x[v] = m.vertices[v].x() * m.vertices[v].y();
     write_vtu(file, m, {Field{"xy", 1, x}}, {}, VtuFormat::ascii);
-    const std::string xml = slurp(file);
-    EXPECT_EQ(attribute(xml, "NumberOfPoints"), std::to_string(41 * 21));
-    EXPECT_EQ(attribute(xml, "NumberOfCells"), std::to_string(2 * 40 * 20));
+    const std::string xml = testutil::slurp(file);
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfPoints"), std::to_string(41 * 21));
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), std::to_string(2 * 40 * 20));
     const auto conn = data_array(xml, "Name=\"connectivity\"");
     ASSERT_EQ(conn.size(), 3u * m.triangles.size());
     for (std::size_t t = 0; t < m.triangles.size(); ++t)
@@ -324,10 +260,10 @@ TEST_F(Vtu, OverwritesAndWritesLargerMeshes) {
 }
 
 TEST_F(Vtu, PvdListsSteps) {
-    const fs::path dir = scratch_dir();
+    const fs::path dir = testutil::scratch_dir("mlc_vtu");
     const fs::path file = dir / "series.pvd";
     write_pvd(file, {{0.0, "step_0.vtu"}, {0.25, "step_1.vtu"}, {1.0 / 3, "out/step_2.vtu"}});
-    const std::string xml = slurp(file);
+    const std::string xml = testutil::slurp(file);
     EXPECT_NE(xml.find("type=\"Collection\""), std::string::npos);
     std::size_t at = 0;
     const std::vector<std::pair<double, std::string>> expected = {
@@ -335,8 +271,8 @@ TEST_F(Vtu, PvdListsSteps) {
     for (const auto& [time, name] : expected) {
         at = xml.find("<DataSet", at);
         ASSERT_NE(at, std::string::npos);
-        EXPECT_EQ(std::stod(attribute(xml, "timestep", at)), time);
-        EXPECT_EQ(attribute(xml, "file", at), name);
+        EXPECT_EQ(std::stod(testutil::xml_attribute(xml, "timestep", at)), time);
+        EXPECT_EQ(testutil::xml_attribute(xml, "file", at), name);
         ++at;
     }
     EXPECT_EQ(xml.find("<DataSet", at), std::string::npos);
@@ -346,11 +282,11 @@ TEST_F(Vtu, PvdListsSteps) {
 }
 
 TEST_F(Vtu, AStopRequestWhileWritesAreStoppableAbandonsTheFile) {
-    const fs::path dir = scratch_dir();
+    const fs::path dir = testutil::scratch_dir("mlc_vtu");
     const Mesh m = structured_rectangle(Vec2(0, 0), Vec2(1, 1), 200, 200);
     Field u{"displacement", 2, std::vector<double>(2 * m.vertices.size(), 0.25)};
     write_vtu(dir / "a.vtu", m, {u}, {}, VtuFormat::ascii);
-    const std::string before = slurp(dir / "a.vtu");
+    const std::string before = testutil::slurp(dir / "a.vtu");
     request_stop(2);
     set_writes_stoppable(true);
     for (const auto format : {VtuFormat::ascii, VtuFormat::binary}) {
@@ -359,10 +295,10 @@ TEST_F(Vtu, AStopRequestWhileWritesAreStoppableAbandonsTheFile) {
     }
     set_writes_stoppable(false);
     clear_stop_request();
-    EXPECT_EQ(slurp(dir / "a.vtu"), before); // left as it was
+    EXPECT_EQ(testutil::slurp(dir / "a.vtu"), before); // left as it was
     EXPECT_FALSE(fs::exists(dir / "b.vtu"));
     EXPECT_TRUE(temporaries(dir).empty());
     write_vtu(dir / "b.vtu", m, {u}, {}, VtuFormat::ascii); // no request: written
-    EXPECT_EQ(slurp(dir / "b.vtu"), before);
+    EXPECT_EQ(testutil::slurp(dir / "b.vtu"), before);
     fs::remove_all(dir);
 }

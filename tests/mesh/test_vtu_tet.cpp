@@ -7,6 +7,9 @@
 #include "mesh/tet_refine.hpp"
 #include "tests/mesh/tet_test_meshes.hpp"
 
+#include "tests/common/files.hpp"
+#include "tests/mesh/vtu_read.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -24,71 +27,6 @@ namespace fs = std::filesystem;
 namespace tmesh = mlc::mesh::testing;
 
 namespace {
-
-/// A fresh, empty directory for the running test; the fixture removes it afterwards.
-fs::path scratch_path() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    return fs::path(::testing::TempDir()) /
-           ("mlc_vtu_tet_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-}
-
-fs::path scratch_dir() {
-    const fs::path dir = scratch_path();
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-/// Value of the first attribute `name="..."` after position `from`.
-std::string attribute(const std::string& xml, const std::string& name, std::size_t from = 0) {
-    const std::string key = " " + name + "=\"";
-    const std::size_t a = xml.find(key, from);
-    if (a == std::string::npos) return "";
-    const std::size_t b = xml.find('"', a + key.size());
-    return xml.substr(a + key.size(), b - a - key.size());
-}
-
-/// The decoded bytes of the appended, zlib-compressed array (header_type UInt64) whose
-/// DataArray tag holds `marker` (for an element such as "<Points>", the first DataArray in it).
-std::vector<unsigned char> appended_array(const std::string& xml, const std::string& marker) {
-    std::size_t at = xml.find(marker);
-    EXPECT_NE(at, std::string::npos) << marker;
-    if (at == std::string::npos) return {};
-    if (marker.back() == '>') at = xml.find("<DataArray", at);
-    EXPECT_EQ(attribute(xml, "format", at), "appended");
-    const std::size_t offset = std::stoull(attribute(xml, "offset", at));
-    const std::size_t data = xml.find('_', xml.find("<AppendedData encoding=\"raw\">")) + 1;
-    const auto* p = reinterpret_cast<const unsigned char*>(xml.data()) + data + offset;
-    std::uint64_t head[3];
-    std::memcpy(head, p, sizeof head);
-    const std::uint64_t n_blocks = head[0], block = head[1], last = head[2];
-    std::vector<std::uint64_t> sizes(n_blocks);
-    std::memcpy(sizes.data(), p + sizeof head, n_blocks * 8);
-    const unsigned char* blocks = p + sizeof head + n_blocks * 8;
-    std::vector<unsigned char> out;
-    for (std::uint64_t b = 0; b < n_blocks; ++b) {
-        uLongf n = (b + 1 == n_blocks && last != 0) ? last : block;
-        std::vector<unsigned char> chunk(n);
-        EXPECT_EQ(uncompress(chunk.data(), &n, blocks, sizes[b]), Z_OK);
-        chunk.resize(n);
-        out.insert(out.end(), chunk.begin(), chunk.end());
-        blocks += sizes[b];
-    }
-    return out;
-}
-
-template <class T> std::vector<T> as(const std::vector<unsigned char>& bytes) {
-    std::vector<T> v(bytes.size() / sizeof(T));
-    std::memcpy(v.data(), bytes.data(), v.size() * sizeof(T));
-    return v;
-}
 
 /// The distorted cube of the Gmsh tests (two bodies, three tags), refined once.
 TetMesh gmsh_mesh() {
@@ -111,31 +49,33 @@ std::vector<Field> point_fields(const TetMesh& m) {
 
 class VtuTet : public ::testing::Test {
 protected:
-    void TearDown() override { fs::remove_all(scratch_path()); }
+    void TearDown() override { fs::remove_all(testutil::scratch_path("mlc_vtu_tet")); }
 };
 
 TEST_F(VtuTet, TetrahedraAndFieldsReadBackBitForBit) {
-    const fs::path file = scratch_dir() / "tets.vtu";
+    const fs::path file = testutil::scratch_dir("mlc_vtu_tet") / "tets.vtu";
     const TetMesh m = gmsh_mesh();
     const auto pf = point_fields(m);
     Field vol{"volume", 1, {}};
     for (int t = 0; t < m.n_tetrahedra(); ++t)
         vol.values.push_back(m.signed_volume(t));
     write_vtu(file, m, pf, {vol});
-    const std::string xml = slurp(file);
-    EXPECT_EQ(attribute(xml, "NumberOfPoints"), std::to_string(m.n_vertices()));
-    EXPECT_EQ(attribute(xml, "NumberOfCells"), std::to_string(m.n_tetrahedra()));
-    EXPECT_EQ(attribute(xml, "compressor"), "vtkZLibDataCompressor");
+    const std::string xml = testutil::slurp(file);
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfPoints"), std::to_string(m.n_vertices()));
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), std::to_string(m.n_tetrahedra()));
+    EXPECT_EQ(testutil::xml_attribute(xml, "compressor"), "vtkZLibDataCompressor");
     const std::size_t nv = m.vertices.size(), nt = m.tetrahedra.size();
 
-    const auto xyz = as<double>(appended_array(xml, "<Points>"));
+    const auto xyz = testutil::as<double>(testutil::appended_array(xml, "<Points>"));
     ASSERT_EQ(xyz.size(), 3 * nv);
     for (std::size_t v = 0; v < nv; ++v)
         for (int c = 0; c < 3; ++c)
             ASSERT_EQ(xyz[3 * v + static_cast<std::size_t>(c)], m.vertices[v][c]) << v;
-    const auto conn = as<std::int32_t>(appended_array(xml, "Name=\"connectivity\""));
-    const auto offsets = as<std::int64_t>(appended_array(xml, "Name=\"offsets\""));
-    const auto types = appended_array(xml, "Name=\"types\"");
+    const auto conn =
+        testutil::as<std::int32_t>(testutil::appended_array(xml, "Name=\"connectivity\""));
+    const auto offsets =
+        testutil::as<std::int64_t>(testutil::appended_array(xml, "Name=\"offsets\""));
+    const auto types = testutil::appended_array(xml, "Name=\"types\"");
     ASSERT_EQ(conn.size(), 4 * nt);
     ASSERT_EQ(offsets.size(), nt);
     ASSERT_EQ(types.size(), nt);
@@ -151,33 +91,37 @@ TEST_F(VtuTet, TetrahedraAndFieldsReadBackBitForBit) {
         const std::size_t at = xml.find("Name=\"" + f.name + "\"");
         EXPECT_LT(point_data, at);
         EXPECT_LT(at, cell_data);
-        EXPECT_EQ(attribute(xml, "NumberOfComponents", at), std::to_string(f.n_components));
-        EXPECT_EQ(as<double>(appended_array(xml, "Name=\"" + f.name + "\"")), f.values) << f.name;
+        EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfComponents", at),
+                  std::to_string(f.n_components));
+        EXPECT_EQ(testutil::as<double>(testutil::appended_array(xml, "Name=\"" + f.name + "\"")),
+                  f.values)
+            << f.name;
     }
     EXPECT_LT(xml.find("Name=\"body\""), xml.find("Name=\"volume\""));
     EXPECT_LT(cell_data, xml.find("Name=\"body\""));
-    const auto body = as<double>(appended_array(xml, "Name=\"body\""));
+    const auto body = testutil::as<double>(testutil::appended_array(xml, "Name=\"body\""));
     ASSERT_EQ(body.size(), nt);
     for (std::size_t t = 0; t < nt; ++t)
         ASSERT_EQ(body[t], m.attribute[t]); // physical volumes 3 (shell) and 4 (core)
     EXPECT_EQ(std::count(body.begin(), body.end(), 4.0), 8); // the core's eight children
-    EXPECT_EQ(as<double>(appended_array(xml, "Name=\"volume\"")), vol.values);
+    EXPECT_EQ(testutil::as<double>(testutil::appended_array(xml, "Name=\"volume\"")), vol.values);
 }
 
 TEST_F(VtuTet, BoundaryFacesWithTheirTags) {
-    const fs::path file = scratch_dir() / "boundary.vtu";
+    const fs::path file = testutil::scratch_dir("mlc_vtu_tet") / "boundary.vtu";
     const TetMesh m = structured_box(Vec3(0, 0, 0), Vec3(1, 2, 3), 2, 1, 1);
     const auto pf = point_fields(m);
     write_boundary_vtu(file, m, pf);
-    const std::string xml = slurp(file);
+    const std::string xml = testutil::slurp(file);
     const std::size_t nf = m.boundary.size();
     ASSERT_EQ(nf, 2u * (2 * 1 + 2 * 1 + 1 * 1) * 2); // two triangles per square face
-    EXPECT_EQ(attribute(xml, "NumberOfPoints"), std::to_string(m.n_vertices()));
-    EXPECT_EQ(attribute(xml, "NumberOfCells"), std::to_string(nf));
-    const auto conn = as<std::int32_t>(appended_array(xml, "Name=\"connectivity\""));
-    const auto types = appended_array(xml, "Name=\"types\"");
-    const auto tag = as<double>(appended_array(xml, "Name=\"tag\""));
-    const auto surface = as<double>(appended_array(xml, "Name=\"surface\""));
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfPoints"), std::to_string(m.n_vertices()));
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), std::to_string(nf));
+    const auto conn =
+        testutil::as<std::int32_t>(testutil::appended_array(xml, "Name=\"connectivity\""));
+    const auto types = testutil::appended_array(xml, "Name=\"types\"");
+    const auto tag = testutil::as<double>(testutil::appended_array(xml, "Name=\"tag\""));
+    const auto surface = testutil::as<double>(testutil::appended_array(xml, "Name=\"surface\""));
     ASSERT_EQ(conn.size(), 3 * nf);
     ASSERT_EQ(tag.size(), nf);
     for (std::size_t f = 0; f < nf; ++f) {
@@ -188,17 +132,18 @@ TEST_F(VtuTet, BoundaryFacesWithTheirTags) {
         EXPECT_EQ(surface[f], -1.0);
     }
     // Faces tagged zmax lie in z = 3.
-    const auto xyz = as<double>(appended_array(xml, "<Points>"));
+    const auto xyz = testutil::as<double>(testutil::appended_array(xml, "<Points>"));
     for (std::size_t f = 0; f < nf; ++f) {
         if (tag[f] != m.tag("zmax")) continue;
         for (std::size_t k = 0; k < 3; ++k)
             EXPECT_EQ(xyz[3 * static_cast<std::size_t>(conn[3 * f + k]) + 2], 3.0);
     }
-    EXPECT_EQ(as<double>(appended_array(xml, "Name=\"displacement\"")), pf[1].values);
+    EXPECT_EQ(testutil::as<double>(testutil::appended_array(xml, "Name=\"displacement\"")),
+              pf[1].values);
 }
 
 TEST_F(VtuTet, SeriesOfStepsInAPvd) {
-    const fs::path dir = scratch_dir();
+    const fs::path dir = testutil::scratch_dir("mlc_vtu_tet");
     const TetMesh m = structured_box(Vec3(0, 0, 0), Vec3(1, 1, 1), 1, 1, 1);
     std::vector<std::pair<double, std::string>> steps;
     for (int s = 0; s < 3; ++s) {
@@ -208,16 +153,18 @@ TEST_F(VtuTet, SeriesOfStepsInAPvd) {
         const std::string name = "step_" + std::to_string(s) + ".vtu";
         write_vtu(dir / name, m, {u}, {});
         steps.emplace_back(s / 2.0, name);
-        EXPECT_EQ(as<double>(appended_array(slurp(dir / name), "Name=\"displacement\"")), u.values);
+        EXPECT_EQ(testutil::as<double>(testutil::appended_array(testutil::slurp(dir / name),
+                                                                "Name=\"displacement\"")),
+                  u.values);
     }
     write_pvd(dir / "series.pvd", steps);
-    const std::string pvd = slurp(dir / "series.pvd");
+    const std::string pvd = testutil::slurp(dir / "series.pvd");
     std::size_t at = 0;
     for (const auto& [time, name] : steps) {
         at = pvd.find("<DataSet", at);
         ASSERT_NE(at, std::string::npos);
-        EXPECT_EQ(std::stod(attribute(pvd, "timestep", at)), time);
-        EXPECT_EQ(attribute(pvd, "file", at), name);
+        EXPECT_EQ(std::stod(testutil::xml_attribute(pvd, "timestep", at)), time);
+        EXPECT_EQ(testutil::xml_attribute(pvd, "file", at), name);
         EXPECT_TRUE(fs::exists(dir / name));
         ++at;
     }
@@ -225,7 +172,7 @@ TEST_F(VtuTet, SeriesOfStepsInAPvd) {
 }
 
 TEST_F(VtuTet, BadInputIsRefusedBeforeAnyFileIsWritten) {
-    const fs::path dir = scratch_dir();
+    const fs::path dir = testutil::scratch_dir("mlc_vtu_tet");
     TetMesh m = structured_box(Vec3(0, 0, 0), Vec3(1, 1, 1), 1, 1, 1);
     tmesh::expect_invalid(
         [&] {

@@ -55,14 +55,14 @@ Eigen::MatrixXd explicit_inverse(const SparseMatrix& A, const std::vector<Index>
     return C.inverse();
 }
 
-struct Case {
+struct SorCase {
     const char* name;
     SparseMatrix A;
     std::vector<Index> starts;
 };
 
-std::vector<Case> cases() {
-    std::vector<Case> c;
+std::vector<SorCase> sor_cases() {
+    std::vector<SorCase> c;
     c.push_back({"point convdiff", testmat::convection_diffusion(), {}});
     c.push_back({"2x2 convdiff", testmat::convection_diffusion(), uniform_block_starts(36, 2)});
     std::vector<Index> vs;
@@ -74,7 +74,7 @@ std::vector<Case> cases() {
 } // namespace
 
 TEST(BlockSOR, ApplyEqualsExplicitFormula) {
-    for (const auto& c : cases())
+    for (const auto& c : sor_cases())
         for (Sweep sweep : {Sweep::forward, Sweep::backward, Sweep::symmetric})
             for (double w : {1.0, 1.3, 0.6}) {
                 BlockSOR S(BlockSORParams{.omega = w, .sweep = sweep, .block_starts = c.starts});
@@ -92,7 +92,7 @@ TEST(BlockSOR, ApplyEqualsExplicitFormula) {
 }
 
 TEST(BlockSOR, TransposeEqualsProbedTranspose) {
-    for (const auto& c : cases())
+    for (const auto& c : sor_cases())
         for (Sweep sweep : {Sweep::forward, Sweep::backward, Sweep::symmetric})
             for (int sweeps : {1, 2}) {
                 BlockSOR S(BlockSORParams{
@@ -106,7 +106,7 @@ TEST(BlockSOR, TransposeEqualsProbedTranspose) {
 }
 
 TEST(BlockSOR, SmoothAndRepeatedSweepsFollowTheIteration) {
-    for (const auto& c : cases())
+    for (const auto& c : sor_cases())
         for (Sweep sweep : {Sweep::forward, Sweep::symmetric}) {
             const double w = 1.1;
             BlockSOR S(BlockSORParams{

@@ -41,12 +41,12 @@ Eigen::MatrixXi reference_levels(const SparseMatrix& A, int K) {
     return lev;
 }
 
-struct Case {
+struct IlukCase {
     const char* name;
     SparseMatrix A;
 };
 
-std::vector<Case> cases() {
+std::vector<IlukCase> iluk_cases() {
     return {{"laplace_2d", testmat::laplace_2d(6)},
             {"convection_diffusion", testmat::convection_diffusion()},
             {"contact_saddle", testmat::contact_saddle(9)}};
@@ -55,7 +55,7 @@ std::vector<Case> cases() {
 } // namespace
 
 TEST(ILUK, FillAtLeastBandwidthEqualsLU) {
-    for (const auto& c : cases()) {
+    for (const auto& c : iluk_cases()) {
         const Index w = testmat::bandwidth(c.A);
         ILUK ilu(ILUKParams{.fill_level = static_cast<int>(w)});
         ilu.setup(c.A);
@@ -86,7 +86,7 @@ TEST(ILUK, ZeroFillIsExactOnTridiagonal) {
 }
 
 TEST(ILUK, ZeroFillProductMatchesAOnItsPattern) {
-    for (const auto& c : cases()) {
+    for (const auto& c : iluk_cases()) {
         ILUK ilu;
         ilu.setup(c.A);
         EXPECT_EQ(ilu.n_nonzeros(), c.A.nonZeros()) << c.name;
@@ -102,7 +102,7 @@ TEST(ILUK, ZeroFillProductMatchesAOnItsPattern) {
 }
 
 TEST(ILUK, FillPatternMatchesDenseLevelReference) {
-    for (const auto& c : cases())
+    for (const auto& c : iluk_cases())
         for (int K : {0, 1, 2, 3}) {
             ILUK ilu(ILUKParams{.fill_level = K});
             ilu.setup(c.A);

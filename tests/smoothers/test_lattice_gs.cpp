@@ -21,14 +21,14 @@ namespace {
 // One level: the elastic stiffness of a 2 x 1 rectangle (four macro triangles) refined `depth`
 // times, the bottom edge fixed in y (vertex blocks of one row there), numbered along the Hilbert
 // curve (`lattice` false) or macro by macro (mesh::lattice_vertex_order).
-struct Case {
+struct LatticeCase {
     SparseMatrix A;
     std::vector<Index> starts;
     LatticeRows lattice;
     std::vector<int> row_of_hilbert_row; // the lattice-numbered row of each Hilbert-numbered row
 };
 
-Case elastic_case(int depth, bool lattice) {
+LatticeCase elastic_case(int depth, bool lattice) {
     mesh::Mesh m =
         mesh::structured_rectangle({0.0, 0.0}, {2.0, 1.0}, 2, 1, mesh::Diagonal::alternate);
     for (int k = 0; k < depth; ++k)
@@ -43,7 +43,7 @@ Case elastic_case(int depth, bool lattice) {
     const fem::DofMap dofs(fixed, std::vector<int>(nv, 0),
                            lattice ? mesh::lattice_vertex_order(m, *L) : hilbert);
     const Vector zero = Vector::Zero(2 * m.n_vertices());
-    Case c;
+    LatticeCase c;
     c.A = fem::assemble_elastic(m, {fem::Material{}}, dofs, zero, zero).K;
     for (Index i = 0; i < dofs.n_dofs(); ++i)
         if (i == 0 || dofs.vertex_of(i) != dofs.vertex_of(i - 1)) c.starts.push_back(i);
@@ -111,7 +111,7 @@ using mlc::testutil::random_vector;
 
 // One sweep of the lattice smoother is block Gauss–Seidel of c.A in its visit order (Jacobi
 // across the parts), to round-off: forward and backward, omega 1 and 1.3.
-void expect_gauss_seidel(const Case& c, unsigned seed) {
+void expect_gauss_seidel(const LatticeCase& c, unsigned seed) {
     const Index n = c.A.rows();
     const Vector b = random_vector(n, seed), x0 = random_vector(n, seed + 1);
     for (double omega : {1.0, 1.3})
@@ -130,7 +130,7 @@ void expect_gauss_seidel(const Case& c, unsigned seed) {
 // In the Hilbert visit, one part (level 4) and two (level 6).
 TEST(LatticeGS, SweepIsBlockGaussSeidelInItsVisitOrder) {
     for (int depth : {4, 6}) {
-        const Case c = elastic_case(depth, true);
+        const LatticeCase c = elastic_case(depth, true);
         LatticeGS S(c.starts, c.lattice, {});
         S.setup(c.A);
         EXPECT_EQ(S.parts(), depth == 4 ? 1 : 2);
@@ -151,7 +151,7 @@ TEST(LatticeGS, SweepIsBlockGaussSeidelInItsVisitOrder) {
 // With the Hilbert visit order the lattice-numbered sweep is BlockSOR's sweep of the
 // Hilbert-numbered matrix (the multigrid smoother: unrolled kernel, hybrid parts), to round-off.
 TEST(LatticeGS, IsTheBlockSmootherOfTheDefaultNumbering) {
-    const Case lat = elastic_case(6, true), hil = elastic_case(6, false);
+    const LatticeCase lat = elastic_case(6, true), hil = elastic_case(6, false);
     const Index n = lat.A.rows();
     const Vector bh = random_vector(n, 7), xh = random_vector(n, 8);
     Vector bl(n), xl(n);
@@ -183,7 +183,7 @@ TEST(LatticeGS, IsTheBlockSmootherOfTheDefaultNumbering) {
 // A deep row that differs from its macro's stencil is swept by its own rows: still Gauss–Seidel
 // of A; and update_values sees a changed deep row.
 TEST(LatticeGS, ARowOffItsStencilIsSweptByItsRows) {
-    Case c = elastic_case(4, true);
+    LatticeCase c = elastic_case(4, true);
     const Index n = c.A.rows();
     const Vector b = random_vector(n, 3), x0 = random_vector(n, 4);
     LatticeGS S(c.starts, c.lattice, {});
@@ -202,7 +202,7 @@ TEST(LatticeGS, ARowOffItsStencilIsSweptByItsRows) {
 
 // Two sweeps in one call are two calls; forward_from_zero returns the residual.
 TEST(LatticeGS, RepeatedSweepsAndTheSweepFromZero) {
-    const Case c = elastic_case(4, true);
+    const LatticeCase c = elastic_case(4, true);
     const Index n = c.A.rows();
     const Vector b = random_vector(n, 5), x0 = random_vector(n, 6);
     LatticeGS S(c.starts, c.lattice, {});
@@ -227,7 +227,7 @@ TEST(LatticeGS, ANewPatternIsSetUpAgain) {
     // same row lengths: only the semi-deep pattern check sees it).
     enum Kind { deep_row, semi_row, swept_row, semi_moved };
     for (Kind kind : {deep_row, semi_row, swept_row, semi_moved}) {
-        Case c = elastic_case(4, true);
+        LatticeCase c = elastic_case(4, true);
         const Index n = c.A.rows();
         LatticeGS S(c.starts, c.lattice, {});
         S.setup(c.A);
@@ -268,7 +268,7 @@ TEST(LatticeGS, ANewPatternIsSetUpAgain) {
 namespace {
 // A visit of each macro's interior in serpentine rows (row j eastwards when j is odd, westwards
 // when even: runs of deep points stepping +2 and -2 rows), then every other block in row order.
-std::vector<Index> serpentine_visit(const Case& c, const std::vector<Index>& starts) {
+std::vector<Index> serpentine_visit(const LatticeCase& c, const std::vector<Index>& starts) {
     const int N = c.lattice.n;
     const size_t np = static_cast<size_t>(N - 1) * static_cast<size_t>(N - 2) / 2;
     std::vector<Index> visit;
@@ -298,7 +298,7 @@ std::vector<Index> serpentine_visit(const Case& c, const std::vector<Index>& sta
 // both directions, each point's update taking its predecessor last (x = c - G x_behind): still
 // block Gauss–Seidel in that order to round-off, forward and backward, omega 1 and 1.3.
 TEST(LatticeGS, SerpentineRowsAreBlockGaussSeidelInThatOrder) {
-    Case c = elastic_case(6, true);
+    LatticeCase c = elastic_case(6, true);
     c.lattice.visit = serpentine_visit(c, c.starts);
     // An east coupling that is not the west one's transpose (a convection-like term): the
     // predecessor's block differs with the direction of the run.
@@ -317,7 +317,7 @@ TEST(LatticeGS, SerpentineRowsAreBlockGaussSeidelInThatOrder) {
 TEST(LatticeGS, MultiplyIsTheMatrixProduct) {
     for (int depth : {4, 6})
         for (bool serpentine : {false, true}) {
-            Case c = elastic_case(depth, true);
+            LatticeCase c = elastic_case(depth, true);
             if (serpentine) c.lattice.visit = serpentine_visit(c, c.starts);
             LatticeGS S(c.starts, c.lattice, {});
             S.setup(c.A);
@@ -338,7 +338,7 @@ TEST(LatticeGS, ItsPassesAreCountedAsStructured) {
     // them out), nothing under smoother or matvec; each counts its vectors (b read and x read and
     // written: 24 n; x read and y written: 16 n) and less than A's 12 bytes per entry for the
     // rows it still reads (most rows by the stencils).
-    const Case c = elastic_case(6, true);
+    const LatticeCase c = elastic_case(6, true);
     LatticeGS S(c.starts, c.lattice, {});
     S.setup(c.A);
     ASSERT_GT(S.deep_points(), 0);
