@@ -104,13 +104,13 @@ int bench_elastic(const BenchElasticOptions& opt, std::ostream& os);
 
 /// `bench elastic` on a 3D scene (one process): the elastic block of the finest level (K on the
 /// free displacement unknowns of the tetrahedral level, right-hand side the full load) solved to
-/// opt.rel_tol by our geometric V(1,1) cycle (3 x 3 vertex blocks, P / P^T of the 1 -> 8
-/// refinement, sparse LU on level 0) inside CG, and by hypre's PCG with BoomerAMG at hypre's
-/// settings for elasticity (solvers::boomeramg_elasticity3d, the three rotational rigid-body
-/// modes as interpolation vectors), both on hypre's thread count. The level sizes and the memory are
-/// predicted first and a run that cannot fit is refused. Per solver: unknowns, iterations,
-/// setup and solve seconds, peak RSS after it and the predicted peak; the time ratio mg /
-/// BoomerAMG. Table and JSON (default out/bench/elastic_<scene>_L<L>.json).
+/// opt.rel_tol by our geometric W(2,2) cycle (levels::elastic3_mg_params; 3 x 3 vertex blocks, P /
+/// P^T of the 1 -> 8 refinement, sparse LU on level 0) inside CG, and by hypre's PCG with BoomerAMG
+/// at hypre's settings for elasticity (solvers::boomeramg_elasticity3d, the three rotational
+/// rigid-body modes as interpolation vectors), both on hypre's thread count. The level sizes and
+/// the memory are predicted first and a run that cannot fit is refused. Per solver: unknowns,
+/// iterations, setup and solve seconds, peak RSS after it and the predicted peak; the time ratio mg
+/// / BoomerAMG. Table and JSON (default out/bench/elastic_<scene>_L<L>.json).
 int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os);
 
 /// Options of `bench newton`.

@@ -45,6 +45,13 @@ struct Run3 {
 
 constexpr double kMiB = 1024.0 * 1024.0;
 
+/// "W(2,2)": the cycle of levels::elastic3_mg_params.
+std::string mg_cycle() {
+    const solvers::MultigridParams p = levels::elastic3_mg_params();
+    return std::string(p.cycles == 2 ? "W(" : "V(") + std::to_string(p.pre_sweeps) + "," +
+           std::to_string(p.post_sweeps) + ")";
+}
+
 /// mg-CG: the multigrid set up anew in every repetition (its setup timed), CG to rel_tol.
 Run3 run_mg(const levels::ElasticHierarchy3& h, const Vector& b, const BenchElasticOptions& opt,
             Vector& x) {
@@ -109,6 +116,7 @@ void write_json3(std::ostream& js, const BenchElasticOptions& opt, int L,
        << ",\n  \"hierarchy_seconds\": " << hierarchy_s
        << ",\n  \"memory_estimate_mib\": " << mem.bytes() / kMiB
        << ",\n  \"peak_rss_mib\": " << peak_rss_mib()
+       << ",\n  \"mg_cycle\": " << json_string(mg_cycle())
        << ",\n  \"time_ratio_mg_over_amg\": " << ratio << ",\n  \"solution_difference\": " << diff
        << ",\n  \"levels\": [";
     for (size_t l = 0; l < h.levels.size(); ++l)
@@ -195,6 +203,7 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
            << std::setprecision(0) << std::setw(14) << r.peak_rss_mib << std::setw(14)
            << r.estimate_mib << std::defaultfloat << (r.converged ? "" : "  NOT CONVERGED") << "\n";
     }
+    os << "mg-cg: " << mg_cycle() << " cycle, vertex-block Gauss-Seidel\n";
     os << "time ratio mg-cg / boomeramg-pcg: " << std::fixed << std::setprecision(3) << ratio
        << std::defaultfloat
        << "\nrelative difference of the AMG and mg solutions: " << std::scientific

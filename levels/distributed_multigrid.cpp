@@ -79,6 +79,8 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
           use_mg_(spec_.pc.name() == "mg"), use_ebe_(spec_.pc.entry->element_matrices),
           op_(levels.size()) {
+        MLC_CHECK(mg.cycles == 1,
+                  "the distributed multigrid runs V-cycles only, found cycles = " << mg.cycles);
         for (size_t k = 1; k < levels.size(); ++k) {
             build_jacobian(k);
             transfer_.emplace_back(*transfers[k - 1].T);

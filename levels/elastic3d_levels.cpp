@@ -160,6 +160,18 @@ std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& 
     return mg;
 }
 
+solvers::MultigridParams elastic3_mg_params() {
+    solvers::MultigridParams p;
+    p.pre_sweeps = 2;
+    p.post_sweeps = 2;
+    p.cycles = 2;
+    return p;
+}
+
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h) {
+    return elastic3_multigrid(h, elastic3_mg_params());
+}
+
 std::vector<Vector> rigid_body_modes3(const ElasticLevel3& L) {
     const mesh::TetMesh& m = L.mesh;
     Vec3 lo = m.vertices.front(), hi = m.vertices.front();

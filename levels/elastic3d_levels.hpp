@@ -127,11 +127,19 @@ ElasticHierarchy3 build_elastic_hierarchy3(const ElasticProblem3& p, int levels)
 
 /// The geometric multigrid on a hierarchy of at least two levels: rediscretized operators (each
 /// level's K), smoother blocks of the 3 components of a vertex, T and R of the hierarchy
-/// (borrowed: `h` must outlive it), sparse LU on level 0. With the default params, a symmetric
-/// V(1,1) cycle (forward pre-sweep, backward post-sweep) that preconditions CG. The lattice
-/// smoother is 2D-only and refused (InvalidInput).
+/// (borrowed: `h` must outlive it), sparse LU on level 0. With the default params
+/// (elastic3_mg_params), a symmetric W(2,2) cycle (forward pre-sweeps, backward post-sweeps)
+/// that preconditions CG. The lattice smoother is 2D-only and refused (InvalidInput).
 std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h,
-                                                       solvers::MultigridParams params = {});
+                                                       solvers::MultigridParams params);
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h);
+
+/// The default cycle of the 3D elastic multigrid: W(2,2). The V(1,1) cycle of the 2D runs needs
+/// more CG iterations as the levels grow (box3d: 13, 15, 17, 18, 18 on levels 1-5); two sweeps
+/// and the W-cycle keep them level-independent (9, 9, 10, 10) for about the same time per solve
+/// as V(2,2), since in 3D each coarser level holds an eighth of the unknowns
+/// (docs/results/benchmarks.md#results-3d-cycle).
+solvers::MultigridParams elastic3_mg_params();
 
 /// The rigid-body modes of a level on its unknowns: the translations along x, y, z and the
 /// rotations about the x, y, z axes through the centre of the mesh's bounding box (6 vectors).

@@ -22,6 +22,8 @@ void MultigridParams::validate() const {
     MLC_CHECK(post_sweeps >= 0, "mg: post must be >= 0, found " << post_sweeps);
     MLC_CHECK(pre_sweeps + post_sweeps >= 1, "mg: pre + post must be >= 1 (no smoothing at all)");
     MLC_CHECK(omega > 0.0 && omega < 2.0, "mg: omega must be in (0, 2), found " << omega);
+    MLC_CHECK(cycles == 1 || cycles == 2,
+              "mg: cycles must be 1 (V-cycle) or 2 (W-cycle), found " << cycles);
     MLC_CHECK(smoother == Smoother::block || precision == Precision::float64,
               "mg: smoother=lattice keeps double data; precision=single is for smoother=block");
 }
@@ -29,7 +31,8 @@ void MultigridParams::validate() const {
 std::ostream& operator<<(std::ostream& os, const MultigridParams& p) {
     return os << "MultigridParams{pre=" << p.pre_sweeps << ", post=" << p.post_sweeps
               << ", omega=" << p.omega << ", precision=" << to_string(p.precision) << ", smoother="
-              << (p.smoother == MultigridParams::Smoother::lattice ? "lattice" : "block") << "}";
+              << (p.smoother == MultigridParams::Smoother::lattice ? "lattice" : "block")
+              << (p.cycles == 2 ? ", cycles=2" : "") << "}";
 }
 
 namespace {
@@ -84,6 +87,7 @@ struct Multigrid::Level final : CycleOperator, CycleSmoother, CycleTransfer {
     const SparseMatrix* A = nullptr;        // the operator (borrowed, or `owned`)
     SparseMatrix owned;                     // Galerkin operator
     mutable Vector res, rc, ec;             // levels >= 1
+    mutable Vector rw, ew;                  // levels >= 2 of a W-cycle: the second coarse cycle
 
     bool single() const { return params.precision == Precision::float32; }
 
@@ -338,7 +342,9 @@ void Multigrid::update_values(const SparseMatrix& A) {
 CycleLevel Multigrid::cycle_level(int k) const {
     const Level& L = *levels_[static_cast<size_t>(k)];
     MLC_CHECK(L.A != nullptr, "Multigrid: the operator of level " << k << " is not set");
-    return {L, L, L, L.params.pre_sweeps, L.params.post_sweeps, L.res, L.rc, L.ec};
+    return {L,     L,    L,    L.params.pre_sweeps, L.params.post_sweeps,
+            L.res, L.rc, L.ec, L.params.cycles,     &L.rw,
+            &L.ew};
 }
 
 void Multigrid::coarse_solve(const Vector& r, Vector& z) const {
@@ -374,6 +380,7 @@ std::string Multigrid::name() const {
     const MultigridParams& p = levels_.back()->params;
     std::ostringstream os;
     os << "mg(pre=" << p.pre_sweeps << ",post=" << p.post_sweeps << ",omega=" << p.omega;
+    if (p.cycles == 2) os << ",cycle=W";
     if (p.precision == Precision::float32) os << ",precision=single";
     if (p.smoother == MultigridParams::Smoother::lattice) os << ",smoother=lattice";
     os << ")";
@@ -403,7 +410,8 @@ MultigridReport Multigrid::report() const {
     r.grid_complexity = top.rows > 0 ? rows / static_cast<double>(top.rows) : 0.0;
     const MultigridParams& p = levels_.back()->params;
     std::ostringstream cyc;
-    cyc << "V(" << p.pre_sweeps << "," << p.post_sweeps << "), omega = " << p.omega;
+    cyc << (p.cycles == 2 ? "W(" : "V(") << p.pre_sweeps << "," << p.post_sweeps
+        << "), omega = " << p.omega;
     r.cycle = cyc.str();
     std::ostringstream sm;
     sm << "vertex-block Gauss-Seidel, forward before / backward after, " << smoothers::kHybridParts

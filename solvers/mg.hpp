@@ -59,6 +59,9 @@ struct MultigridParams {
     /// (BlockSOR on the others); double precision only.
     enum class Smoother { block, lattice };
     Smoother smoother = Smoother::block;
+    /// Cycles of the level below per visit of a level: 1, the V-cycle (default); 2, the W-cycle
+    /// (solvers/vcycle.hpp), the default of the 3D elastic multigrid (levels/elastic3d_levels.hpp).
+    int cycles = 1;
     /// Throws mlc::InvalidInput naming the first field out of range.
     void validate() const;
 };

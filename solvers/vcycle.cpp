@@ -18,6 +18,14 @@ void VCycle::cycle(int k, const Vector& r, Vector& z) const {
     }
     L.transfer.restrict_residual(from_zero ? r : L.res, L.rc);
     cycle(k - 1, L.rc, L.ec);
+    if (L.cycles > 1 && k > 1) {
+        const CycleLevel below = cycle_level(k - 1);
+        for (int c = 1; c < L.cycles; ++c) {
+            below.op.residual(L.rc, L.ec, *L.rw);
+            cycle(k - 1, *L.rw, *L.ew);
+            L.ec += *L.ew;
+        }
+    }
     L.transfer.prolongate(L.ec, z, !from_zero);
     L.smoother.smooth(r, z, smoothers::Sweep::backward, L.post_sweeps);
 }

@@ -63,13 +63,12 @@ TEST(Elastic3dMg, BoxScene_IterationsBoundedOverLevelsAndSolutionIsTheDirectOne)
     const levels::ElasticProblem3 p = scene::load_scene3("box3d");
     EXPECT_EQ(p.name, "box3d");
     EXPECT_EQ(p.mesh0.n_tetrahedra(), 4 * 4 * 2 * 6);
-    // Measured 13, 15, 17 (and 18 on level 4): at most 20 on every level, and growing by at
-    // most 2 per level.
+    // The W(2,2) default: measured 9, 9, 10 (and 10 on levels 4 and 5; the V(1,1) cycle took
+    // 13, 15, 17, 18, 18). At most 20 on every level, and the finest at most 1.3 times level 1's.
     const std::vector<int> its = check_levels(p);
-    for (size_t k = 0; k < its.size(); ++k) {
+    for (size_t k = 0; k < its.size(); ++k)
         EXPECT_LE(its[k], 20) << "level " << k + 1;
-        if (k > 0) EXPECT_LE(its[k], its[k - 1] + 2) << "level " << k + 1;
-    }
+    EXPECT_LE(its.back(), 1.3 * its.front());
 }
 
 // A box of 3^3 cells, vertices moved at random inside their faces, as a Gmsh 4.1 file with two
@@ -169,11 +168,12 @@ TEST(Elastic3dMg, GmshTwoVolumes_BodiesMaterialsAndIterationsBoundedOverLevels) 
     }
     EXPECT_GT(soft, 0);
     EXPECT_LT(soft, p.mesh0.n_tetrahedra());
-    // Measured 18, 21, 26 on this perturbed two-material mesh: the counts grow with the levels
-    // (the box's do not beyond level 3); bounded here as measured.
+    // The W(2,2) default on this perturbed two-material mesh: measured 12, 13, 15 (the V(1,1)
+    // cycle took 18, 21, 26). At most 20 on every level, the finest at most 1.3 times level 1's.
     const std::vector<int> its = check_levels(p);
     for (size_t k = 0; k < its.size(); ++k)
-        EXPECT_LE(its[k], 18 + 4 * static_cast<int>(k)) << "level " << k + 1;
+        EXPECT_LE(its[k], 20) << "level " << k + 1;
+    EXPECT_LE(its.back(), 1.3 * its.front());
 }
 
 TEST(Elastic3dLevels, PredictedSizesAgainstTheBuiltLevels) {
@@ -205,9 +205,10 @@ TEST(Elastic3dLevels, PredictedSizesAgainstTheBuiltLevels) {
             const Vector uf = h.T[static_cast<size_t>(l)] * uc;
             for (int v = 0; v < L.mesh.n_vertices(); ++v)
                 for (int c = 0; c < 3; ++c)
-                    if (const int d = L.dofs.u_dof(v, c); d >= 0)
+                    if (const int d = L.dofs.u_dof(v, c); d >= 0) {
                         EXPECT_NEAR(uf[d], (c + 1) * L.mesh.vertices[static_cast<size_t>(v)][axis],
                                     1e-12);
+                    }
         }
     }
 }

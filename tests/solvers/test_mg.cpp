@@ -351,6 +351,62 @@ TEST(Multigrid, OneVCycleCountsItsPasses) {
     EXPECT_LT(d.b(traffic::Kind::smoother), 4 * ops);
 }
 
+TEST(Multigrid, OneWCycleVisitsEachLevelTwiceAsOftenAsTheOneAbove) {
+    // Levels 0..3, W(1,1): level 3 once, level 2 twice, level 1 four times (level 1 solves its
+    // coarse problem once: level 0's LU is exact), four coarse solves; per visit three smoother
+    // and two transfer passes; one residual of the level below per second coarse cycle (at
+    // level 3 and at each visit of level 2).
+    solvers::MultigridParams w;
+    w.cycles = 2;
+    ElasticHierarchy e(3, w);
+    Vector z;
+    const traffic::Account a0 = traffic::snapshot();
+    e.mg->finest().apply(e.b, z);
+    const traffic::Account d = traffic::snapshot() - a0;
+    EXPECT_EQ(d.p(traffic::Kind::smoother), 3.0 * (1 + 2 + 4));
+    EXPECT_EQ(d.p(traffic::Kind::transfer), 2.0 * (1 + 2 + 4));
+    EXPECT_EQ(d.p(traffic::Kind::coarse), 4.0);
+    EXPECT_EQ(d.p(traffic::Kind::matvec), 3.0);
+    EXPECT_EQ(e.mg->finest().report().cycle.substr(0, 6), "W(1,1)");
+    EXPECT_NE(e.mg->finest().name().find("cycle=W"), std::string::npos);
+}
+
+TEST(Multigrid, OnTwoLevelsTheWCycleIsTheVCycleBitForBit) {
+    solvers::MultigridParams w;
+    w.cycles = 2;
+    ElasticHierarchy v1(1), w1(1, w);
+    Vector zv, zw;
+    v1.mg->finest().apply(v1.b, zv);
+    w1.mg->finest().apply(w1.b, zw);
+    EXPECT_EQ(zv, zw);
+}
+
+TEST(Multigrid, WCycleIsSymmetricAndNeedsNoMoreCGIterationsThanTheVCycle) {
+    solvers::MultigridParams w;
+    w.cycles = 2;
+    ElasticHierarchy v(3), e(3, w);
+    // Symmetric: (B r1, r2) = (r1, B r2).
+    const Index n = e.K().rows();
+    Vector r1(n), r2(n), z1, z2;
+    for (Index i = 0; i < n; ++i) {
+        r1[i] = std::sin(0.7 * static_cast<double>(i));
+        r2[i] = std::cos(1.3 * static_cast<double>(i));
+    }
+    e.mg->finest().apply(r1, z1);
+    e.mg->finest().apply(r2, z2);
+    EXPECT_NEAR(z1.dot(r2), r1.dot(z2), 1e-12 * z1.norm() * r2.norm());
+    const solvers::KrylovParams kp{.rel_tol = 1e-8, .max_iter = 100};
+    Vector xv, xw;
+    const SolveResult rv = solvers::cg(MatrixOperator(v.K()), v.mg->finest(), v.b, xv, kp);
+    const SolveResult rw = solvers::cg(MatrixOperator(e.K()), e.mg->finest(), e.b, xw, kp);
+    ASSERT_TRUE(rv.converged && rw.converged);
+    EXPECT_LE(rw.iterations, rv.iterations);
+    EXPECT_LT((xw - xv).norm(), 1e-6 * xv.norm());
+    // Cycles other than 1 and 2 are refused.
+    w.cycles = 3;
+    EXPECT_THROW(w.validate(), InvalidInput);
+}
+
 TEST(Multigrid, OneVCycleCountsItsBytesInBothPrecisions) {
     // Every pass of a V-cycle on levels 0..2 in closed form (core/traffic.hpp): per level above
     // 0 the sweep from zero with its residual and the backward sweep on K_l (vertex blocks), the
