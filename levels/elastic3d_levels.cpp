@@ -19,17 +19,85 @@ namespace mlc::levels {
 
 namespace {
 
-/// The support's vertices on mesh m (a tagged face's, or the point's level-0 vertex).
+/// Relative distance under which a support point is a vertex, or a vertex on a support line.
+constexpr double kPointTol = 1e-9;
+
+/// The support's vertices on mesh m (a tagged face's, the line's, or the point's level-0
+/// vertex).
 std::vector<int> support_vertices(const ElasticProblem3& p, const Support3& s,
                                   const mesh::TetMesh& m) {
     if (!s.tag.empty()) return fem::face_vertices(m, m.tag(s.tag));
+    if (s.line) {
+        std::vector<int> v = line_vertices(m, *s.line);
+        std::sort(v.begin(), v.end());
+        return v;
+    }
     return {p.mesh0.nearest_vertex(*s.point)};
 }
 
-/// Relative distance under which a support point is a vertex.
-constexpr double kPointTol = 1e-9;
+/// "(x, y, z)".
+std::string point_text(const Vec3& x) {
+    std::ostringstream os;
+    os << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
+    return os.str();
+}
+
+/// The level-0 edges of a line support (pairs of vertices, smaller first), after checking that
+/// its ends are level-0 vertices and its segment runs along level-0 edges.
+std::vector<std::pair<int, int>> line_edges0(const mesh::TetMesh& m0,
+                                             const std::array<Vec3, 2>& line) {
+    const double tol = kPointTol * m0.diameter();
+    for (const Vec3& x : line) {
+        const int v = m0.nearest_vertex(x);
+        const double d = (m0.vertices[static_cast<size_t>(v)] - x).norm();
+        MLC_CHECK(d <= tol, "support line: its end " << point_text(x)
+                                                     << " is no vertex of the level-0 mesh (the "
+                                                        "nearest vertex lies "
+                                                     << d << " away)");
+    }
+    MLC_CHECK((line[1] - line[0]).norm() > tol,
+              "support line: its two ends are the same point " << point_text(line[0]));
+    const std::vector<int> on = line_vertices(m0, line);
+    std::set<std::pair<int, int>> edges;
+    for (const auto& t : m0.tetrahedra)
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b)
+                edges.insert(std::minmax(t[static_cast<size_t>(a)], t[static_cast<size_t>(b)]));
+    std::vector<std::pair<int, int>> out;
+    for (size_t k = 0; k + 1 < on.size(); ++k) {
+        const auto e = std::minmax(on[k], on[k + 1]);
+        MLC_CHECK(edges.count(e), "support line from "
+                                      << point_text(line[0]) << " to " << point_text(line[1])
+                                      << " does not run along edges of the level-0 mesh: "
+                                         "its vertices "
+                                      << point_text(m0.vertices[static_cast<size_t>(on[k])])
+                                      << " and "
+                                      << point_text(m0.vertices[static_cast<size_t>(on[k + 1])])
+                                      << " are not joined by an edge");
+        out.push_back(e);
+    }
+    return out;
+}
 
 } // namespace
+
+std::vector<int> line_vertices(const mesh::TetMesh& m, const std::array<Vec3, 2>& line) {
+    const double tol = kPointTol * m.diameter();
+    const Vec3 d = line[1] - line[0];
+    const double len2 = d.squaredNorm();
+    std::vector<std::pair<double, int>> on;
+    for (int v = 0; v < m.n_vertices(); ++v) {
+        const Vec3 x = m.vertices[static_cast<size_t>(v)] - line[0];
+        const double s = len2 > 0 ? x.dot(d) / len2 : 0.0;
+        if (s < -tol || s > 1 + tol) continue;
+        if ((x - s * d).norm() <= tol) on.push_back({s, v});
+    }
+    std::sort(on.begin(), on.end());
+    std::vector<int> out;
+    for (const auto& [s, v] : on)
+        out.push_back(v);
+    return out;
+}
 
 void ElasticProblem3::validate() const {
     MLC_CHECK(!bodies.empty(), "the 3D problem has no body");
@@ -54,8 +122,11 @@ void ElasticProblem3::validate() const {
     }
     for (const Support3& s : supports) {
         MLC_CHECK(s.u[0] || s.u[1] || s.u[2], "a support fixes nothing: give ux, uy and/or uz");
-        MLC_CHECK(s.tag.empty() != !s.point, "a support takes a tag or a point");
-        if (!s.tag.empty()) {
+        MLC_CHECK(int(!s.tag.empty()) + int(s.point.has_value()) + int(s.line.has_value()) == 1,
+                  "a support takes one of a tag, a line or a point");
+        if (s.line) {
+            line_edges0(mesh0, *s.line);
+        } else if (!s.tag.empty()) {
             MLC_CHECK(mesh0.find_tag(s.tag) && mesh0.is_boundary_tag(mesh0.tag(s.tag)),
                       "support: no boundary face carries the tag '" << s.tag << "'");
         } else {
@@ -221,18 +292,23 @@ constexpr double kAmgPerUnknown3 = 0.0;
 
 namespace {
 
-/// Fixed components on level l: per component, the vertices of the faces whose tags hold it
-/// (V' = V + E, E' = 2 E + 3 F, F' = 4 F over those faces), and the point supports' vertices
-/// (kept by refinement) off them.
+/// Fixed components on level l: per component, the vertices of the faces whose tags hold it and
+/// of the lines that hold it (V' = V + E + E_l, E' = 2 E + 3 F, F' = 4 F over those faces,
+/// E_l' = 2 E_l over the line edges that are no edges of those faces), and the point supports'
+/// vertices (kept by refinement) off them.
 std::vector<double> predict_fixed_components(const ElasticProblem3& p, int levels) {
     std::vector<double> fixed(static_cast<size_t>(levels) + 1, 0.0);
     for (int c = 0; c < 3; ++c) {
         std::set<int> tags;
         std::set<int> points;
+        std::set<std::pair<int, int>> line_edges;
         for (const Support3& s : p.supports) {
             if (!s.u[static_cast<size_t>(c)]) continue;
             if (!s.tag.empty())
                 tags.insert(p.mesh0.tag(s.tag));
+            else if (s.line)
+                for (const auto& e : line_edges0(p.mesh0, *s.line))
+                    line_edges.insert(e);
             else
                 points.insert(p.mesh0.nearest_vertex(*s.point));
         }
@@ -249,6 +325,13 @@ std::vector<double> predict_fixed_components(const ElasticProblem3& p, int level
             edges.insert({k[1], k[2]});
             verts.insert(k.begin(), k.end());
         }
+        double El = 0;
+        for (const auto& e : line_edges) {
+            if (edges.count(e)) continue;
+            El += 1;
+            verts.insert(e.first);
+            verts.insert(e.second);
+        }
         double off = 0;
         for (int v : points)
             off += verts.count(v) ? 0.0 : 1.0;
@@ -256,10 +339,11 @@ std::vector<double> predict_fixed_components(const ElasticProblem3& p, int level
                F = static_cast<double>(faces.size());
         for (int l = 0; l <= levels; ++l) {
             fixed[static_cast<size_t>(l)] += V + off;
-            const double V1 = V + E, E1 = 2 * E + 3 * F, F1 = 4 * F;
+            const double V1 = V + E + El, E1 = 2 * E + 3 * F, F1 = 4 * F;
             V = V1;
             E = E1;
             F = F1;
+            El = 2 * El;
         }
     }
     return fixed;

@@ -40,13 +40,21 @@ struct FaceLoad3 {
     Vec3 traction = Vec3::Zero();
 };
 
-/// Prescribed displacement components on the faces with a tag, or at a vertex of level 0 (a
-/// point; refinement keeps its index). Unset components are free.
+/// Prescribed displacement components on the faces with a tag, along a line, or at a vertex of
+/// level 0 (a point; refinement keeps its index). Unset components are free.
 struct Support3 {
-    std::string tag;                          ///< a boundary tag, or empty for a point support
-    std::optional<Vec3> point;                ///< a level-0 vertex (for a point support)
+    std::string tag;           ///< a boundary tag, or empty for a line or point support
+    std::optional<Vec3> point; ///< a level-0 vertex (for a point support)
+    /// A line support: the straight segment between two level-0 vertices, which must run along
+    /// edges of the level-0 mesh; it holds every vertex on the segment, on every level (the
+    /// midpoints refinement puts on its edges).
+    std::optional<std::array<Vec3, 2>> line;
     std::array<std::optional<double>, 3> u{}; ///< ux, uy, uz
 };
+
+/// The vertices of m on a line support's segment (within 1e-9 of m's diameter), ordered along
+/// it from line[0].
+std::vector<int> line_vertices(const mesh::TetMesh& m, const std::array<Vec3, 2>& line);
 
 /// A 3D elastic problem: the level-0 mesh (attribute = body index), bodies, loads and supports,
 /// and the finest level.
@@ -58,7 +66,8 @@ struct ElasticProblem3 {
     std::vector<Support3> supports;
     int levels = 0;
     /// Throws InvalidInput naming the first defect: no body, an attribute without a body, a bad
-    /// material, a tag no boundary face carries, a point that is no level-0 vertex, a support
+    /// material, a tag no boundary face carries, a point that is no level-0 vertex, a line whose
+    /// ends are no level-0 vertices or whose segment does not run along level-0 edges, a support
     /// that fixes nothing, levels outside 0..12.
     void validate() const;
 };

@@ -205,22 +205,30 @@ void read_loads3(const Reader& rd, const toml::table& root, ElasticProblem3& p) 
     }
 }
 
-/// [[support]]: a tag or a point, and ux, uy and/or uz.
+/// [[support]]: a tag, a line or a point, and ux, uy and/or uz.
 void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
     for (const toml::table* st : rd.tables(root, "support", "the scene")) {
         const std::string w = "[[support]]";
         refuse_2d_only(rd, *st, {"active"}, w, "its supports hold throughout");
-        rd.check_keys(*st, {"tag", "point", "ux", "uy", "uz"}, w);
+        rd.check_keys(*st, {"tag", "line", "point", "ux", "uy", "uz"}, w);
         levels::Support3 s;
-        if (st->get("tag") && st->get("point"))
-            rd.fail(st, w + " takes a tag or a point, not both");
+        if (int(st->get("tag") != nullptr) + int(st->get("line") != nullptr) +
+                int(st->get("point") != nullptr) >
+            1)
+            rd.fail(st, w + " takes one of a tag, a line or a point");
         if (st->get("tag")) {
             s.tag = rd.string(*st, "tag", w);
             check_tag3(rd, p.mesh0, *st, s.tag, w);
+        } else if (const toml::node* ln = st->get("line")) {
+            const toml::array* a = ln->as_array();
+            if (!a || a->size() != 2)
+                rd.fail(ln, w + ".line must be two points [[x, y, z], [x, y, z]]");
+            s.line = std::array<Vec3, 2>{vec3(rd, a->get(0), w + ".line[0]"),
+                                         vec3(rd, a->get(1), w + ".line[1]")};
         } else if (st->get("point")) {
             s.point = vec3(rd, *st, "point", w);
         } else {
-            rd.fail(st, w + " needs a tag or a point");
+            rd.fail(st, w + " needs a tag, a line or a point");
         }
         const char* keys[3] = {"ux", "uy", "uz"};
         for (int c = 0; c < 3; ++c) {
@@ -232,8 +240,8 @@ void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& 
             s.u[static_cast<size_t>(c)] = rd.number(n, w + "." + keys[c]);
         }
         if (!s.u[0] && !s.u[1] && !s.u[2]) rd.fail(st, w + " fixes nothing: give ux, uy and/or uz");
-        if (s.point)
-            at(rd, st->get("point"), [&] {
+        if (s.point || s.line)
+            at(rd, st->get(s.point ? "point" : "line"), [&] {
                 levels::ElasticProblem3 probe;
                 probe.mesh0 = p.mesh0;
                 probe.bodies = p.bodies;

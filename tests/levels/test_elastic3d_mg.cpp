@@ -294,6 +294,74 @@ TEST(Scene3, UnknownKeysWrongTypesAndBadTagsAreRefused) {
         {"divisions must be [nx, ny, nz]"});
 }
 
+TEST(Scene3, LineSupportsHoldTheVerticesOnTheirSegmentOnEveryLevel) {
+    // The unit box (2 x 2 x 2 cubes) held in uz on zmin, in ux and uy along its edge y = z = 0
+    // (on zmin) and in ux along its edge x = y = 0 (off zmin but for its end).
+    const levels::ElasticProblem3 p = scene::parse_scene3(
+        box_scene("", "",
+                  "[[support]]\nline = [[0, 0, 0], [1, 0, 0]]\nux = 0.0\nuy = 0.0\n"
+                  "[[support]]\nline = [[0, 0, 1], [0, 0, 0]]\nux = 0.0\n"),
+        "t.toml");
+    ASSERT_EQ(p.supports.size(), 3u);
+    ASSERT_TRUE(p.supports[1].line.has_value());
+    const auto sizes = levels::predict_elastic3_sizes(p, 3);
+    const levels::ElasticHierarchy3 h = levels::build_elastic_hierarchy3(p, 3);
+    for (int l = 0; l <= 3; ++l) {
+        const auto& L = h.levels[static_cast<size_t>(l)];
+        const int n = 2 << l; // edges along a unit side of level l
+        const std::vector<int> xs = levels::line_vertices(L.mesh, *p.supports[1].line);
+        const std::vector<int> zs = levels::line_vertices(L.mesh, *p.supports[2].line);
+        ASSERT_EQ(xs.size(), static_cast<size_t>(n + 1)) << "level " << l;
+        ASSERT_EQ(zs.size(), static_cast<size_t>(n + 1)) << "level " << l;
+        // Ordered from the line's first end: x grows along the first, z falls along the second.
+        for (int k = 0; k <= n; ++k) {
+            EXPECT_EQ(L.mesh.vertices[static_cast<size_t>(xs[static_cast<size_t>(k)])],
+                      Vec3(static_cast<double>(k) / n, 0, 0));
+            EXPECT_EQ(L.mesh.vertices[static_cast<size_t>(zs[static_cast<size_t>(k)])],
+                      Vec3(0, 0, 1.0 - static_cast<double>(k) / n));
+        }
+        for (int v : xs) {
+            EXPECT_LT(L.dofs.u_dof(v, 0), 0);
+            EXPECT_LT(L.dofs.u_dof(v, 1), 0);
+            EXPECT_LT(L.dofs.u_dof(v, 2), 0); // on zmin
+        }
+        for (int v : zs) {
+            EXPECT_LT(L.dofs.u_dof(v, 0), 0);
+            if (v == zs.back()) { // (0, 0, 0): on the first line too
+                EXPECT_LT(L.dofs.u_dof(v, 1), 0);
+            } else {
+                EXPECT_GE(L.dofs.u_dof(v, 1), 0);
+            }
+        }
+        // The predicted unknowns are exact (faces and lines counted once where they meet).
+        // uz on zmin, ux on both lines (sharing (0, 0, 0)), uy on the first.
+        const double free = 3.0 * L.mesh.n_vertices() - (n + 1) * (n + 1) - (2 * n + 1) - (n + 1);
+        EXPECT_EQ(static_cast<double>(L.dofs.n_dofs()), free) << "level " << l;
+        EXPECT_EQ(sizes[static_cast<size_t>(l)].unknowns, free) << "level " << l;
+    }
+    // The supports remove the rigid-body modes: mg-CG solves the finest level.
+    Vector x;
+    EXPECT_LE(mg_cg_iterations(h, x), 20);
+}
+
+TEST(Scene3, ALineOffTheEdgesOrWithoutVertexEndsIsRefused) {
+    expect_scene3_error(
+        box_scene("", "", "[[support]]\nline = [[0.3, 0, 0], [1, 0, 0]]\nux = 0.0\n"),
+        {"support line: its end (0.3, 0, 0) is no vertex of the level-0 mesh"});
+    // Across the cells' faces against their Kuhn diagonals.
+    expect_scene3_error(
+        box_scene("", "", "[[support]]\nline = [[1, 0, 0], [0, 1, 0]]\nux = 0.0\n"),
+        {"does not run along edges of the level-0 mesh", "(1, 0, 0) and (0.5, 0.5, 0)"});
+    expect_scene3_error(box_scene("", "", "[[support]]\nline = [[1, 0, 0]]\nux = 0.0\n"),
+                        {"line must be two points"});
+    expect_scene3_error(
+        box_scene("", "", "[[support]]\nline = [[1, 0, 0], [1, 1, 0]]\ntag = \"xmin\"\nux = 0.0\n"),
+        {"takes one of a tag, a line or a point"});
+    // Along a cube's main diagonal (a Kuhn edge) is a line.
+    EXPECT_NO_THROW(scene::parse_scene3(
+        box_scene("", "", "[[support]]\nline = [[0, 0, 0], [1, 1, 1]]\nux = 0.0\n"), "t.toml"));
+}
+
 TEST(Scene3, AMissingPhysicalVolumeIsRefusedListingThoseThereAre) {
     const GmshScene g;
     std::string text = kGmshScene;
