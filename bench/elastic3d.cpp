@@ -47,9 +47,7 @@ constexpr double kMiB = 1024.0 * 1024.0;
 
 /// "W(2,2)": the cycle of levels::elastic3_mg_params.
 std::string mg_cycle() {
-    const solvers::MultigridParams p = levels::elastic3_mg_params();
-    return std::string(p.cycles == 2 ? "W(" : "V(") + std::to_string(p.pre_sweeps) + "," +
-           std::to_string(p.post_sweeps) + ")";
+    return solvers::cycle_text(levels::elastic3_mg_params());
 }
 
 /// mg-CG: the multigrid set up anew in every repetition (its setup timed), CG to rel_tol.

@@ -42,39 +42,45 @@ std::string point_text(const Vec3& x) {
     return os.str();
 }
 
+/// The edges of m (mesh::tet_edges, smaller vertex first), sorted.
+std::vector<std::array<int, 2>> sorted_edges(const mesh::TetMesh& m) {
+    std::vector<std::array<int, 2>> e = mesh::tet_edges(m).edges;
+    std::sort(e.begin(), e.end());
+    return e;
+}
+
+/// Throws InvalidInput unless x is a vertex of the level-0 mesh m0 (within kPointTol of its
+/// diameter); `what` names x in the message ("support point", "support line: its end").
+void check_vertex0(const mesh::TetMesh& m0, const Vec3& x, const std::string& what) {
+    const int v = m0.nearest_vertex(x);
+    const double d = (m0.vertices[static_cast<size_t>(v)] - x).norm();
+    MLC_CHECK(d <= kPointTol * m0.diameter(),
+              what << " " << point_text(x) << " is no vertex of the level-0 mesh (the nearest "
+                   << "vertex lies " << d << " away)");
+}
+
 /// The level-0 edges of a line support (pairs of vertices, smaller first), after checking that
-/// its ends are level-0 vertices and its segment runs along level-0 edges.
+/// its ends are level-0 vertices and its segment runs along level-0 edges (`edges`: those of
+/// sorted_edges(m0)).
 std::vector<std::pair<int, int>> line_edges0(const mesh::TetMesh& m0,
+                                             const std::vector<std::array<int, 2>>& edges,
                                              const std::array<Vec3, 2>& line) {
-    const double tol = kPointTol * m0.diameter();
-    for (const Vec3& x : line) {
-        const int v = m0.nearest_vertex(x);
-        const double d = (m0.vertices[static_cast<size_t>(v)] - x).norm();
-        MLC_CHECK(d <= tol, "support line: its end " << point_text(x)
-                                                     << " is no vertex of the level-0 mesh (the "
-                                                        "nearest vertex lies "
-                                                     << d << " away)");
-    }
-    MLC_CHECK((line[1] - line[0]).norm() > tol,
+    for (const Vec3& x : line)
+        check_vertex0(m0, x, "support line: its end");
+    MLC_CHECK((line[1] - line[0]).norm() > kPointTol * m0.diameter(),
               "support line: its two ends are the same point " << point_text(line[0]));
     const std::vector<int> on = line_vertices(m0, line);
-    std::set<std::pair<int, int>> edges;
-    for (const auto& t : m0.tetrahedra)
-        for (int a = 0; a < 4; ++a)
-            for (int b = a + 1; b < 4; ++b)
-                edges.insert(std::minmax(t[static_cast<size_t>(a)], t[static_cast<size_t>(b)]));
     std::vector<std::pair<int, int>> out;
     for (size_t k = 0; k + 1 < on.size(); ++k) {
-        const auto e = std::minmax(on[k], on[k + 1]);
-        MLC_CHECK(edges.count(e), "support line from "
-                                      << point_text(line[0]) << " to " << point_text(line[1])
-                                      << " does not run along edges of the level-0 mesh: "
-                                         "its vertices "
-                                      << point_text(m0.vertices[static_cast<size_t>(on[k])])
-                                      << " and "
-                                      << point_text(m0.vertices[static_cast<size_t>(on[k + 1])])
-                                      << " are not joined by an edge");
-        out.push_back(e);
+        const auto [a, b] = std::minmax(on[k], on[k + 1]);
+        MLC_CHECK(std::binary_search(edges.begin(), edges.end(), std::array<int, 2>{a, b}),
+                  "support line from "
+                      << point_text(line[0]) << " to " << point_text(line[1])
+                      << " does not run along edges of the level-0 mesh: its vertices "
+                      << point_text(m0.vertices[static_cast<size_t>(on[k])]) << " and "
+                      << point_text(m0.vertices[static_cast<size_t>(on[k + 1])])
+                      << " are not joined by an edge");
+        out.emplace_back(a, b);
     }
     return out;
 }
@@ -125,19 +131,12 @@ void ElasticProblem3::validate() const {
         MLC_CHECK(int(!s.tag.empty()) + int(s.point.has_value()) + int(s.line.has_value()) == 1,
                   "a support takes one of a tag, a line or a point");
         if (s.line) {
-            line_edges0(mesh0, *s.line);
+            line_edges0(mesh0, sorted_edges(mesh0), *s.line);
         } else if (!s.tag.empty()) {
             MLC_CHECK(mesh0.find_tag(s.tag) && mesh0.is_boundary_tag(mesh0.tag(s.tag)),
                       "support: no boundary face carries the tag '" << s.tag << "'");
         } else {
-            const int v = mesh0.nearest_vertex(*s.point);
-            const double d = (mesh0.vertices[static_cast<size_t>(v)] - *s.point).norm();
-            MLC_CHECK(d <= kPointTol * mesh0.diameter(),
-                      "support point (" << s.point->x() << ", " << s.point->y() << ", "
-                                        << s.point->z()
-                                        << ") is no vertex of the level-0 mesh (the nearest "
-                                           "vertex lies "
-                                        << d << " away)");
+            check_vertex0(mesh0, *s.point, "support point");
         }
     }
 }
@@ -298,17 +297,26 @@ namespace {
 /// vertices (kept by refinement) off them.
 std::vector<double> predict_fixed_components(const ElasticProblem3& p, int levels) {
     std::vector<double> fixed(static_cast<size_t>(levels) + 1, 0.0);
+    // The level-0 edges of each line support, found once for the three components.
+    std::vector<std::vector<std::pair<int, int>>> line_edges_of(p.supports.size());
+    const auto has_line = [](const Support3& s) { return s.line.has_value(); };
+    if (std::any_of(p.supports.begin(), p.supports.end(), has_line)) {
+        const std::vector<std::array<int, 2>> edges0 = sorted_edges(p.mesh0);
+        for (size_t k = 0; k < p.supports.size(); ++k)
+            if (p.supports[k].line)
+                line_edges_of[k] = line_edges0(p.mesh0, edges0, *p.supports[k].line);
+    }
     for (int c = 0; c < 3; ++c) {
         std::set<int> tags;
         std::set<int> points;
         std::set<std::pair<int, int>> line_edges;
-        for (const Support3& s : p.supports) {
+        for (size_t k = 0; k < p.supports.size(); ++k) {
+            const Support3& s = p.supports[k];
             if (!s.u[static_cast<size_t>(c)]) continue;
             if (!s.tag.empty())
                 tags.insert(p.mesh0.tag(s.tag));
             else if (s.line)
-                for (const auto& e : line_edges0(p.mesh0, *s.line))
-                    line_edges.insert(e);
+                line_edges.insert(line_edges_of[k].begin(), line_edges_of[k].end());
             else
                 points.insert(p.mesh0.nearest_vertex(*s.point));
         }

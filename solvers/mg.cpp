@@ -28,6 +28,11 @@ void MultigridParams::validate() const {
               "mg: smoother=lattice keeps double data; precision=single is for smoother=block");
 }
 
+std::string cycle_text(const MultigridParams& p) {
+    return std::string(p.cycles == 2 ? "W(" : "V(") + std::to_string(p.pre_sweeps) + "," +
+           std::to_string(p.post_sweeps) + ")";
+}
+
 std::ostream& operator<<(std::ostream& os, const MultigridParams& p) {
     return os << "MultigridParams{pre=" << p.pre_sweeps << ", post=" << p.post_sweeps
               << ", omega=" << p.omega << ", precision=" << to_string(p.precision) << ", smoother="
@@ -410,8 +415,7 @@ MultigridReport Multigrid::report() const {
     r.grid_complexity = top.rows > 0 ? rows / static_cast<double>(top.rows) : 0.0;
     const MultigridParams& p = levels_.back()->params;
     std::ostringstream cyc;
-    cyc << (p.cycles == 2 ? "W(" : "V(") << p.pre_sweeps << "," << p.post_sweeps
-        << "), omega = " << p.omega;
+    cyc << cycle_text(p) << ", omega = " << p.omega;
     r.cycle = cyc.str();
     std::ostringstream sm;
     sm << "vertex-block Gauss-Seidel, forward before / backward after, " << smoothers::kHybridParts

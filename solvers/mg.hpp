@@ -66,6 +66,9 @@ struct MultigridParams {
     void validate() const;
 };
 
+/// The cycle of `p` as "V(1,1)" or "W(2,2)" (pre- and post-sweeps).
+std::string cycle_text(const MultigridParams& p);
+
 /// Prints every field of `p` on one line.
 std::ostream& operator<<(std::ostream& os, const MultigridParams& p);
 
