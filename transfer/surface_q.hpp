@@ -88,7 +88,7 @@ struct SurfaceQ {
 /// Builds Q on the contact surface of two nested levels: coarse_points are the coarse mesh's
 /// vertices (n_coarse of them), fine_points the fine mesh's (n_coarse + parents.size()), and the
 /// facets the contact surface on each level (the fine facets are the children of the coarse
-/// ones). Per component, with m the lumped masses (lumped_surface_masses):
+/// ones). Per component, with m the lumped masses (lumped_surface_masses; m_H as `rule` says):
 ///   coarse vertex i kept:        (Q lambda_H)(i) = m_h(i) lambda_H(i) / m_H(i);
 ///   new vertex j of edge (a, b): (Q lambda_H)(j) = m_h(j) (lambda_H(a)/m_H(a) +
 ///                                                          lambda_H(b)/m_H(b)) / 2.
