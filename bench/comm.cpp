@@ -108,7 +108,7 @@ int report_comm(std::ostream& os, bool root, const BenchCommOptions& opt, const 
                << "\",\n  \"level\": " << opt.levels << ",\n  \"processes\": " << np
                << ",\n  \"threads_per_process\": 1,\n  \"partition_level\": " << p
                << ",\n  \"coarse_unknowns\": " << h.level_p.n_unknowns()
-               << ",\n  \"level0_triangles\": " << h.problem.mesh0.n_triangles()
+               << ",\n  \"level0_triangles\": " << h.problem.mesh0.n_cells()
                << ",\n  \"counted\": " << (counting ? "true" : "false")
                << ",\n  \"ops\": " << opt.ops << ",\n  \"cgs_iterations\": " << cgs_its
                << ",\n  \"cgs_converged\": " << (converged ? "true" : "false")

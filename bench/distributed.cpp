@@ -49,7 +49,7 @@ int bench_square_distributed(const BenchSquareOptions& opt, const Communicator& 
     p.numbering = plan.numbering();
     parallel::set_num_threads(1);
     const int np = comm.size();
-    const int plevel = levels::partition_level(p.mesh0.n_triangles(), p.levels, np);
+    const int plevel = levels::partition_level(p.mesh0.n_cells(), p.levels, np);
     levels::SolveOptions so;
     so.coarse_to_fine = true;
     so.linear = plan.spec;
@@ -200,7 +200,7 @@ std::unique_ptr<ElasticHierarchy> build_elastic_hierarchy(const std::string& sce
     problem.validate();
     const int p = partition_level >= 0
                       ? partition_level
-                      : levels::partition_level(problem.mesh0.n_triangles(), L, comm.size());
+                      : levels::partition_level(problem.mesh0.n_cells(), L, comm.size());
     MLC_CHECK(p >= 0 && p < L, "the partition level must lie in 0.." << L - 1 << ", found " << p);
     h->partition_level = p;
 

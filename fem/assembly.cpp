@@ -40,11 +40,11 @@ Vector nodal_loads(const mesh::Mesh& m, const std::vector<Traction>& tractions,
                 F.segment<2>(2 * v) += 0.5 * L * t;
         }
     if (!body_force.empty())
-        for (int t = 0; t < m.n_triangles(); ++t) {
+        for (int t = 0; t < m.n_cells(); ++t) {
             const int a = m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
             MLC_CHECK(a < static_cast<int>(body_force.size()), "no body force for attribute " << a);
-            const Vec2 f = m.signed_area(t) / 3.0 * body_force[static_cast<size_t>(a)];
-            for (int v : m.triangles[static_cast<size_t>(t)])
+            const Vec2 f = m.signed_measure(t) / 3.0 * body_force[static_cast<size_t>(a)];
+            for (int v : m.cells[static_cast<size_t>(t)])
                 F.segment<2>(2 * v) += f;
         }
     return F;
@@ -90,7 +90,7 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
         int* out = adj.get() + b;
         for (int k = vt_start[static_cast<size_t>(v)]; k < vt_start[static_cast<size_t>(v) + 1];
              ++k)
-            for (int w : m.triangles[static_cast<size_t>(vt[static_cast<size_t>(k)])])
+            for (int w : m.cells[static_cast<size_t>(vt[static_cast<size_t>(k)])])
                 *out++ = w;
         std::sort(adj.get() + b, out);
         adj_end[static_cast<size_t>(v)] =
@@ -140,7 +140,7 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
         for (int k = vt_start[static_cast<size_t>(v)]; k < vt_start[static_cast<size_t>(v) + 1];
              ++k) {
             const int t = vt[static_cast<size_t>(k)];
-            const auto& tri = m.triangles[static_cast<size_t>(t)];
+            const auto& tri = m.cells[static_cast<size_t>(t)];
             const int a = m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
             const int iv = tri[0] == v ? 0 : tri[1] == v ? 1 : 2;
             const auto ke = element_stiffness_rows(
@@ -173,8 +173,8 @@ ElasticSystem assemble_elastic(const mesh::Mesh& m, const std::vector<Material>&
 Vector internal_forces(const mesh::Mesh& m, const std::vector<Material>& materials,
                        const Vector& u_full) {
     Vector F = Vector::Zero(2 * m.n_vertices());
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         const auto ke = element_stiffness(
             m.vertices[static_cast<size_t>(tri[0])], m.vertices[static_cast<size_t>(tri[1])],
             m.vertices[static_cast<size_t>(tri[2])], material_of(m, materials, t));
@@ -190,9 +190,9 @@ Vector internal_forces(const mesh::Mesh& m, const std::vector<Material>& materia
 
 std::vector<double> triangle_stresses(const mesh::Mesh& m, const std::vector<Material>& materials,
                                       const Vector& u_full) {
-    std::vector<double> s(static_cast<size_t>(3 * m.n_triangles()));
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    std::vector<double> s(static_cast<size_t>(3 * m.n_cells()));
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         double area = 0;
         const auto B = strain_matrix(m.vertices[static_cast<size_t>(tri[0])],
                                      m.vertices[static_cast<size_t>(tri[1])],

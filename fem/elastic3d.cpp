@@ -18,7 +18,7 @@ namespace {
 using Tet = std::array<int, 4>;
 
 const Tet& tet_of(const mesh::TetMesh& m, int t) {
-    return m.tetrahedra[static_cast<size_t>(t)];
+    return m.cells[static_cast<size_t>(t)];
 }
 
 SimplexCorners<3> corners_of(const mesh::TetMesh& m, int t) {
@@ -63,8 +63,8 @@ std::vector<VoigtMatrix<3>> material_matrices(const mesh::TetMesh& m,
                   "material " << k << " asks for plane stress, a 2D reduction; a 3D body has none");
         D.push_back(elasticity_matrix<3>(materials[k]));
     }
-    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.tetrahedra.size(),
-              "the mesh has " << m.attribute.size() << " attributes for " << m.n_tetrahedra()
+    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.cells.size(),
+              "the mesh has " << m.attribute.size() << " attributes for " << m.n_cells()
                               << " tetrahedra");
     for (size_t t = 0; t < m.attribute.size(); ++t) {
         const int a = m.attribute[t];
@@ -84,7 +84,7 @@ struct VertexTets {
 VertexTets vertex_tets(const mesh::TetMesh& m) {
     VertexTets r;
     r.offset.assign(static_cast<size_t>(m.n_vertices()) + 1, 0);
-    for (const auto& tet : m.tetrahedra)
+    for (const auto& tet : m.cells)
         for (int v : tet) {
             MLC_CHECK(v >= 0 && v < m.n_vertices(), "tetrahedron vertex " << v << " out of range");
             ++r.offset[static_cast<size_t>(v) + 1];
@@ -93,7 +93,7 @@ VertexTets vertex_tets(const mesh::TetMesh& m) {
         r.offset[v + 1] += r.offset[v];
     r.tets.resize(static_cast<size_t>(r.offset.back()));
     std::vector<int> next(r.offset.begin(), r.offset.end() - 1);
-    for (int t = 0; t < m.n_tetrahedra(); ++t)
+    for (int t = 0; t < m.n_cells(); ++t)
         for (int v : tet_of(m, t))
             r.tets[static_cast<size_t>(next[static_cast<size_t>(v)]++)] = t;
     return r;
@@ -237,13 +237,13 @@ Vector nodal_loads(const mesh::TetMesh& m, const std::vector<Traction3>& tractio
         }
     }
     if (!body_force.empty())
-        for (int t = 0; t < m.n_tetrahedra(); ++t) {
+        for (int t = 0; t < m.n_cells(); ++t) {
             const int a = attribute_of(m, t);
             MLC_CHECK(a >= 0 && a < static_cast<int>(body_force.size()),
                       "tetrahedron " << t << " has attribute " << a << ", which has no body force ("
                                      << body_force.size() << " given)");
             const Vec3 share =
-                std::abs(m.signed_volume(t)) / 4.0 * body_force[static_cast<size_t>(a)];
+                std::abs(m.signed_measure(t)) / 4.0 * body_force[static_cast<size_t>(a)];
             for (int v : tet_of(m, t))
                 F.segment<3>(3 * v) += share;
         }
@@ -255,9 +255,9 @@ Vector body_force_loads(const mesh::TetMesh& m, const std::function<Vec3(const V
     // weights 1/4.
     const double a = 0.5854101966249685, c = 0.1381966011250105;
     Vector F = Vector::Zero(3 * m.n_vertices());
-    for (int t = 0; t < m.n_tetrahedra(); ++t) {
+    for (int t = 0; t < m.n_cells(); ++t) {
         const auto x = corners_of(m, t);
-        const double w = std::abs(m.signed_volume(t)) / 4.0;
+        const double w = std::abs(m.signed_measure(t)) / 4.0;
         for (int q = 0; q < 4; ++q) {
             double l[4] = {c, c, c, c};
             l[q] = a;
@@ -328,7 +328,7 @@ Vector internal_forces(const mesh::TetMesh& m, const std::vector<Material>& mate
               "displacements: " << u_full.size() << " values for " << m.n_vertices()
                                 << " vertices (3 per vertex)");
     Vector F = Vector::Zero(3 * m.n_vertices());
-    for (int t = 0; t < m.n_tetrahedra(); ++t) {
+    for (int t = 0; t < m.n_cells(); ++t) {
         const Tet& tet = tet_of(m, t);
         const auto ke =
             simplex_stiffness<3>(corners_of(m, t), D[static_cast<size_t>(attribute_of(m, t))]);
@@ -349,8 +349,8 @@ std::vector<double> tetrahedron_stresses(const mesh::TetMesh& m,
     MLC_CHECK(u_full.size() == 3 * m.n_vertices(),
               "displacements: " << u_full.size() << " values for " << m.n_vertices()
                                 << " vertices (3 per vertex)");
-    std::vector<double> s(static_cast<size_t>(6 * m.n_tetrahedra()));
-    for (int t = 0; t < m.n_tetrahedra(); ++t) {
+    std::vector<double> s(static_cast<size_t>(6 * m.n_cells()));
+    for (int t = 0; t < m.n_cells(); ++t) {
         const Tet& tet = tet_of(m, t);
         double volume = 0;
         const auto B = voigt_strain_matrix<3>(barycentric_gradients<3>(corners_of(m, t), volume));

@@ -48,8 +48,8 @@ std::array<double, 5> balance_sums(const Level& level, double s, const Vector& u
     }
     // The internal forces' own scale: sum of |K_e| |u_e| over the rows of counted vertices.
     double internal = 0.0;
-    for (int t = 0; t < level.mesh.n_triangles(); ++t) {
-        const auto& tri = level.mesh.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < level.mesh.n_cells(); ++t) {
+        const auto& tri = level.mesh.cells[static_cast<size_t>(t)];
         const auto ke = fem::element_stiffness(level.mesh.vertices[static_cast<size_t>(tri[0])],
                                                level.mesh.vertices[static_cast<size_t>(tri[1])],
                                                level.mesh.vertices[static_cast<size_t>(tri[2])],

@@ -16,9 +16,9 @@ namespace {
 /// Body index of every vertex (the attribute of a triangle holding it; 0 without attributes).
 std::vector<int> vertex_bodies(const Level& L) {
     std::vector<int> body(static_cast<size_t>(L.mesh.n_vertices()), -1);
-    for (int t = 0; t < L.mesh.n_triangles(); ++t) {
+    for (int t = 0; t < L.mesh.n_cells(); ++t) {
         const int b = L.mesh.attribute.empty() ? 0 : L.mesh.attribute[static_cast<size_t>(t)];
-        for (int v : L.mesh.triangles[static_cast<size_t>(t)])
+        for (int v : L.mesh.cells[static_cast<size_t>(t)])
             body[static_cast<size_t>(v)] = b;
     }
     return body;
@@ -203,8 +203,8 @@ std::string no_equilibrium(const Problem& p, const Level& L, double s) {
 
 Deformation max_deformation(const Level& L, const Vector& u_full) {
     Deformation d;
-    for (int t = 0; t < L.mesh.n_triangles(); ++t) {
-        const auto& tri = L.mesh.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < L.mesh.n_cells(); ++t) {
+        const auto& tri = L.mesh.cells[static_cast<size_t>(t)];
         double area = 0.0;
         const auto B = fem::strain_matrix(L.mesh.vertices[static_cast<size_t>(tri[0])],
                                           L.mesh.vertices[static_cast<size_t>(tri[1])],

@@ -84,8 +84,8 @@ int n_extra_of(const fem::DofMap& dofs, int v) {
 std::optional<mesh::MacroLattice> owned_macro_lattice(const Problem& problem,
                                                       const mesh::LocalLevel& part) {
     if (problem.numbering != Problem::Numbering::lattice) return std::nullopt;
-    const std::int64_t t0 = problem.mesh0.n_triangles();
-    const long nt = part.mesh.n_triangles();
+    const std::int64_t t0 = problem.mesh0.n_cells();
+    const long nt = part.mesh.n_cells();
     int depth = -1; // this level is depth refinements of mesh0
     for (int d = 0; d <= 14 && t0 > 0; ++d)
         if (t0 << (2 * d) == part.n_global_triangles) depth = d;
@@ -114,7 +114,7 @@ std::optional<mesh::MacroLattice> owned_macro_lattice(const Problem& problem,
         }
         if (owned && e - t == per_macro)
             for (long q = t; q < e; ++q) {
-                std::array<int, 3> tri = part.mesh.triangles[static_cast<size_t>(q)];
+                std::array<int, 3> tri = part.mesh.cells[static_cast<size_t>(q)];
                 for (int& v : tri) {
                     int& s = sub_of[static_cast<size_t>(v)];
                     if (s < 0) {
@@ -123,11 +123,11 @@ std::optional<mesh::MacroLattice> owned_macro_lattice(const Problem& problem,
                     }
                     v = s;
                 }
-                sub.triangles.push_back(tri);
+                sub.cells.push_back(tri);
             }
         t = e;
     }
-    if (sub.triangles.empty()) return std::nullopt;
+    if (sub.cells.empty()) return std::nullopt;
     sub.vertices.resize(local_of.size());
     auto lattice = mesh::macro_lattice(sub, depth);
     if (!lattice) return std::nullopt;

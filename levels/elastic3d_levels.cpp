@@ -6,7 +6,7 @@
 #include "core/check.hpp"
 #include "fem/elastic3d.hpp"
 #include "mesh/tet_refine.hpp"
-#include "transfer/tet_transfer.hpp"
+#include "transfer/prolongation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -109,7 +109,7 @@ void ElasticProblem3::validate() const {
     MLC_CHECK(!bodies.empty(), "the 3D problem has no body");
     MLC_CHECK(levels >= 0 && levels <= kMaxLevels3,
               "levels must lie in [0, " << kMaxLevels3 << "], found " << levels);
-    MLC_CHECK(mesh0.n_tetrahedra() > 0, "the 3D problem's mesh has no tetrahedra");
+    MLC_CHECK(mesh0.n_cells() > 0, "the 3D problem's mesh has no tetrahedra");
     for (size_t t = 0; t < mesh0.attribute.size(); ++t)
         MLC_CHECK(mesh0.attribute[t] >= 0 && mesh0.attribute[t] < static_cast<int>(bodies.size()),
                   "tetrahedron " << t << " belongs to body " << mesh0.attribute[t] << ", but "
@@ -193,7 +193,7 @@ ElasticHierarchy3 build_elastic_hierarchy3(const ElasticProblem3& p, int levels)
     for (int l = 1; l <= levels; ++l) {
         mesh::TetMesh fine = mesh::refine(h.levels.back().mesh);
         mesh::check_refined_quality(fine);
-        const SparseMatrix Pv = transfer::tet_vertex_prolongation(fine);
+        const SparseMatrix Pv = transfer::vertex_prolongation(fine);
         ElasticLevel3 L = build_elastic_level3(p, std::move(fine));
         const ElasticLevel3& C = h.levels.back();
         SparseMatrix T = transfer::restrict_to_unknowns(

@@ -51,7 +51,7 @@ void Hierarchy::report(std::ostream& os) const {
     for (size_t l = 0; l < levels.size(); ++l) {
         const auto& L = levels[l];
         os << std::setw(7) << l << std::setw(10) << L.mesh.n_vertices() << std::setw(11)
-           << L.mesh.n_triangles() << std::setw(10) << L.n_unknowns() << std::setw(15)
+           << L.mesh.n_cells() << std::setw(10) << L.n_unknowns() << std::setw(15)
            << L.n_contact_nodes() << std::setw(9) << L.elastic.K.nonZeros() << "\n";
     }
     os << "  operator complexity " << std::setprecision(3)

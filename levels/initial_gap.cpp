@@ -18,8 +18,8 @@ std::vector<std::string> initial_gap_warnings(const Problem& problem, const Leve
     std::vector<int> body(static_cast<size_t>(m.n_vertices()), 0);
     int n_bodies = 1;
     if (!m.attribute.empty())
-        for (int t = m.n_triangles() - 1; t >= 0; --t)
-            for (int v : m.triangles[static_cast<size_t>(t)]) {
+        for (int t = m.n_cells() - 1; t >= 0; --t)
+            for (int v : m.cells[static_cast<size_t>(t)]) {
                 body[static_cast<size_t>(v)] = m.attribute[static_cast<size_t>(t)];
                 n_bodies = std::max(n_bodies, m.attribute[static_cast<size_t>(t)] + 1);
             }

@@ -350,9 +350,9 @@ solvers::AggregationInput aggregation_input(const Level& L) {
 std::vector<smoothers::ElementMatrix> elastic_element_matrices(const Level& level) {
     const auto& m = level.mesh;
     std::vector<smoothers::ElementMatrix> out;
-    out.reserve(static_cast<size_t>(m.n_triangles()));
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    out.reserve(static_cast<size_t>(m.n_cells()));
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         const auto ke = fem::element_stiffness(
             m.vertices[static_cast<size_t>(tri[0])], m.vertices[static_cast<size_t>(tri[1])],
             m.vertices[static_cast<size_t>(tri[2])], fem::material_of(m, level.materials, t));

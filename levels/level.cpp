@@ -276,7 +276,7 @@ void number_unknowns(const Problem& problem, Level& L, const LevelPart* part,
         if (!part->order.empty()) order = part->order;
     } else if (problem.numbering == Problem::Numbering::lattice) {
         // The refinements of mesh0 this level is, when it is (4^d times mesh0's triangles).
-        const long t0 = problem.mesh0.n_triangles(), t = L.mesh.n_triangles();
+        const long t0 = problem.mesh0.n_cells(), t = L.mesh.n_cells();
         int depth = -1;
         for (int d = 0; d <= 14 && t0 > 0; ++d)
             if (t0 << (2 * d) == t) depth = d;
@@ -387,7 +387,8 @@ smoothers::LatticeRows lattice_rows(const Level& L, const mesh::MacroLattice& la
     // The visit: the blocks in the numbering's order, each macro's interior in serpentine rows
     // (row j = 1, 3, ... left to right, j = 2, 4, ... right to left): as cheap to sweep as the
     // numbering's row-by-row order (the rows still stream) and a better Gauss-Seidel order on
-    // the square (fewer BiCGStab iterations per Newton step; docs/solver-guide.md#solver-why-default).
+    // the square (fewer BiCGStab iterations per Newton step;
+    // docs/solver-guide.md#solver-why-default).
     const int N = rows.n;
     const long np = mesh::MacroLattice::interior_points(N);
     const long n_macros = np > 0 ? static_cast<long>(rows.first_row.size()) / np : 0;

@@ -24,7 +24,7 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem) {
     problem.validate();
     const Level L0 = build_level(problem, problem.mesh0);
     std::unordered_set<std::uint64_t> edges;
-    for (const auto& t : L0.mesh.triangles)
+    for (const auto& t : L0.mesh.cells)
         for (int k = 0; k < 3; ++k) {
             const auto a = static_cast<std::uint64_t>(t[static_cast<size_t>(k)]);
             const auto b = static_cast<std::uint64_t>(t[static_cast<size_t>((k + 1) % 3)]);
@@ -33,7 +33,7 @@ std::vector<LevelSize> predict_level_sizes(const Problem& problem) {
     LevelSize s;
     s.vertices = L0.mesh.n_vertices();
     s.edges = static_cast<double>(edges.size());
-    s.triangles = L0.mesh.n_triangles();
+    s.triangles = L0.mesh.n_cells();
     s.contact_nodes = L0.n_contact_nodes();
     for (const auto& c : L0.contacts)
         s.multipliers += c.n_multipliers();

@@ -129,7 +129,7 @@ public:
     /// One sentence per warning, appended to `warnings`.
     void warn(const Level& F, std::vector<std::string>& warnings) const {
         const auto centroid = [&](int t) {
-            const auto& tri = F.mesh.triangles[static_cast<size_t>(t)];
+            const auto& tri = F.mesh.cells[static_cast<size_t>(t)];
             Vec2 c = Vec2::Zero();
             for (int v : tri)
                 c += F.mesh.vertices[static_cast<size_t>(v)] / 3.0;

@@ -32,8 +32,8 @@ struct LevelP {
 
 LevelP level_p_edges(const Mesh& m, const Partition& part) {
     LevelP e;
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         const int pt = part.triangle_part[static_cast<size_t>(t)];
         for (int k = 0; k < 3; ++k) {
             const auto [a, b] =
@@ -72,8 +72,8 @@ void widen_along_contact(const Mesh& m, const std::vector<GhostReach>& reach,
     if (reach.empty()) return;
     // The triangle of every boundary edge.
     std::map<std::pair<int, int>, int> triangle_of;
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         for (int k = 0; k < 3; ++k)
             triangle_of.emplace(
                 std::minmax(tri[static_cast<size_t>(k)], tri[static_cast<size_t>((k + 1) % 3)]), t);
@@ -114,15 +114,15 @@ void widen_along_contact(const Mesh& m, const std::vector<GhostReach>& reach,
 /// `reach` adds along contact interfaces.
 LocalLevel local_level_p(const Mesh& m, const Partition& part, int rank,
                          const std::vector<GhostReach>& reach) {
-    const int nv = m.n_vertices(), nt = m.n_triangles();
+    const int nv = m.n_vertices(), nt = m.n_cells();
     std::vector<char> touched(static_cast<size_t>(nv), 0);
     for (int t = 0; t < nt; ++t)
         if (part.triangle_part[static_cast<size_t>(t)] == rank)
-            for (int v : m.triangles[static_cast<size_t>(t)])
+            for (int v : m.cells[static_cast<size_t>(t)])
                 touched[static_cast<size_t>(v)] = 1;
     std::vector<char> local_triangle(static_cast<size_t>(nt), 0);
     for (int t = 0; t < nt; ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         local_triangle[static_cast<size_t>(t)] = touched[static_cast<size_t>(tri[0])] ||
                                                  touched[static_cast<size_t>(tri[1])] ||
                                                  touched[static_cast<size_t>(tri[2])];
@@ -132,7 +132,7 @@ LocalLevel local_level_p(const Mesh& m, const Partition& part, int rank,
     std::vector<int> local_of(static_cast<size_t>(nv), -1);
     std::vector<int> tris;
     for (int t = 0; t < nt; ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         if (local_triangle[static_cast<size_t>(t)]) {
             tris.push_back(t);
             for (int v : tri)
@@ -148,10 +148,10 @@ LocalLevel local_level_p(const Mesh& m, const Partition& part, int rank,
         }
     std::map<std::pair<int, int>, int> local_edges;
     for (int t : tris) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
-        L.mesh.triangles.push_back({local_of[static_cast<size_t>(tri[0])],
-                                    local_of[static_cast<size_t>(tri[1])],
-                                    local_of[static_cast<size_t>(tri[2])]});
+        const auto& tri = m.cells[static_cast<size_t>(t)];
+        L.mesh.cells.push_back({local_of[static_cast<size_t>(tri[0])],
+                                local_of[static_cast<size_t>(tri[1])],
+                                local_of[static_cast<size_t>(tri[2])]});
         if (!m.attribute.empty()) L.mesh.attribute.push_back(m.attribute[static_cast<size_t>(t)]);
         L.triangle_ancestor.push_back(t);
         L.triangle_owned.push_back(part.triangle_part[static_cast<size_t>(t)] == rank ? 1 : 0);
@@ -165,11 +165,11 @@ LocalLevel local_level_p(const Mesh& m, const Partition& part, int rank,
         for (const auto& e : from)
             if (local_edges.count(std::minmax(e.v0, e.v1)))
                 to.push_back({local_of[static_cast<size_t>(e.v0)],
-                              local_of[static_cast<size_t>(e.v1)], e.tag, e.curve});
+                              local_of[static_cast<size_t>(e.v1)], e.tag, e.shape});
     };
     keep(m.boundary, L.mesh.boundary);
     keep(m.lines, L.mesh.lines);
-    L.mesh.circles = m.circles;
+    L.mesh.shapes = m.shapes;
     L.mesh.tag_names = m.tag_names;
     return L;
 }
@@ -179,7 +179,7 @@ LocalLevel local_level_p(const Mesh& m, const Partition& part, int rank,
 LocalLevel refine_local(const LocalLevel& c, const LevelP& lp, const Partition& part) {
     LocalLevel f;
     f.mesh = refine(c.mesh);
-    const size_t nt = c.mesh.triangles.size();
+    const size_t nt = c.mesh.cells.size();
     f.triangle_ancestor.resize(4 * nt);
     f.triangle_owned.resize(4 * nt);
     for (size_t t = 0; t < nt; ++t)
@@ -209,9 +209,9 @@ LocalLevel refine_local(const LocalLevel& c, const LevelP& lp, const Partition& 
     };
     // refine(): children 4t = {a, ab, ca}, 4t+1 = {ab, b, bc}: the midpoints of t's edges.
     for (size_t t = 0; t < nt; ++t) {
-        const auto& tri = c.mesh.triangles[t];
-        const auto& c0 = f.mesh.triangles[4 * t];
-        const auto& c1 = f.mesh.triangles[4 * t + 1];
+        const auto& tri = c.mesh.cells[t];
+        const auto& c0 = f.mesh.cells[4 * t];
+        const auto& c1 = f.mesh.cells[4 * t + 1];
         const std::array<std::array<int, 3>, 3> mids = {
             {{tri[0], tri[1], c0[1]}, {tri[1], tri[2], c1[2]}, {tri[2], tri[0], c0[2]}}};
         for (const auto& [a, b, m] : mids) {
@@ -349,7 +349,7 @@ void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& 
                            const std::vector<Field>& cell_fields, const Communicator& comm,
                            VtuFormat format) {
     on_every_process(comm, "write_distributed_vtu (pieces)", [&] {
-        const int nv = L.mesh.n_vertices(), nt = L.mesh.n_triangles();
+        const int nv = L.mesh.n_vertices(), nt = L.mesh.n_cells();
         for (const Field& f : point_fields)
             MLC_CHECK(f.n_components >= 1 &&
                           f.values.size() == static_cast<size_t>(nv * f.n_components),
@@ -367,7 +367,7 @@ void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& 
         for (int t = 0; t < nt; ++t)
             if (L.triangle_owned[static_cast<size_t>(t)]) {
                 triangles.push_back(t);
-                for (int v : L.mesh.triangles[static_cast<size_t>(t)])
+                for (int v : L.mesh.cells[static_cast<size_t>(t)])
                     piece_of[static_cast<size_t>(v)] = 0;
             }
         for (int v = 0; v < nv; ++v)
@@ -377,10 +377,10 @@ void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& 
                 piece.vertices.push_back(L.mesh.vertices[static_cast<size_t>(v)]);
             }
         for (int t : triangles) {
-            const auto& tri = L.mesh.triangles[static_cast<size_t>(t)];
-            piece.triangles.push_back({piece_of[static_cast<size_t>(tri[0])],
-                                       piece_of[static_cast<size_t>(tri[1])],
-                                       piece_of[static_cast<size_t>(tri[2])]});
+            const auto& tri = L.mesh.cells[static_cast<size_t>(t)];
+            piece.cells.push_back({piece_of[static_cast<size_t>(tri[0])],
+                                   piece_of[static_cast<size_t>(tri[1])],
+                                   piece_of[static_cast<size_t>(tri[2])]});
         }
         auto subset = [](const std::vector<Field>& fields, const std::vector<int>& entities) {
             std::vector<Field> out;

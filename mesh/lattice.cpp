@@ -9,7 +9,7 @@ namespace mlc::mesh {
 
 std::optional<MacroLattice> macro_lattice(const Mesh& fine, int depth) {
     MLC_CHECK(depth >= 0 && depth <= 14, "macro_lattice: depth " << depth << " out of [0, 14]");
-    const long nt = fine.n_triangles();
+    const long nt = fine.n_cells();
     const long per_macro = 1L << (2 * depth);
     if (nt == 0 || nt % per_macro != 0) return std::nullopt;
     MacroLattice L;
@@ -40,7 +40,7 @@ std::optional<MacroLattice> macro_lattice(const Mesh& fine, int depth) {
                 c = {ab, bc, ca};
         }
         for (int q = 0; q < 3; ++q) {
-            const int v = fine.triangles[static_cast<size_t>(t)][static_cast<size_t>(q)];
+            const int v = fine.cells[static_cast<size_t>(t)][static_cast<size_t>(q)];
             const int i = c[static_cast<size_t>(q)][0], j = c[static_cast<size_t>(q)][1];
             const bool interior = i >= 1 && j >= 1 && i + j <= n - 1;
             const long id = interior ? m * np + MacroLattice::point_index(n, i, j) : -2;
@@ -63,11 +63,11 @@ std::optional<MacroLattice> macro_lattice(const Mesh& fine, int depth) {
 
 std::vector<int> lattice_vertex_order(const Mesh& fine, const MacroLattice& lattice) {
     const size_t nv = static_cast<size_t>(fine.n_vertices());
-    const long per_macro = lattice.n_macros > 0 ? fine.n_triangles() / lattice.n_macros : 1;
+    const long per_macro = lattice.n_macros > 0 ? fine.n_cells() / lattice.n_macros : 1;
     std::vector<int> macro_of(nv, -1);
-    for (long t = 0; t < fine.n_triangles(); ++t) {
+    for (long t = 0; t < fine.n_cells(); ++t) {
         const int m = static_cast<int>(t / per_macro);
-        for (int v : fine.triangles[static_cast<size_t>(t)]) {
+        for (int v : fine.cells[static_cast<size_t>(t)]) {
             int& k = macro_of[static_cast<size_t>(v)];
             if (k < 0 || m < k) k = m;
         }

@@ -18,116 +18,6 @@
 
 namespace mlc::mesh {
 
-int Mesh::tag(const std::string& name) const {
-    auto it = tag_names.find(name);
-    if (it == tag_names.end()) {
-        std::string known;
-        for (const auto& [n, id] : tag_names)
-            known += (known.empty() ? "" : ", ") + n;
-        MLC_CHECK(false, "unknown boundary tag '" << name << "'; the mesh has: " << known);
-    }
-    return it->second;
-}
-
-std::optional<int> Mesh::find_tag(const std::string& name) const {
-    auto it = tag_names.find(name);
-    if (it == tag_names.end()) return std::nullopt;
-    return it->second;
-}
-
-std::string Mesh::tag_name(int t) const {
-    for (const auto& [n, id] : tag_names)
-        if (id == t) return n;
-    return "tag " + std::to_string(t);
-}
-
-int Mesh::add_tag(const std::string& name) {
-    auto it = tag_names.find(name);
-    if (it != tag_names.end()) return it->second;
-    int id = 0;
-    for (const auto& [n, t] : tag_names)
-        id = std::max(id, t + 1);
-    tag_names[name] = id;
-    return id;
-}
-
-double Mesh::signed_area(int t) const {
-    const auto& tri = triangles[static_cast<size_t>(t)];
-    const Vec2& a = vertices[static_cast<size_t>(tri[0])];
-    const Vec2& b = vertices[static_cast<size_t>(tri[1])];
-    const Vec2& c = vertices[static_cast<size_t>(tri[2])];
-    return 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
-}
-
-namespace {
-
-// The sorted distinct end vertices of the edges tagged t in each of the lists.
-template <class... Edges> std::vector<int> end_vertices(int t, const Edges&... lists) {
-    std::vector<int> out;
-    auto add = [&](const auto& edges) {
-        for (const auto& e : edges)
-            if (e.tag == t) {
-                out.push_back(e.v0);
-                out.push_back(e.v1);
-            }
-    };
-    (add(lists), ...);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-}
-
-} // namespace
-
-std::vector<int> Mesh::vertices_with_tag(int t) const {
-    return end_vertices(t, boundary);
-}
-
-std::vector<int> Mesh::vertices_on_tag(int t) const {
-    return end_vertices(t, boundary, lines);
-}
-
-bool Mesh::is_boundary_tag(int t) const {
-    return std::any_of(boundary.begin(), boundary.end(),
-                       [t](const BoundaryEdge& e) { return e.tag == t; });
-}
-
-std::pair<double, double> Mesh::edge_length_range() const {
-    double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
-    for (const auto& tri : triangles)
-        for (int k = 0; k < 3; ++k) {
-            double l = (vertices[static_cast<size_t>(tri[static_cast<size_t>(k)])] -
-                        vertices[static_cast<size_t>(tri[static_cast<size_t>((k + 1) % 3)])])
-                           .norm();
-            lo = std::min(lo, l);
-            hi = std::max(hi, l);
-        }
-    return {lo, hi};
-}
-
-double Mesh::diameter() const {
-    if (vertices.empty()) return 0.0;
-    Vec2 lo = vertices[0], hi = vertices[0];
-    for (const auto& v : vertices) {
-        lo = lo.cwiseMin(v);
-        hi = hi.cwiseMax(v);
-    }
-    return (hi - lo).norm();
-}
-
-int Mesh::nearest_vertex(const Vec2& p) const {
-    int best = -1;
-    double bd = std::numeric_limits<double>::infinity();
-    for (int v = 0; v < n_vertices(); ++v) {
-        double d = (vertices[static_cast<size_t>(v)] - p).squaredNorm();
-        if (d < bd) {
-            bd = d;
-            best = v;
-        }
-    }
-    return best;
-}
-
 std::vector<int> hilbert_order(const std::vector<Vec2>& points) {
     const size_t n = points.size();
     std::vector<int> order(n);
@@ -172,11 +62,11 @@ std::vector<int> hilbert_order(const std::vector<Vec2>& points) {
 
 Mesh refine(const Mesh& coarse) {
     Mesh fine;
-    fine.circles = coarse.circles;
+    fine.shapes = coarse.shapes;
     fine.tag_names = coarse.tag_names;
     fine.n_coarse_vertices = coarse.n_vertices();
     fine.vertices = coarse.vertices;
-    const size_t nt = coarse.triangles.size();
+    const size_t nt = coarse.cells.size();
     fine.vertices.reserve(coarse.vertices.size() + 2 * nt);
     fine.parents.reserve(2 * nt);
     std::unordered_map<std::uint64_t, int> midpoint;
@@ -191,14 +81,14 @@ Mesh refine(const Mesh& coarse) {
         }
         return it->second;
     };
-    fine.triangles.reserve(4 * nt);
-    for (const auto& t : coarse.triangles) {
+    fine.cells.reserve(4 * nt);
+    for (const auto& t : coarse.cells) {
         const int a = t[0], b = t[1], c = t[2];
         const int ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
-        fine.triangles.push_back({a, ab, ca});
-        fine.triangles.push_back({ab, b, bc});
-        fine.triangles.push_back({ca, bc, c});
-        fine.triangles.push_back({ab, bc, ca});
+        fine.cells.push_back({a, ab, ca});
+        fine.cells.push_back({ab, b, bc});
+        fine.cells.push_back({ca, bc, c});
+        fine.cells.push_back({ab, bc, ca});
     }
     if (!coarse.attribute.empty()) {
         fine.attribute.reserve(4 * nt);
@@ -209,16 +99,16 @@ Mesh refine(const Mesh& coarse) {
     fine.boundary.reserve(2 * coarse.boundary.size());
     for (const auto& e : coarse.boundary) {
         const int m = mid(e.v0, e.v1);
-        if (e.curve >= 0) {
-            const Circle& c = coarse.circles[static_cast<size_t>(e.curve)];
+        if (e.shape >= 0) {
+            const Circle& c = coarse.shapes[static_cast<size_t>(e.shape)];
             Vec2& p = fine.vertices[static_cast<size_t>(m)];
             Vec2 d = p - c.center;
             const double n = d.norm();
             MLC_CHECK(n > 0, "boundary edge midpoint at the centre of its circle");
             p = c.center + (c.radius / n) * d;
         }
-        fine.boundary.push_back({e.v0, m, e.tag, e.curve});
-        fine.boundary.push_back({m, e.v1, e.tag, e.curve});
+        fine.boundary.push_back({e.v0, m, e.tag, e.shape});
+        fine.boundary.push_back({m, e.v1, e.tag, e.shape});
     }
     fine.lines.reserve(2 * coarse.lines.size());
     for (const auto& e : coarse.lines) {
@@ -247,18 +137,18 @@ Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diago
         for (int i = 0; i <= nx; ++i)
             m.vertices.push_back(corner + Vec2(size.x() * i / nx, size.y() * j / ny));
     auto id = [&](int i, int j) { return j * (nx + 1) + i; };
-    m.triangles.reserve(static_cast<size_t>(n_triangles));
+    m.cells.reserve(static_cast<size_t>(n_triangles));
     for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {
             const int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
             bool slash = diagonal == Diagonal::right ||
                          (diagonal == Diagonal::alternate && (i + j) % 2 == 0);
             if (slash) {
-                m.triangles.push_back({a, b, c});
-                m.triangles.push_back({a, c, d});
+                m.cells.push_back({a, b, c});
+                m.cells.push_back({a, c, d});
             } else {
-                m.triangles.push_back({a, b, d});
-                m.triangles.push_back({b, c, d});
+                m.cells.push_back({a, b, d});
+                m.cells.push_back({b, c, d});
             }
         }
     const int bottom = m.add_tag("bottom"), right = m.add_tag("right"), top = m.add_tag("top"),
@@ -278,15 +168,15 @@ VertexTriangles vertex_triangles(const Mesh& m) {
     const size_t nv = m.vertices.size();
     VertexTriangles r;
     r.offset.assign(nv + 1, 0);
-    for (const auto& tri : m.triangles)
+    for (const auto& tri : m.cells)
         for (int v : tri)
             ++r.offset[static_cast<size_t>(v) + 1];
     for (size_t v = 0; v < nv; ++v)
         r.offset[v + 1] += r.offset[v];
     r.triangles.resize(static_cast<size_t>(r.offset.back()));
     std::vector<int> fill(r.offset.begin(), r.offset.end() - 1);
-    for (size_t t = 0; t < m.triangles.size(); ++t) // ascending per vertex
-        for (int v : m.triangles[t])
+    for (size_t t = 0; t < m.cells.size(); ++t) // ascending per vertex
+        for (int v : m.cells[t])
             r.triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(t);
     return r;
 }
@@ -297,7 +187,7 @@ VertexTriangles::OnEdge VertexTriangles::on_edge(const Mesh& m, int a, int b) co
     if (a < 0 || a >= nv || b < 0 || b >= nv || a == b) return r;
     for (int k = offset[static_cast<size_t>(a)]; k < offset[static_cast<size_t>(a) + 1]; ++k) {
         const int t = triangles[static_cast<size_t>(k)];
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         if (tri[0] != b && tri[1] != b && tri[2] != b) continue;
         if (r.count < 2) r.first[static_cast<size_t>(r.count)] = t;
         ++r.count;

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
-/// @file P1 triangle mesh with tagged boundary edges, uniform 1->4 refinement and quality checks.
+/// @file The 2D algorithms on SimplexMesh<2> (Mesh, mesh/simplex_mesh.hpp): uniform 1->4
+/// refinement, its inverse, quality checks, the structured rectangle and the Hilbert order.
 #pragma once
 
 #include "core/types.hpp"
+#include "mesh/simplex_mesh.hpp"
 
 #include <array>
 #include <map>
@@ -11,78 +13,6 @@
 #include <vector>
 
 namespace mlc::mesh {
-
-/// Exact geometry a boundary edge lies on, so that refinement can put new vertices on it.
-/// Only circles are needed (straight edges need nothing).
-struct Circle {
-    Vec2 center = Vec2::Zero();
-    double radius = 0.0;
-};
-
-/// One boundary edge (v0, v1) of a triangle, oriented counter-clockwise around its body
-/// (the domain lies to the left of v0 -> v1).
-struct BoundaryEdge {
-    int v0 = -1;
-    int v1 = -1;
-    int tag = 0;    ///< boundary tag id; names in Mesh::tag_names
-    int curve = -1; ///< index into Mesh::circles, or -1 for a straight edge
-};
-
-/// A 2D triangle mesh of one body.
-///
-/// Triangles are counter-clockwise (positive signed area). Boundary edges carry an integer tag
-/// and, optionally, the circle they lie on. A mesh made by `refine` keeps the coarse vertices
-/// with their indices (0 .. n_coarse-1) and appends one vertex per coarse edge; `parents`
-/// records the two coarse vertices of each new one, which is all the interpolation P needs.
-struct Mesh {
-    std::vector<Vec2> vertices;
-    std::vector<std::array<int, 3>> triangles;
-    /// Per-triangle body (or material) id, inherited by refinement; empty means all 0.
-    std::vector<int> attribute;
-    std::vector<BoundaryEdge> boundary;
-    /// Tagged interior edges ("lines": constrained interior segments of a domain, physical lines
-    /// of a Gmsh file inside the body, the mirror line of mirror_about_x). Both ends are vertices
-    /// of the mesh and the edge is an edge of two triangles; the orientation means nothing and
-    /// `curve` is -1. Refinement splits them like boundary edges (the halves keep the tag), so
-    /// the vertices it creates on a tagged line carry the tag. Supports may name their tags;
-    /// loads and contact pairs need boundary tags.
-    std::vector<BoundaryEdge> lines;
-    std::vector<Circle> circles;
-    std::map<std::string, int> tag_names; ///< name -> tag id
-    /// For a refined mesh: parents[v - n_coarse] = the two coarse vertices of new vertex v.
-    /// Empty for a level-0 mesh.
-    std::vector<std::array<int, 2>> parents;
-    /// Number of vertices of the mesh this one was refined from (0 for a level-0 mesh).
-    int n_coarse_vertices = 0;
-
-    int n_vertices() const { return static_cast<int>(vertices.size()); }
-    int n_triangles() const { return static_cast<int>(triangles.size()); }
-
-    /// Tag id of a name; throws InvalidInput naming the known tags if absent.
-    int tag(const std::string& name) const;
-    /// Tag id of a name, or nullopt.
-    std::optional<int> find_tag(const std::string& name) const;
-    /// Name of a tag id ("tag <id>" if unnamed).
-    std::string tag_name(int tag) const;
-    /// Registers a name (returns the existing id if already present).
-    int add_tag(const std::string& name);
-
-    /// Signed area of triangle t (positive when counter-clockwise).
-    double signed_area(int t) const;
-    /// Vertices on boundary edges carrying `tag`, sorted and unique.
-    std::vector<int> vertices_with_tag(int tag) const;
-    /// Vertices on boundary edges or interior lines carrying `tag`, sorted and unique (what a
-    /// support on the tag holds).
-    std::vector<int> vertices_on_tag(int tag) const;
-    /// Whether some boundary edge carries `tag` (a tag only on interior lines does not).
-    bool is_boundary_tag(int tag) const;
-    /// Smallest and largest edge length.
-    std::pair<double, double> edge_length_range() const;
-    /// Diameter of the bounding box (the mesh's length scale).
-    double diameter() const;
-    /// Index of the vertex nearest to p.
-    int nearest_vertex(const Vec2& p) const;
-};
 
 /// Checks a mesh for use: at least one triangle, indices in range, every triangle with positive
 /// area (relative to the square of the mesh diameter), no two vertices of one body (attribute)

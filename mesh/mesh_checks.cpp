@@ -20,13 +20,13 @@ namespace mlc::mesh {
 namespace {
 void check_triangle_areas(const Mesh& m, double diam) {
     const int nv = m.n_vertices();
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         for (int k = 0; k < 3; ++k)
             MLC_CHECK(tri[static_cast<size_t>(k)] >= 0 && tri[static_cast<size_t>(k)] < nv,
                       "triangle " << t << " refers to vertex " << tri[static_cast<size_t>(k)]
                                   << " but the mesh has " << nv << " vertices");
-        const double a = m.signed_area(t);
+        const double a = m.signed_measure(t);
         const Vec2& p = m.vertices[static_cast<size_t>(tri[0])];
         MLC_CHECK(a > 1e-14 * diam * diam, "degenerate or inverted triangle "
                                                << t << " (vertices " << tri[0] << ", " << tri[1]
@@ -39,7 +39,7 @@ void check_triangle_areas(const Mesh& m, double diam) {
 } // namespace
 
 void check_refined_quality(const Mesh& m) {
-    MLC_CHECK(m.n_triangles() > 0, "the mesh has no triangles");
+    MLC_CHECK(m.n_cells() > 0, "the mesh has no triangles");
     check_triangle_areas(m, m.diameter());
 }
 
@@ -48,11 +48,11 @@ void check_quality(const Mesh& m) {
 }
 
 void check_quality(const Mesh& m, const TriangleNamer& name) {
-    MLC_CHECK(m.n_triangles() > 0, "the mesh has no triangles");
+    MLC_CHECK(m.n_cells() > 0, "the mesh has no triangles");
     const int nv = m.n_vertices();
-    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.triangles.size(),
-              "the mesh has " << m.attribute.size() << " triangle attributes for "
-                              << m.triangles.size() << " triangles");
+    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.cells.size(),
+              "the mesh has " << m.attribute.size() << " triangle attributes for " << m.cells.size()
+                              << " triangles");
     for (const auto& v : m.vertices)
         MLC_CHECK(std::isfinite(v.x()) && std::isfinite(v.y()), "a mesh vertex is not finite");
     const double diam = m.diameter();
@@ -62,8 +62,8 @@ void check_quality(const Mesh& m, const TriangleNamer& name) {
     // touch: their vertices may coincide (a matching interface).
     std::vector<int> body(static_cast<size_t>(nv), -1);
     if (!m.attribute.empty())
-        for (int t = 0; t < m.n_triangles(); ++t)
-            for (int v : m.triangles[static_cast<size_t>(t)])
+        for (int t = 0; t < m.n_cells(); ++t)
+            for (int v : m.cells[static_cast<size_t>(t)])
                 if (body[static_cast<size_t>(v)] < 0)
                     body[static_cast<size_t>(v)] = m.attribute[static_cast<size_t>(t)];
     // Each vertex goes into a square cell of side h >= tol, so that a pair closer than tol lies in
@@ -164,10 +164,10 @@ struct BoundarySide {
 
 /// Duplicated elements: the same vertex set, in any order.
 void check_duplicate_elements(const Mesh& m, const TopologyNames& names) {
-    const size_t nt = m.triangles.size();
+    const size_t nt = m.cells.size();
     std::vector<std::pair<std::array<int, 3>, int>> sorted(nt);
     for (size_t t = 0; t < nt; ++t) {
-        std::array<int, 3> k = m.triangles[t];
+        std::array<int, 3> k = m.cells[t];
         std::sort(k.begin(), k.end());
         sorted[t] = {k, static_cast<int>(t)};
     }
@@ -187,7 +187,7 @@ void check_duplicate_elements(const Mesh& m, const TopologyNames& names) {
 /// Edges and how many triangles share each: 1 on the boundary, 2 inside, more is an error.
 /// Returns the boundary edges.
 std::vector<BoundarySide> boundary_sides(const Mesh& m, const TopologyNames& names) {
-    const size_t nt = m.triangles.size();
+    const size_t nt = m.cells.size();
     struct Side {
         std::uint64_t key;
         int t;
@@ -197,8 +197,8 @@ std::vector<BoundarySide> boundary_sides(const Mesh& m, const TopologyNames& nam
     sides.reserve(3 * nt);
     for (size_t t = 0; t < nt; ++t)
         for (int k = 0; k < 3; ++k)
-            sides.push_back({detail::edge_key(m.triangles[t][static_cast<size_t>(k)],
-                                              m.triangles[t][static_cast<size_t>((k + 1) % 3)]),
+            sides.push_back({detail::edge_key(m.cells[t][static_cast<size_t>(k)],
+                                              m.cells[t][static_cast<size_t>((k + 1) % 3)]),
                              static_cast<int>(t)});
     std::sort(sides.begin(), sides.end());
     std::vector<BoundarySide> boundary; // edges of one triangle

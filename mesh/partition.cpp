@@ -44,7 +44,7 @@ bool dual_graph_connected(const std::vector<std::vector<idx_t>>& adj) {
 } // namespace
 
 Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& weights) {
-    const int nt = m.n_triangles();
+    const int nt = m.n_cells();
     MLC_CHECK(parts >= 1, "a partition needs at least one part, found " << parts);
     MLC_CHECK(parts <= nt, "cannot split " << nt << " triangles into " << parts << " parts");
     MLC_CHECK(weights.empty() || static_cast<int>(weights.size()) == nt,
@@ -55,7 +55,7 @@ Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& 
     std::map<std::pair<int, int>, int> first_side;
     std::vector<std::vector<idx_t>> adj(static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         for (int k = 0; k < 3; ++k) {
             const int a = tri[k], b = tri[(k + 1) % 3];
             const auto key = std::minmax(a, b);
@@ -106,7 +106,7 @@ Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& 
     const int nv = m.n_vertices();
     std::vector<std::map<int, int>> count(static_cast<size_t>(nv));
     for (int t = 0; t < nt; ++t)
-        for (int v : m.triangles[static_cast<size_t>(t)])
+        for (int v : m.cells[static_cast<size_t>(t)])
             ++count[static_cast<size_t>(v)][p.triangle_part[static_cast<size_t>(t)]];
     p.vertex_owner.assign(static_cast<size_t>(nv), 0);
     for (int v = 0; v < nv; ++v) {

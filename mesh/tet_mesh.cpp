@@ -76,116 +76,23 @@ void attach_surface(TetMesh& m, const std::string& tag, CurvedSurface surface) {
                                         << " of the radius): check the centre, axis and radius "
                                            "against the mesh (in its frame and units)");
     }
-    const int index = static_cast<int>(m.surfaces.size());
-    m.surfaces.push_back(surface);
+    const int index = static_cast<int>(m.shapes.size());
+    m.shapes.push_back(surface);
     for (auto& f : m.boundary)
-        if (f.tag == *id) f.surface = index;
-}
-
-int TetMesh::tag(const std::string& name) const {
-    auto it = tag_names.find(name);
-    if (it == tag_names.end()) {
-        std::string known;
-        for (const auto& [n, id] : tag_names)
-            known += (known.empty() ? "" : ", ") + n;
-        MLC_CHECK(false, "unknown boundary tag '" << name << "'; the mesh has: " << known);
-    }
-    return it->second;
-}
-
-std::optional<int> TetMesh::find_tag(const std::string& name) const {
-    auto it = tag_names.find(name);
-    if (it == tag_names.end()) return std::nullopt;
-    return it->second;
-}
-
-std::string TetMesh::tag_name(int t) const {
-    for (const auto& [n, id] : tag_names)
-        if (id == t) return n;
-    return "tag " + std::to_string(t);
-}
-
-int TetMesh::add_tag(const std::string& name) {
-    auto it = tag_names.find(name);
-    if (it != tag_names.end()) return it->second;
-    int id = 0;
-    for (const auto& [n, t] : tag_names)
-        id = std::max(id, t + 1);
-    tag_names[name] = id;
-    return id;
-}
-
-double TetMesh::signed_volume(int t) const {
-    const auto& k = tetrahedra[static_cast<size_t>(t)];
-    const Vec3& a = vertices[static_cast<size_t>(k[0])];
-    return (vertices[static_cast<size_t>(k[1])] - a)
-               .cross(vertices[static_cast<size_t>(k[2])] - a)
-               .dot(vertices[static_cast<size_t>(k[3])] - a) /
-           6.0;
-}
-
-std::vector<int> TetMesh::vertices_with_tag(int t) const {
-    std::vector<int> v;
-    for (const auto& f : boundary)
-        if (f.tag == t) v.insert(v.end(), f.v.begin(), f.v.end());
-    std::sort(v.begin(), v.end());
-    v.erase(std::unique(v.begin(), v.end()), v.end());
-    return v;
-}
-
-bool TetMesh::is_boundary_tag(int t) const {
-    return std::any_of(boundary.begin(), boundary.end(),
-                       [t](const BoundaryFace& f) { return f.tag == t; });
-}
-
-std::pair<double, double> TetMesh::edge_length_range() const {
-    double lo = std::numeric_limits<double>::infinity(), hi = 0;
-    for (const auto& k : tetrahedra)
-        for (int i = 0; i < 4; ++i)
-            for (int j = i + 1; j < 4; ++j) {
-                const double l = (vertices[static_cast<size_t>(k[static_cast<size_t>(i)])] -
-                                  vertices[static_cast<size_t>(k[static_cast<size_t>(j)])])
-                                     .norm();
-                lo = std::min(lo, l);
-                hi = std::max(hi, l);
-            }
-    return {lo, hi};
-}
-
-double TetMesh::diameter() const {
-    if (vertices.empty()) return 0;
-    Vec3 lo = vertices[0], hi = vertices[0];
-    for (const auto& v : vertices) {
-        lo = lo.cwiseMin(v);
-        hi = hi.cwiseMax(v);
-    }
-    return (hi - lo).norm();
-}
-
-int TetMesh::nearest_vertex(const Vec3& p) const {
-    int best = -1;
-    double d = std::numeric_limits<double>::infinity();
-    for (int v = 0; v < n_vertices(); ++v) {
-        const double dv = (vertices[static_cast<size_t>(v)] - p).squaredNorm();
-        if (dv < d) {
-            d = dv;
-            best = v;
-        }
-    }
-    return best;
+        if (f.tag == *id) f.shape = index;
 }
 
 TetEdges tet_edges(const TetMesh& m) {
     static constexpr int kLocal[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
     TetEdges out;
-    const size_t nt = m.tetrahedra.size();
+    const size_t nt = m.cells.size();
     out.tet_edges.resize(nt);
     std::unordered_map<std::uint64_t, int> index;
     index.reserve(2 * nt);
     for (size_t t = 0; t < nt; ++t)
         for (int e = 0; e < 6; ++e) {
-            int a = m.tetrahedra[t][static_cast<size_t>(kLocal[e][0])];
-            int b = m.tetrahedra[t][static_cast<size_t>(kLocal[e][1])];
+            int a = m.cells[t][static_cast<size_t>(kLocal[e][0])];
+            int b = m.cells[t][static_cast<size_t>(kLocal[e][1])];
             if (a > b) std::swap(a, b);
             const std::uint64_t key =
                 (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
@@ -199,8 +106,8 @@ TetEdges tet_edges(const TetMesh& m) {
 
 long long count_faces(const TetMesh& m) {
     std::vector<std::array<int, 3>> faces;
-    faces.reserve(4 * m.tetrahedra.size());
-    for (const auto& k : m.tetrahedra)
+    faces.reserve(4 * m.cells.size());
+    for (const auto& k : m.cells)
         for (int skip = 0; skip < 4; ++skip) {
             std::array<int, 3> f{};
             int n = 0;
@@ -251,7 +158,7 @@ TetMesh structured_box(Vec3 corner, Vec3 size, int nx, int ny, int nz) {
     auto id = [&](int i, int j, int k) { return (k * (ny + 1) + j) * (nx + 1) + i; };
     static constexpr int kPaths[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
                                          {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    m.tetrahedra.reserve(static_cast<size_t>(n_tets));
+    m.cells.reserve(static_cast<size_t>(n_tets));
     for (int k = 0; k < nz; ++k)
         for (int j = 0; j < ny; ++j)
             for (int i = 0; i < nx; ++i)
@@ -262,7 +169,7 @@ TetMesh structured_box(Vec3 corner, Vec3 size, int nx, int ny, int nz) {
                         ++c[static_cast<size_t>(path[s])];
                         tet[static_cast<size_t>(s + 1)] = id(c[0], c[1], c[2]);
                     }
-                    m.tetrahedra.push_back(tet);
+                    m.cells.push_back(tet);
                 }
     // Each side: the axis it is normal to, low or high, its tag.
     static constexpr const char* kNames[3][2] = {

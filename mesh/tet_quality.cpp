@@ -36,7 +36,7 @@ struct Names {
     std::string tet(int t) const { return name ? name(t) : "tetrahedron " + std::to_string(t); }
     /// "tetrahedron t (vertices a, b, c, d at (..), (..), (..), (..))".
     std::string tet_with_vertices(int t) const {
-        const auto& k = m.tetrahedra[static_cast<size_t>(t)];
+        const auto& k = m.cells[static_cast<size_t>(t)];
         return tet(t) + " (vertices " + std::to_string(k[0]) + ", " + std::to_string(k[1]) + ", " +
                std::to_string(k[2]) + ", " + std::to_string(k[3]) + " at " + point(k[0]) + ", " +
                point(k[1]) + ", " + point(k[2]) + ", " + point(k[3]) + ")";
@@ -60,15 +60,15 @@ double orient(const TetMesh& m, int a, int b, int c, int d) {
 }
 
 void check_indices(const TetMesh& m) {
-    MLC_CHECK(m.n_tetrahedra() > 0, "the mesh has no tetrahedra");
-    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.tetrahedra.size(),
+    MLC_CHECK(m.n_cells() > 0, "the mesh has no tetrahedra");
+    MLC_CHECK(m.attribute.empty() || m.attribute.size() == m.cells.size(),
               "the mesh has " << m.attribute.size() << " tetrahedron attributes for "
-                              << m.tetrahedra.size() << " tetrahedra; expected one each");
+                              << m.cells.size() << " tetrahedra; expected one each");
     for (const auto& v : m.vertices)
         MLC_CHECK(v.allFinite(), "a mesh vertex is not finite");
     const int nv = m.n_vertices();
-    for (int t = 0; t < m.n_tetrahedra(); ++t)
-        for (int v : m.tetrahedra[static_cast<size_t>(t)])
+    for (int t = 0; t < m.n_cells(); ++t)
+        for (int v : m.cells[static_cast<size_t>(t)])
             MLC_CHECK(v >= 0 && v < nv, "tetrahedron " << t << " refers to vertex " << v
                                                        << " but the mesh has " << nv
                                                        << " vertices");
@@ -77,16 +77,15 @@ void check_indices(const TetMesh& m) {
             MLC_CHECK(v >= 0 && v < nv, "a boundary face tagged '"
                                             << m.tag_name(f.tag) << "' refers to vertex " << v
                                             << " but the mesh has " << nv << " vertices");
-        MLC_CHECK(f.surface >= -1 && f.surface < static_cast<int>(m.surfaces.size()),
+        MLC_CHECK(f.shape >= -1 && f.shape < static_cast<int>(m.shapes.size()),
                   "a boundary face tagged '" << m.tag_name(f.tag) << "' refers to curved surface "
-                                             << f.surface << " but the mesh has "
-                                             << m.surfaces.size());
+                                             << f.shape << " but the mesh has " << m.shapes.size());
     }
 }
 
 void check_flat(const TetMesh& m, const Names& names) {
-    for (int t = 0; t < m.n_tetrahedra(); ++t) {
-        const auto& k = m.tetrahedra[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& k = m.cells[static_cast<size_t>(t)];
         double longest = 0;
         for (int i = 0; i < 4; ++i)
             for (int j = i + 1; j < 4; ++j)
@@ -106,9 +105,9 @@ void check_flat(const TetMesh& m, const Names& names) {
 }
 
 void check_duplicates(const TetMesh& m, const Names& names) {
-    std::vector<std::pair<std::array<int, 4>, int>> sorted(m.tetrahedra.size());
-    for (size_t t = 0; t < m.tetrahedra.size(); ++t) {
-        sorted[t] = {m.tetrahedra[t], static_cast<int>(t)};
+    std::vector<std::pair<std::array<int, 4>, int>> sorted(m.cells.size());
+    for (size_t t = 0; t < m.cells.size(); ++t) {
+        sorted[t] = {m.cells[t], static_cast<int>(t)};
         std::sort(sorted[t].first.begin(), sorted[t].first.end());
     }
     std::sort(sorted.begin(), sorted.end());
@@ -122,9 +121,9 @@ void check_duplicates(const TetMesh& m, const Names& names) {
 
 std::vector<FaceRecord> face_records(const TetMesh& m) {
     std::vector<FaceRecord> faces;
-    faces.reserve(4 * m.tetrahedra.size());
-    for (int t = 0; t < m.n_tetrahedra(); ++t) {
-        const auto& k = m.tetrahedra[static_cast<size_t>(t)];
+    faces.reserve(4 * m.cells.size());
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& k = m.cells[static_cast<size_t>(t)];
         for (int skip = 0; skip < 4; ++skip) {
             FaceRecord r{{}, t, k[static_cast<size_t>(skip)]};
             int n = 0;

@@ -15,13 +15,13 @@ namespace mlc::mesh {
 
 namespace {
 
-/// Splits the boundary faces of `coarse` into fine (whose vertices are in place) and moves the
-/// midpoints of edges of curved faces onto their surfaces. Returns for each new vertex the
-/// coarse boundary face whose surface moved it, or -1.
+/// Splits the boundary faces and the lines of `coarse` into fine (whose vertices are in place)
+/// and moves the midpoints of edges of curved faces onto their surfaces. Returns for each new
+/// vertex the coarse boundary face whose surface moved it, or -1.
 std::vector<int> refine_boundary(const TetMesh& coarse, const TetEdges& edges, TetMesh& fine) {
     const int n0 = coarse.n_vertices();
     std::vector<int> moved(edges.edges.size(), -1);
-    if (coarse.boundary.empty()) return moved;
+    if (coarse.boundary.empty() && coarse.lines.empty()) return moved;
     std::unordered_map<std::uint64_t, int> midpoint;
     midpoint.reserve(edges.edges.size());
     for (size_t e = 0; e < edges.edges.size(); ++e)
@@ -30,9 +30,16 @@ std::vector<int> refine_boundary(const TetMesh& coarse, const TetEdges& edges, T
     auto mid = [&](int a, int b) {
         const auto it = midpoint.find(detail::edge_key(a, b));
         MLC_CHECK(it != midpoint.end(),
-                  "boundary face edge (" << a << ", " << b << ") is not an edge of a tetrahedron");
+                  "the edge (" << a << ", " << b
+                               << ") of a boundary face or line is not an edge of a tetrahedron");
         return it->second;
     };
+    fine.lines.reserve(2 * coarse.lines.size());
+    for (const BoundaryEdge& l : coarse.lines) { // tagged edges: both halves keep the tag
+        const int m = mid(l.v0, l.v1);
+        fine.lines.push_back({l.v0, m, l.tag, -1});
+        fine.lines.push_back({m, l.v1, l.tag, -1});
+    }
     fine.boundary.reserve(4 * coarse.boundary.size());
     for (size_t b = 0; b < coarse.boundary.size(); ++b) {
         const BoundaryFace& f = coarse.boundary[b];
@@ -43,9 +50,9 @@ std::vector<int> refine_boundary(const TetMesh& coarse, const TetEdges& edges, T
                 {{p[static_cast<size_t>(child[0])], p[static_cast<size_t>(child[1])],
                   p[static_cast<size_t>(child[2])]},
                  f.tag,
-                 f.surface});
-        if (f.surface < 0) continue;
-        const CurvedSurface& s = coarse.surfaces[static_cast<size_t>(f.surface)];
+                 f.shape});
+        if (f.shape < 0) continue;
+        const CurvedSurface& s = coarse.shapes[static_cast<size_t>(f.shape)];
         for (int k = 3; k < 6; ++k) {
             const int v = p[static_cast<size_t>(k)];
             if (moved[static_cast<size_t>(v - n0)] >= 0) continue;
@@ -66,22 +73,22 @@ std::vector<int> refine_boundary(const TetMesh& coarse, const TetEdges& edges, T
 void check_moved(const TetMesh& coarse, const TetEdges& edges, const std::vector<int>& moved,
                  const TetMesh& fine) {
     const int n0 = coarse.n_vertices();
-    for (int t = 0; t < coarse.n_tetrahedra(); ++t) {
+    for (int t = 0; t < coarse.n_cells(); ++t) {
         const auto& te = edges.tet_edges[static_cast<size_t>(t)];
         if (std::none_of(te.begin(), te.end(),
                          [&](int e) { return moved[static_cast<size_t>(e)] >= 0; }))
             continue;
-        const double parent = coarse.signed_volume(t);
+        const double parent = coarse.signed_measure(t);
         for (int k = 0; k < kTetrahedronChildren; ++k) {
             const int c = kTetrahedronChildren * t + k;
-            const auto& kv = fine.tetrahedra[static_cast<size_t>(c)];
+            const auto& kv = fine.cells[static_cast<size_t>(c)];
             double longest = 0;
             for (int i = 0; i < 4; ++i)
                 for (int j = i + 1; j < 4; ++j)
                     longest = std::max(longest, (fine.vertices[static_cast<size_t>(kv[i])] -
                                                  fine.vertices[static_cast<size_t>(kv[j])])
                                                     .norm());
-            const double v = fine.signed_volume(c);
+            const double v = fine.signed_measure(c);
             const double expected = (parent > 0) == (k == 5 || k == 7) ? -1.0 : 1.0;
             if (6 * v * expected > kFlatTetrahedronTol * longest * longest * longest) continue;
             int w = -1; // a moved vertex of the child
@@ -90,17 +97,16 @@ void check_moved(const TetMesh& coarse, const TetEdges& edges, const std::vector
             const BoundaryFace& f = coarse.boundary[static_cast<size_t>(
                 moved[static_cast<size_t>(w < 0 ? te[0] : w - n0)])];
             const Vec3& p = fine.vertices[static_cast<size_t>(w < 0 ? kv[0] : w)];
-            MLC_CHECK(false, "moving vertex "
-                                 << w << " to (" << p.x() << ", " << p.y() << ", " << p.z()
-                                 << ") on the "
-                                 << coarse.surfaces[static_cast<size_t>(f.surface)].describe()
-                                 << " of tag '" << coarse.tag_name(f.tag)
-                                 << "' inverts tetrahedron " << c << " (child " << k
-                                 << " of coarse tetrahedron " << t << "): its volume becomes " << v
-                                 << "; expected " << (expected > 0 ? "positive" : "negative")
-                                 << " as Bey's rule orders it: the coarse faces are too large "
-                                    "for the curvature there; refine the start mesh near the "
-                                    "curved boundary");
+            MLC_CHECK(false,
+                      "moving vertex "
+                          << w << " to (" << p.x() << ", " << p.y() << ", " << p.z() << ") on the "
+                          << coarse.shapes[static_cast<size_t>(f.shape)].describe() << " of tag '"
+                          << coarse.tag_name(f.tag) << "' inverts tetrahedron " << c << " (child "
+                          << k << " of coarse tetrahedron " << t << "): its volume becomes " << v
+                          << "; expected " << (expected > 0 ? "positive" : "negative")
+                          << " as Bey's rule orders it: the coarse faces are too large "
+                             "for the curvature there; refine the start mesh near the "
+                             "curved boundary");
         }
     }
 }
@@ -111,9 +117,9 @@ TetMesh refine(const TetMesh& coarse) {
     const TetEdges edges = tet_edges(coarse);
     const std::int64_t nv =
         std::int64_t{coarse.n_vertices()} + static_cast<std::int64_t>(edges.edges.size());
-    const std::int64_t nt = 8 * std::int64_t{coarse.n_tetrahedra()};
+    const std::int64_t nt = 8 * std::int64_t{coarse.n_cells()};
     MLC_CHECK(std::max(nv, nt) <= std::numeric_limits<int>::max(),
-              "refining a mesh of " << coarse.n_tetrahedra() << " tetrahedra gives " << nv
+              "refining a mesh of " << coarse.n_cells() << " tetrahedra gives " << nv
                                     << " vertices and " << nt
                                     << " tetrahedra, more than an int index can address; use "
                                        "fewer levels");
@@ -127,15 +133,15 @@ TetMesh refine(const TetMesh& coarse) {
         fine.vertices.push_back(0.5 * (coarse.vertices[static_cast<size_t>(e[0])] +
                                        coarse.vertices[static_cast<size_t>(e[1])]));
     const int n0 = coarse.n_vertices();
-    fine.tetrahedra.reserve(static_cast<size_t>(nt));
-    for (size_t t = 0; t < coarse.tetrahedra.size(); ++t) {
+    fine.cells.reserve(static_cast<size_t>(nt));
+    for (size_t t = 0; t < coarse.cells.size(); ++t) {
         std::array<int, 10> p{};
         for (int i = 0; i < 4; ++i)
-            p[static_cast<size_t>(i)] = coarse.tetrahedra[t][static_cast<size_t>(i)];
+            p[static_cast<size_t>(i)] = coarse.cells[t][static_cast<size_t>(i)];
         for (int e = 0; e < 6; ++e)
             p[static_cast<size_t>(4 + e)] = n0 + edges.tet_edges[t][static_cast<size_t>(e)];
         for (const auto& child : kBeyChildren)
-            fine.tetrahedra.push_back(
+            fine.cells.push_back(
                 {p[static_cast<size_t>(child[0])], p[static_cast<size_t>(child[1])],
                  p[static_cast<size_t>(child[2])], p[static_cast<size_t>(child[3])]});
     }
@@ -145,7 +151,7 @@ TetMesh refine(const TetMesh& coarse) {
             for (int c = 0; c < kTetrahedronChildren; ++c)
                 fine.attribute.push_back(a);
     }
-    fine.surfaces = coarse.surfaces;
+    fine.shapes = coarse.shapes;
     const std::vector<int> moved = refine_boundary(coarse, edges, fine);
     if (std::any_of(moved.begin(), moved.end(), [](int f) { return f >= 0; }))
         check_moved(coarse, edges, moved, fine);
@@ -158,7 +164,7 @@ std::vector<TetLevelSize> predict_tet_level_sizes(const TetMesh& level0, int lev
     s.vertices = level0.n_vertices();
     s.edges = static_cast<double>(tet_edges(level0).edges.size());
     s.faces = static_cast<double>(count_faces(level0));
-    s.tetrahedra = level0.n_tetrahedra();
+    s.tetrahedra = level0.n_cells();
     s.boundary_faces = 2 * s.faces - 4 * s.tetrahedra; // 4 T = 2 F_interior + F_boundary
     s.tagged_faces = static_cast<double>(level0.boundary.size());
     const bool attributes = !level0.attribute.empty();

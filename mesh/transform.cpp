@@ -34,23 +34,23 @@ Mesh mirror_about_x(const Mesh& h, double x0) {
     }
     MLC_CHECK(on_line, "mirror_x = " << x0 << ": no boundary vertex lies on the mirror line; the "
                                      << "half domain must have an edge on it");
-    for (const auto& t : h.triangles)
-        m.triangles.push_back({image[static_cast<size_t>(t[0])], image[static_cast<size_t>(t[2])],
-                               image[static_cast<size_t>(t[1])]});
+    for (const auto& t : h.cells)
+        m.cells.push_back({image[static_cast<size_t>(t[0])], image[static_cast<size_t>(t[2])],
+                           image[static_cast<size_t>(t[1])]});
     if (!h.attribute.empty())
         m.attribute.insert(m.attribute.end(), h.attribute.begin(), h.attribute.end());
-    const int coff = static_cast<int>(h.circles.size());
-    for (const auto& c : h.circles)
-        m.circles.push_back({Vec2(2.0 * x0 - c.center.x(), c.center.y()), c.radius});
+    const int coff = static_cast<int>(h.shapes.size());
+    for (const auto& c : h.shapes)
+        m.shapes.push_back({Vec2(2.0 * x0 - c.center.x(), c.center.y()), c.radius});
     auto on = [&](int v) { return image[static_cast<size_t>(v)] == v; };
     for (const auto& e : h.boundary) {
-        if (e.curve < 0 && on(e.v0) && on(e.v1)) { // on the mirror line: now an interior line
+        if (e.shape < 0 && on(e.v0) && on(e.v1)) { // on the mirror line: now an interior line
             m.lines.push_back({e.v0, e.v1, e.tag, -1});
             continue;
         }
         m.boundary.push_back(e);
         m.boundary.push_back({image[static_cast<size_t>(e.v1)], image[static_cast<size_t>(e.v0)],
-                              e.tag, e.curve >= 0 ? e.curve + coff : -1});
+                              e.tag, e.shape >= 0 ? e.shape + coff : -1});
     }
     for (const auto& e : h.lines) {
         m.lines.push_back(e);
@@ -96,21 +96,21 @@ bool RigidMotion::keeps_axes() const {
 void transform_mesh(Mesh& m, const RigidMotion& motion) {
     for (auto& v : m.vertices)
         v = motion.apply(v);
-    for (auto& c : m.circles)
+    for (auto& c : m.shapes)
         c.center = motion.apply(c.center);
 }
 
 void merge_into(Mesh& all, const Mesh& b, int body) {
     const int voff = all.n_vertices();
-    const int coff = static_cast<int>(all.circles.size());
+    const int coff = static_cast<int>(all.shapes.size());
     all.vertices.insert(all.vertices.end(), b.vertices.begin(), b.vertices.end());
-    all.circles.insert(all.circles.end(), b.circles.begin(), b.circles.end());
-    for (const auto& t : b.triangles)
-        all.triangles.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
-    all.attribute.resize(all.triangles.size(), body);
+    all.shapes.insert(all.shapes.end(), b.shapes.begin(), b.shapes.end());
+    for (const auto& t : b.cells)
+        all.cells.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
+    all.attribute.resize(all.cells.size(), body);
     for (const auto& e : b.boundary)
         all.boundary.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)),
-                                e.curve >= 0 ? e.curve + coff : -1});
+                                e.shape >= 0 ? e.shape + coff : -1});
     for (const auto& e : b.lines)
         all.lines.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)), -1});
 }

@@ -18,11 +18,11 @@ using Neighbours = std::vector<std::array<int, 3>>;
 /// The neighbour across local edge e (opposite local vertex e) of every triangle, -1 on the
 /// boundary; nothing when an edge has more than two triangles (no refinement of ours).
 std::optional<Neighbours> neighbours(const Mesh& f, const VertexTriangles& vtri) {
-    const int nt = f.n_triangles();
+    const int nt = f.n_cells();
     Neighbours nb(static_cast<size_t>(nt), {-1, -1, -1});
     for (int t = 0; t < nt; ++t)
         for (int e = 0; e < 3; ++e) {
-            const auto& tri = f.triangles[static_cast<size_t>(t)];
+            const auto& tri = f.cells[static_cast<size_t>(t)];
             const auto on = vtri.on_edge(f, tri[(e + 1) % 3], tri[(e + 2) % 3]);
             if (on.count > 2) return std::nullopt; // a third triangle on an edge
             if (on.count == 2)
@@ -40,12 +40,12 @@ std::optional<Neighbours> neighbours(const Mesh& f, const VertexTriangles& vtri)
 class ChildLabels {
 public:
     ChildLabels(const Mesh& f, const Neighbours& nb)
-        : f_(f), nb_(nb), label_(static_cast<size_t>(f.n_triangles()), -2) {}
+        : f_(f), nb_(nb), label_(static_cast<size_t>(f.n_cells()), -2) {}
 
     /// Labels every connected component, trying the four roles of its first triangle; false if
     /// none fits the rules.
     bool label_all() {
-        for (int t0 = 0; t0 < f_.n_triangles(); ++t0) {
+        for (int t0 = 0; t0 < f_.n_cells(); ++t0) {
             if (label_[static_cast<size_t>(t0)] != -2) continue;
             bool ok = false;
             for (int guess : {-1, 0, 1, 2}) {
@@ -64,7 +64,7 @@ public:
 
 private:
     int local(int t, int v) const {
-        const auto& tri = f_.triangles[static_cast<size_t>(t)];
+        const auto& tri = f_.cells[static_cast<size_t>(t)];
         for (int i = 0; i < 3; ++i)
             if (tri[i] == v) return i;
         return -1;
@@ -89,14 +89,14 @@ private:
             const int t = stack_.back();
             stack_.pop_back();
             const int l = label_[static_cast<size_t>(t)];
-            const auto& tri = f_.triangles[static_cast<size_t>(t)];
+            const auto& tri = f_.cells[static_cast<size_t>(t)];
             for (int e = 0; e < 3; ++e) {
                 const int n = nb_[static_cast<size_t>(t)][static_cast<size_t>(e)];
                 if (l == -1 || e == l) { // a middle child's edge, or a corner's edge off its vertex
                     if (n < 0) return false;
                     if (l == -1) {
                         // n's vertex off the shared edge (tri[e+1], tri[e+2]) is coarse
-                        const auto& tn = f_.triangles[static_cast<size_t>(n)];
+                        const auto& tn = f_.cells[static_cast<size_t>(n)];
                         int off = -1;
                         for (int i = 0; i < 3; ++i)
                             if (tn[i] != tri[(e + 1) % 3] && tn[i] != tri[(e + 2) % 3]) off = i;
@@ -123,14 +123,14 @@ private:
 /// in c, or -1. Nothing if a triangle holds another number of them than its label says.
 std::optional<std::vector<int>> coarse_vertices(const Mesh& f, const std::vector<int>& label,
                                                 Mesh& c) {
-    const int nt = f.n_triangles(), nv = f.n_vertices();
+    const int nt = f.n_cells(), nv = f.n_vertices();
     std::vector<int> coarse_of(static_cast<size_t>(nv), -1);
     for (int t = 0; t < nt; ++t)
         if (const int l = label[static_cast<size_t>(t)]; l >= 0)
-            coarse_of[static_cast<size_t>(f.triangles[static_cast<size_t>(t)][l])] = 0;
+            coarse_of[static_cast<size_t>(f.cells[static_cast<size_t>(t)][l])] = 0;
     for (int t = 0; t < nt; ++t) {
         int n_coarse = 0;
-        for (int v : f.triangles[static_cast<size_t>(t)])
+        for (int v : f.cells[static_cast<size_t>(t)])
             n_coarse += coarse_of[static_cast<size_t>(v)] == 0;
         if (n_coarse != (label[static_cast<size_t>(t)] >= 0 ? 1 : 0)) return std::nullopt;
     }
@@ -148,7 +148,7 @@ std::optional<std::vector<int>> coarse_vertices(const Mesh& f, const std::vector
 bool coarse_triangles(const Mesh& f, const Neighbours& nb, const std::vector<int>& label,
                       const std::vector<int>& coarse_of, Mesh& c,
                       std::vector<std::array<int, 2>>& edge_of) {
-    const int nt = f.n_triangles(), nv = f.n_vertices();
+    const int nt = f.n_cells(), nv = f.n_vertices();
     std::vector<char> grouped(static_cast<size_t>(nt), 0);
     edge_of.assign(static_cast<size_t>(nv), {-1, -1});
     auto set_mid = [&](int m, int a, int b) {
@@ -159,22 +159,22 @@ bool coarse_triangles(const Mesh& f, const Neighbours& nb, const std::vector<int
     };
     for (int t = 0; t < nt; ++t) {
         if (label[static_cast<size_t>(t)] != -1) continue;
-        const auto& mid = f.triangles[static_cast<size_t>(t)];
+        const auto& mid = f.cells[static_cast<size_t>(t)];
         std::array<int, 3> p{};
         for (int e = 0; e < 3; ++e) {
             const int n = nb[static_cast<size_t>(t)][static_cast<size_t>(e)];
             if (grouped[static_cast<size_t>(n)]) return false;
             grouped[static_cast<size_t>(n)] = 1;
             p[static_cast<size_t>(e)] =
-                f.triangles[static_cast<size_t>(n)][label[static_cast<size_t>(n)]];
+                f.cells[static_cast<size_t>(n)][label[static_cast<size_t>(n)]];
         }
         grouped[static_cast<size_t>(t)] = 1;
         // mid = (ab, bc, ca): across (bc, ca) lies c = p[0], across (ca, ab) a = p[1], b = p[2].
         const int a = p[1], b = p[2], cc = p[0];
         if (!set_mid(mid[0], a, b) || !set_mid(mid[1], b, cc) || !set_mid(mid[2], cc, a))
             return false;
-        c.triangles.push_back({coarse_of[static_cast<size_t>(a)], coarse_of[static_cast<size_t>(b)],
-                               coarse_of[static_cast<size_t>(cc)]});
+        c.cells.push_back({coarse_of[static_cast<size_t>(a)], coarse_of[static_cast<size_t>(b)],
+                           coarse_of[static_cast<size_t>(cc)]});
         if (!f.attribute.empty()) {
             const int at = f.attribute[static_cast<size_t>(t)];
             for (int e = 0; e < 3; ++e)
@@ -183,7 +183,7 @@ bool coarse_triangles(const Mesh& f, const Neighbours& nb, const std::vector<int
             c.attribute.push_back(at);
         }
     }
-    return 4 * c.n_triangles() == nt;
+    return 4 * c.n_cells() == nt;
 }
 
 /// Boundary edges or lines: the two halves (a, m), (m, b) of each coarse edge, same tag and
@@ -207,7 +207,7 @@ bool join_halves(const std::vector<BoundaryEdge>& halves, std::vector<BoundaryEd
             continue;
         }
         const BoundaryEdge& g = halves[static_cast<size_t>(other)];
-        if (g.tag != e.tag || g.curve != e.curve) return false;
+        if (g.tag != e.tag || g.shape != e.shape) return false;
         const int ga = g.v0 == m ? g.v1 : g.v0, ea = c0 ? e.v0 : e.v1;
         const auto& pair = edge_of[static_cast<size_t>(m)];
         if (std::array<int, 2>{std::min(ga, ea), std::max(ga, ea)} != pair) return false;
@@ -224,7 +224,7 @@ bool join_halves(const std::vector<BoundaryEdge>& halves, std::vector<BoundaryEd
             }
         }
         out.push_back(
-            {coarse_of[static_cast<size_t>(a)], coarse_of[static_cast<size_t>(b)], e.tag, e.curve});
+            {coarse_of[static_cast<size_t>(a)], coarse_of[static_cast<size_t>(b)], e.tag, e.shape});
         other = -2;
     }
     for (size_t v = 0; v < nv; ++v)
@@ -237,14 +237,14 @@ bool join_halves(const std::vector<BoundaryEdge>& halves, std::vector<BoundaryEd
 bool refines_to(const Mesh& c, const Mesh& f, const VertexTriangles& vtri,
                 const std::vector<int>& coarse_of, const std::vector<std::array<int, 2>>& edge_of,
                 double tol) {
-    const int nt = f.n_triangles(), nv = f.n_vertices(), nc = c.n_vertices();
+    const int nt = f.n_cells(), nv = f.n_vertices(), nc = c.n_vertices();
     Mesh r;
     try {
         r = refine(c);
     } catch (const InvalidInput&) {
         return false; // e.g. an arc whose chord's midpoint is its centre
     }
-    if (r.n_vertices() != nv || r.n_triangles() != nt || r.boundary.size() != f.boundary.size() ||
+    if (r.n_vertices() != nv || r.n_cells() != nt || r.boundary.size() != f.boundary.size() ||
         r.lines.size() != f.lines.size())
         return false;
     std::vector<int> to_f(static_cast<size_t>(nv), -1); // r's vertex -> f's
@@ -283,13 +283,13 @@ bool refines_to(const Mesh& c, const Mesh& f, const VertexTriangles& vtri,
             (r.vertices[static_cast<size_t>(v)] - f.vertices[static_cast<size_t>(w)]).norm() > tol)
             return false;
     }
-    for (const auto& t : r.triangles) {
+    for (const auto& t : r.cells) {
         const int x = to_f[static_cast<size_t>(t[0])], y = to_f[static_cast<size_t>(t[1])],
                   z = to_f[static_cast<size_t>(t[2])];
         bool found = false; // a triangle of f on the edge (x, y) holds z (f's edges hold <= 2)
         for (const int u : vtri.on_edge(f, x, y).first) {
             if (u < 0) continue;
-            const auto& tu = f.triangles[static_cast<size_t>(u)];
+            const auto& tu = f.cells[static_cast<size_t>(u)];
             found = found || tu[0] == z || tu[1] == z || tu[2] == z;
         }
         if (!found) return false;
@@ -300,7 +300,7 @@ bool refines_to(const Mesh& c, const Mesh& f, const VertexTriangles& vtri,
 } // namespace
 
 std::optional<Mesh> unrefine(const Mesh& f, double tol) {
-    const int nt = f.n_triangles();
+    const int nt = f.n_cells();
     if (nt < 4 || nt % 4 != 0) return std::nullopt;
     const VertexTriangles vtri = vertex_triangles(f);
     const std::optional<Neighbours> nb = neighbours(f, vtri);
@@ -308,7 +308,7 @@ std::optional<Mesh> unrefine(const Mesh& f, double tol) {
     ChildLabels labels(f, *nb);
     if (!labels.label_all()) return std::nullopt;
     Mesh c;
-    c.circles = f.circles;
+    c.shapes = f.shapes;
     c.tag_names = f.tag_names;
     const std::optional<std::vector<int>> coarse_of = coarse_vertices(f, labels.labels(), c);
     if (!coarse_of) return std::nullopt;

@@ -57,7 +57,7 @@ py::list level_reports(const Result& r) {
         d["unknowns"] = static_cast<long>(L.n_unknowns());
         d["contact_nodes"] = L.n_contact_nodes();
         d["vertices"] = L.mesh.n_vertices();
-        d["triangles"] = L.mesh.n_triangles();
+        d["triangles"] = L.mesh.n_cells();
         py::list steps;
         for (const auto& st : r.run.level_steps[l]) {
             py::dict s = step_dict(st.report);

@@ -40,7 +40,7 @@ void bind_result_solution(ResultClass& cls) {
         .def_property_readonly(
             "triangles",
             [](py::object self) {
-                const auto& t = self.cast<const Result&>().run.finest().mesh.triangles;
+                const auto& t = self.cast<const Result&>().run.finest().mesh.cells;
                 return view<int>(self, t.empty() ? nullptr : t[0].data(),
                                  {static_cast<py::ssize_t>(t.size()), 3},
                                  {sizeof(t[0]), sizeof(int)});

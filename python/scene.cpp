@@ -80,7 +80,7 @@ void bind_scene_sources(SceneClass& cls) {
             "n_vertices", [](const Scene& s) { return s.problem.mesh0.n_vertices(); },
             "vertices of the level-0 mesh")
         .def_property_readonly(
-            "n_triangles", [](const Scene& s) { return s.problem.mesh0.n_triangles(); },
+            "n_triangles", [](const Scene& s) { return s.problem.mesh0.n_cells(); },
             "triangles of the level-0 mesh")
         .def_property_readonly(
             "recovered_levels", [](const Scene& s) { return s.problem.recovered_levels; },
@@ -223,7 +223,7 @@ void bind_scene_parts(SceneClass& cls) {
                             }
                     return l;
                 }();
-                d["circles"] = static_cast<int>(s.problem.mesh0.circles.size());
+                d["circles"] = static_cast<int>(s.problem.mesh0.shapes.size());
                 return d;
             },
             "the level-0 mesh's tags: boundary_tags, line_tags (tagged interior lines: mirror "

@@ -55,14 +55,14 @@ std::shared_ptr<TetMesh> from_arrays(
     for (py::ssize_t i = 0; i < points.shape(0); ++i)
         m->vertices.emplace_back(points.at(i, 0), points.at(i, 1), points.at(i, 2));
     for (py::ssize_t t = 0; t < tets.shape(0); ++t)
-        m->tetrahedra.push_back({tets.at(t, 0), tets.at(t, 1), tets.at(t, 2), tets.at(t, 3)});
+        m->cells.push_back({tets.at(t, 0), tets.at(t, 1), tets.at(t, 2), tets.at(t, 3)});
     if (attributes) {
         if (attributes->ndim() != 1 || attributes->shape(0) != tets.shape(0))
             throw InvalidInput("TetMesh: attributes must have shape (m,), one per tetrahedron");
         m->attribute.assign(attributes->data(), attributes->data() + attributes->size());
     }
-    for (std::size_t t = 0; t < m->tetrahedra.size(); ++t)
-        for (int v : m->tetrahedra[t])
+    for (std::size_t t = 0; t < m->cells.size(); ++t)
+        for (int v : m->cells[t])
             if (v < 0 || v >= m->n_vertices())
                 throw InvalidInput("TetMesh: tetrahedron " + std::to_string(t) +
                                    " refers to vertex " + std::to_string(v) + " but there are " +
@@ -151,7 +151,7 @@ void bind_tet_arrays(TetMeshClass& cls) {
         .def_property_readonly(
             "tetrahedra",
             [](py::object self) {
-                const auto& t = self.cast<const TetMesh&>().tetrahedra;
+                const auto& t = self.cast<const TetMesh&>().cells;
                 return view<int>(self, t.empty() ? nullptr : t[0].data(),
                                  {static_cast<py::ssize_t>(t.size()), 4},
                                  {sizeof(t[0]), sizeof(int)});
@@ -179,8 +179,7 @@ void bind_tet_arrays(TetMeshClass& cls) {
         .def_property_readonly(
             "attributes",
             [](const TetMesh& m) {
-                if (m.attribute.empty())
-                    return copy_array(std::vector<int>(m.tetrahedra.size(), 0));
+                if (m.attribute.empty()) return copy_array(std::vector<int>(m.cells.size(), 0));
                 return copy_array(m.attribute);
             },
             "(m,) body (Gmsh physical volume) of each tetrahedron, 0 when none is given (a copy)")
@@ -201,13 +200,13 @@ void bind_tet_arrays(TetMeshClass& cls) {
             "tag_names", [](const TetMesh& m) { return m.tag_names; },
             "dict boundary tag name -> tag id")
         .def_property_readonly("n_vertices", &TetMesh::n_vertices, "number of vertices")
-        .def_property_readonly("n_tetrahedra", &TetMesh::n_tetrahedra, "number of tetrahedra")
+        .def_property_readonly("n_tetrahedra", &TetMesh::n_cells, "number of tetrahedra")
         .def(
             "signed_volumes",
             [](const TetMesh& m) {
-                std::vector<double> v(m.tetrahedra.size());
-                for (int t = 0; t < m.n_tetrahedra(); ++t)
-                    v[static_cast<size_t>(t)] = m.signed_volume(t);
+                std::vector<double> v(m.cells.size());
+                for (int t = 0; t < m.n_cells(); ++t)
+                    v[static_cast<size_t>(t)] = m.signed_measure(t);
                 return copy_array(v);
             },
             "(m,) signed volume of each tetrahedron (its sign: the vertex order's orientation)")
@@ -219,7 +218,7 @@ void bind_tet_arrays(TetMeshClass& cls) {
             py::arg("tag"), "sorted indices of the vertices on the boundary faces tagged `tag`")
         .def("__repr__", [](const TetMesh& m) {
             return "<mlcontact.TetMesh " + std::to_string(m.n_vertices()) + " vertices, " +
-                   std::to_string(m.n_tetrahedra()) + " tetrahedra, " +
+                   std::to_string(m.n_cells()) + " tetrahedra, " +
                    std::to_string(m.boundary.size()) + " tagged boundary faces>";
         });
 }

@@ -62,10 +62,9 @@ SolutionFields solution_fields(const levels::Level& L, const Vector& u_full,
         ln.values[v] = n.lambda_n;
     }
     mesh::Field stress{"stress", 3, stresses};
-    mesh::Field vm{"von_mises", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()))};
-    mesh::Field body{"body", 1,
-                     std::vector<double>(static_cast<size_t>(L.mesh.n_triangles()), 0.0)};
-    for (int t = 0; t < L.mesh.n_triangles(); ++t) {
+    mesh::Field vm{"von_mises", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_cells()))};
+    mesh::Field body{"body", 1, std::vector<double>(static_cast<size_t>(L.mesh.n_cells()), 0.0)};
+    for (int t = 0; t < L.mesh.n_cells(); ++t) {
         const double sx = stresses[static_cast<size_t>(3 * t)],
                      sy = stresses[static_cast<size_t>(3 * t + 1)],
                      sxy = stresses[static_cast<size_t>(3 * t + 2)];
@@ -361,7 +360,7 @@ void write_summary(const std::filesystem::path& dir, const levels::Problem& p,
         root.insert("displacement_unknowns", static_cast<int64_t>(L.dofs.n_displacement_dofs()));
         root.insert("contact_nodes", static_cast<int64_t>(L.n_contact_nodes()));
         root.insert("vertices", static_cast<int64_t>(L.mesh.n_vertices()));
-        root.insert("triangles", static_cast<int64_t>(L.mesh.n_triangles()));
+        root.insert("triangles", static_cast<int64_t>(L.mesh.n_cells()));
         root.insert("converged", r.converged);
         root.insert("stopped", status.stopped);
         if (status.stopped) root.insert("stopped_at", status.stopped_at);

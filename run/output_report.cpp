@@ -64,12 +64,11 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
     for (const auto& b : p.bodies)
         os << "body       " << b.name << ": " << b.material << "\n";
     os << "mesh       level " << r.levels().size() - 1 << ": " << L.mesh.n_vertices()
-       << " vertices, " << L.mesh.n_triangles() << " triangles (" << plane_name(p) << ")\n";
+       << " vertices, " << L.mesh.n_cells() << " triangles (" << plane_name(p) << ")\n";
     if (p.recovered_levels > 0)
         os << "           the Gmsh file's mesh is level " << p.recovered_levels
-           << ", a uniform refinement of a " << p.mesh0.n_triangles()
-           << "-triangle mesh: levels 0.." << p.recovered_levels
-           << " recovered ([scene].recover_levels)"
+           << ", a uniform refinement of a " << p.mesh0.n_cells() << "-triangle mesh: levels 0.."
+           << p.recovered_levels << " recovered ([scene].recover_levels)"
            << (p.levels < p.recovered_levels ? "; this run stops at a coarser level" : "") << "\n";
     os << "unknowns   " << L.n_unknowns() << " (" << L.dofs.n_displacement_dofs()
        << " displacement, " << L.n_unknowns() - L.dofs.n_displacement_dofs() << " multipliers), "

@@ -189,7 +189,7 @@ ProcessFigures process_figures(std::ostream& os, const levels::DistributedRunRes
         static_cast<double>(F.local.n_contact_nodes()),
         static_cast<double>(F.part.n_owned_vertices()),
         static_cast<double>(F.local.mesh.n_vertices() - F.part.n_owned_vertices()),
-        static_cast<double>(F.local.mesh.n_triangles()),
+        static_cast<double>(F.local.mesh.n_cells()),
         r.distributed_seconds,
         static_cast<double>(peak_rss_bytes()),
         static_cast<double>(cut_elements(F)),
@@ -480,7 +480,7 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     const int finest = p.levels;
     int plevel = opt.partition_level
                      ? *opt.partition_level
-                     : levels::partition_level(p.mesh0.n_triangles(), finest, comm.size());
+                     : levels::partition_level(p.mesh0.n_cells(), finest, comm.size());
     MLC_CHECK(plevel >= 0 && plevel < finest, "--partition-level must lie in [0, "
                                                   << finest - 1 << "] for --levels " << finest
                                                   << ", found " << plevel);

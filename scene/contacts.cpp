@@ -25,17 +25,17 @@ std::string obstacle_faces_away(const levels::Problem& p, const std::string& tag
         return m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
     };
     std::vector<int> vbody(static_cast<size_t>(m.n_vertices()), -1);
-    for (int t = 0; t < m.n_triangles(); ++t)
-        for (int v : m.triangles[static_cast<size_t>(t)])
+    for (int t = 0; t < m.n_cells(); ++t)
+        for (int v : m.cells[static_cast<size_t>(t)])
             vbody[static_cast<size_t>(v)] = body_of(t);
     std::set<int> bodies;
     for (int v : m.vertices_with_tag(*tid))
         bodies.insert(vbody[static_cast<size_t>(v)]);
     for (int b : bodies) {
         double total = 0.0, behind = 0.0;
-        for (int t = 0; t < m.n_triangles(); ++t) {
+        for (int t = 0; t < m.n_cells(); ++t) {
             if (body_of(t) != b) continue;
-            const auto& tri = m.triangles[static_cast<size_t>(t)];
+            const auto& tri = m.cells[static_cast<size_t>(t)];
             const Vec2 c =
                 (m.vertices[static_cast<size_t>(tri[0])] + m.vertices[static_cast<size_t>(tri[1])] +
                  m.vertices[static_cast<size_t>(tri[2])]) /
@@ -46,7 +46,7 @@ std::string obstacle_faces_away(const levels::Problem& p, const std::string& tag
             else
                 gap = o.body_outside ? (c - o.center).norm() - o.radius
                                      : o.radius - (c - o.center).norm();
-            const double a = std::abs(m.signed_area(t));
+            const double a = std::abs(m.signed_measure(t));
             total += a;
             if (gap < 0) behind += a;
         }

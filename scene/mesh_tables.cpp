@@ -101,10 +101,10 @@ void apply_arcs(const Reader& rd, const toml::table& t, const std::string& where
                 rd.fail(at.get("center"), os.str());
             }
         }
-        const int c = static_cast<int>(m.circles.size());
-        m.circles.push_back({center, radius});
+        const int c = static_cast<int>(m.shapes.size());
+        m.shapes.push_back({center, radius});
         for (auto& e : m.boundary)
-            if (e.tag == *id) e.curve = c;
+            if (e.tag == *id) e.shape = c;
     }
 }
 

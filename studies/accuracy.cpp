@@ -2,11 +2,11 @@
 // Accuracy study: closed-form quantities of hertz, mindlin and patch per level, observed orders.
 #include "studies/accuracy.hpp"
 
-#include "run/closed_form.hpp"
-#include "run/plot_script.hpp"
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
 #include "core/timer.hpp"
+#include "run/closed_form.hpp"
+#include "run/plot_script.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -66,8 +66,7 @@ template <class Pred> double zone_half_width(const SortedNodes& s, Pred in, cons
 double contactor_radius(const levels::Problem& p, const levels::Level& L) {
     const int tag = L.mesh.tag(p.contacts.front().contactor);
     for (const auto& e : L.mesh.boundary)
-        if (e.tag == tag && e.curve >= 0)
-            return L.mesh.circles[static_cast<size_t>(e.curve)].radius;
+        if (e.tag == tag && e.shape >= 0) return L.mesh.shapes[static_cast<size_t>(e.shape)].radius;
     MLC_CHECK(false, "the contactor boundary '" << p.contacts.front().contactor
                                                 << "' lies on no circle: no Hertz radius");
     return 0.0;

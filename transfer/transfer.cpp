@@ -2,6 +2,7 @@
 // Construction and application of the two-level interpolation P (displacements) and Q (contact
 // multipliers) of Alart & Lebon (1995), sect. 2.4 (docs/theory.md#theory-transfer).
 #include "transfer/transfer.hpp"
+#include "transfer/prolongation.hpp"
 
 #include "core/check.hpp"
 #include "core/first_touch.hpp"
@@ -127,52 +128,6 @@ void check_contacts_nest(int nc, const std::vector<int>& cnode, const std::vecto
                           << " multipliers on the coarse level and "
                           << fine_contacts.n_multipliers[static_cast<size_t>(j)]
                           << " on the fine one");
-    }
-}
-
-/// Nodal P: identity at coarse vertices, 1/2, 1/2 at edge midpoints, straight into CSR (each
-/// row's entries in column order; no triplets: they would take 16 bytes per entry and a sort).
-void build_nodal_prolongation(const mesh::Mesh& fine, LevelTransfer& tr) {
-    const int nf = fine.n_vertices();
-    const int nc = fine.n_coarse_vertices;
-    tr.P_vertex.resize(nf, nc);
-    tr.P_nodal.resize(2 * nf, 2 * nc);
-    tr.P_vertex.resizeNonZeros(nc + 2 * (nf - nc));
-    tr.P_nodal.resizeNonZeros(2 * (nc + 2 * (nf - nc)));
-    int* ov = tr.P_vertex.outerIndexPtr();
-    int* iv = tr.P_vertex.innerIndexPtr();
-    double* vv = tr.P_vertex.valuePtr();
-    int* on = tr.P_nodal.outerIndexPtr();
-    int* in = tr.P_nodal.innerIndexPtr();
-    double* vn = tr.P_nodal.valuePtr();
-    int kv = 0, kn = 0;
-    ov[0] = 0;
-    on[0] = 0;
-    for (int v = 0; v < nf; ++v) {
-        if (v < nc) {
-            iv[kv] = v;
-            vv[kv++] = 1.0;
-            for (int c = 0; c < 2; ++c) {
-                in[kn] = 2 * v + c;
-                vn[kn++] = 1.0;
-                on[2 * v + c + 1] = kn;
-            }
-        } else {
-            std::array<int, 2> pr = fine.parents[static_cast<size_t>(v - nc)];
-            if (pr[1] < pr[0]) std::swap(pr[0], pr[1]);
-            for (int p : pr) {
-                iv[kv] = p;
-                vv[kv++] = 0.5;
-            }
-            for (int c = 0; c < 2; ++c) {
-                for (int p : pr) {
-                    in[kn] = 2 * p + c;
-                    vn[kn++] = 0.5;
-                }
-                on[2 * v + c + 1] = kn;
-            }
-        }
-        ov[v + 1] = kv;
     }
 }
 
@@ -333,7 +288,8 @@ LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_d
     check_contacts_nest(nc, cnode, fnode, coarse_contacts, fine_contacts);
     LevelTransfer tr;
     tr.rule = rule;
-    build_nodal_prolongation(fine, tr);
+    tr.P_vertex = vertex_prolongation(fine);
+    tr.P_nodal = expand_components(tr.P_vertex, 2);
     const std::vector<Triplet> tq =
         multiplier_rows(fine, cnode, coarse_contacts, fine_contacts, rule);
     const Index n_f = fine_dofs.n_dofs(), n_c = coarse_dofs.n_dofs();

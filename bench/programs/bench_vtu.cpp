@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
         const auto size_ascii = std::filesystem::file_size(ascii);
         std::cout << "{\"scene\": \"" << p.name << "\", \"level\": " << level
                   << ", \"vertices\": " << L.mesh.n_vertices()
-                  << ", \"triangles\": " << L.mesh.n_triangles()
+                  << ", \"triangles\": " << L.mesh.n_cells()
                   << ", \"solve_seconds\": " << solve_seconds << ", \"repeat\": " << repeat
                   << ",\n \"binary_bytes\": " << size_bin << ", \"ascii_bytes\": " << size_ascii
                   << ", \"size_ratio_ascii_over_binary\": "

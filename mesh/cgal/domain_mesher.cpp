@@ -572,15 +572,15 @@ Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField
     }
     for (auto f = tr.finite_faces_begin(); f != tr.finite_faces_end(); ++f)
         if (f->is_in_domain())
-            out.triangles.push_back(
+            out.cells.push_back(
                 {f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id});
-    std::sort(out.triangles.begin(), out.triangles.end(),
+    std::sort(out.cells.begin(), out.cells.end(),
               [](const auto& s, const auto& t) { return s[0] + s[1] + s[2] < t[0] + t[1] + t[2]; });
 
     std::vector<int> tag_of(segs.size());
     for (std::size_t s = 0; s < segs.size(); ++s)
         tag_of[s] = out.add_tag(segs[s].tag);
-    out.circles = std::move(circles);
+    out.shapes = std::move(circles);
     std::unordered_map<std::uint64_t, bool> seen;
     for (const SubEdge& e : result.sub_edges) {
         FaceHandle f;
@@ -601,7 +601,7 @@ Mesh mesh_domain(const std::vector<std::vector<Segment>>& loops, const SizeField
         be.v0 = f->vertex(CDT::ccw(i))->info().id;
         be.v1 = f->vertex(CDT::cw(i))->info().id;
         be.tag = tag_of[e.seg];
-        be.curve = g.circle;
+        be.shape = g.circle;
         MLC_CHECK(!seen[detail::edge_key(be.v0, be.v1)],
                   "mesh_domain: internal error: boundary edge listed twice");
         seen[detail::edge_key(be.v0, be.v1)] = true;

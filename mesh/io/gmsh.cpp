@@ -569,7 +569,7 @@ Mesh build_triangles(const MshData& d, const Selection& s, const std::string& wh
                         << d.node_ids[d.node_begin[e]] << ", " << d.node_ids[d.node_begin[e] + 1]
                         << ", " << d.node_ids[d.node_begin[e] + 2] << ")");
         if (area2 < 0) std::swap(t[1], t[2]);
-        m.triangles.push_back(t);
+        m.cells.push_back(t);
     }
     if (std::any_of(s.tri_phys.begin(), s.tri_phys.end(), [](int p) { return p != 0; }))
         m.attribute = s.tri_phys;
@@ -590,7 +590,7 @@ void tag_lines(const MshData& d, const Selection& s, const NodeLookup& node,
         const int count = on.count;
         std::array<int, 2> dir{};
         if (count > 0) {
-            const auto& t = m.triangles[static_cast<std::size_t>(on.first[0])];
+            const auto& t = m.cells[static_cast<std::size_t>(on.first[0])];
             for (int i = 0; i < 3; ++i)
                 if ((t[i] == a && t[(i + 1) % 3] == b) || (t[i] == b && t[(i + 1) % 3] == a))
                     dir = {t[i], t[(i + 1) % 3]};
@@ -671,15 +671,14 @@ void write_gmsh(const Mesh& m, std::ostream& os) {
     for (int v = 0; v < m.n_vertices(); ++v)
         os << v + 1 << " " << m.vertices[static_cast<size_t>(v)].x() << " "
            << m.vertices[static_cast<size_t>(v)].y() << " 0\n";
-    os << "$EndNodes\n$Elements\n"
-       << m.boundary.size() + m.lines.size() + m.triangles.size() << "\n";
+    os << "$EndNodes\n$Elements\n" << m.boundary.size() + m.lines.size() + m.cells.size() << "\n";
     int id = 1;
     for (const auto* edges : {&m.boundary, &m.lines})
         for (const BoundaryEdge& e : *edges)
             os << id++ << " 1 2 " << e.tag + 1 << " " << e.tag + 1 << " " << e.v0 + 1 << " "
                << e.v1 + 1 << "\n";
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         const int phys = m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)] + 1;
         os << id++ << " 2 2 " << phys << " " << std::max(phys, 1) << " " << tri[0] + 1 << " "
            << tri[1] + 1 << " " << tri[2] + 1 << "\n";

@@ -83,8 +83,8 @@ void add_boundary_faces(TetMesh& m, const MshData& d, const std::vector<std::siz
                         const std::unordered_map<std::int64_t, int>& node_index) {
     // Every face of every tetrahedron: (sorted vertices, opposite vertex).
     std::vector<std::tuple<std::array<int, 3>, int>> faces;
-    faces.reserve(4 * m.tetrahedra.size());
-    for (const auto& k : m.tetrahedra)
+    faces.reserve(4 * m.cells.size());
+    for (const auto& k : m.cells)
         for (int skip = 0; skip < 4; ++skip) {
             std::array<int, 3> f{};
             int n = 0;
@@ -186,9 +186,9 @@ TetMesh read_gmsh_tet_text(const std::string& text, const std::filesystem::path&
         std::array<int, 4> t{};
         for (std::size_t k = 0; k < 4; ++k)
             t[k] = new_index[static_cast<size_t>(tets[i][k])];
-        m.tetrahedra.push_back(t);
+        m.cells.push_back(t);
         // A flat one is left to check_quality, which says so.
-        const double v = m.signed_volume(static_cast<int>(i));
+        const double v = m.signed_measure(static_cast<int>(i));
         const double longest = [&] {
             double l = 0;
             for (int a = 0; a < 4; ++a)

@@ -400,7 +400,7 @@ namespace {
 void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
                       const std::vector<Field>& point_fields,
                       const std::vector<Field>& cell_fields) {
-    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    const std::size_t nv = m.vertices.size(), nt = m.cells.size();
     detail::VtuGrid grid;
     grid.xyz.assign(3 * nv, 0.0);
     for (std::size_t v = 0; v < nv; ++v) {
@@ -411,7 +411,7 @@ void write_vtu_binary(const std::filesystem::path& file, const Mesh& m,
     grid.offsets.resize(nt);
     for (std::size_t t = 0; t < nt; ++t) {
         for (std::size_t k = 0; k < 3; ++k)
-            grid.connectivity[3 * t + k] = m.triangles[t][k];
+            grid.connectivity[3 * t + k] = m.cells[t][k];
         grid.offsets[t] = static_cast<std::int64_t>(3 * (t + 1));
     }
     grid.types.assign(nt, detail::kVtkTriangle);
@@ -427,13 +427,13 @@ const char* to_string(VtuFormat f) {
 void write_vtu(const std::filesystem::path& file, const Mesh& m,
                const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields,
                VtuFormat format) {
-    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    const std::size_t nv = m.vertices.size(), nt = m.cells.size();
     for (std::size_t v = 0; v < nv; ++v)
         MLC_CHECK(m.vertices[v].allFinite(),
                   "write_vtu: vertex " << v << " has a non-finite coordinate (" << m.vertices[v].x()
                                        << ", " << m.vertices[v].y() << "); nothing was written");
     for (std::size_t t = 0; t < nt; ++t)
-        for (int k : m.triangles[t])
+        for (int k : m.cells[t])
             MLC_CHECK(k >= 0 && static_cast<std::size_t>(k) < nv,
                       "write_vtu: triangle " << t << " refers to vertex " << k
                                              << " but the mesh has " << nv << " vertices");
@@ -469,7 +469,7 @@ void write_vtu(const std::filesystem::path& file, const Mesh& m,
                 "      </Points>\n"
                 "      <Cells>\n"
                 "        <DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n");
-        for (const auto& t : m.triangles) {
+        for (const auto& t : m.cells) {
             out.put_number(t[0]);
             out.put(' ');
             out.put_number(t[1]);

@@ -55,7 +55,7 @@ std::vector<Field> with_own_fields(std::vector<Field> own, const std::vector<Fie
 
 void write_vtu(const std::filesystem::path& file, const TetMesh& m,
                const std::vector<Field>& point_fields, const std::vector<Field>& cell_fields) {
-    const std::size_t nt = m.tetrahedra.size();
+    const std::size_t nt = m.cells.size();
     MLC_CHECK(m.attribute.empty() || m.attribute.size() == nt,
               "write_vtu: " << m.attribute.size() << " attributes for " << nt << " tetrahedra");
     detail::VtuGrid g;
@@ -64,8 +64,7 @@ void write_vtu(const std::filesystem::path& file, const TetMesh& m,
     g.offsets.reserve(nt);
     g.types.reserve(nt);
     for (std::size_t t = 0; t < nt; ++t)
-        add_cell(g, m.tetrahedra[t], detail::kVtkTetra, m.n_vertices(), "write_vtu", "tetrahedron",
-                 t);
+        add_cell(g, m.cells[t], detail::kVtkTetra, m.n_vertices(), "write_vtu", "tetrahedron", t);
     Field body{"body", 1, std::vector<double>(nt, 0.0)};
     for (std::size_t t = 0; t < m.attribute.size(); ++t)
         body.values[t] = m.attribute[t];
@@ -89,7 +88,7 @@ void write_boundary_vtu(const std::filesystem::path& file, const TetMesh& m,
         add_cell(g, m.boundary[f].v, detail::kVtkTriangle, m.n_vertices(), "write_boundary_vtu",
                  "boundary face", f);
         tag.values[f] = m.boundary[f].tag;
-        surface.values[f] = m.boundary[f].surface;
+        surface.values[f] = m.boundary[f].shape;
     }
     const std::vector<Field> cells =
         with_own_fields({std::move(tag), std::move(surface)}, cell_fields, "write_boundary_vtu");

@@ -27,7 +27,7 @@ TEST(Scene, BuiltinSquareParses) {
     ASSERT_EQ(p.contacts.size(), 1u);
     EXPECT_DOUBLE_EQ(p.contacts[0].mu, 1.0);
     EXPECT_DOUBLE_EQ(p.contacts[0].r, 1.3e4);
-    EXPECT_EQ(p.mesh0.n_triangles(), 512);
+    EXPECT_EQ(p.mesh0.n_cells(), 512);
 }
 
 TEST(Scene, UnknownKeyIsNamedWithItsLine) {

@@ -41,14 +41,14 @@ void write_msh(const mesh::Mesh& m, const std::filesystem::path& file) {
     for (int v = 0; v < m.n_vertices(); ++v)
         f << v + 1 << " " << m.vertices[static_cast<size_t>(v)].x() << " "
           << m.vertices[static_cast<size_t>(v)].y() << " 0\n";
-    const size_t n = m.boundary.size() + m.lines.size() + m.triangles.size();
+    const size_t n = m.boundary.size() + m.lines.size() + m.cells.size();
     f << "$EndNodes\n$Elements\n" << n << "\n";
     int id = 1;
     for (const auto* edges : {&m.boundary, &m.lines})
         for (const auto& e : *edges)
             f << id++ << " 1 2 " << e.tag + 1 << " " << e.tag + 1 << " " << e.v0 + 1 << " "
               << e.v1 + 1 << "\n";
-    for (const auto& t : m.triangles)
+    for (const auto& t : m.cells)
         f << id++ << " 2 2 1000 1 " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
     f << "$EndElements\n";
 }
@@ -92,9 +92,9 @@ NodalForces nodal_forces(const levels::Level& L, double s, const Vector& u,
 /// |sum x x f| / sum |x| |f| of the external forces F - C + Rs on its vertices.
 std::pair<double, double> body_balance(const levels::Level& L, const NodalForces& nf, int body) {
     std::vector<char> in(static_cast<size_t>(L.mesh.n_vertices()), 0);
-    for (int t = 0; t < L.mesh.n_triangles(); ++t)
+    for (int t = 0; t < L.mesh.n_cells(); ++t)
         if (L.mesh.attribute.empty() || L.mesh.attribute[static_cast<size_t>(t)] == body)
-            for (int v : L.mesh.triangles[static_cast<size_t>(t)])
+            for (int v : L.mesh.cells[static_cast<size_t>(t)])
                 in[static_cast<size_t>(v)] = 1;
     Vec2 sum = Vec2::Zero(), mag = Vec2::Zero();
     double moment = 0.0, moment_mag = 0.0;

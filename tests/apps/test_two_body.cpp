@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Two-body contact (node on node, node on facet) on the benchmark scenes patch, patch_matching,
 // mindlin and dovetail, the ring scene calumet, and the scene keys of two-body pairs.
-#include "run/output.hpp"
-#include "studies/accuracy.hpp"
 #include "core/check.hpp"
 #include "levels/checks.hpp"
 #include "levels/solve.hpp"
+#include "run/output.hpp"
 #include "scene/scene.hpp"
+#include "studies/accuracy.hpp"
 #include "tests/common/scene_text.hpp"
 
 #include <gtest/gtest.h>
@@ -27,8 +27,8 @@ using test::replace;
 /// Body of each vertex (attribute of a triangle using it).
 std::vector<int> vertex_body(const mesh::Mesh& m) {
     std::vector<int> b(static_cast<size_t>(m.n_vertices()), -1);
-    for (int t = 0; t < m.n_triangles(); ++t)
-        for (int v : m.triangles[static_cast<size_t>(t)])
+    for (int t = 0; t < m.n_cells(); ++t)
+        for (int v : m.cells[static_cast<size_t>(t)])
             b[static_cast<size_t>(v)] = m.attribute[static_cast<size_t>(t)];
     return b;
 }

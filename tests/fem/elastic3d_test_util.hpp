@@ -83,7 +83,7 @@ inline mesh::TetMesh perturbed_gmsh_box(int n, const std::string& version) {
         const int tag = f.tag + 1;
         s.triangles.push_back({tag, {f.v[0] + 1, f.v[1] + 1, f.v[2] + 1}});
     }
-    for (std::array<int, 4> k : box.tetrahedra) {
+    for (std::array<int, 4> k : box.cells) {
         const auto& x = s.nodes;
         const Vec3& a = x[static_cast<size_t>(k[0])];
         if ((x[static_cast<size_t>(k[1])] - a)

@@ -50,8 +50,8 @@ void expect_linear_field_reproduced(const mesh::TetMesh& m, const std::vector<in
     voigt << eps(0, 0), eps(1, 1), eps(2, 2), 2 * eps(0, 1), 2 * eps(1, 2), 2 * eps(0, 2);
     const Eigen::Matrix<double, 6, 1> sigma = fem::elasticity_matrix<3>(materials.back()) * voigt;
     const std::vector<double> s = fem::tetrahedron_stresses(m, materials, u);
-    ASSERT_EQ(s.size(), 6 * m.tetrahedra.size());
-    for (size_t t = 0; t < m.tetrahedra.size(); ++t)
+    ASSERT_EQ(s.size(), 6 * m.cells.size());
+    for (size_t t = 0; t < m.cells.size(); ++t)
         for (int k = 0; k < 6; ++k)
             ASSERT_NEAR(s[6 * t + static_cast<size_t>(k)], sigma[k], 1e-9 * sigma.norm()) << t;
 }
@@ -180,8 +180,8 @@ TEST(Elastic3dLoads, ResultantsOfPressureTractionAndBodyForce) {
     EXPECT_LE((on_zmin - t).norm(), 1e-14 * t.norm());
     // Body force: b times the volume, constant per attribute or as a function.
     double volume = 0;
-    for (int k = 0; k < m.n_tetrahedra(); ++k)
-        volume += std::abs(m.signed_volume(k));
+    for (int k = 0; k < m.n_cells(); ++k)
+        volume += std::abs(m.signed_measure(k));
     const Vec3 b(0.0, 0.0, -9.81);
     EXPECT_LE((resultant(fem::nodal_loads(m, {}, {b})) - volume * b).norm(), 1e-13 * b.norm());
     EXPECT_LE(
@@ -194,7 +194,7 @@ TEST(Elastic3dLoads, SharesOfOneFaceAndOneTetrahedron) {
     // resultant, each vertex a quarter of V b.
     mesh::TetMesh m;
     m.vertices = {{0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {0, 0, 1}};
-    m.tetrahedra = {{0, 1, 2, 3}};
+    m.cells = {{0, 1, 2, 3}};
     m.boundary = {{{0, 2, 1}, m.add_tag("bottom"), -1}}; // normal -z, area 3
     mesh::check_quality(m);
     const double p = 1.5;

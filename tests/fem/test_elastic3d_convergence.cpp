@@ -89,8 +89,8 @@ std::pair<double, double> errors(const mesh::TetMesh& m, const Vector& uh, const
     const double wg[4] = {0.1739274225687269, 0.3260725774312731, 0.3260725774312731,
                           0.1739274225687269};
     double energy = 0, l2 = 0;
-    for (int t = 0; t < m.n_tetrahedra(); ++t) {
-        const auto& tet = m.tetrahedra[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tet = m.cells[static_cast<size_t>(t)];
         fem::SimplexCorners<3> x;
         Eigen::Matrix<double, 3, 4> U;
         for (int i = 0; i < 4; ++i) {

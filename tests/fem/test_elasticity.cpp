@@ -150,7 +150,7 @@ TEST(Assembly, UniaxialTractionGivesTheClosedFormExtension) {
         EXPECT_NEAR(u[2 * v + 1], -mat.nu * p * x.y() / mat.E, 1e-13);
     }
     const auto s = fem::triangle_stresses(m, {mat}, u);
-    for (int t = 0; t < m.n_triangles(); ++t) {
+    for (int t = 0; t < m.n_cells(); ++t) {
         EXPECT_NEAR(s[static_cast<size_t>(3 * t)], p, 1e-11);
         EXPECT_NEAR(s[static_cast<size_t>(3 * t + 1)], 0.0, 1e-11);
     }
@@ -164,8 +164,8 @@ TEST(Assembly, RowsOverThreadsAreTheSerialElementLoopBitForBit) {
     mesh::Mesh m =
         mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 90, 60, mesh::Diagonal::alternate);
     ASSERT_GT(m.n_vertices(), 2 * 2048);
-    m.attribute.assign(static_cast<size_t>(m.n_triangles()), 0);
-    for (int t = 0; t < m.n_triangles(); t += 3)
+    m.attribute.assign(static_cast<size_t>(m.n_cells()), 0);
+    for (int t = 0; t < m.n_cells(); t += 3)
         m.attribute[static_cast<size_t>(t)] = 1;
     const std::vector<fem::Material> mats{{.E = 7.0, .nu = 0.35}, {.E = 3e3, .nu = 0.1}};
     std::vector<std::array<bool, 2>> fixed(static_cast<size_t>(m.n_vertices()), {false, false});
@@ -189,8 +189,8 @@ TEST(Assembly, RowsOverThreadsAreTheSerialElementLoopBitForBit) {
         for (int c = 0; c < 2; ++c)
             if (const int d = dofs.u_dof(v, c); d >= 0) f[d] = F[2 * v + c];
     const Vector loads = f;
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         const auto ke = fem::element_stiffness(
             m.vertices[static_cast<size_t>(tri[0])], m.vertices[static_cast<size_t>(tri[1])],
             m.vertices[static_cast<size_t>(tri[2])], fem::material_of(m, mats, t));

@@ -62,7 +62,7 @@ std::vector<int> check_levels(const levels::ElasticProblem3& p) {
 TEST(Elastic3dMg, BoxScene_IterationsBoundedOverLevelsAndSolutionIsTheDirectOne) {
     const levels::ElasticProblem3 p = scene::load_scene3("box3d");
     EXPECT_EQ(p.name, "box3d");
-    EXPECT_EQ(p.mesh0.n_tetrahedra(), 4 * 4 * 2 * 6);
+    EXPECT_EQ(p.mesh0.n_cells(), 4 * 4 * 2 * 6);
     // The W(2,2) default: measured 9, 9, 10 (and 10 on levels 4 and 5; the V(1,1) cycle took
     // 13, 15, 17, 18, 18). At most 20 on every level, and the finest at most 1.3 times level 1's.
     const std::vector<int> its = check_levels(p);
@@ -88,8 +88,8 @@ std::string two_volume_box_msh() {
     }
     for (const auto& f : box.boundary)
         s.triangles.push_back({f.tag + 1, {f.v[0] + 1, f.v[1] + 1, f.v[2] + 1}});
-    for (int t = 0; t < box.n_tetrahedra(); ++t) {
-        std::array<int, 4> k = box.tetrahedra[static_cast<size_t>(t)];
+    for (int t = 0; t < box.n_cells(); ++t) {
+        std::array<int, 4> k = box.cells[static_cast<size_t>(t)];
         Vec3 c = Vec3::Zero();
         for (int v : k)
             c += box.vertices[static_cast<size_t>(v)] / 4;
@@ -157,17 +157,17 @@ TEST(Elastic3dMg, GmshTwoVolumes_BodiesMaterialsAndIterationsBoundedOverLevels) 
     EXPECT_EQ(p.bodies[1].material.E, 10.0);
     EXPECT_EQ(p.bodies[1].body_force, Vec3(0, 0, -0.1));
     // Every tetrahedron is in the body of its physical volume (x below or above 0.55).
-    ASSERT_EQ(p.mesh0.attribute.size(), p.mesh0.tetrahedra.size());
+    ASSERT_EQ(p.mesh0.attribute.size(), p.mesh0.cells.size());
     int soft = 0;
-    for (int t = 0; t < p.mesh0.n_tetrahedra(); ++t) {
+    for (int t = 0; t < p.mesh0.n_cells(); ++t) {
         Vec3 c = Vec3::Zero();
-        for (int v : p.mesh0.tetrahedra[static_cast<size_t>(t)])
+        for (int v : p.mesh0.cells[static_cast<size_t>(t)])
             c += p.mesh0.vertices[static_cast<size_t>(v)] / 4;
         EXPECT_EQ(p.mesh0.attribute[static_cast<size_t>(t)], c.x() < 0.55 ? 0 : 1) << t;
         soft += p.mesh0.attribute[static_cast<size_t>(t)] == 0;
     }
     EXPECT_GT(soft, 0);
-    EXPECT_LT(soft, p.mesh0.n_tetrahedra());
+    EXPECT_LT(soft, p.mesh0.n_cells());
     // The W(2,2) default on this perturbed two-material mesh: measured 12, 13, 15 (the V(1,1)
     // cycle took 18, 21, 26). At most 20 on every level, the finest at most 1.3 times level 1's.
     const std::vector<int> its = check_levels(p);

@@ -393,7 +393,7 @@ TEST(RecoveredLevels, TheExportedSquareSolvesAsTheRefinedSquareDoes) {
     const Problem p = exported_square(3, true);
     EXPECT_EQ(p.recovered_levels, 7);
     EXPECT_EQ(p.levels, 7);
-    EXPECT_EQ(p.mesh0.n_triangles(), 2);
+    EXPECT_EQ(p.mesh0.n_cells(), 2);
     auto q = scene::load_scene("square");
     q.levels = 3;
     const RunResult a = solve(p, {});
@@ -469,6 +469,6 @@ TEST(RecoveredLevels, StopAtTheCoarsestMeshWhoseLevel0TheSceneCanBuild) {
         built_in.substr(built_in.find('\n', at)) + "\n[[support]]\npoint = [5.0, 40.0]\nux = 0.0\n";
     const Problem p = scene::parse_scene(text, (dir / "square.toml").string(), dir);
     EXPECT_EQ(p.recovered_levels, 4);
-    EXPECT_EQ(p.mesh0.n_triangles(), 2 * 8 * 8);
+    EXPECT_EQ(p.mesh0.n_cells(), 2 * 8 * 8);
     EXPECT_NO_THROW(build_level(p, p.mesh0));
 }

@@ -45,7 +45,7 @@ TEST(PredictLevelSizes, RefinementCountsAreExactAndUnknownsClose) {
             SCOPED_TRACE(l);
             const auto& L = h.levels[l];
             EXPECT_EQ(sizes[l].vertices, L.mesh.n_vertices());
-            EXPECT_EQ(sizes[l].triangles, L.mesh.n_triangles());
+            EXPECT_EQ(sizes[l].triangles, L.mesh.n_cells());
             // Boundary terms are doubled per level, so the finer counts are estimates: within
             // 3 % for the unknowns and nonzeros, within a factor for the contact nodes.
             EXPECT_NEAR(sizes[l].unknowns / L.n_unknowns(), 1.0, 0.03);

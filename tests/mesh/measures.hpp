@@ -12,16 +12,16 @@ namespace mlc::mesh::testing {
 /// Sum of the triangles' signed areas.
 inline double total_area(const Mesh& m) {
     double a = 0;
-    for (int t = 0; t < m.n_triangles(); ++t)
-        a += m.signed_area(t);
+    for (int t = 0; t < m.n_cells(); ++t)
+        a += m.signed_measure(t);
     return a;
 }
 
 /// Sum of the tetrahedra's volumes (either orientation).
 inline double total_volume(const TetMesh& m) {
     double v = 0;
-    for (int t = 0; t < m.n_tetrahedra(); ++t)
-        v += std::abs(m.signed_volume(t));
+    for (int t = 0; t < m.n_cells(); ++t)
+        v += std::abs(m.signed_measure(t));
     return v;
 }
 

@@ -33,10 +33,10 @@ Point point(const Mesh& m, int v) {
 /// A 5 x 3 rectangle whose top edge lies on a circle (refinement moves its midpoints onto it).
 Mesh curved_rectangle() {
     Mesh m = mesh::structured_rectangle({0, 0}, {1, 0.6}, 5, 3, mesh::Diagonal::alternate);
-    m.circles.push_back({{0.5, -10.0}, 10.6});
+    m.shapes.push_back({{0.5, -10.0}, 10.6});
     const int top = m.tag("top");
     for (auto& e : m.boundary)
-        if (e.tag == top) e.curve = 0;
+        if (e.tag == top) e.shape = 0;
     return m;
 }
 
@@ -82,7 +82,7 @@ TEST(Distributed, EveryVertexOwnedOnceWithContiguousNumbers) {
         const LocalLevel& L = H.levels[l];
         const Mesh& S = serial[l];
         EXPECT_EQ(L.n_global_vertices, S.n_vertices());
-        EXPECT_EQ(L.n_global_triangles, S.n_triangles());
+        EXPECT_EQ(L.n_global_triangles, S.n_cells());
         // Contiguous blocks in rank order: rank r starts where rank r - 1 ends.
         const auto firsts = W().allgather(std::span<const std::int64_t>(&L.first_vertex, 1));
         const std::int64_t n_owned = L.n_owned_vertices();
@@ -134,32 +134,32 @@ TEST(Distributed, OwnedTrianglesTileTheMeshAndGhostsCompleteTheRows) {
         // Owned triangles as triples of global numbers, gathered: each serial triangle once.
         std::vector<std::int64_t> tri;
         double area = 0;
-        for (int t = 0; t < L.mesh.n_triangles(); ++t) {
+        for (int t = 0; t < L.mesh.n_cells(); ++t) {
             if (!L.triangle_owned[static_cast<size_t>(t)]) continue;
             std::array<std::int64_t, 3> g;
             for (int k = 0; k < 3; ++k)
-                g[k] = L.global_vertex[static_cast<size_t>(L.mesh.triangles[t][k])];
+                g[k] = L.global_vertex[static_cast<size_t>(L.mesh.cells[t][k])];
             std::sort(g.begin(), g.end());
             tri.insert(tri.end(), g.begin(), g.end());
-            area += L.mesh.signed_area(t);
+            area += L.mesh.signed_measure(t);
         }
         const auto all = W().allgather(std::span<const std::int64_t>(tri));
-        ASSERT_EQ(all.size(), 3 * static_cast<size_t>(S.n_triangles()));
+        ASSERT_EQ(all.size(), 3 * static_cast<size_t>(S.n_cells()));
         const auto table = owned_table(L);
         std::set<std::array<Point, 3>> owned, expected;
         for (size_t i = 0; i < all.size(); i += 3)
             owned.insert({table.at(all[i]), table.at(all[i + 1]), table.at(all[i + 2])});
         double serial_area = 0;
         std::map<Point, int> serial_valence;
-        for (int t = 0; t < S.n_triangles(); ++t) {
+        for (int t = 0; t < S.n_cells(); ++t) {
             std::array<Point, 3> p;
             for (int k = 0; k < 3; ++k) {
-                p[k] = point(S, S.triangles[t][k]);
+                p[k] = point(S, S.cells[t][k]);
                 ++serial_valence[p[k]];
             }
             std::sort(p.begin(), p.end());
             expected.insert(p);
-            serial_area += S.signed_area(t);
+            serial_area += S.signed_measure(t);
         }
         // Sorting by global number and by coordinates may differ: compare sorted coordinates.
         std::set<std::array<Point, 3>> owned_sorted;
@@ -170,7 +170,7 @@ TEST(Distributed, OwnedTrianglesTileTheMeshAndGhostsCompleteTheRows) {
         EXPECT_EQ(owned_sorted, expected);
         EXPECT_NEAR(W().sum(area), serial_area, 1e-12 * serial_area);
         std::vector<int> valence(static_cast<size_t>(L.mesh.n_vertices()), 0);
-        for (const auto& t : L.mesh.triangles)
+        for (const auto& t : L.mesh.cells)
             for (int v : t)
                 ++valence[static_cast<size_t>(v)];
         for (int v : L.owned_vertices)
@@ -189,8 +189,8 @@ TEST(Distributed, LevelsAreNestedPerProcess) {
         ASSERT_EQ(f.n_coarse_vertices, c.n_vertices());
         for (int v = 0; v < c.n_vertices(); ++v)
             EXPECT_EQ(point(f, v), point(c, v));
-        ASSERT_EQ(f.triangles.size(), 4 * c.triangles.size());
-        for (size_t t = 0; t < f.triangles.size(); ++t)
+        ASSERT_EQ(f.cells.size(), 4 * c.cells.size());
+        for (size_t t = 0; t < f.cells.size(); ++t)
             EXPECT_EQ(H.levels[l].triangle_owned[t], H.levels[l - 1].triangle_owned[t / 4]);
     }
 }
@@ -209,10 +209,10 @@ Mesh two_blocks() {
     const int off = m.n_vertices();
     for (const auto& x : up.vertices)
         m.vertices.push_back(x);
-    for (auto t : up.triangles) {
+    for (auto t : up.cells) {
         for (int& v : t)
             v += off;
-        m.triangles.push_back(t);
+        m.cells.push_back(t);
     }
     for (auto e : up.boundary) {
         const std::string name = up.tag_name(e.tag);
@@ -221,8 +221,8 @@ Mesh two_blocks() {
         e.v1 += off;
         m.boundary.push_back(e);
     }
-    m.attribute.assign(static_cast<size_t>(m.n_triangles()), 0);
-    for (size_t t = m.triangles.size() - up.triangles.size(); t < m.triangles.size(); ++t)
+    m.attribute.assign(static_cast<size_t>(m.n_cells()), 0);
+    for (size_t t = m.cells.size() - up.cells.size(); t < m.cells.size(); ++t)
         m.attribute[t] = 1;
     return m;
 }
@@ -246,8 +246,8 @@ TEST(Distributed, GhostReachHoldsEveryInterfaceFacetWithinReach) {
     const DistributedHierarchy H = mesh::distribute(m0, 2, W(), {}, {{{tags[0], tags[1]}, reach}});
     const DistributedHierarchy H1 = mesh::distribute(m0, 2, W());
     // The widened layer holds more triangles (somewhere, on several processes).
-    const std::int64_t wide = W().sum(static_cast<std::int64_t>(H.levels[0].mesh.n_triangles()));
-    const std::int64_t narrow = W().sum(static_cast<std::int64_t>(H1.levels[0].mesh.n_triangles()));
+    const std::int64_t wide = W().sum(static_cast<std::int64_t>(H.levels[0].mesh.n_cells()));
+    const std::int64_t narrow = W().sum(static_cast<std::int64_t>(H1.levels[0].mesh.n_cells()));
     if (W().size() > 1) {
         EXPECT_GT(wide, narrow);
     }
@@ -291,7 +291,7 @@ TEST(Distributed, OneProcessIsTheSerialHierarchy) {
     for (size_t l = 0; l < H.levels.size(); ++l) {
         const LocalLevel& L = H.levels[l];
         EXPECT_EQ(L.mesh.vertices, serial[l].vertices);
-        EXPECT_EQ(L.mesh.triangles, serial[l].triangles);
+        EXPECT_EQ(L.mesh.cells, serial[l].cells);
         EXPECT_EQ(L.mesh.boundary.size(), serial[l].boundary.size());
         EXPECT_EQ(L.n_ghost_vertices(), 0);
         for (int v = 0; v < L.mesh.n_vertices(); ++v)

@@ -34,7 +34,7 @@ std::map<std::string, double> boundary_length_per_tag(const Mesh& m) {
 /// Smallest interior angle over all triangles, in degrees.
 double min_angle_deg(const Mesh& m) {
     double worst = 180;
-    for (const auto& t : m.triangles)
+    for (const auto& t : m.cells)
         for (int i = 0; i < 3; ++i) {
             const Vec2 a = m.vertices[t[(i + 1) % 3]] - m.vertices[t[i]];
             const Vec2 b = m.vertices[t[(i + 2) % 3]] - m.vertices[t[i]];
@@ -47,9 +47,9 @@ double min_angle_deg(const Mesh& m) {
 /// listed once, with that triangle on its left (the edge appears in the same direction in it).
 void expect_consistent_boundary(const Mesh& m) {
     std::map<std::pair<int, int>, int> directed;
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        EXPECT_GT(m.signed_area(t), 0) << "triangle " << t;
-        const auto& tri = m.triangles[t];
+    for (int t = 0; t < m.n_cells(); ++t) {
+        EXPECT_GT(m.signed_measure(t), 0) << "triangle " << t;
+        const auto& tri = m.cells[t];
         for (int i = 0; i < 3; ++i)
             directed[{tri[i], tri[(i + 1) % 3]}]++;
     }
@@ -70,9 +70,9 @@ void expect_consistent_boundary(const Mesh& m) {
 double sagitta_area_bound(const Mesh& m, int curve) {
     double bound = 0;
     for (const BoundaryEdge& e : m.boundary)
-        if (e.curve == curve) {
+        if (e.shape == curve) {
             const double L = edge_length(m, e);
-            bound += 1.05 * L * L * L / (12 * m.circles[curve].radius);
+            bound += 1.05 * L * L * L / (12 * m.shapes[curve].radius);
         }
     return bound;
 }
@@ -114,13 +114,13 @@ TEST(DomainMesher, UnitSquareHasExactAreaAndTaggedSides) {
     EXPECT_EQ(m.tag("bottom"), 0);
     EXPECT_EQ(m.tag("left"), 3);
     for (const BoundaryEdge& e : m.boundary)
-        EXPECT_EQ(e.curve, -1);
-    EXPECT_TRUE(m.circles.empty());
+        EXPECT_EQ(e.shape, -1);
+    EXPECT_TRUE(m.shapes.empty());
     // Uniform field: every edge at most h; the shape bound holds (all input angles are 90).
     EXPECT_LE(m.edge_length_range().second, 0.1 * (1 + 1e-12));
     EXPECT_GE(min_angle_deg(m), 20.6);
-    EXPECT_GT(m.n_triangles(), 200);
-    EXPECT_LT(m.n_triangles(), 1000);
+    EXPECT_GT(m.n_cells(), 200);
+    EXPECT_LT(m.n_cells(), 1000);
     expect_consistent_boundary(m);
     // Boundary vertices of "bottom" lie on y = 0.
     for (int v : m.vertices_with_tag(m.tag("bottom")))
@@ -132,16 +132,16 @@ TEST(DomainMesher, QuarterDiscKeepsArcVerticesOnCircleAndGradesSize) {
     const Mesh m = mesh_domain({quarter_disc()}, size);
     expect_consistent_boundary(m);
 
-    ASSERT_EQ(m.circles.size(), 1u);
-    EXPECT_EQ(m.circles[0].center, Vec2(0, 1));
-    EXPECT_EQ(m.circles[0].radius, 1.0);
+    ASSERT_EQ(m.shapes.size(), 1u);
+    EXPECT_EQ(m.shapes[0].center, Vec2(0, 1));
+    EXPECT_EQ(m.shapes[0].radius, 1.0);
     const int arc = m.tag("arc");
     const auto arc_vertices = m.vertices_with_tag(arc);
     EXPECT_GT(arc_vertices.size(), 30u);
     for (int v : arc_vertices)
         EXPECT_NEAR((m.vertices[v] - Vec2(0, 1)).norm(), 1.0, 1e-12) << "vertex " << v;
     for (const BoundaryEdge& e : m.boundary)
-        EXPECT_EQ(e.curve, e.tag == arc ? 0 : -1);
+        EXPECT_EQ(e.shape, e.tag == arc ? 0 : -1);
 
     // Straight sides exact, arc longer than its chords only by the polygonal error.
     const auto len = boundary_length_per_tag(m);
@@ -160,7 +160,7 @@ TEST(DomainMesher, QuarterDiscKeepsArcVerticesOnCircleAndGradesSize) {
     // Sizes: fine at the focus, never above ~1.5 max_size, and following h(x) everywhere.
     int n_near = 0;
     double longest = 0;
-    for (const auto& t : m.triangles)
+    for (const auto& t : m.cells)
         for (int i = 0; i < 3; ++i) {
             const Vec2 a = m.vertices[t[i]], b = m.vertices[t[(i + 1) % 3]];
             const Vec2 mid = (a + b) / 2;
@@ -187,19 +187,19 @@ TEST(DomainMesher, RingHoleIsEmpty) {
     const Mesh m = mesh_domain({outer, hole}, SizeField{.max_size = 1.0});
     expect_consistent_boundary(m);
 
-    ASSERT_EQ(m.circles.size(), 2u);
+    ASSERT_EQ(m.shapes.size(), 2u);
     for (const BoundaryEdge& e : m.boundary) {
-        const Circle& circle = m.circles.at(e.curve);
+        const Circle& circle = m.shapes.at(e.shape);
         EXPECT_EQ(circle.center, c);
         EXPECT_EQ(circle.radius, m.tag_name(e.tag) == "outer" ? 20.0 : 15.0);
         for (int v : {e.v0, e.v1})
             EXPECT_NEAR((m.vertices[v] - c).norm(), circle.radius, 1e-12 * circle.radius);
     }
-    for (const auto& t : m.triangles) {
+    for (const auto& t : m.cells) {
         const Vec2 g = (m.vertices[t[0]] + m.vertices[t[1]] + m.vertices[t[2]]) / 3;
         EXPECT_GT((g - c).norm(), 15.0 - 0.1) << "triangle in the hole at " << g.transpose();
     }
-    const int outer_curve = m.boundary[0].curve;
+    const int outer_curve = m.boundary[0].shape;
     const double exact = pi * (20 * 20 - 15 * 15);
     const double outer_loss = sagitta_area_bound(m, outer_curve);
     const double hole_loss = sagitta_area_bound(m, 1 - outer_curve);
@@ -213,7 +213,7 @@ TEST(DomainMesher, RingHoleIsEmpty) {
     const std::vector<Segment> ccw_hole = {Segment::arc({0, 5}, {0, 5}, c, true, "inner")};
     const Mesh m2 = mesh_domain({outer, ccw_hole}, SizeField{.max_size = 1.0});
     expect_consistent_boundary(m2);
-    const int outer2 = m2.boundary[0].curve;
+    const int outer2 = m2.boundary[0].shape;
     EXPECT_GE(mesh::testing::total_area(m2), exact - sagitta_area_bound(m2, outer2));
     EXPECT_LE(mesh::testing::total_area(m2), exact + sagitta_area_bound(m2, 1 - outer2));
 }
@@ -253,7 +253,7 @@ TEST(DomainMesher, ManyFocusPointsFollowSizeField) {
     expect_consistent_boundary(m);
     EXPECT_NEAR(mesh::testing::total_area(m), 1.0 - 0.04, 1e-13);
     EXPECT_NEAR(boundary_length_per_tag(m).at("hole"), 0.8, 1e-13);
-    for (const auto& t : m.triangles)
+    for (const auto& t : m.cells)
         for (int i = 0; i < 3; ++i) {
             const Vec2 a = m.vertices[t[i]], b = m.vertices[t[(i + 1) % 3]];
             EXPECT_LE((b - a).norm(), 1.3 * size((a + b) / 2));
@@ -415,7 +415,7 @@ TEST(DomainMesher, HugeSegmentsAndFarLinesAreRefusedAtOnce) {
 
 TEST(DomainMesherSlow, LargeMeshIsValid) {
     const Mesh m = mesh_domain({quarter_disc()}, SizeField{.max_size = 0.004});
-    EXPECT_GT(m.n_triangles(), 100000);
+    EXPECT_GT(m.n_cells(), 100000);
     expect_consistent_boundary(m);
     for (int v : m.vertices_with_tag(m.tag("arc")))
         EXPECT_NEAR((m.vertices[v] - Vec2(0, 1)).norm(), 1.0, 1e-12);

@@ -45,7 +45,7 @@ std::string replace(std::string s, const std::string& from, const std::string& t
 std::set<std::tuple<double, double, double, double, std::string>> boundary_set(const Mesh& m) {
     std::set<std::tuple<double, double, double, double, std::string>> s;
     for (const BoundaryEdge& e : m.boundary) {
-        EXPECT_EQ(e.curve, -1);
+        EXPECT_EQ(e.shape, -1);
         const Vec2 a = m.vertices[e.v0], b = m.vertices[e.v1];
         s.insert({a.x(), a.y(), b.x(), b.y(), m.tag_name(e.tag)});
     }
@@ -59,13 +59,13 @@ void expect_unit_square(const Mesh& m) {
     EXPECT_EQ(m.vertices[0], Vec2(0, 0));
     EXPECT_EQ(m.vertices[1], Vec2(1, 0));
     EXPECT_EQ(m.vertices[4], Vec2(0.5, 0.5));
-    ASSERT_EQ(m.n_triangles(), 4);
+    ASSERT_EQ(m.n_cells(), 4);
     for (int t = 0; t < 4; ++t)
-        EXPECT_DOUBLE_EQ(m.signed_area(t), 0.25) << "triangle " << t;
+        EXPECT_DOUBLE_EQ(m.signed_measure(t), 0.25) << "triangle " << t;
     EXPECT_DOUBLE_EQ(mesh::testing::total_area(m), 1.0);
     // Two clockwise triangles in the file were re-oriented, keeping their first vertex.
-    EXPECT_EQ(m.triangles[1], (std::array<int, 3>{1, 2, 4}));
-    EXPECT_EQ(m.triangles[3], (std::array<int, 3>{3, 0, 4}));
+    EXPECT_EQ(m.cells[1], (std::array<int, 3>{1, 2, 4}));
+    EXPECT_EQ(m.cells[3], (std::array<int, 3>{3, 0, 4}));
     // "top" is listed reversed in the file; the unnamed physical line 7 is "tag7"; the left side
     // has no physical line and is not listed.
     const std::set<std::tuple<double, double, double, double, std::string>> expected = {
@@ -112,7 +112,7 @@ TEST_F(Gmsh, SelectsPhysicalSurface) {
 
     const Mesh lower = read_gmsh(data("two_bodies_v22.msh"), "lower");
     ASSERT_EQ(lower.n_vertices(), 4);
-    ASSERT_EQ(lower.n_triangles(), 2);
+    ASSERT_EQ(lower.n_cells(), 2);
     EXPECT_DOUBLE_EQ(mesh::testing::total_area(lower), 1.0);
     const std::set<std::tuple<double, double, double, double, std::string>> lower_edges = {
         {0, 0, 1, 0, "bottom"}, {1, 1, 0, 1, "contact_lower"}};
@@ -120,15 +120,15 @@ TEST_F(Gmsh, SelectsPhysicalSurface) {
 
     const Mesh upper = read_gmsh(data("two_bodies_v22.msh"), "upper");
     ASSERT_EQ(upper.n_vertices(), 4);
-    ASSERT_EQ(upper.n_triangles(), 2);
+    ASSERT_EQ(upper.n_cells(), 2);
     EXPECT_DOUBLE_EQ(mesh::testing::total_area(upper), 1.0);
     for (const Vec2& v : upper.vertices)
         EXPECT_GE(v.y(), 1.1);
     const std::set<std::tuple<double, double, double, double, std::string>> upper_edges = {
         {0, 1.1, 1, 1.1, "contact_upper"}, {1, 2.1, 0, 2.1, "top"}};
     EXPECT_EQ(boundary_set(upper), upper_edges);
-    for (int t = 0; t < upper.n_triangles(); ++t)
-        EXPECT_DOUBLE_EQ(upper.signed_area(t), 0.5);
+    for (int t = 0; t < upper.n_cells(); ++t)
+        EXPECT_DOUBLE_EQ(upper.signed_measure(t), 0.5);
 
     // Everything: both bodies, told apart by the attribute.
     const Mesh both = read_gmsh(data("two_bodies_v22.msh"));
@@ -143,7 +143,7 @@ TEST_F(Gmsh, SelectsPhysicalSurface) {
     const std::string unnamed = replace(testutil::slurp(data("two_bodies_v22.msh")),
                                         "2 11 \"upper\"\n", "2 12 \"other\"\n");
     const Mesh by_tag = read_gmsh(scratch_file(unnamed), "tag11");
-    EXPECT_EQ(by_tag.n_triangles(), 2);
+    EXPECT_EQ(by_tag.n_cells(), 2);
     EXPECT_GE(by_tag.vertices[0].y(), 1.1);
 }
 
@@ -161,7 +161,7 @@ TEST_F(Gmsh, UnsupportedElementsThrowNamingType) {
     // ... but elements outside the selected surface are ignored.
     const std::string two = testutil::slurp(data("two_bodies_v22.msh"));
     const std::string quad_upper = replace(two, "8 2 2 11 2 5 8 7", "8 3 2 11 2 5 6 7 8");
-    EXPECT_EQ(read_gmsh(scratch_file(quad_upper), "lower").n_triangles(), 2);
+    EXPECT_EQ(read_gmsh(scratch_file(quad_upper), "lower").n_cells(), 2);
     expect_error(quad_upper, {"element type 3"}, "upper");
     // An unknown element type.
     expect_error(replace(v22, "1 15 2 0 1 10", "1 999 2 0 1 10"),
@@ -216,7 +216,7 @@ TEST_F(Gmsh, MalformedFilesThrowNamingLine) {
     std::string moved = v22;
     for (std::size_t at; (at = moved.find(" 2 2 3 1 ")) != std::string::npos;)
         moved.replace(at, 9, " 2 2 5 1 ");
-    EXPECT_EQ(read_gmsh(scratch_file(moved)).n_triangles(), 4);
+    EXPECT_EQ(read_gmsh(scratch_file(moved)).n_cells(), 4);
     expect_error(moved, {"no 3-node triangles found in physical surface 'body'"}, "body");
     // A file that does not exist.
     EXPECT_THROW(read_gmsh(data("no_such_file.msh")), InvalidInput);

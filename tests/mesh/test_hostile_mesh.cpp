@@ -72,7 +72,7 @@ TEST(CheckQuality, EveryPairCloserThanTheToleranceIsADuplicate) {
         for (const double r : {0.0, 0.3 * tol, 0.9 * tol}) {
             auto dup = m;
             dup.vertices.push_back(m.vertices[4] + r * dir);
-            dup.triangles.push_back({0, 2, dup.n_vertices() - 1});
+            dup.cells.push_back({0, 2, dup.n_vertices() - 1});
             try {
                 mesh::check_quality(dup);
                 ADD_FAILURE() << "no duplicate found at distance " << r << " in direction " << k;
@@ -87,7 +87,7 @@ TEST(CheckQuality, EveryPairCloserThanTheToleranceIsADuplicate) {
         // duplicate-vertex one) refuses as a hanging node.
         auto apart = m;
         apart.vertices.push_back(m.vertices[4] + 3 * tol * dir);
-        apart.triangles.push_back({0, 2, apart.n_vertices() - 1});
+        apart.cells.push_back({0, 2, apart.n_vertices() - 1});
         try {
             mesh::check_quality(apart);
             ADD_FAILURE() << "the overlapping triangle was accepted in direction " << k;

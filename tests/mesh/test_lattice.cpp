@@ -27,11 +27,11 @@ TEST(MacroLattice, InteriorPointsSitWhereTheirLatticeCoordinatesSay) {
         const auto L = macro_lattice(m, depth);
         ASSERT_TRUE(L.has_value()) << depth;
         EXPECT_EQ(L->n, 1 << depth);
-        EXPECT_EQ(L->n_macros, m0.n_triangles());
+        EXPECT_EQ(L->n_macros, m0.n_cells());
         const long np = MacroLattice::interior_points(L->n);
         ASSERT_EQ(L->vertex.size(), static_cast<size_t>(np * L->n_macros));
         for (int t = 0; t < L->n_macros; ++t) {
-            const auto& tri = m0.triangles[static_cast<size_t>(t)];
+            const auto& tri = m0.cells[static_cast<size_t>(t)];
             const Vec2 A = m0.vertices[static_cast<size_t>(tri[0])];
             const Vec2 B = m0.vertices[static_cast<size_t>(tri[1])];
             const Vec2 C = m0.vertices[static_cast<size_t>(tri[2])];
@@ -68,9 +68,9 @@ TEST(MacroLattice, NoLatticeWhenTheTrianglesAreNotRefineOrder) {
     // Three refinements are two of the level-1 mesh, in refine's order too.
     const auto two = macro_lattice(m, 2);
     ASSERT_TRUE(two.has_value());
-    EXPECT_EQ(two->n_macros, 4 * refined(0).n_triangles());
+    EXPECT_EQ(two->n_macros, 4 * refined(0).n_cells());
     EXPECT_FALSE(macro_lattice(m, 4).has_value()); // one macro of all triangles: no lattice
     std::mt19937 rng(5);
-    std::shuffle(m.triangles.begin(), m.triangles.end(), rng);
+    std::shuffle(m.cells.begin(), m.cells.end(), rng);
     EXPECT_FALSE(macro_lattice(m, 3).has_value());
 }

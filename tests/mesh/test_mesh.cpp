@@ -16,11 +16,11 @@ using namespace mlc;
 TEST(StructuredRectangle, SquareLadderCounts) {
     const auto m = mesh::structured_rectangle(Vec2(0, 0), Vec2(40, 40), 16, 16);
     EXPECT_EQ(m.n_vertices(), 17 * 17);
-    EXPECT_EQ(m.n_triangles(), 512);
+    EXPECT_EQ(m.n_cells(), 512);
     EXPECT_EQ(m.vertices_with_tag(m.tag("bottom")).size(), 17u);
     double area = 0;
-    for (int t = 0; t < m.n_triangles(); ++t)
-        area += m.signed_area(t);
+    for (int t = 0; t < m.n_cells(); ++t)
+        area += m.signed_measure(t);
     EXPECT_NEAR(area, 1600.0, 1e-10);
     EXPECT_NO_THROW(mesh::check_quality(m));
 }
@@ -30,7 +30,7 @@ TEST(Refine, SplitsEveryTriangleInFourAndKeepsCoarseVertices) {
     auto f = c;
     for (int l = 1; l <= 3; ++l) {
         const auto g = mesh::refine(f);
-        EXPECT_EQ(g.n_triangles(), 4 * f.n_triangles());
+        EXPECT_EQ(g.n_cells(), 4 * f.n_cells());
         EXPECT_EQ(g.n_coarse_vertices, f.n_vertices());
         for (int v = 0; v < f.n_vertices(); ++v)
             EXPECT_EQ(g.vertices[static_cast<size_t>(v)], f.vertices[static_cast<size_t>(v)]);
@@ -51,12 +51,12 @@ TEST(Refine, SplitsEveryTriangleInFourAndKeepsCoarseVertices) {
 TEST(Refine, MovesArcMidpointsOntoTheCircle) {
     // A square whose bottom edge is declared to lie on a circle of radius 5 centred above.
     auto m = mesh::structured_rectangle(Vec2(-1, 0), Vec2(2, 1), 2, 1);
-    m.circles.push_back({Vec2(0, 5), 5.0});
+    m.shapes.push_back({Vec2(0, 5), 5.0});
     for (auto& e : m.boundary)
-        if (e.tag == m.tag("bottom")) e.curve = 0;
+        if (e.tag == m.tag("bottom")) e.shape = 0;
     const auto f = mesh::refine(m);
     for (const auto& e : f.boundary) {
-        if (e.curve == 0 && e.v0 >= m.n_vertices()) {
+        if (e.shape == 0 && e.v0 >= m.n_vertices()) {
             EXPECT_NEAR((f.vertices[static_cast<size_t>(e.v0)] - Vec2(0, 5)).norm(), 5.0, 1e-14);
         }
     }
@@ -65,17 +65,17 @@ TEST(Refine, MovesArcMidpointsOntoTheCircle) {
 TEST(CheckQuality, RejectsDegenerateInvertedAndDuplicate) {
     auto m = mesh::structured_rectangle(Vec2(0, 0), Vec2(1, 1), 2, 2);
     auto inverted = m;
-    std::swap(inverted.triangles[3][1], inverted.triangles[3][2]);
+    std::swap(inverted.cells[3][1], inverted.cells[3][2]);
     EXPECT_THROW(mesh::check_quality(inverted), InvalidInput);
     auto degenerate = m;
     degenerate.vertices[4] = Vec2(0.25, 0.0); // collinear with vertices 0 and 1
     EXPECT_THROW(mesh::check_quality(degenerate), InvalidInput);
     auto dup = m;
     dup.vertices.push_back(dup.vertices[2]);
-    dup.triangles.push_back({0, 1, static_cast<int>(dup.vertices.size() - 1)});
+    dup.cells.push_back({0, 1, static_cast<int>(dup.vertices.size() - 1)});
     EXPECT_THROW(mesh::check_quality(dup), InvalidInput);
     auto bad_index = m;
-    bad_index.triangles[0][0] = 99;
+    bad_index.cells[0][0] = 99;
     EXPECT_THROW(mesh::check_quality(bad_index), InvalidInput);
 }
 
@@ -83,10 +83,10 @@ TEST(CheckQuality, RefinedMeshesHaveTheirAreasChecked) {
     const auto m = mesh::refine(mesh::structured_rectangle(Vec2(0, 0), Vec2(1, 1), 2, 2));
     EXPECT_NO_THROW(mesh::check_refined_quality(m));
     auto inverted = m;
-    std::swap(inverted.triangles[5][1], inverted.triangles[5][2]);
+    std::swap(inverted.cells[5][1], inverted.cells[5][2]);
     EXPECT_THROW(mesh::check_refined_quality(inverted), InvalidInput);
     auto bad_index = m;
-    bad_index.triangles[0][2] = -1;
+    bad_index.cells[0][2] = -1;
     EXPECT_THROW(mesh::check_refined_quality(bad_index), InvalidInput);
 }
 
@@ -107,7 +107,7 @@ TEST(HilbertOrder, IsAPermutationThatKeepsMeshNeighboursClose) {
     }
     auto close_fraction = [&](const std::vector<int>& position) {
         int close = 0, edges = 0;
-        for (const auto& t : m.triangles)
+        for (const auto& t : m.cells)
             for (int k = 0; k < 3; ++k) {
                 const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
                 ++edges;
@@ -143,11 +143,11 @@ mesh::Mesh shuffled(const mesh::Mesh& f) {
     for (int v = 0; v < n; ++v)
         g.vertices[static_cast<size_t>(to[static_cast<size_t>(v)])] =
             f.vertices[static_cast<size_t>(v)];
-    for (size_t t = 0; t < g.triangles.size(); ++t) {
-        const auto& a = f.triangles[t];
+    for (size_t t = 0; t < g.cells.size(); ++t) {
+        const auto& a = f.cells[t];
         const size_t r = t % 3;
         for (size_t i = 0; i < 3; ++i)
-            g.triangles[t][i] = to[static_cast<size_t>(a[(i + r) % 3])];
+            g.cells[t][i] = to[static_cast<size_t>(a[(i + r) % 3])];
     }
     for (auto* edges : {&g.boundary, &g.lines})
         for (auto& e : *edges) {
@@ -180,19 +180,19 @@ double vertex_set_distance(const mesh::Mesh& a, const mesh::Mesh& b) {
 TEST(Unrefine, RecoversEveryCoarserMeshOfARefinementInAnyNumbering) {
     // 3 x 2 squares with alternating diagonals (12 triangles): itself no refinement of ours.
     auto c = mesh::structured_rectangle(Vec2(0, 0), Vec2(3, 2), 3, 2, mesh::Diagonal::alternate);
-    c.attribute.assign(c.triangles.size(), 0);
+    c.attribute.assign(c.cells.size(), 0);
     c.attribute[5] = 1; // a second body id must survive
     ASSERT_FALSE(mesh::unrefine(c, 1e-12).has_value());
     const auto f2 = shuffled(mesh::refine(mesh::refine(c)));
     const auto f1 = mesh::unrefine(f2, 1e-12);
     ASSERT_TRUE(f1.has_value());
-    EXPECT_EQ(f1->n_triangles(), 48);
+    EXPECT_EQ(f1->n_cells(), 48);
     EXPECT_EQ(f1->n_vertices(), mesh::refine(c).n_vertices());
     EXPECT_NO_THROW(mesh::check_quality(*f1));
     const auto c0 = mesh::unrefine(*f1, 1e-12);
     ASSERT_TRUE(c0.has_value());
     EXPECT_FALSE(mesh::unrefine(*c0, 1e-12).has_value());
-    EXPECT_EQ(c0->n_triangles(), 12);
+    EXPECT_EQ(c0->n_cells(), 12);
     EXPECT_EQ(vertex_set_distance(*c0, c), 0.0);
     // Refining the recovered mesh gives the file's mesh back: vertices, boundary with its tags,
     // and the body ids (one coarse triangle of body 1, four children of it per level).
@@ -208,16 +208,16 @@ TEST(Unrefine, RecoversEveryCoarserMeshOfARefinementInAnyNumbering) {
 
 TEST(Unrefine, KeepsArcsAndPutsTheirMidpointsBackOnTheCircle) {
     auto m = mesh::structured_rectangle(Vec2(-1, 0), Vec2(2, 1), 2, 1);
-    m.circles.push_back({Vec2(0, 5), 5.0});
+    m.shapes.push_back({Vec2(0, 5), 5.0});
     for (auto& e : m.boundary)
-        if (e.tag == m.tag("bottom")) e.curve = 0;
+        if (e.tag == m.tag("bottom")) e.shape = 0;
     const auto f = mesh::refine(mesh::refine(m));
     const auto c = mesh::unrefine(mesh::unrefine(f, 1e-12).value(), 1e-12);
     ASSERT_TRUE(c.has_value());
     EXPECT_EQ(vertex_set_distance(*c, m), 0.0);
     int on_arc = 0;
     for (const auto& e : c->boundary)
-        on_arc += e.curve == 0;
+        on_arc += e.shape == 0;
     EXPECT_EQ(on_arc, 2);
 }
 
@@ -234,10 +234,10 @@ TEST(Unrefine, RefusesAMeshThatIsNoUniformRefinement) {
     // One diagonal flipped: the topology is no 1->4 split any more.
     auto flipped = f;
     bool done = false;
-    for (size_t t = 0; t < flipped.triangles.size() && !done; ++t)
-        for (size_t u = t + 1; u < flipped.triangles.size() && !done; ++u) {
-            auto& A = flipped.triangles[t];
-            auto& B = flipped.triangles[u];
+    for (size_t t = 0; t < flipped.cells.size() && !done; ++t)
+        for (size_t u = t + 1; u < flipped.cells.size() && !done; ++u) {
+            auto& A = flipped.cells[t];
+            auto& B = flipped.cells[u];
             // shared edge (A[1], A[2]) = (B[2], B[1]): flip to (A[0], B[0])
             for (int i = 0; i < 3 && !done; ++i) {
                 const int a0 = A[i], a1 = A[(i + 1) % 3], a2 = A[(i + 2) % 3];
@@ -254,7 +254,7 @@ TEST(Unrefine, RefusesAMeshThatIsNoUniformRefinement) {
     EXPECT_FALSE(mesh::unrefine(flipped, 1e-12).has_value());
     // Triangle counts that are no multiple of 4.
     auto fewer = f;
-    fewer.triangles.pop_back();
+    fewer.cells.pop_back();
     EXPECT_FALSE(mesh::unrefine(fewer, 1e-12).has_value());
 }
 
@@ -283,7 +283,7 @@ TEST(Unrefine, JoinsInteriorLineHalvesAndRefusesHalvesWithDifferentTags) {
     boundary.boundary[0].tag = boundary.tag("top");
     EXPECT_FALSE(mesh::unrefine(boundary, 1e-12).has_value());
     auto bodies = f;
-    bodies.attribute.assign(bodies.triangles.size(), 0);
+    bodies.attribute.assign(bodies.cells.size(), 0);
     bodies.attribute[0] = 1;
     EXPECT_FALSE(mesh::unrefine(bodies, 1e-12).has_value());
 }
@@ -296,8 +296,8 @@ TEST(Unrefine, ReturnsNothingWhereRefiningTheAncestorWouldThrow) {
     f.vertices = {Vec2(-1, 0),    Vec2(0, -1), Vec2(1, 0),
                   Vec2(0.5, 0.5), Vec2(0, 1),  Vec2(-0.5, 0.5)};
     // a = 0, m = 1, b = 2, bc = 3, c = 4, ca = 5
-    f.triangles = {{0, 1, 5}, {1, 2, 3}, {5, 3, 4}, {1, 3, 5}};
-    f.circles.push_back({Vec2(0, 0), 1.0});
+    f.cells = {{0, 1, 5}, {1, 2, 3}, {5, 3, 4}, {1, 3, 5}};
+    f.shapes.push_back({Vec2(0, 0), 1.0});
     const int arc = f.add_tag("arc"), rest = f.add_tag("rest");
     f.boundary = {{0, 1, arc, 0},   {1, 2, arc, 0},   {2, 3, rest, -1},
                   {3, 4, rest, -1}, {4, 5, rest, -1}, {5, 0, rest, -1}};
@@ -306,12 +306,12 @@ TEST(Unrefine, ReturnsNothingWhereRefiningTheAncestorWouldThrow) {
     // Without the arc, m = (0, -1) is no midpoint of its chord: refused. At the chord's
     // midpoint (0, 0) it is an ordinary refinement of one triangle.
     for (auto& e : f.boundary)
-        e.curve = -1;
+        e.shape = -1;
     EXPECT_FALSE(mesh::unrefine(f, 1e-12).has_value());
     f.vertices[1] = Vec2(0, 0);
     const auto c = mesh::unrefine(f, 1e-12);
     ASSERT_TRUE(c.has_value());
-    EXPECT_EQ(c->n_triangles(), 1);
+    EXPECT_EQ(c->n_cells(), 1);
 }
 
 TEST(CheckQuality, FindsDuplicatesInEveryNeighbouringCellOfItsGrid) {
@@ -322,7 +322,7 @@ TEST(CheckQuality, FindsDuplicatesInEveryNeighbouringCellOfItsGrid) {
     auto mesh_with = [](Vec2 a, Vec2 b) {
         mesh::Mesh m;
         m.vertices = {Vec2(0, 0), Vec2(1, 0), a, b, Vec2(1, 1), Vec2(0, 1)};
-        m.triangles = {{0, 1, 2}, {3, 4, 5}}; // a and b in different triangles
+        m.cells = {{0, 1, 2}, {3, 4, 5}}; // a and b in different triangles
         return m;
     };
     const mesh::Mesh probe = mesh_with(Vec2(0.5, 0.5), Vec2(0.5, 0.5));
@@ -337,8 +337,8 @@ TEST(CheckQuality, FindsDuplicatesInEveryNeighbouringCellOfItsGrid) {
             try {
                 mesh::check_quality(mesh_with(a, b));
             } catch (const InvalidInput& e) {
-                found += std::string(e.what()).find("duplicate vertices 2 and 3") !=
-                         std::string::npos;
+                found +=
+                    std::string(e.what()).find("duplicate vertices 2 and 3") != std::string::npos;
             }
         }
     EXPECT_EQ(found, 8);

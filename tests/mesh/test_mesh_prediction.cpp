@@ -83,7 +83,7 @@ TEST(MeshPrediction, AtOrAboveTheMeshedCountAndWithinOneAndAHalfTimesIt) {
     };
     for (size_t i = 0; i < cases.size(); ++i) {
         const double predicted = predict_mesh_size(cases[i].loops, cases[i].size).triangles;
-        const double made = mesh_domain(cases[i].loops, cases[i].size).n_triangles();
+        const double made = mesh_domain(cases[i].loops, cases[i].size).n_cells();
         EXPECT_GE(predicted, made) << "case " << i;
         EXPECT_LE(predicted, 1.5 * made) << "case " << i;
     }
@@ -106,5 +106,5 @@ TEST(MeshStop, APollThatSaysStopThrowsInterruptedAndOneThatNeverDoesChangesNothi
     const Mesh without = mesh_domain(loops, size);
     ASSERT_EQ(with.n_vertices(), without.n_vertices());
     EXPECT_EQ(with.vertices, without.vertices);
-    EXPECT_EQ(with.triangles, without.triangles);
+    EXPECT_EQ(with.cells, without.cells);
 }

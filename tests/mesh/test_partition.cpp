@@ -18,14 +18,14 @@ namespace {
 // Number of connected pieces of part p (triangles joined through shared edges).
 int pieces(const mesh::Mesh& m, const mesh::Partition& P, int p) {
     std::map<std::pair<int, int>, std::vector<int>> by_edge;
-    for (int t = 0; t < m.n_triangles(); ++t)
+    for (int t = 0; t < m.n_cells(); ++t)
         for (int k = 0; k < 3; ++k) {
-            const auto& tri = m.triangles[static_cast<size_t>(t)];
+            const auto& tri = m.cells[static_cast<size_t>(t)];
             by_edge[std::minmax(tri[k], tri[(k + 1) % 3])].push_back(t);
         }
-    std::vector<int> seen(static_cast<size_t>(m.n_triangles()), 0);
+    std::vector<int> seen(static_cast<size_t>(m.n_cells()), 0);
     int n = 0;
-    for (int t0 = 0; t0 < m.n_triangles(); ++t0) {
+    for (int t0 = 0; t0 < m.n_cells(); ++t0) {
         if (P.triangle_part[static_cast<size_t>(t0)] != p || seen[static_cast<size_t>(t0)])
             continue;
         ++n;
@@ -34,7 +34,7 @@ int pieces(const mesh::Mesh& m, const mesh::Partition& P, int p) {
         while (!stack.empty()) {
             const int t = stack.back();
             stack.pop_back();
-            const auto& tri = m.triangles[static_cast<size_t>(t)];
+            const auto& tri = m.cells[static_cast<size_t>(t)];
             for (int k = 0; k < 3; ++k)
                 for (int u : by_edge[std::minmax(tri[k], tri[(k + 1) % 3])])
                     if (P.triangle_part[static_cast<size_t>(u)] == p &&
@@ -56,7 +56,7 @@ TEST(Partition, BalancedConnectedPartsWithFewCutEdges) {
     for (int parts : {2, 3, 4, 7}) {
         SCOPED_TRACE(parts);
         const auto P = mesh::partition_triangles(m, parts);
-        ASSERT_EQ(P.triangle_part.size(), static_cast<size_t>(m.n_triangles()));
+        ASSERT_EQ(P.triangle_part.size(), static_cast<size_t>(m.n_cells()));
         std::vector<int> count(static_cast<size_t>(parts), 0);
         for (int p : P.triangle_part) {
             ASSERT_GE(p, 0);
@@ -75,8 +75,8 @@ TEST(Partition, BalancedConnectedPartsWithFewCutEdges) {
         EXPECT_LT(P.cut_edges, 4.0 * 64.0 * std::sqrt(static_cast<double>(parts)));
         // Every vertex has one owner, among the parts of its triangles.
         std::vector<std::set<int>> around(static_cast<size_t>(m.n_vertices()));
-        for (int t = 0; t < m.n_triangles(); ++t)
-            for (int v : m.triangles[static_cast<size_t>(t)])
+        for (int t = 0; t < m.n_cells(); ++t)
+            for (int v : m.cells[static_cast<size_t>(t)])
                 around[static_cast<size_t>(v)].insert(P.triangle_part[static_cast<size_t>(t)]);
         for (int v = 0; v < m.n_vertices(); ++v)
             EXPECT_TRUE(
@@ -90,9 +90,9 @@ TEST(Partition, WeightsMoveTheCut) {
     // Triangles of the left half weigh 3: two parts of equal work put fewer triangles in the
     // part that holds the left half.
     const auto m = mesh::structured_rectangle(Vec2(0, 0), Vec2(40, 40), 32, 32);
-    std::vector<int> w(static_cast<size_t>(m.n_triangles()), 1);
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        const auto& tri = m.triangles[static_cast<size_t>(t)];
+    std::vector<int> w(static_cast<size_t>(m.n_cells()), 1);
+    for (int t = 0; t < m.n_cells(); ++t) {
+        const auto& tri = m.cells[static_cast<size_t>(t)];
         const double x = (m.vertices[static_cast<size_t>(tri[0])].x() +
                           m.vertices[static_cast<size_t>(tri[1])].x() +
                           m.vertices[static_cast<size_t>(tri[2])].x()) /
@@ -101,13 +101,13 @@ TEST(Partition, WeightsMoveTheCut) {
     }
     const auto P = mesh::partition_triangles(m, 2, w);
     EXPECT_LE(P.imbalance(), 1.031);
-    EXPECT_NEAR(P.part_work[0] + P.part_work[1], 4.0 * m.n_triangles() / 2.0, 1e-9);
+    EXPECT_NEAR(P.part_work[0] + P.part_work[1], 4.0 * m.n_cells() / 2.0, 1e-9);
     std::vector<int> count(2, 0);
     for (int p : P.triangle_part)
         ++count[static_cast<size_t>(p)];
     // Total work 2 n: each part 1 n; the part on the heavy side holds about n / 3 triangles.
     const int fewer = std::min(count[0], count[1]);
-    EXPECT_LT(fewer, 0.45 * m.n_triangles());
+    EXPECT_LT(fewer, 0.45 * m.n_cells());
 }
 
 TEST(Partition, OnePartAndBadArguments) {
@@ -132,10 +132,10 @@ TEST(Partition, ADisconnectedMeshOfTwoBodiesIsPartitioned) {
     const int off = m.n_vertices();
     for (const auto& x : upper.vertices)
         m.vertices.push_back(x);
-    for (auto t : upper.triangles) {
+    for (auto t : upper.cells) {
         for (int& v : t)
             v += off;
-        m.triangles.push_back(t);
+        m.cells.push_back(t);
     }
     for (int parts : {2, 3, 4}) {
         SCOPED_TRACE(parts);

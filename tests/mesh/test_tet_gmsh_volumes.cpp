@@ -19,12 +19,12 @@ TEST(TetGmshVolumes, ATetrahedronInNoPhysicalVolumeIsNamed) {
                            "'core')"});
     // Selecting one volume by name reads its tetrahedra alone.
     const TetMesh core = read_gmsh_tet_text(tmesh::msh22(spec), "cube.msh", "core");
-    EXPECT_EQ(core.n_tetrahedra(), 1);
+    EXPECT_EQ(core.n_cells(), 1);
     EXPECT_EQ(core.attribute, std::vector<int>{4});
     // No tetrahedron in a physical volume: all are body 0 (no attributes).
     for (auto& t : spec.tets)
         t.first = 0;
     const TetMesh none = read_gmsh_tet_text(tmesh::msh22(spec), "cube.msh");
-    EXPECT_EQ(none.n_tetrahedra(), 5);
+    EXPECT_EQ(none.n_cells(), 5);
     EXPECT_TRUE(none.attribute.empty());
 }

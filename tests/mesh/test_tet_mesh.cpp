@@ -35,10 +35,10 @@ TetMesh merge(const TetMesh& a, const TetMesh& b) {
         if (inserted) m.vertices.push_back(b.vertices[v]);
         index[v] = it->second;
     }
-    for (auto k : b.tetrahedra) {
+    for (auto k : b.cells) {
         for (int& v : k)
             v = index[v];
-        m.tetrahedra.push_back(k);
+        m.cells.push_back(k);
     }
     return m;
 }
@@ -60,13 +60,13 @@ TEST(TetBox, CountsTagsAndKuhnPaths) {
     const Vec3 corner(-1, 0.5, 2), size(3, 2, 1);
     const TetMesh m = structured_box(corner, size, 3, 4, 2);
     EXPECT_EQ(m.n_vertices(), 4 * 5 * 3);
-    EXPECT_EQ(m.n_tetrahedra(), 6 * 3 * 4 * 2);
+    EXPECT_EQ(m.n_cells(), 6 * 3 * 4 * 2);
     EXPECT_EQ(m.boundary.size(), 4u * (3 * 4 + 4 * 2 + 2 * 3));
     EXPECT_NEAR(mesh::testing::total_volume(m), 6.0, 1e-13);
     EXPECT_EQ(m.vertices[(2 * 5 + 3) * 4 + 1], corner + Vec3(1, 1.5, 1)); // vertex (1, 3, 2)
     // Every tetrahedron runs along a Kuhn path: three steps along three different axes.
     const Vec3 h(1, 0.5, 0.5);
-    for (const auto& k : m.tetrahedra) {
+    for (const auto& k : m.cells) {
         std::set<int> axes;
         for (int s = 0; s < 3; ++s) {
             const Vec3 d = m.vertices[k[s + 1]] - m.vertices[k[s]];
@@ -125,11 +125,11 @@ TEST(TetGmsh, ReadsBothFormats) {
         ASSERT_EQ(m.n_vertices(), 8);
         for (int v = 0; v < 8; ++v)
             EXPECT_EQ(m.vertices[v], spec.nodes[v]);
-        ASSERT_EQ(m.n_tetrahedra(), 5);
+        ASSERT_EQ(m.n_cells(), 5);
         for (int t = 0; t < 5; ++t) {
             for (int i = 0; i < 4; ++i)
-                EXPECT_EQ(m.tetrahedra[t][i], spec.tets[t].second[i] - 1);
-            EXPECT_GT(m.signed_volume(t), 0);
+                EXPECT_EQ(m.cells[t][i], spec.tets[t].second[i] - 1);
+            EXPECT_GT(m.signed_measure(t), 0);
         }
         EXPECT_EQ(m.attribute, (std::vector<int>{3, 3, 3, 3, 4}));
         const std::set<std::pair<std::array<int, 3>, std::string>> expected = {
@@ -143,8 +143,8 @@ TEST(TetGmsh, ReadsBothFormats) {
         EXPECT_LT(n.z(), 0);
         // One body out of two: the core alone, its own vertices renumbered in file order.
         const TetMesh core = read_gmsh_tet_text(text, "cube.msh", "core");
-        ASSERT_EQ(core.n_tetrahedra(), 1);
-        EXPECT_EQ(core.tetrahedra[0], (std::array<int, 4>{0, 1, 2, 3}));
+        ASSERT_EQ(core.n_cells(), 1);
+        EXPECT_EQ(core.cells[0], (std::array<int, 4>{0, 1, 2, 3}));
         EXPECT_EQ(core.vertices[3], spec.nodes[7]);
         EXPECT_TRUE(core.boundary.empty()); // no tagged triangle is a face of the core
         // The shell alone: its four corners touch each other along edges only.
@@ -161,7 +161,7 @@ TEST(TetGmsh, ReadsAFile) {
     std::ofstream(file) << msh41(distorted_cube());
     const TetMesh core = read_gmsh_tet(file, "core");
     std::filesystem::remove(file);
-    ASSERT_EQ(core.n_tetrahedra(), 1);
+    ASSERT_EQ(core.n_cells(), 1);
     EXPECT_EQ(core.attribute, std::vector<int>{4});
     expect_invalid([&] { read_gmsh_tet(file); }, {"cannot open '" + file.string() + "'"});
 }
@@ -203,14 +203,14 @@ TEST(TetQuality, NamesTheBadElement) {
     // Three tetrahedra on one face: two above it, one below.
     TetMesh three;
     three.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.2, 0.2, 2}, {0, 0, -1}};
-    three.tetrahedra = {{0, 1, 2, 3}, {0, 1, 2, 4}, {0, 1, 2, 5}};
+    three.cells = {{0, 1, 2, 3}, {0, 1, 2, 4}, {0, 1, 2, 5}};
     expect_invalid([&] { check_quality(three); },
                    {"a face shared by 3 tetrahedra: the face (0, 1, 2) at (0, 0, 0), (1, 0, 0), "
                     "(0, 1, 0) belongs to tetrahedron 0, tetrahedron 1, tetrahedron 2",
                     "expected at most two"});
     // Two of them: both above their common face, one folded over the other.
     TetMesh folded = three;
-    folded.tetrahedra.pop_back();
+    folded.cells.pop_back();
     expect_invalid([&] { check_quality(folded); },
                    {"inverted tetrahedron: tetrahedron 1 (vertices 0, 1, 2, 4", "and tetrahedron 0",
                     "lie on the same side of their common face (0, 1, 2)"});
@@ -223,12 +223,12 @@ TEST(TetQuality, NamesTheBadElement) {
                     "of their common face (1, 10, 13)"});
     // A flat one named by the caller's namer.
     TetMesh flat = structured_box(Vec3::Zero(), Vec3(1, 1, 1), 1, 1, 1);
-    flat.tetrahedra[4] = {0, 1, 2, 3};
+    flat.cells[4] = {0, 1, 2, 3};
     expect_invalid([&] { check_quality(flat, [](int t) { return "cell #" + std::to_string(t); }); },
                    {"flat tetrahedron: cell #4 (vertices 0, 1, 2, 3 at (0, 0, 0), (1, 0, 0), "
                     "(0, 1, 0), (1, 1, 0)) has volume 0"});
     TetMesh twice = structured_box(Vec3::Zero(), Vec3(1, 1, 1), 1, 1, 1);
-    twice.tetrahedra.push_back({7, 0, 1, 3});
+    twice.cells.push_back({7, 0, 1, 3});
     expect_invalid([&] { check_quality(twice); },
                    {"duplicated element: tetrahedron 0 (vertices 0, 1, 3, 7", "and tetrahedron 6"});
     // Two cubes touching along an edge, and at a corner.
@@ -254,7 +254,7 @@ TEST(TetQuality, NamesTheBadElement) {
         [&] { check_quality(inside); },
         {"boundary face (0, 3, 7) tagged 'xmin' is a face of 2 tetrahedra; expected one"});
     TetMesh out_of_range = a;
-    out_of_range.tetrahedra[2][3] = 8;
+    out_of_range.cells[2][3] = 8;
     expect_invalid([&] { check_quality(out_of_range); },
                    {"tetrahedron 2 refers to vertex 8 but the mesh has 8 vertices"});
     TetMesh attributes = a;

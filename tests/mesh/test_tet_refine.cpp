@@ -73,7 +73,7 @@ int similarity_classes(const Corners& t, const int (&table)[8][4], int levels) {
 /// The smallest dihedral angle of the mesh's tetrahedra.
 double smallest_dihedral_angle(const TetMesh& m) {
     double smallest = std::numbers::pi;
-    for (int t = 0; t < m.n_tetrahedra(); ++t) {
+    for (int t = 0; t < m.n_cells(); ++t) {
         const Corners x = corners(m, t);
         for (int i = 0; i < 4; ++i)
             for (int j = i + 1; j < 4; ++j) {
@@ -95,10 +95,10 @@ double smallest_dihedral_angle(const TetMesh& m) {
 TEST(TetRefine, ChildrenFollowBeysNumbering) {
     TetMesh m;
     m.vertices = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 2}};
-    m.tetrahedra = {{0, 1, 2, 3}};
+    m.cells = {{0, 1, 2, 3}};
     m.attribute = {7};
     const TetMesh f = refine(m);
-    ASSERT_EQ(f.n_tetrahedra(), 8);
+    ASSERT_EQ(f.n_cells(), 8);
     EXPECT_EQ(f.attribute, std::vector<int>(8, 7));
     // The midpoints in local edge order 01, 02, 03, 12, 13, 23 are vertices 4..9.
     EXPECT_EQ(f.n_coarse_vertices, 4);
@@ -119,7 +119,7 @@ TEST(TetRefine, ChildrenFollowBeysNumbering) {
         EXPECT_EQ(parent_tetrahedron(8 * 3 + c), 3);
         EXPECT_EQ(child_number(8 * 3 + c), c);
         // Children 5 and 7 are mirrored; every child has an eighth of the volume.
-        EXPECT_EQ(f.signed_volume(c), (c == 5 || c == 7 ? -1 : 1) * m.signed_volume(0) / 8);
+        EXPECT_EQ(f.signed_measure(c), (c == 5 || c == 7 ? -1 : 1) * m.signed_measure(0) / 8);
     }
 }
 
@@ -127,7 +127,7 @@ TEST(TetRefine, KuhnChildrenAreSimilarToTheirParent) {
     const std::vector<TetMesh> levels = hierarchy(kuhn_box(), 3);
     const Corners first = corners(levels[0], 0);
     for (int l = 1; l <= 3; ++l)
-        for (int c = 0; c < levels[l].n_tetrahedra(); ++c) {
+        for (int c = 0; c < levels[l].n_cells(); ++c) {
             const double r = similarity_ratio(corners(levels[l], c),
                                               corners(levels[l - 1], parent_tetrahedron(c)), 1e-12);
             ASSERT_NEAR(r, 0.5, 1e-12) << "level " << l << " tetrahedron " << c;
@@ -142,7 +142,7 @@ TEST(TetRefine, KuhnChildrenAreSimilarToTheirParent) {
 TEST(TetRefine, AtMostThreeSimilarityClassesPerStartTetrahedron) {
     const TetMesh m0 = gmsh_cube();
     const std::vector<TetMesh> levels = hierarchy(m0, 3);
-    for (int s = 0; s < m0.n_tetrahedra(); ++s) {
+    for (int s = 0; s < m0.n_cells(); ++s) {
         // The mesh's descendants of s are 8^l s .. 8^l (s + 1) - 1 on level l.
         std::vector<Corners> reps{corners(m0, s)};
         for (int l = 1, n = 8; l <= 3; ++l, n *= 8)
@@ -181,15 +181,15 @@ TEST(TetRefine, VolumesVerticesAndFaceTagsAreKept) {
         const std::vector<TetMesh> levels = hierarchy(m0, 3);
         for (int l = 1; l <= 3; ++l) {
             const TetMesh &c = levels[l - 1], &f = levels[l];
-            for (int t = 0; t < c.n_tetrahedra(); ++t) {
+            for (int t = 0; t < c.n_cells(); ++t) {
                 double sum = 0;
                 for (int k = 0; k < 8; ++k) {
-                    const double v = f.signed_volume(8 * t + k);
-                    EXPECT_EQ(v > 0, (c.signed_volume(t) > 0) != (k == 5 || k == 7));
+                    const double v = f.signed_measure(8 * t + k);
+                    EXPECT_EQ(v > 0, (c.signed_measure(t) > 0) != (k == 5 || k == 7));
                     sum += std::abs(v);
                 }
-                ASSERT_NEAR(sum, std::abs(c.signed_volume(t)),
-                            1e-14 * std::abs(c.signed_volume(t)));
+                ASSERT_NEAR(sum, std::abs(c.signed_measure(t)),
+                            1e-14 * std::abs(c.signed_measure(t)));
             }
             // Coarse vertices keep their index; a new one is its parents' midpoint.
             ASSERT_EQ(f.n_coarse_vertices, c.n_vertices());
@@ -245,10 +245,10 @@ TEST(TetRefine, ConformingLevelsOfThePredictedSizes) {
             EXPECT_EQ(sizes[l].vertices, m.n_vertices());
             EXPECT_EQ(sizes[l].edges, static_cast<double>(tet_edges(m).edges.size()));
             EXPECT_EQ(sizes[l].faces, faces);
-            EXPECT_EQ(sizes[l].tetrahedra, m.n_tetrahedra());
+            EXPECT_EQ(sizes[l].tetrahedra, m.n_cells());
             EXPECT_EQ(sizes[l].tagged_faces, static_cast<double>(m.boundary.size()));
             // Faces of one tetrahedron: 4 T = 2 F_interior + F_boundary.
-            EXPECT_EQ(sizes[l].boundary_faces, 2 * faces - 4 * m.n_tetrahedra());
+            EXPECT_EQ(sizes[l].boundary_faces, 2 * faces - 4 * m.n_cells());
             EXPECT_EQ(sizes[l].boundary_faces, std::pow(4, l) * sizes[0].boundary_faces);
             EXPECT_GT(sizes[l].bytes, 24 * sizes[l].vertices + 16 * sizes[l].tetrahedra);
         }

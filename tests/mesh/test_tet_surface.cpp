@@ -36,7 +36,7 @@ TetMesh octahedron() {
     for (int a : {1, 2})
         for (int b : {3, 4})
             for (int c : {5, 6}) {
-                m.tetrahedra.push_back({0, a, b, c});
+                m.cells.push_back({0, a, b, c});
                 add_face(m, {a, b, c}, 0, ball);
             }
     return m;
@@ -56,9 +56,9 @@ TEST(TetSurface, NewVerticesGoOntoTheSphere) {
     TetMesh m = octahedron();
     const CurvedSurface sphere{CurvedSurface::Kind::sphere, Vec3::Zero(), Vec3::UnitZ(), 1.0};
     attach_surface(m, "ball", sphere);
-    ASSERT_EQ(m.surfaces.size(), 1u);
+    ASSERT_EQ(m.shapes.size(), 1u);
     for (const auto& f : m.boundary)
-        EXPECT_EQ(f.surface, 0);
+        EXPECT_EQ(f.shape, 0);
     const std::vector<TetLevelSize> sizes = predict_tet_level_sizes(m, 3);
     std::vector<double> error{4 * std::numbers::pi / 3 - mesh::testing::total_volume(m)};
     for (int l = 1; l <= 3; ++l) {
@@ -67,7 +67,7 @@ TEST(TetSurface, NewVerticesGoOntoTheSphere) {
         EXPECT_LE(largest_offset(m, "ball", sphere), 1e-15);
         EXPECT_EQ(m.n_vertices(), sizes[l].vertices);
         for (const auto& f : m.boundary)
-            EXPECT_EQ(f.surface, 0);
+            EXPECT_EQ(f.shape, 0);
         error.push_back(4 * std::numbers::pi / 3 - mesh::testing::total_volume(m));
         // The volume grows towards the ball's, its error falling about fourfold per level once
         // the octahedron's (a coarse start) has been refined away.
@@ -85,12 +85,12 @@ TEST(TetSurface, NewVerticesGoOntoTheCylinder) {
     const CurvedSurface cylinder{CurvedSurface::Kind::cylinder, Vec3(0, 0, 5), Vec3(0, 0, 2), 1.0};
     for (const char* side : {"xmin", "xmax", "ymin", "ymax"})
         attach_surface(m, side, cylinder);
-    EXPECT_EQ(m.surfaces[0].axis, Vec3::UnitZ());
+    EXPECT_EQ(m.shapes[0].axis, Vec3::UnitZ());
     for (int l = 1; l <= 2; ++l) {
         m = refine(m);
         EXPECT_NO_THROW(check_quality(m)) << "level " << l;
         for (const char* side : {"xmin", "xmax", "ymin", "ymax"})
-            EXPECT_LE(largest_offset(m, side, m.surfaces[0]), 1e-15) << side;
+            EXPECT_LE(largest_offset(m, side, m.shapes[0]), 1e-15) << side;
         // The rim's new vertices stay in the planes of the ends.
         for (int v : m.vertices_with_tag(m.tag("zmin")))
             EXPECT_EQ(m.vertices[v].z(), 0.0);
@@ -120,7 +120,7 @@ TEST(TetSurface, RefusesABadDeclarationOrAnInvertingMove) {
     // near that face: the face's midpoints, moved onto the sphere, pass that vertex.
     TetMesh cavity;
     cavity.vertices = {Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), Vec3(0.4, 0.4, 0.4)};
-    cavity.tetrahedra = {{0, 1, 2, 3}};
+    cavity.cells = {{0, 1, 2, 3}};
     add_face(cavity, {0, 1, 2}, 3, cavity.add_tag("cavity"));
     EXPECT_NO_THROW(check_quality(cavity));
     attach_surface(cavity, "cavity", sphere);

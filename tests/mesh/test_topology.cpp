@@ -36,8 +36,8 @@ void add_square(Mesh& m, const Vec2& at, int body) {
     const int b = m.n_vertices();
     for (const Vec2& p : {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)})
         m.vertices.push_back(at + p);
-    m.triangles.push_back({b, b + 1, b + 2});
-    m.triangles.push_back({b, b + 2, b + 3});
+    m.cells.push_back({b, b + 1, b + 2});
+    m.cells.push_back({b, b + 2, b + 3});
     m.attribute.push_back(body);
     m.attribute.push_back(body);
 }
@@ -58,7 +58,7 @@ Mesh square_beside_fan(double x0, int left_body, int right_body) {
                                                    {b + 2, b + 3, b + 5},
                                                    {b + 3, b + 4, b + 5},
                                                    {b + 4, b, b + 5}}) {
-        m.triangles.push_back(t);
+        m.cells.push_back(t);
         m.attribute.push_back(right_body);
     }
     return m;
@@ -103,16 +103,16 @@ TEST(MeshTopology, HangingNodeAndItsConformingRepair) {
     Mesh m;
     m.vertices = {Vec2(0, 0),   Vec2(1, 0), Vec2(1, 1), Vec2(0, 1),
                   Vec2(1, 0.5), Vec2(2, 0), Vec2(2, 1), Vec2(1.5, 0.5)};
-    m.triangles = {{0, 1, 2}, {0, 2, 3}, {1, 5, 7}, {5, 6, 7}, {6, 2, 7}, {2, 4, 7}, {4, 1, 7}};
+    m.cells = {{0, 1, 2}, {0, 2, 3}, {1, 5, 7}, {5, 6, 7}, {6, 2, 7}, {2, 4, 7}, {4, 1, 7}};
     EXPECT_NE(refusal(m).find("hanging node (T-junction): vertex 4 (1, 0.5) lies inside the edge "
                               "from vertex 1 (1, 0) to vertex 2 (1, 1) of triangle 0"),
               std::string::npos)
         << refusal(m);
     // The left square split at the vertex: conforming.
     Mesh fixed = m;
-    fixed.triangles[0] = {0, 1, 4};
-    fixed.triangles[1] = {0, 4, 3};
-    fixed.triangles.push_back({4, 2, 3});
+    fixed.cells[0] = {0, 1, 4};
+    fixed.cells[1] = {0, 4, 3};
+    fixed.cells.push_back({4, 2, 3});
     EXPECT_EQ(refusal(fixed), "");
 }
 
@@ -138,16 +138,16 @@ TEST(MeshTopology, TouchingBodiesAndTheTolerance) {
 TEST(MeshTopology, DuplicatedAndNonManifoldTrianglesAreNamed) {
     Mesh m;
     m.vertices = {Vec2(0, 0), Vec2(1, 0), Vec2(0.5, 1), Vec2(0.5, -1), Vec2(0.5, 2)};
-    m.triangles = {{0, 1, 2}, {1, 0, 3}};
+    m.cells = {{0, 1, 2}, {1, 0, 3}};
     EXPECT_EQ(refusal(m), "");
     Mesh dup = m;
-    dup.triangles.push_back({2, 0, 1}); // triangle 0 again, rotated
+    dup.cells.push_back({2, 0, 1}); // triangle 0 again, rotated
     EXPECT_NE(refusal(dup).find("duplicated element: triangle 0 and triangle 2 have the same "
                                 "vertices, vertex 0 (0, 0), vertex 1 (1, 0) and vertex 2 (0.5, 1)"),
               std::string::npos)
         << refusal(dup);
     Mesh fold = m;
-    fold.triangles.push_back({0, 1, 4}); // a third triangle on the edge (0, 1), over triangle 0
+    fold.cells.push_back({0, 1, 4}); // a third triangle on the edge (0, 1), over triangle 0
     EXPECT_NE(refusal(fold).find("non-manifold edge: the edge from vertex 0 (0, 0) to vertex 1 "
                                  "(1, 0) is shared by 3 triangles (triangle 0, triangle 1 and "
                                  "triangle 2)"),

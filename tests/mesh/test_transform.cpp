@@ -14,17 +14,17 @@ namespace {
 /// (i, j) at index 3 j + i, attribute 3, the "right" edge on a circle (geometry irrelevant here).
 mesh::Mesh right_half() {
     auto h = mesh::structured_rectangle(Vec2(1, 0), Vec2(2, 1), 2, 1);
-    h.attribute.assign(h.triangles.size(), 3);
-    h.circles.push_back({Vec2(2.5, 0.5), 0.75});
+    h.attribute.assign(h.cells.size(), 3);
+    h.shapes.push_back({Vec2(2.5, 0.5), 0.75});
     for (auto& e : h.boundary)
-        if (e.tag == h.tag("right")) e.curve = 0;
+        if (e.tag == h.tag("right")) e.shape = 0;
     return h;
 }
 
 /// Whether the directed edge (a, b) is an edge of a triangle in that direction (then the triangle,
 /// counter-clockwise, lies to its left).
 bool has_directed_edge(const mesh::Mesh& m, int a, int b) {
-    for (const auto& t : m.triangles)
+    for (const auto& t : m.cells)
         for (int k = 0; k < 3; ++k)
             if (t[static_cast<size_t>(k)] == a && t[static_cast<size_t>((k + 1) % 3)] == b)
                 return true;
@@ -45,20 +45,20 @@ TEST(MirrorAboutX, ImagesVerticesTrianglesCirclesAndEdges) {
     EXPECT_EQ(m.vertices[8], Vec2(0, 1));
     EXPECT_EQ(m.vertices[9], Vec2(-1, 1));
     // Triangles doubled, all counter-clockwise, total area twice the half's (2 each).
-    ASSERT_EQ(m.n_triangles(), 8);
+    ASSERT_EQ(m.n_cells(), 8);
     double area = 0.0;
-    for (int t = 0; t < m.n_triangles(); ++t) {
-        EXPECT_GT(m.signed_area(t), 0.0) << "triangle " << t;
-        area += m.signed_area(t);
+    for (int t = 0; t < m.n_cells(); ++t) {
+        EXPECT_GT(m.signed_measure(t), 0.0) << "triangle " << t;
+        area += m.signed_measure(t);
     }
     EXPECT_DOUBLE_EQ(area, 4.0);
     for (int t = 0; t < 4; ++t)
-        EXPECT_EQ(m.triangles[static_cast<size_t>(t)], h.triangles[static_cast<size_t>(t)]);
+        EXPECT_EQ(m.cells[static_cast<size_t>(t)], h.cells[static_cast<size_t>(t)]);
     EXPECT_EQ(m.attribute, std::vector<int>(8, 3));
     // The circle is mirrored after the original.
-    ASSERT_EQ(m.circles.size(), 2u);
-    EXPECT_EQ(m.circles[1].center, Vec2(-0.5, 0.5));
-    EXPECT_EQ(m.circles[1].radius, 0.75);
+    ASSERT_EQ(m.shapes.size(), 2u);
+    EXPECT_EQ(m.shapes[1].center, Vec2(-0.5, 0.5));
+    EXPECT_EQ(m.shapes[1].radius, 0.75);
     // Boundary: the "left" edge lies on the mirror line and is dropped; the 5 others are kept,
     // each followed by its reversed image with the same tag.
     EXPECT_EQ(m.tag_names, h.tag_names);
@@ -71,9 +71,9 @@ TEST(MirrorAboutX, ImagesVerticesTrianglesCirclesAndEdges) {
         EXPECT_EQ(kept.v0, e.v0);
         EXPECT_EQ(kept.v1, e.v1);
         EXPECT_EQ(kept.tag, e.tag);
-        EXPECT_EQ(kept.curve, e.curve);
+        EXPECT_EQ(kept.shape, e.shape);
         EXPECT_EQ(img.tag, e.tag);
-        EXPECT_EQ(img.curve, e.curve >= 0 ? 1 : -1);
+        EXPECT_EQ(img.shape, e.shape >= 0 ? 1 : -1);
         // The image runs from the mirror of v1 to the mirror of v0.
         const Vec2 a = m.vertices[static_cast<size_t>(img.v0)];
         const Vec2 b = m.vertices[static_cast<size_t>(img.v1)];
@@ -102,34 +102,34 @@ TEST(MergeInto, RenumbersVerticesCirclesAndMergesTagsByName) {
     const auto a = mesh::structured_rectangle(Vec2(0, 0), Vec2(1, 1), 1, 1);
     mesh::merge_into(all, a, 0);
     EXPECT_EQ(all.n_vertices(), 4);
-    EXPECT_EQ(all.n_triangles(), 2);
+    EXPECT_EQ(all.n_cells(), 2);
     EXPECT_EQ(all.attribute, (std::vector<int>{0, 0}));
     EXPECT_EQ(all.boundary.size(), 4u);
 
     // A second body above the first: 2 x 1 squares, a circle, one new tag and its own attribute
     // (which merge_into replaces by the body number).
     auto b = mesh::structured_rectangle(Vec2(0, 1), Vec2(2, 1), 2, 1);
-    b.attribute.assign(b.triangles.size(), 7);
-    b.circles.push_back({Vec2(1, 3), 1.0});
+    b.attribute.assign(b.cells.size(), 7);
+    b.shapes.push_back({Vec2(1, 3), 1.0});
     const int contact = b.add_tag("contact");
     for (auto& e : b.boundary)
         if (e.tag == b.tag("bottom")) {
             e.tag = contact;
-            e.curve = 0;
+            e.shape = 0;
         }
-    all.circles.push_back({Vec2(5, 5), 2.0}); // one circle already in `all`
+    all.shapes.push_back({Vec2(5, 5), 2.0}); // one circle already in `all`
     mesh::merge_into(all, b, 1);
 
     ASSERT_EQ(all.n_vertices(), 4 + 6);
-    ASSERT_EQ(all.n_triangles(), 2 + 4);
+    ASSERT_EQ(all.n_cells(), 2 + 4);
     for (int v = 0; v < 6; ++v)
         EXPECT_EQ(all.vertices[static_cast<size_t>(4 + v)], b.vertices[static_cast<size_t>(v)]);
-    for (size_t t = 0; t < b.triangles.size(); ++t)
+    for (size_t t = 0; t < b.cells.size(); ++t)
         for (size_t k = 0; k < 3; ++k)
-            EXPECT_EQ(all.triangles[2 + t][k], b.triangles[t][k] + 4);
+            EXPECT_EQ(all.cells[2 + t][k], b.cells[t][k] + 4);
     EXPECT_EQ(all.attribute, (std::vector<int>{0, 0, 1, 1, 1, 1}));
-    ASSERT_EQ(all.circles.size(), 2u);
-    EXPECT_EQ(all.circles[1].center, Vec2(1, 3));
+    ASSERT_EQ(all.shapes.size(), 2u);
+    EXPECT_EQ(all.shapes[1].center, Vec2(1, 3));
     // Tags: bottom/right/top/left keep their ids 0..3, "contact" gets 4.
     EXPECT_EQ(all.tag_names.size(), 5u);
     EXPECT_EQ(all.tag("contact"), 4);
@@ -142,7 +142,7 @@ TEST(MergeInto, RenumbersVerticesCirclesAndMergesTagsByName) {
         EXPECT_EQ(e.v0, eb.v0 + 4);
         EXPECT_EQ(e.v1, eb.v1 + 4);
         EXPECT_EQ(all.tag_name(e.tag), b.tag_name(eb.tag));
-        EXPECT_EQ(e.curve, eb.curve >= 0 ? 1 : -1);
+        EXPECT_EQ(e.shape, eb.shape >= 0 ? 1 : -1);
     }
     EXPECT_EQ(all.vertices_with_tag(all.tag("contact")), (std::vector<int>{4, 5, 6}));
     // Vertices (0,1) and (1,1) of the two bodies coincide but stay distinct: two bodies.

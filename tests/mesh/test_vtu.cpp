@@ -56,7 +56,7 @@ Mesh small_mesh() {
     Mesh m;
     m.vertices = {Vec2(0.1, 1.0 / 3), Vec2(1e-300, -2.5e17), Vec2(std::sqrt(2.0), std::acos(-1.0)),
                   Vec2(-7.0 / 9, 0)};
-    m.triangles = {{0, 1, 2}, {0, 2, 3}};
+    m.cells = {{0, 1, 2}, {0, 2, 3}};
     return m;
 }
 
@@ -131,7 +131,7 @@ TEST_F(Vtu, BinaryHoldsTheSameArraysBitForBit) {
     // Large enough for several 1 MiB compression blocks: 90601 points (2.2 MB of coordinates),
     // 180000 triangles (a 4.3 MB stress field), none a whole number of blocks.
     const Mesh m = structured_rectangle(Vec2(0, 0), Vec2(2, 1), 300, 300);
-    const std::size_t nv = m.vertices.size(), nt = m.triangles.size();
+    const std::size_t nv = m.vertices.size(), nt = m.cells.size();
     Field u{"displacement", 2, {}};
     for (std::size_t v = 0; v < nv; ++v) {
         u.values.push_back(std::sin(1.0 + v) / 3);
@@ -173,7 +173,7 @@ TEST_F(Vtu, BinaryHoldsTheSameArraysBitForBit) {
     ASSERT_EQ(conn.size(), 3 * nt);
     for (std::size_t t = 0; t < nt; ++t)
         for (int k = 0; k < 3; ++k)
-            ASSERT_EQ(conn[3 * t + k], m.triangles[t][k]);
+            ASSERT_EQ(conn[3 * t + k], m.cells[t][k]);
     const auto offsets =
         testutil::as<std::int64_t>(testutil::appended_array(xml, "Name=\"offsets\""));
     ASSERT_EQ(offsets.size(), nt);
@@ -226,7 +226,7 @@ TEST_F(Vtu, InconsistentSizesThrow) {
     EXPECT_THROW(write_vtu(file, m, {}, {Field{"c", 1, {1, 2}}, Field{"c", 1, {1, 2}}}),
                  InvalidInput);
     Mesh broken = m;
-    broken.triangles[1][2] = 4;
+    broken.cells[1][2] = 4;
     EXPECT_THROW(write_vtu(file, broken, {}, {}), InvalidInput);
     EXPECT_TRUE(fs::is_empty(dir));
     // A directory that does not exist.
@@ -245,14 +245,14 @@ TEST_F(Vtu, OverwritesAndWritesLargerMeshes) {
     EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfPoints"), std::to_string(41 * 21));
     EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), std::to_string(2 * 40 * 20));
     const auto conn = data_array(xml, "Name=\"connectivity\"");
-    ASSERT_EQ(conn.size(), 3u * m.triangles.size());
-    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+    ASSERT_EQ(conn.size(), 3u * m.cells.size());
+    for (std::size_t t = 0; t < m.cells.size(); ++t)
         for (int k = 0; k < 3; ++k)
-            EXPECT_EQ(conn[3 * t + k], m.triangles[t][k]);
+            EXPECT_EQ(conn[3 * t + k], m.cells[t][k]);
     const auto offsets = data_array(xml, "Name=\"offsets\"");
-    ASSERT_EQ(offsets.size(), m.triangles.size());
-    EXPECT_EQ(offsets.back(), 3.0 * m.triangles.size());
-    EXPECT_EQ(data_array(xml, "Name=\"types\"").size(), m.triangles.size());
+    ASSERT_EQ(offsets.size(), m.cells.size());
+    EXPECT_EQ(offsets.back(), 3.0 * m.cells.size());
+    EXPECT_EQ(data_array(xml, "Name=\"types\"").size(), m.cells.size());
     const auto xy = data_array(xml, "Name=\"xy\"");
     ASSERT_EQ(xy.size(), x.size());
     for (std::size_t v = 0; v < x.size(); ++v)

@@ -57,14 +57,14 @@ TEST_F(VtuTet, TetrahedraAndFieldsReadBackBitForBit) {
     const TetMesh m = gmsh_mesh();
     const auto pf = point_fields(m);
     Field vol{"volume", 1, {}};
-    for (int t = 0; t < m.n_tetrahedra(); ++t)
-        vol.values.push_back(m.signed_volume(t));
+    for (int t = 0; t < m.n_cells(); ++t)
+        vol.values.push_back(m.signed_measure(t));
     write_vtu(file, m, pf, {vol});
     const std::string xml = testutil::slurp(file);
     EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfPoints"), std::to_string(m.n_vertices()));
-    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), std::to_string(m.n_tetrahedra()));
+    EXPECT_EQ(testutil::xml_attribute(xml, "NumberOfCells"), std::to_string(m.n_cells()));
     EXPECT_EQ(testutil::xml_attribute(xml, "compressor"), "vtkZLibDataCompressor");
-    const std::size_t nv = m.vertices.size(), nt = m.tetrahedra.size();
+    const std::size_t nv = m.vertices.size(), nt = m.cells.size();
 
     const auto xyz = testutil::as<double>(testutil::appended_array(xml, "<Points>"));
     ASSERT_EQ(xyz.size(), 3 * nv);
@@ -81,7 +81,7 @@ TEST_F(VtuTet, TetrahedraAndFieldsReadBackBitForBit) {
     ASSERT_EQ(types.size(), nt);
     for (std::size_t t = 0; t < nt; ++t) {
         for (std::size_t k = 0; k < 4; ++k)
-            ASSERT_EQ(conn[4 * t + k], m.tetrahedra[t][k]) << t;
+            ASSERT_EQ(conn[4 * t + k], m.cells[t][k]) << t;
         ASSERT_EQ(offsets[t], static_cast<std::int64_t>(4 * (t + 1)));
         ASSERT_EQ(types[t], 10); // VTK_TETRA
     }
@@ -193,10 +193,10 @@ TEST_F(VtuTet, BadInputIsRefusedBeforeAnyFileIsWritten) {
     nan.values[5] = std::nan("");
     tmesh::expect_invalid([&] { write_vtu(dir / "a.vtu", m, {nan}, {}); },
                           {"non-finite value", "vertex 5"});
-    m.tetrahedra[4][2] = 8;
+    m.cells[4][2] = 8;
     tmesh::expect_invalid([&] { write_vtu(dir / "a.vtu", m, {}, {}); },
                           {"tetrahedron 4 refers to vertex 8", "8 vertices"});
-    m.tetrahedra[4][2] = 1;
+    m.cells[4][2] = 1;
     m.vertices[3].y() = INFINITY;
     tmesh::expect_invalid([&] { write_boundary_vtu(dir / "a.vtu", m, {}); },
                           {"vertex 3 has a non-finite coordinate"});

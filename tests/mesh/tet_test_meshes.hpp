@@ -137,7 +137,7 @@ inline std::array<Vec3, 4> corners(const TetMesh& m, int t) {
     std::array<Vec3, 4> x;
     for (int i = 0; i < 4; ++i)
         x[static_cast<size_t>(i)] = m.vertices[static_cast<size_t>(
-            m.tetrahedra[static_cast<size_t>(t)][static_cast<size_t>(i)])];
+            m.cells[static_cast<size_t>(t)][static_cast<size_t>(i)])];
     return x;
 }
 

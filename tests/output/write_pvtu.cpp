@@ -23,13 +23,13 @@ int main(int argc, char** argv) {
         const Communicator& comm = comm::world();
         mesh::Mesh m =
             mesh::structured_rectangle({0, 0}, {1, 0.6}, 5, 3, mesh::Diagonal::alternate);
-        m.circles.push_back({{0.5, -10.0}, 10.6});
+        m.shapes.push_back({{0.5, -10.0}, 10.6});
         for (auto& e : m.boundary)
-            if (e.tag == m.tag("top")) e.curve = 0;
+            if (e.tag == m.tag("top")) e.shape = 0;
         const auto H = mesh::distribute(m, std::atoi(argv[2]), comm);
         const mesh::LocalLevel& L = H.levels.back();
         const size_t nv = static_cast<size_t>(L.mesh.n_vertices());
-        const size_t nt = static_cast<size_t>(L.mesh.n_triangles());
+        const size_t nt = static_cast<size_t>(L.mesh.n_cells());
         mesh::Field f{"f", 1, std::vector<double>(nv)}, u{"u", 2, std::vector<double>(2 * nv)},
             g{"global_vertex", 1, std::vector<double>(nv)};
         for (size_t v = 0; v < nv; ++v) {
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
         mesh::Field owner{"owner", 1, std::vector<double>(nt, comm.rank())};
         mesh::Field area{"area", 1, std::vector<double>(nt)};
         for (size_t t = 0; t < nt; ++t)
-            area.values[t] = L.mesh.signed_area(static_cast<int>(t));
+            area.values[t] = L.mesh.signed_measure(static_cast<int>(t));
         const bool ascii = argc > 3 && std::string(argv[3]) == "ascii";
         mesh::write_distributed_vtu(argv[1], L, {f, u, g}, {owner, area}, comm,
                                     ascii ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary);

@@ -32,9 +32,9 @@ using Point = std::pair<double, double>;
 
 mesh::Mesh curved_rectangle() {
     mesh::Mesh m = mesh::structured_rectangle({0, 0}, {1, 0.6}, 5, 3, mesh::Diagonal::alternate);
-    m.circles.push_back({{0.5, -10.0}, 10.6});
+    m.shapes.push_back({{0.5, -10.0}, 10.6});
     for (auto& e : m.boundary)
-        if (e.tag == m.tag("top")) e.curve = 0;
+        if (e.tag == m.tag("top")) e.shape = 0;
     return m;
 }
 
@@ -48,7 +48,7 @@ solvers::DistributedRows owned_rows(const mesh::LocalLevel& L) {
     for (int i = 0; i < L.n_owned_vertices(); ++i)
         row_of[static_cast<size_t>(L.owned_vertices[static_cast<size_t>(i)])] = 2 * i;
     std::vector<Eigen::Triplet<double>> trip;
-    for (const auto& t : L.mesh.triangles) {
+    for (const auto& t : L.mesh.cells) {
         const auto K = fem::element_stiffness(L.mesh.vertices[static_cast<size_t>(t[0])],
                                               L.mesh.vertices[static_cast<size_t>(t[1])],
                                               L.mesh.vertices[static_cast<size_t>(t[2])], steel);
@@ -78,7 +78,7 @@ solvers::DistributedRows owned_rows(const mesh::LocalLevel& L) {
 SparseMatrix serial_shifted(const mesh::Mesh& m, double shift) {
     const int n = 2 * m.n_vertices();
     std::vector<Eigen::Triplet<double>> trip;
-    for (const auto& t : m.triangles) {
+    for (const auto& t : m.cells) {
         const auto K = fem::element_stiffness(m.vertices[static_cast<size_t>(t[0])],
                                               m.vertices[static_cast<size_t>(t[1])],
                                               m.vertices[static_cast<size_t>(t[2])], steel);

@@ -188,8 +188,8 @@ TEST(Prolongation, OnTheHertzArcInterpolatesAtTheChordMidpoint) {
         tr.interpolate_nodal(sample_linear(C.mesh, A, c), uf);
         const int nc = F.mesh.n_coarse_vertices;
         ASSERT_EQ(nc, C.mesh.n_vertices());
-        ASSERT_EQ(F.mesh.circles.size(), 1u);
-        const double R = F.mesh.circles[0].radius;
+        ASSERT_EQ(F.mesh.shapes.size(), 1u);
+        const double R = F.mesh.shapes[0].radius;
         int n_moved = 0, n_unmoved = 0;
         double max_shift = 0.0;
         for (int v = 0; v < F.mesh.n_vertices(); ++v) {
@@ -232,7 +232,7 @@ TEST(Prolongation, TwoStepsEqualDirectInterpolationOnCoarseTriangles) {
         for (int v = 0; v < fine.n_vertices(); ++v) {
             const Vec2& x = fine.vertices[static_cast<size_t>(v)];
             bool found = false;
-            for (const auto& tri : coarse.triangles) {
+            for (const auto& tri : coarse.cells) {
                 const Vec2& a = coarse.vertices[static_cast<size_t>(tri[0])];
                 const Vec2& b = coarse.vertices[static_cast<size_t>(tri[1])];
                 const Vec2& c = coarse.vertices[static_cast<size_t>(tri[2])];

@@ -6,7 +6,7 @@
 #include "mesh/tet_refine.hpp"
 #include "tests/common/random.hpp"
 #include "tests/mesh/tet_test_meshes.hpp"
-#include "transfer/tet_transfer.hpp"
+#include "transfer/prolongation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -64,13 +64,13 @@ Vector random_field(int n, unsigned seed) {
 /// the vertex in the parent of a fine tetrahedron containing it.
 Vector evaluate_at_fine_vertices(const TetMesh& coarse, const Vector& u, const TetMesh& fine) {
     Vector out = Vector::Constant(fine.n_vertices(), std::nan(""));
-    for (int t = 0; t < fine.n_tetrahedra(); ++t) {
-        const auto& ct = coarse.tetrahedra[static_cast<size_t>(parent_tetrahedron(t))];
+    for (int t = 0; t < fine.n_cells(); ++t) {
+        const auto& ct = coarse.cells[static_cast<size_t>(parent_tetrahedron(t))];
         const auto x = tmesh::corners(coarse, parent_tetrahedron(t));
         Eigen::Matrix3d J;
         J << x[1] - x[0], x[2] - x[0], x[3] - x[0];
         const Eigen::PartialPivLU<Eigen::Matrix3d> lu(J);
-        for (int v : fine.tetrahedra[static_cast<size_t>(t)]) {
+        for (int v : fine.cells[static_cast<size_t>(t)]) {
             const Vec3 b = lu.solve(fine.vertices[static_cast<size_t>(v)] - x[0]);
             out[v] = (1 - b.sum()) * u[ct[0]] + b[0] * u[ct[1]] + b[1] * u[ct[2]] + b[2] * u[ct[3]];
         }
@@ -121,7 +121,7 @@ TEST(TetTransfer, ExactOnLinearFieldsAndEqualToInterpolation) {
         for (size_t l = 1; l < levels.size(); ++l) {
             SCOPED_TRACE(name + " level " + std::to_string(l));
             const TetMesh &coarse = levels[l - 1], &fine = levels[l];
-            const MovableSparseMatrix P = tet_vertex_prolongation(fine);
+            const MovableSparseMatrix P = vertex_prolongation(fine);
             ASSERT_EQ(P.rows(), fine.n_vertices());
             ASSERT_EQ(P.cols(), coarse.n_vertices());
             const Vec3 grad(0.7, -1.3, 2.9);
@@ -146,7 +146,7 @@ TEST(TetTransfer, ExpandedMatrixInterpolatesVectorFieldsComponentByComponent) {
         for (size_t l = 1; l < levels.size(); ++l) {
             SCOPED_TRACE(name + " level " + std::to_string(l));
             const TetMesh &coarse = levels[l - 1], &fine = levels[l];
-            const MovableSparseMatrix P = tet_vertex_prolongation(fine);
+            const MovableSparseMatrix P = vertex_prolongation(fine);
             const MovableSparseMatrix P3 = expand_components(P, 3);
             ASSERT_EQ(P3.rows(), 3 * fine.n_vertices());
             ASSERT_EQ(P3.cols(), 3 * coarse.n_vertices());
@@ -190,7 +190,7 @@ TEST(TetTransfer, RestrictedToFreeUnknownsOfAnyNumbering) {
                 const auto fixed_c = supports(coarse, name), fixed_f = supports(fine, name);
                 const auto [uc, nc] = number(fixed_c, interleaved);
                 const auto [uf, nf] = number(fixed_f, interleaved);
-                const MovableSparseMatrix P = tet_vertex_prolongation(fine);
+                const MovableSparseMatrix P = vertex_prolongation(fine);
                 const MovableSparseMatrix T = restrict_to_unknowns(P, 3, uc, nc, uf, nf);
                 ASSERT_EQ(T.rows(), nf);
                 ASSERT_EQ(T.cols(), nc);
@@ -224,7 +224,7 @@ TEST(TetTransfer, RestrictedToFreeUnknownsOfAnyNumbering) {
 TEST(TetTransfer, RefusesSupportsThatDoNotNestAndBadNumberings) {
     const TetMesh coarse = structured_box(Vec3(0, 0, 0), Vec3(1, 1, 1), 1, 1, 1);
     const TetMesh fine = refine(coarse);
-    const MovableSparseMatrix P = tet_vertex_prolongation(fine);
+    const MovableSparseMatrix P = vertex_prolongation(fine);
     std::vector<std::array<bool, 3>> fc(8, {false, false, false});
     auto ff = std::vector<std::array<bool, 3>>(static_cast<size_t>(fine.n_vertices()),
                                                {false, false, false});
@@ -245,7 +245,6 @@ TEST(TetTransfer, RefusesSupportsThatDoNotNestAndBadNumberings) {
                           {"fine unknown 9 is used twice", "vertex 9"});
     tmesh::expect_invalid([&] { restrict_to_unknowns(P, 3, uc, nc - 1, uf, nf); },
                           {"component 2 of coarse vertex 7 has unknown 22, outside 0..21"});
-    tmesh::expect_invalid([&] { tet_vertex_prolongation(coarse); },
-                          {"must come from mesh::refine"});
+    tmesh::expect_invalid([&] { vertex_prolongation(coarse); }, {"must come from mesh::refine"});
     tmesh::expect_invalid([&] { expand_components(P, 4); }, {"4 components per vertex"});
 }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The nodal P of a tetrahedral 1->8 refinement, its component expansion and its restriction to
-// free unknowns (docs/theory.md#theory-transfer).
-#include "transfer/tet_transfer.hpp"
+// The nodal P of a 1->4 or 1->8 refinement, its component expansion and its restriction to free
+// unknowns (docs/theory.md#theory-transfer).
+#include "transfer/prolongation.hpp"
 
 #include "core/check.hpp"
 
@@ -9,11 +9,11 @@
 
 namespace mlc::transfer {
 
-MovableSparseMatrix tet_vertex_prolongation(const mesh::TetMesh& fine) {
+template <int dim> MovableSparseMatrix vertex_prolongation(const mesh::SimplexMesh<dim>& fine) {
     const int nf = fine.n_vertices();
     const int nc = fine.n_coarse_vertices;
     MLC_CHECK(nc > 0 && static_cast<int>(fine.parents.size()) == nf - nc,
-              "tet_vertex_prolongation: the fine mesh must come from mesh::refine; found "
+              "vertex_prolongation: the fine mesh must come from mesh::refine; found "
                   << nc << " coarse vertices, " << nf << " vertices and " << fine.parents.size()
                   << " parent pairs");
     MovableSparseMatrix P;
@@ -31,7 +31,7 @@ MovableSparseMatrix tet_vertex_prolongation(const mesh::TetMesh& fine) {
         } else {
             std::array<int, 2> pr = fine.parents[static_cast<size_t>(v - nc)];
             MLC_CHECK(pr[0] >= 0 && pr[0] < nc && pr[1] >= 0 && pr[1] < nc && pr[0] != pr[1],
-                      "tet_vertex_prolongation: new vertex "
+                      "vertex_prolongation: new vertex "
                           << v << " has parents (" << pr[0] << ", " << pr[1]
                           << "), expected two distinct coarse vertices in 0.." << nc - 1);
             if (pr[1] < pr[0]) std::swap(pr[0], pr[1]);
@@ -44,6 +44,9 @@ MovableSparseMatrix tet_vertex_prolongation(const mesh::TetMesh& fine) {
     }
     return P;
 }
+
+template MovableSparseMatrix vertex_prolongation(const mesh::SimplexMesh<2>&);
+template MovableSparseMatrix vertex_prolongation(const mesh::SimplexMesh<3>&);
 
 MovableSparseMatrix expand_components(const SparseMatrix& P_vertex, int dim) {
     MLC_CHECK(dim >= 1 && dim <= 3,

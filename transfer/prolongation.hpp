@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: MIT
-/// @file The P transfer of displacements through Bey's 1->8 refinement of a tetrahedral mesh
-/// (mesh/tet_refine.hpp): the nodal interpolation as a sparse matrix, per vertex and per
-/// interleaved component, and its restriction to the free unknowns of two numberings.
+/// @file The P transfer of displacements between two nested levels of a simplex mesh, in 2D (1->4
+/// refinement, mesh/mesh.hpp) and 3D (Bey's 1->8, mesh/tet_refine.hpp): the nodal interpolation
+/// as a sparse matrix, per vertex and per interleaved component, and its restriction to the free
+/// unknowns of two numberings.
 #pragma once
 
 #include "core/types.hpp"
-#include "mesh/tet_mesh.hpp"
+#include "mesh/simplex_mesh.hpp"
 
 #include <array>
 #include <vector>
@@ -20,11 +21,14 @@ using VertexUnknowns = std::vector<std::array<int, 3>>;
 /// Nodal interpolation from the coarse mesh to `fine` = mesh::refine(coarse), one scalar per
 /// vertex (n_fine_vertices x n_coarse_vertices): row v < n_coarse is the unit row of v (coarse
 /// vertices keep their index), row n_coarse + e has 1/2 at both parents of edge e
-/// (TetMesh::parents). P u_H is the coarse P1 field evaluated at the fine vertices (at the edge
-/// midpoints, also where refinement moved a midpoint onto a curved surface). Each row's entries
-/// are in column order. Throws InvalidInput when `fine` has no parents (not made by refine) or
-/// a parent is out of range.
-MovableSparseMatrix tet_vertex_prolongation(const mesh::TetMesh& fine);
+/// (SimplexMesh::parents). P u_H is the coarse P1 field evaluated at the fine vertices (at the
+/// edge midpoints, also where refinement moved a midpoint onto a curved boundary). Each row's
+/// entries are in column order. Throws InvalidInput when `fine` has no parents (not made by
+/// refine) or a parent is out of range.
+template <int dim> MovableSparseMatrix vertex_prolongation(const mesh::SimplexMesh<dim>& fine);
+
+extern template MovableSparseMatrix vertex_prolongation(const mesh::SimplexMesh<2>&);
+extern template MovableSparseMatrix vertex_prolongation(const mesh::SimplexMesh<3>&);
 
 /// The same interpolation for `dim` components per vertex, interleaved (component c of vertex v
 /// at dim v + c): (dim rows x dim cols) of P_vertex, each entry w at (i, j) becoming w at
