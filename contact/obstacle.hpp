@@ -22,8 +22,8 @@ template <int dim> struct BasicObstacle {
     enum class Kind { line, circle, cylinder, plane = line, sphere = circle };
     Kind kind = Kind::line;
     Point point = Point::Zero(); ///< line/plane: a point on it
-    Point normal =
-        Point::Unit(dim - 1);     ///< line/plane: normal toward the body (normalized on validate)
+    /// line/plane: normal toward the body (normalized on validate); default the last axis
+    Point normal = Point::Unit(dim - 1);
     Point center = Point::Zero(); ///< circle/sphere: centre; cylinder: a point of the axis
     double radius = 0.0;          ///< circle/sphere/cylinder: radius > 0
     bool body_outside = true; ///< circle/sphere/cylinder: body outside the solid or inside a hole
