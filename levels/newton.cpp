@@ -29,6 +29,9 @@ void StatusCounts::add(contact::Status s) {
     case contact::Status::slip_backward:
         ++slip_backward;
         break;
+    case contact::Status::slip:
+        ++slip;
+        break;
     }
 }
 

@@ -19,9 +19,9 @@ namespace mlc::levels {
 
 /// Number of contact nodes per status.
 struct StatusCounts {
-    int gap = 0, stick = 0, slip_forward = 0, slip_backward = 0;
+    int gap = 0, stick = 0, slip_forward = 0, slip_backward = 0, slip = 0;
     void add(contact::Status s);
-    int total() const { return gap + stick + slip_forward + slip_backward; }
+    int total() const { return gap + stick + slip_forward + slip_backward + slip; }
 };
 
 /// What one load step's Newton did.
