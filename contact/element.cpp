@@ -4,6 +4,7 @@
 
 #include "core/check.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mlc::contact {
@@ -20,17 +21,19 @@ std::string_view to_string(FacetIntegration f) {
     return "?";
 }
 
-std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector<int>& contactors,
-                                          const Obstacle& obstacle, double mu, double r, int pair) {
-    std::vector<ContactElement> out;
+template <int dim>
+std::vector<BasicContactElement<dim>>
+node_on_rigid(const mesh::SimplexMesh<dim>& m, const std::vector<int>& contactors,
+              const BasicObstacle<dim>& obstacle, double mu, double r, int pair) {
+    std::vector<BasicContactElement<dim>> out;
     out.reserve(contactors.size());
     for (int v : contactors) {
-        ContactElement e;
+        BasicContactElement<dim> e;
         e.n_nodes = 1;
         e.vertex[0] = v;
         e.weight[0] = 1.0;
         obstacle.frame(m.vertices[static_cast<size_t>(v)], e.n, e.g0);
-        e.t = Vec2(e.n.y(), -e.n.x());
+        e.t = tangent_basis<dim>(e.n);
         e.mu = mu;
         e.r = r;
         e.pair = pair;
@@ -123,86 +126,123 @@ ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, d
     return with_frame(e, n, g0, mu, r, pair);
 }
 
-HeldComponents held_components(const ContactElement& e,
-                               const std::vector<std::array<bool, 2>>& fixed) {
-    std::array<bool, 2> held = {true, true}; // components prescribed at every vertex
+template <int dim>
+HeldComponents
+held_components(const BasicContactElement<dim>& e,
+                const std::type_identity_t<std::vector<std::array<bool, dim>>>& fixed) {
+    using Element = BasicContactElement<dim>;
+    std::array<bool, dim> held; // components prescribed at every vertex
+    held.fill(true);
     for (int j = 0; j < e.n_nodes; ++j) {
         if (e.weight[static_cast<size_t>(j)] == 0.0) continue;
         const auto& f = fixed[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])];
-        for (size_t c = 0; c < 2; ++c)
+        for (size_t c = 0; c < dim; ++c)
             held[c] = held[c] && f[c];
     }
     HeldComponents out;
-    if (!held[0] && !held[1]) return out;
+    if (std::none_of(held.begin(), held.end(), [](bool h) { return h; })) return out;
     // The part of a unit direction along the components left free somewhere.
-    auto is_held = [&](const Vec2& g) {
+    auto is_held = [&](const typename Element::Point& g) {
         double free2 = 0.0;
-        for (int c = 0; c < 2; ++c)
+        for (int c = 0; c < dim; ++c)
             if (!held[static_cast<size_t>(c)]) free2 += g[c] * g[c];
         return std::sqrt(free2) <= kHeldDirectionTolerance;
     };
     if (is_held(e.n)) {
-        out.pinned = ContactElement::kPinnedN;
-        if (e.frictional()) out.pinned |= ContactElement::kPinnedT;
+        out.pinned = Element::kPinnedN;
+        if (e.frictional()) out.pinned |= Element::kPinnedT;
         return out;
     }
     if (!e.frictional()) return out; // n alone, not held, never along the held span then
-    if (is_held(e.t)) {
-        out.pinned = ContactElement::kPinnedT;
+    int tangents_held = 0;
+    for (int c = 0; c < dim - 1; ++c)
+        tangents_held += is_held(e.t.col(c)) ? 1 : 0;
+    if (tangents_held == dim - 1) {
+        out.pinned = Element::kPinnedT;
         return out;
     }
-    // (t, n) spans the plane: it meets the held components without lying in them.
+    // The frame spans the space: it meets the held components without lying in them.
     out.ambiguous = true;
     return out;
 }
 
-ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vector& u_prev_full,
-                      const Vector& x, int lambda_dof) {
-    Vec2 du = Vec2::Zero(), du_prev = Vec2::Zero();
+template <int dim>
+BasicElementState<dim> evaluate(const BasicContactElement<dim>& e, const Vector& u_full,
+                                const Vector& u_prev_full, const Vector& x, int lambda_dof) {
+    using Element = BasicContactElement<dim>;
+    using Point = typename Element::Point;
+    Point du = Point::Zero(), du_prev = Point::Zero();
     for (int j = 0; j < e.n_nodes; ++j) {
         const int v = e.vertex[static_cast<size_t>(j)];
-        du += e.weight[static_cast<size_t>(j)] * u_full.segment<2>(2 * v);
-        du_prev += e.weight[static_cast<size_t>(j)] * u_prev_full.segment<2>(2 * v);
+        du += e.weight[static_cast<size_t>(j)] * u_full.segment<dim>(dim * v);
+        du_prev += e.weight[static_cast<size_t>(j)] * u_prev_full.segment<dim>(dim * v);
     }
-    ElementState s;
+    BasicElementState<dim> s;
     s.d_n = e.g0 + e.n.dot(du);
-    s.d_t = e.t.dot(du - du_prev);
+    for (int c = 0; c < dim - 1; ++c)
+        s.d_t[c] = e.t.col(c).dot(du - du_prev);
     if (e.frictional())
-        s.lambda = {x[lambda_dof], x[lambda_dof + 1]};
+        for (int q = 0; q < dim; ++q)
+            s.lambda[q] = x[lambda_dof + q];
     else
-        s.lambda = {0.0, x[lambda_dof]};
-    if (e.pinned & ContactElement::kPinnedN) return s; // Phi = 0, M = 0, status gap
+        s.lambda[dim - 1] = x[lambda_dof];
+    if (e.pinned & Element::kPinnedN) return s; // Phi = 0, M = 0, status gap
+    using Tangential = Eigen::Matrix<double, dim - 1, 1>;
     if (e.frictional()) {
-        // A pinned tangent projects as sigma_t = 0: the status follows the normal alone.
-        const bool pin_t = (e.pinned & ContactElement::kPinnedT) != 0;
-        s.proj = project(pin_t ? 0.0 : s.lambda[0] + e.r * s.d_t, s.lambda[1] + e.r * s.d_n, e.mu);
+        // Pinned tangents project as sigma_t = 0: the status follows the normal alone.
+        const bool pin_t = (e.pinned & Element::kPinnedT) != 0;
+        const Tangential sigma_t =
+            pin_t ? Tangential(Tangential::Zero())
+                  : Tangential(s.lambda.template head<dim - 1>() + e.r * s.d_t);
+        s.proj = project<dim>(sigma_t, s.lambda[dim - 1] + e.r * s.d_n, e.mu);
         if (pin_t) {
-            s.proj.phi[0] = 0.0;
-            s.proj.M.row(0).setZero();
-            s.proj.M.col(0).setZero();
+            s.proj.phi.template head<dim - 1>().setZero();
+            s.proj.M.template topRows<dim - 1>().setZero();
+            s.proj.M.template leftCols<dim - 1>().setZero();
         }
     } else {
-        s.proj = project(0.0, s.lambda[1] + e.r * s.d_n, 0.0);
-        s.proj.M(0, 0) = 0.0; // no tangential unknown: keep M_tt out of the tangent
+        s.proj = project<dim>(Tangential::Zero(), s.lambda[dim - 1] + e.r * s.d_n, 0.0);
+        // no tangential unknown: keep M_tt out of the tangent
+        s.proj.M.template topLeftCorner<dim - 1, dim - 1>().setZero();
     }
     return s;
 }
 
-void add_residual(const ContactElement& e, const ElementState& s, const fem::DofMap& dofs,
-                  int lambda_dof, Vector& R) {
-    const Vec2 force = s.proj.phi[0] * e.t + s.proj.phi[1] * e.n;
+template <int dim>
+void add_residual(const BasicContactElement<dim>& e, const BasicElementState<dim>& s,
+                  const fem::BasicDofMap<dim>& dofs, int lambda_dof, Vector& R) {
+    using Point = typename BasicContactElement<dim>::Point;
+    Point force = s.proj.phi[dim - 1] * e.n;
+    for (int c = 0; c < dim - 1; ++c)
+        force += s.proj.phi[c] * e.t.col(c);
     for (int j = 0; j < e.n_nodes; ++j) {
         const int v = e.vertex[static_cast<size_t>(j)];
-        for (int a = 0; a < 2; ++a)
+        for (int a = 0; a < dim; ++a)
             if (int d = dofs.u_dof(v, a); d >= 0)
                 R[d] += e.weight[static_cast<size_t>(j)] * force[a];
     }
     if (e.frictional()) {
-        R[lambda_dof] = -(s.lambda[0] - s.proj.phi[0]) / e.r;
-        R[lambda_dof + 1] = -(s.lambda[1] - s.proj.phi[1]) / e.r;
+        for (int q = 0; q < dim; ++q)
+            R[lambda_dof + q] = -(s.lambda[q] - s.proj.phi[q]) / e.r;
     } else {
-        R[lambda_dof] = -(s.lambda[1] - s.proj.phi[1]) / e.r;
+        R[lambda_dof] = -(s.lambda[dim - 1] - s.proj.phi[dim - 1]) / e.r;
     }
 }
+
+#define MLC_CONTACT_ELEMENT(dim)                                                                   \
+    template std::vector<BasicContactElement<dim>> node_on_rigid<dim>(                             \
+        const mesh::SimplexMesh<dim>&, const std::vector<int>&, const BasicObstacle<dim>&, double, \
+        double, int);                                                                              \
+    template HeldComponents held_components<dim>(                                                  \
+        const BasicContactElement<dim>&,                                                           \
+        const std::type_identity_t<std::vector<std::array<bool, dim>>>&);                          \
+    template BasicElementState<dim> evaluate<dim>(const BasicContactElement<dim>&, const Vector&,  \
+                                                  const Vector&, const Vector&, int);              \
+    template void add_residual<dim>(const BasicContactElement<dim>&,                               \
+                                    const BasicElementState<dim>&, const fem::BasicDofMap<dim>&,   \
+                                    int, Vector&);
+MLC_CONTACT_ELEMENT(2)
+MLC_CONTACT_ELEMENT(3)
+#undef MLC_CONTACT_ELEMENT
 
 } // namespace mlc::contact

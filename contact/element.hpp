@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 /// @file Contact elements (node on rigid, node on node, node on facet): relative displacement in
-/// the local (t, n) frame, the Alart–Curnier residual, and the element tangent A_ce.
+/// the local frame (the tangents t, then the normal n), the Alart–Curnier residual, and the
+/// element tangent A_ce, in 2D and 3D (the dimension a template parameter; the two-body element
+/// builders are 2D so far).
 #pragma once
 
 #include "contact/law.hpp"
@@ -11,6 +13,7 @@
 
 #include <array>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 namespace mlc::contact {
@@ -42,36 +45,57 @@ template <size_t N> constexpr std::array<int, N> filled_minus_one() {
 }
 } // namespace detail
 
-/// One contact element: a contactor vertex and up to kMaxNodes - 1 target vertices with weights
-/// w so that the relative displacement is u_rel = sum_j w_j u_(vertex j) (docs/theory.md#theory-contact-elements):
-/// node on rigid (1), node on node (1, -1), node on facet (1, -(1-alpha), -alpha), segment-
-/// integrated node on facet (1, -M_i1 / D_i, ..., -M_im / D_i). Entries at and beyond n_nodes
-/// are unused.
-struct ContactElement {
+/// One contact element in `dim` dimensions: a contactor vertex and up to kMaxNodes - 1 target
+/// vertices with weights w so that the relative displacement is u_rel = sum_j w_j u_(vertex j)
+/// (docs/theory.md#theory-contact-elements): node on rigid (1), node on node (1, -1), node on
+/// facet (1, -(1-alpha), -alpha), segment-integrated node on facet (1, -M_i1 / D_i, ...,
+/// -M_im / D_i). Entries at and beyond n_nodes are unused. The frame: n the unit normal of the
+/// target toward the contactor and the dim - 1 tangents t (columns; contact::tangent_basis: 2D
+/// t = (n_y, -n_x), 3D t1 = normalize(e x n) with e the axis least aligned with n, t2 = n x t1).
+/// Frictional elements carry dim multipliers (the tangents' then the normal's), frictionless ones
+/// lambda_n only.
+template <int dim> struct BasicContactElement {
+    static_assert(dim == 2 || dim == 3, "contact elements are for dim = 2 or 3");
+    using Point = Eigen::Matrix<double, dim, 1>;
+    using Tangents = Eigen::Matrix<double, dim, dim - 1>; ///< 2D: a Vec2
     static constexpr int kMaxNodes = 8;
     int n_nodes = 1; ///< 1 .. kMaxNodes
     /// vertex[0] is the contactor node; unused entries are -1.
     std::array<int, kMaxNodes> vertex = detail::filled_minus_one<kMaxNodes>();
     /// weight[0] = 1; unused entries 0.
     std::array<double, kMaxNodes> weight{1.0};
-    Vec2 n = Vec2(0.0, 1.0); ///< unit normal of the target, toward the contactor
-    Vec2 t = Vec2(1.0, 0.0); ///< t = (n_y, -n_x)
-    double g0 = 0.0;         ///< initial normal gap (>= 0 apart)
-    double mu = 0.0;         ///< Coulomb coefficient (0: frictionless)
-    double r = 1.0;          ///< augmentation parameter (force / length)
-    int pair = 0;            ///< index of the contact pair in the scene
+    Point n = Point::Unit(dim - 1);  ///< unit normal of the target, toward the contactor
+    Tangents t = default_tangents(); ///< the tangents (columns)
+    double g0 = 0.0;                 ///< initial normal gap (>= 0 apart)
+    double mu = 0.0;                 ///< Coulomb coefficient (0: frictionless)
+    double r = 1.0;                  ///< augmentation parameter (force / length)
+    int pair = 0;                    ///< index of the contact pair in the scene
     /// Multiplier components pinned to zero because supports prescribe the relative displacement
-    /// along them (kPinnedT, kPinnedN; pin_held_components). A pinned component keeps its
-    /// unknown, but its Phi and its row and column of M are zero: its equation reads
-    /// lambda = 0, and the reaction goes to the support. A pinned normal pins every component
-    /// (a contact that carries no normal force carries no friction).
+    /// along them (kPinnedT: every tangential one, kPinnedN; pin_held_components). A pinned
+    /// component keeps its unknown, but its Phi and its row and column of M are zero: its
+    /// equation reads lambda = 0, and the reaction goes to the support. A pinned normal pins
+    /// every component (a contact that carries no normal force carries no friction).
     unsigned char pinned = 0;
     /// Frictional elements carry (lambda_t, lambda_n); frictionless ones lambda_n only.
     bool frictional() const { return mu > 0.0; }
-    int n_multipliers() const { return frictional() ? 2 : 1; }
-    /// Bits of `pinned`, one per local component (a 3D element would have one per tangent).
+    int n_multipliers() const { return frictional() ? dim : 1; }
+    /// Bits of `pinned`: the tangential multipliers, the normal one.
     static constexpr unsigned char kPinnedT = 1, kPinnedN = 2;
+
+private:
+    /// The tangents of the default normal e_(dim-1): 2D (1, 0), 3D tangent_basis(e_z).
+    static Tangents default_tangents() {
+        if constexpr (dim == 2)
+            return Tangents(1.0, 0.0);
+        else
+            return tangent_basis<dim>(Point::Unit(dim - 1));
+    }
 };
+
+/// The 2D element.
+using ContactElement = BasicContactElement<2>;
+/// The 3D element.
+using ContactElement3 = BasicContactElement<3>;
 
 /// Directions closer than this (in the norm of their free part, for unit directions) to the
 /// span of the prescribed displacement components count as held.
@@ -91,15 +115,21 @@ struct HeldComponents {
 /// relative displacement along them is prescribed, so their equation d = 0 holds no unknown
 /// and their multiplier appears in no equation. A direction g counts as held when its part
 /// along the components some vertex leaves free has norm at most kHeldDirectionTolerance. The
-/// normal held pins every component; otherwise a held tangent pins lambda_t. Rigid obstacles
+/// normal held pins every component; otherwise every tangent held pins the tangential
+/// multipliers (in 3D, one tangent held and the other not is `ambiguous`). Rigid obstacles
 /// (one vertex) pin where the contactor's components are held; two-body elements only where
 /// the target vertices' matching components are held too.
-HeldComponents held_components(const ContactElement& e,
-                               const std::vector<std::array<bool, 2>>& fixed);
+template <int dim>
+HeldComponents
+held_components(const BasicContactElement<dim>& e,
+                const std::type_identity_t<std::vector<std::array<bool, dim>>>& fixed);
 
-/// Node-on-rigid elements for the given contactor vertices against an obstacle.
-std::vector<ContactElement> node_on_rigid(const mesh::Mesh& m, const std::vector<int>& contactors,
-                                          const Obstacle& obstacle, double mu, double r, int pair);
+/// Node-on-rigid elements for the given contactor vertices against an obstacle (frame and gap
+/// from BasicObstacle::frame and tangent_basis).
+template <int dim>
+std::vector<BasicContactElement<dim>>
+node_on_rigid(const mesh::SimplexMesh<dim>& m, const std::vector<int>& contactors,
+              const BasicObstacle<dim>& obstacle, double mu, double r, int pair);
 
 /// Node-on-facet element: contactor vertex c against the target facet (a, b), the projection of
 /// c at barycentric coordinate alpha in [0, 1] (0 at a, 1 at b): weights (1, -(1-alpha), -alpha),
@@ -122,73 +152,81 @@ ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
 ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, double r, int pair);
 
 /// Local state of an element at (u, lambda).
-struct ElementState {
-    double d_n = 0.0;                                 ///< normal gap g0 + n . u_rel
-    double d_t = 0.0;                                 ///< slip increment t . (u_rel - u_rel_prev)
-    Eigen::Vector2d lambda = Eigen::Vector2d::Zero(); ///< (lambda_t, lambda_n)
-    Projection proj;                                  ///< Phi(lambda + r d) and M
+template <int dim> struct BasicElementState {
+    double d_n = 0.0; ///< normal gap g0 + n . u_rel
+    /// slip increment t . (u_rel - u_rel_prev), one per tangent
+    Eigen::Matrix<double, dim - 1, 1> d_t = Eigen::Matrix<double, dim - 1, 1>::Zero();
+    /// (lambda_t, lambda_n): the tangents' multipliers (0 when frictionless), then the normal's
+    Eigen::Matrix<double, dim, 1> lambda = Eigen::Matrix<double, dim, 1>::Zero();
+    LawProjection<dim> proj; ///< Phi(lambda + r d) and M
 };
+using ElementState = BasicElementState<2>;
 
 /// Evaluates element e: relative displacements from the full nodal displacement vectors
-/// (2 per vertex) of the current iterate and of the previous converged load step, and the
-/// multipliers from the unknowns x at `lambda_dof` (lambda_t then lambda_n, or lambda_n alone).
-/// Pinned components (ContactElement::pinned): a pinned tangent projects as sigma_t = 0 (stick
-/// or gap by the normal alone) with Phi_t = 0 and M's t row and column zero; a pinned normal
-/// gives Phi = 0, M = 0 and status gap. Either way a pinned component's residual row reads
-/// -lambda / r and its tangent row and column hold only -1 / r on the diagonal.
-ElementState evaluate(const ContactElement& e, const Vector& u_full, const Vector& u_prev_full,
-                      const Vector& x, int lambda_dof);
+/// (dim per vertex) of the current iterate and of the previous converged load step, and the
+/// multipliers from the unknowns x at `lambda_dof` (the tangents' then lambda_n, or lambda_n
+/// alone). Pinned components (BasicContactElement::pinned): pinned tangents project as
+/// sigma_t = 0 (stick or gap by the normal alone) with Phi_t = 0 and M's tangential rows and
+/// columns zero; a pinned normal gives Phi = 0, M = 0 and status gap. Either way a pinned
+/// component's residual row reads -lambda / r and its tangent row and column hold only -1 / r on
+/// the diagonal.
+template <int dim>
+BasicElementState<dim> evaluate(const BasicContactElement<dim>& e, const Vector& u_full,
+                                const Vector& u_prev_full, const Vector& x, int lambda_dof);
 
-/// Adds the element's residual to R: R_u += sum_j w_j (Phi_t t + Phi_n n) at the free
+/// Adds the element's residual to R: R_u += sum_j w_j (t Phi_t + Phi_n n) at the free
 /// displacement unknowns of its vertices; R_lambda = -(1/r) (lambda - Phi).
-void add_residual(const ContactElement& e, const ElementState& s, const fem::DofMap& dofs,
-                  int lambda_dof, Vector& R);
+template <int dim>
+void add_residual(const BasicContactElement<dim>& e, const BasicElementState<dim>& s,
+                  const fem::BasicDofMap<dim>& dofs, int lambda_dof, Vector& R);
 
-/// Element tangent entries (docs/theory.md#theory-element-blocks) in a fixed order: every (row, col) pair of the
-/// element's free unknowns appears once, whatever the status, so the Jacobian pattern never
-/// changes. Calls `add(row, col, value)` for each.
+/// Element tangent entries (docs/theory.md#theory-element-blocks) in a fixed order: every (row,
+/// col) pair of the element's free unknowns appears once, whatever the status, so the Jacobian
+/// pattern never changes. Calls `add(row, col, value)` for each.
 ///   uu: w_j w_k r G M G^T, u-lambda: w_j G M, lambda-u: w_k M G^T, lambda-lambda: (M - I) / r,
 /// with G = [t n] (for frictionless elements only the n column/row and M_nn).
-template <class Add>
-void for_each_tangent_entry(const ContactElement& e, const Eigen::Matrix2d& M,
-                            const fem::DofMap& dofs, int lambda_dof, Add&& add) {
-    Eigen::Matrix2d G;
-    G.col(0) = e.t;
-    G.col(1) = e.n;
+template <int dim, class Add>
+void for_each_tangent_entry(const BasicContactElement<dim>& e,
+                            const Eigen::Matrix<double, dim, dim>& M,
+                            const fem::BasicDofMap<dim>& dofs, int lambda_dof, Add&& add) {
+    using Mat = Eigen::Matrix<double, dim, dim>;
+    Mat G;
+    G.template leftCols<dim - 1>() = e.t;
+    G.col(dim - 1) = e.n;
     const int nm = e.n_multipliers();
-    const int m0 = nm == 2 ? 0 : 1; // first local multiplier component (t or n)
-    const Eigen::Matrix2d GMGt = G * M * G.transpose();
-    const Eigen::Matrix2d GM = G * M;
-    const Eigen::Matrix2d MGt = M * G.transpose();
+    const int m0 = nm == dim ? 0 : dim - 1; // first local multiplier component (t or n)
+    const Mat GMGt = G * M * G.transpose();
+    const Mat GM = G * M;
+    const Mat MGt = M * G.transpose();
     for (int j = 0; j < e.n_nodes; ++j) {
         const int vj = e.vertex[static_cast<size_t>(j)];
         const double wj = e.weight[static_cast<size_t>(j)];
-        for (int a = 0; a < 2; ++a) {
+        for (int a = 0; a < dim; ++a) {
             const int row = dofs.u_dof(vj, a);
             if (row < 0) continue;
             for (int k = 0; k < e.n_nodes; ++k) {
                 const int vk = e.vertex[static_cast<size_t>(k)];
                 const double wk = e.weight[static_cast<size_t>(k)];
-                for (int b = 0; b < 2; ++b) {
+                for (int b = 0; b < dim; ++b) {
                     const int col = dofs.u_dof(vk, b);
                     if (col >= 0) add(row, col, wj * wk * e.r * GMGt(a, b));
                 }
             }
-            for (int q = m0; q < 2; ++q)
+            for (int q = m0; q < dim; ++q)
                 add(row, lambda_dof + q - m0, wj * GM(a, q));
         }
     }
-    for (int q = m0; q < 2; ++q) {
+    for (int q = m0; q < dim; ++q) {
         const int row = lambda_dof + q - m0;
         for (int k = 0; k < e.n_nodes; ++k) {
             const int vk = e.vertex[static_cast<size_t>(k)];
             const double wk = e.weight[static_cast<size_t>(k)];
-            for (int b = 0; b < 2; ++b) {
+            for (int b = 0; b < dim; ++b) {
                 const int col = dofs.u_dof(vk, b);
                 if (col >= 0) add(row, col, wk * MGt(q, b));
             }
         }
-        for (int p = m0; p < 2; ++p)
+        for (int p = m0; p < dim; ++p)
             add(row, lambda_dof + p - m0, (M(q, p) - (q == p ? 1.0 : 0.0)) / e.r);
     }
 }

@@ -377,13 +377,13 @@ std::vector<ContactNodeState> ContactNewton::node_states(double s, const Vector&
         ns.lambda_t = es.lambda[0];
         ns.lambda_n = es.lambda[1];
         ns.d_n = es.d_n;
-        ns.d_t = es.d_t;
+        ns.d_t = es.d_t[0];
         ns.status = es.proj.status;
         if (ns.status == contact::Status::gap) ns.lambda_t = ns.lambda_n = 0.0;
         if (!el.frictional() && ns.status != contact::Status::gap) {
-            if (es.d_t > 1e-9 * umax)
+            if (es.d_t[0] > 1e-9 * umax)
                 ns.status = contact::Status::slip_forward;
-            else if (es.d_t < -1e-9 * umax)
+            else if (es.d_t[0] < -1e-9 * umax)
                 ns.status = contact::Status::slip_backward;
         }
         out.push_back(ns);
