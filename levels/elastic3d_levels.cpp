@@ -22,11 +22,12 @@ namespace {
 /// Relative distance under which a support point is a vertex, or a vertex on a support line.
 constexpr double kPointTol = 1e-9;
 
-/// The support's vertices on mesh m (a tagged face's, the line's, or the point's level-0
-/// vertex).
+/// The support's vertices on mesh m (a tag's faces and lines, the line's, or the point's
+/// level-0 vertex).
 std::vector<int> support_vertices(const ElasticProblem3& p, const Support3& s,
                                   const mesh::TetMesh& m) {
-    if (!s.tag.empty()) return fem::face_vertices(m, m.tag(s.tag));
+    if (!s.tag.empty()) return m.vertices_on_tag(m.tag(s.tag)); // its faces' and lines'
+
     if (s.line) {
         std::vector<int> v = line_vertices(m, *s.line);
         std::sort(v.begin(), v.end());
@@ -133,8 +134,9 @@ void ElasticProblem3::validate() const {
         if (s.line) {
             line_edges0(mesh0, sorted_edges(mesh0), *s.line);
         } else if (!s.tag.empty()) {
-            MLC_CHECK(mesh0.find_tag(s.tag) && mesh0.is_boundary_tag(mesh0.tag(s.tag)),
-                      "support: no boundary face carries the tag '" << s.tag << "'");
+            const auto id = mesh0.find_tag(s.tag);
+            MLC_CHECK(id && !mesh0.vertices_on_tag(*id).empty(),
+                      "support: no boundary face or line carries the tag '" << s.tag << "'");
         } else {
             check_vertex0(mesh0, *s.point, "support point");
         }
@@ -292,9 +294,9 @@ constexpr double kAmgPerUnknown3 = 0.0;
 namespace {
 
 /// Fixed components on level l: per component, the vertices of the faces whose tags hold it and
-/// of the lines that hold it (V' = V + E + E_l, E' = 2 E + 3 F, F' = 4 F over those faces,
-/// E_l' = 2 E_l over the line edges that are no edges of those faces), and the point supports'
-/// vertices (kept by refinement) off them.
+/// of the lines that hold it, line supports and the tags' tagged lines (V' = V + E + E_l,
+/// E' = 2 E + 3 F, F' = 4 F over those faces, E_l' = 2 E_l over the line edges that are no edges
+/// of those faces), and the point supports' vertices (kept by refinement) off them.
 std::vector<double> predict_fixed_components(const ElasticProblem3& p, int levels) {
     std::vector<double> fixed(static_cast<size_t>(levels) + 1, 0.0);
     // The level-0 edges of each line support, found once for the three components.
@@ -313,9 +315,13 @@ std::vector<double> predict_fixed_components(const ElasticProblem3& p, int level
         for (size_t k = 0; k < p.supports.size(); ++k) {
             const Support3& s = p.supports[k];
             if (!s.u[static_cast<size_t>(c)]) continue;
-            if (!s.tag.empty())
-                tags.insert(p.mesh0.tag(s.tag));
-            else if (s.line)
+            if (!s.tag.empty()) {
+                const int tag = p.mesh0.tag(s.tag);
+                tags.insert(tag);
+                for (const mesh::BoundaryEdge& l : p.mesh0.lines) // the tag's lines
+                    if (l.tag == tag)
+                        line_edges.insert({std::min(l.v0, l.v1), std::max(l.v0, l.v1)});
+            } else if (s.line)
                 line_edges.insert(line_edges_of[k].begin(), line_edges_of[k].end());
             else
                 points.insert(p.mesh0.nearest_vertex(*s.point));

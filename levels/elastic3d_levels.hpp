@@ -43,7 +43,8 @@ struct FaceLoad3 {
 /// Prescribed displacement components on the faces with a tag, along a line, or at a vertex of
 /// level 0 (a point; refinement keeps its index). Unset components are free.
 struct Support3 {
-    std::string tag;           ///< a boundary tag, or empty for a line or point support
+    std::string
+        tag; ///< a tag of boundary faces and/or tagged lines; empty for a line or point support
     std::optional<Vec3> point; ///< a level-0 vertex (for a point support)
     /// A line support: the straight segment between two level-0 vertices, which must run along
     /// edges of the level-0 mesh; it holds every vertex on the segment, on every level (the
@@ -66,7 +67,8 @@ struct ElasticProblem3 {
     std::vector<Support3> supports;
     int levels = 0;
     /// Throws InvalidInput naming the first defect: no body, an attribute without a body, a bad
-    /// material, a tag no boundary face carries, a point that is no level-0 vertex, a line whose
+    /// material, a support tag no boundary face or tagged line carries (a
+    /// load tag no boundary face carries), a point that is no level-0 vertex, a line whose
     /// ends are no level-0 vertices or whose segment does not run along level-0 edges, a support
     /// that fixes nothing, levels outside 0..12.
     void validate() const;

@@ -48,7 +48,8 @@ inline constexpr double kFlatTetrahedronTol = 1e-10;
 /// - a non-manifold boundary: an edge on more than two boundary faces (parts touching along an
 ///   edge) or a vertex where separate sheets of the boundary meet (parts touching at a point);
 /// - a BoundaryFace that is not a face of exactly one tetrahedron, or whose normal points into
-///   the body, or whose surface is not in TetMesh::surfaces.
+///   the body, or whose surface is not in TetMesh::shapes;
+/// - a tagged line (SimplexMesh::lines) that is no edge of a tetrahedron.
 /// O(n log n) (sorting faces and edges). Tetrahedra are named by `name`.
 void check_quality(const TetMesh& m, const TetrahedronNamer& name = {});
 

@@ -290,6 +290,27 @@ void check_tagged_faces(const TetMesh& m, const std::vector<FaceRecord>& faces,
     }
 }
 
+/// Every tagged line joins two vertices of the mesh along an edge of a tetrahedron.
+void check_lines(const TetMesh& m) {
+    if (m.lines.empty()) return;
+    const int nv = m.n_vertices();
+    std::vector<std::array<int, 2>> edges = tet_edges(m).edges;
+    std::sort(edges.begin(), edges.end());
+    for (size_t i = 0; i < m.lines.size(); ++i) {
+        const BoundaryEdge& l = m.lines[i];
+        MLC_CHECK(l.v0 >= 0 && l.v0 < nv && l.v1 >= 0 && l.v1 < nv,
+                  "line " << i << " of tag '" << m.tag_name(l.tag) << "' refers to vertices ("
+                          << l.v0 << ", " << l.v1 << ") but the mesh has " << nv << " vertices");
+        const std::array<int, 2> e{std::min(l.v0, l.v1), std::max(l.v0, l.v1)};
+        MLC_CHECK(l.v0 != l.v1 && std::binary_search(edges.begin(), edges.end(), e),
+                  "line " << i << " of tag '" << m.tag_name(l.tag) << "' from vertex " << l.v0
+                          << " to vertex " << l.v1
+                          << " is no edge of a tetrahedron; a tagged line (a physical curve) "
+                             "must follow edges of the mesh: embed the curve in the volume "
+                             "before meshing");
+    }
+}
+
 } // namespace
 
 void check_quality(const TetMesh& m, const TetrahedronNamer& name) {
@@ -302,6 +323,7 @@ void check_quality(const TetMesh& m, const TetrahedronNamer& name) {
     check_boundary_edges(boundary, names);
     check_boundary_vertices(boundary, names);
     check_tagged_faces(m, faces, names);
+    check_lines(m);
 }
 
 void check_refined_quality(const TetMesh& m) {

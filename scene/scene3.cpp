@@ -8,6 +8,7 @@
 #include "mesh/tet_mesh.hpp"
 #include "scene/reader.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <set>
@@ -46,20 +47,29 @@ Vec3 vec3(const Reader& rd, const toml::table& t, std::string_view key, const st
     return vec3(rd, rd.need(t, key, w), w + "." + std::string(key));
 }
 
-/// The boundary tags of m, for messages.
-std::string known_tags(const mesh::TetMesh& m) {
+/// Whether some tagged line of m carries tag id.
+bool is_line_tag(const mesh::TetMesh& m, int id) {
+    return std::any_of(m.lines.begin(), m.lines.end(),
+                       [id](const mesh::BoundaryEdge& l) { return l.tag == id; });
+}
+
+/// The boundary tags of m (and, with lines_too, its line tags), for messages.
+std::string known_tags(const mesh::TetMesh& m, bool lines_too) {
     std::string s;
     for (const auto& [name, id] : m.tag_names)
-        if (m.is_boundary_tag(id)) s += (s.empty() ? "" : ", ") + name;
+        if (m.is_boundary_tag(id) || (lines_too && is_line_tag(m, id)))
+            s += (s.empty() ? "" : ", ") + name;
     return s.empty() ? "none" : s;
 }
 
+/// Refuses a tag that no boundary face (or, with lines_too, no tagged line) of m carries.
 void check_tag3(const Reader& rd, const mesh::TetMesh& m, const toml::table& t,
-                const std::string& tag, const std::string& w) {
+                const std::string& tag, const std::string& w, bool lines_too) {
     const auto id = m.find_tag(tag);
-    if (!id || !m.is_boundary_tag(*id))
-        rd.fail(t.get("tag"),
-                w + ": unknown boundary tag '" + tag + "' (the mesh has: " + known_tags(m) + ")");
+    if (!id || !(m.is_boundary_tag(*id) || (lines_too && is_line_tag(m, *id))))
+        rd.fail(t.get("tag"), w + ": unknown " + (lines_too ? "boundary or line" : "boundary") +
+                                  " tag '" + tag + "' (the mesh has: " + known_tags(m, lines_too) +
+                                  ")");
 }
 
 /// [scene]: name, description, units, dimension, levels.
@@ -196,7 +206,7 @@ void read_loads3(const Reader& rd, const toml::table& root, ElasticProblem3& p) 
         rd.check_keys(*lt, {"tag", "pressure", "traction"}, w);
         levels::FaceLoad3 ld;
         ld.tag = rd.string(*lt, "tag", w);
-        check_tag3(rd, p.mesh0, *lt, ld.tag, w);
+        check_tag3(rd, p.mesh0, *lt, ld.tag, w, false);
         ld.pressure = rd.number_or(*lt, "pressure", 0.0, w);
         if (lt->get("traction")) ld.traction = vec3(rd, *lt, "traction", w);
         if (!lt->get("pressure") && !lt->get("traction"))
@@ -218,7 +228,7 @@ void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& 
             rd.fail(st, w + " takes one of a tag, a line or a point");
         if (st->get("tag")) {
             s.tag = rd.string(*st, "tag", w);
-            check_tag3(rd, p.mesh0, *st, s.tag, w);
+            check_tag3(rd, p.mesh0, *st, s.tag, w, true); // a support may hold a line
         } else if (const toml::node* ln = st->get("line")) {
             const toml::array* a = ln->as_array();
             if (!a || a->size() != 2)

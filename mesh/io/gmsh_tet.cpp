@@ -119,6 +119,26 @@ void add_boundary_faces(TetMesh& m, const MshData& d, const std::vector<std::siz
     }
 }
 
+/// The 2-node lines of physical curves whose nodes are both vertices of the mesh become its
+/// tagged lines, named as Gmsh names the curve ("tag<N>" for an unnamed one), each edge once per
+/// tag; check_quality refuses one that is no edge of a tetrahedron.
+void add_lines(TetMesh& m, const MshData& d, const std::vector<std::size_t>& segments,
+               const std::vector<int>& new_index,
+               const std::unordered_map<std::int64_t, int>& node_index) {
+    std::set<std::array<int, 3>> seen; // (smaller vertex, larger vertex, tag)
+    for (std::size_t e : segments) {
+        std::array<int, 2> v{};
+        for (std::size_t k = 0; k < 2; ++k)
+            v[k] = new_index[static_cast<size_t>(node_index.at(d.node_ids[d.node_begin[e] + k]))];
+        if (std::min(v[0], v[1]) < 0) continue;
+        const int p = d.phys[d.phys_begin[e]];
+        const auto name = d.names.find({1, p});
+        const int tag = m.add_tag(name == d.names.end() ? "tag" + std::to_string(p) : name->second);
+        if (!seen.insert({std::min(v[0], v[1]), std::max(v[0], v[1]), tag}).second) continue;
+        m.lines.push_back({v[0], v[1], tag, -1});
+    }
+}
+
 } // namespace
 
 TetMesh read_gmsh_tet(const std::filesystem::path& file, const std::string& volume) {
@@ -144,7 +164,7 @@ TetMesh read_gmsh_tet_text(const std::string& text, const std::filesystem::path&
     // Selected tetrahedra (in node indices of the file) and candidate boundary triangles.
     std::vector<std::array<int, 4>> tets;
     std::vector<int> tet_phys;
-    std::vector<std::size_t> tet_element, triangles;
+    std::vector<std::size_t> tet_element, triangles, segments;
     for (std::size_t e = 0; e < d.n_elements(); ++e) {
         const int type = d.elem_type[e];
         const gmsh_io::ElementType et = gmsh_io::msh_element_type(type);
@@ -158,6 +178,7 @@ TetMesh read_gmsh_tet_text(const std::string& text, const std::filesystem::path&
             if (k < 4) nodes[k] = it->second;
         }
         if (type == 2 && d.phys_begin[e + 1] > d.phys_begin[e]) triangles.push_back(e);
+        if (type == 1 && d.phys_begin[e + 1] > d.phys_begin[e]) segments.push_back(e);
         if (et.dim != 3 || (!volume.empty() && !has_phys(e, wanted))) continue;
         MLC_CHECK(type == 4, where << ":" << d.elem_line[e] << ": element type " << type << " ("
                                    << et.name
@@ -210,6 +231,7 @@ TetMesh read_gmsh_tet_text(const std::string& text, const std::filesystem::path&
     if (std::any_of(tet_phys.begin(), tet_phys.end(), [](int p) { return p != 0; }))
         m.attribute = tet_phys;
     add_boundary_faces(m, d, triangles, new_index, node_index);
+    add_lines(m, d, segments, new_index, node_index);
     try {
         check_quality(m, [&](int t) {
             return "tetrahedron " + std::to_string(t) + " (" +

@@ -107,6 +107,9 @@ std::string two_volume_box_msh() {
         s.names.push_back("2 " + std::to_string(id + 1) + " \"" + name + "\"");
     s.names.push_back("3 1 \"soft\"");
     s.names.push_back("3 2 \"hard\"");
+    // A physical curve "edge" along the box's edge y = z = 0 (nodes 1 to 4).
+    s.lines = {{7, {1, 2}}, {7, {2, 3}}, {7, {3, 4}}};
+    s.names.push_back("1 7 \"edge\"");
     return mesh::testing::msh41(s);
 }
 
@@ -342,6 +345,80 @@ TEST(Scene3, LineSupportsHoldTheVerticesOnTheirSegmentOnEveryLevel) {
     // The supports remove the rigid-body modes: mg-CG solves the finest level.
     Vector x;
     EXPECT_LE(mg_cg_iterations(h, x), 20);
+}
+
+TEST(Scene3, ASupportOnATaggedLineHoldsWhatTheSameLineByItsEndsHolds) {
+    // The edge y = z = 0 of the unit box held in ux and uy, once by its ends and once by a tag
+    // on the level-0 edges along it (as a Gmsh physical curve gives them).
+    const levels::ElasticProblem3 by_ends = scene::parse_scene3(
+        box_scene("", "", "[[support]]\nline = [[0, 0, 0], [1, 0, 0]]\nux = 0.0\nuy = 0.0\n"),
+        "t.toml");
+    levels::ElasticProblem3 by_tag = by_ends;
+    mesh::TetMesh& m0 = by_tag.mesh0;
+    const int edge = m0.add_tag("edge");
+    const std::vector<int> on = levels::line_vertices(m0, *by_ends.supports[1].line);
+    for (size_t k = 0; k + 1 < on.size(); ++k)
+        m0.lines.push_back({on[k], on[k + 1], edge, -1});
+    mesh::check_quality(m0);
+    by_tag.supports[1].line.reset();
+    by_tag.supports[1].tag = "edge";
+    by_tag.validate();
+    const auto predicted = levels::predict_elastic3_sizes(by_tag, 2);
+    const auto h_ends = levels::build_elastic_hierarchy3(by_ends, 2);
+    const auto h_tag = levels::build_elastic_hierarchy3(by_tag, 2);
+    for (int l = 0; l <= 2; ++l) {
+        const auto& a = h_ends.levels[static_cast<size_t>(l)];
+        const auto& b = h_tag.levels[static_cast<size_t>(l)];
+        ASSERT_EQ(a.dofs.n_dofs(), b.dofs.n_dofs()) << "level " << l;
+        for (int v = 0; v < a.mesh.n_vertices(); ++v)
+            for (int c = 0; c < 3; ++c)
+                ASSERT_EQ(a.dofs.u_dof(v, c), b.dofs.u_dof(v, c)) << v << " " << c;
+        EXPECT_EQ(predicted[static_cast<size_t>(l)].unknowns, static_cast<double>(b.dofs.n_dofs()))
+            << "level " << l;
+        EXPECT_EQ(b.mesh.vertices_on_tag(edge).size(), static_cast<size_t>((2 << l) + 1));
+    }
+    // A tag on neither a face nor a line is refused.
+    by_tag.supports[1].tag = "nowhere";
+    by_tag.mesh0.add_tag("nowhere");
+    try {
+        by_tag.validate();
+        ADD_FAILURE() << "validate accepted a support tag on nothing";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("no boundary face or line carries the tag 'nowhere'"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(Scene3, AGmshPhysicalCurveIsASupportTag) {
+    const GmshScene g;
+    const levels::ElasticProblem3 p =
+        g.parse(std::string(kGmshScene) + "[[support]]\ntag = \"edge\"\nuy = 0.0\nuz = 0.0\n");
+    ASSERT_EQ(p.supports.back().tag, "edge");
+    const int edge = p.mesh0.tag("edge");
+    const auto sizes = levels::predict_elastic3_sizes(p, 2);
+    const auto h = levels::build_elastic_hierarchy3(p, 2);
+    for (int l = 0; l <= 2; ++l) {
+        const auto& L = h.levels[static_cast<size_t>(l)];
+        const std::vector<int> on = L.mesh.vertices_on_tag(edge);
+        ASSERT_EQ(on.size(), static_cast<size_t>(3 * (1 << l) + 1)) << "level " << l;
+        for (int v : on) {
+            const Vec3& x = L.mesh.vertices[static_cast<size_t>(v)];
+            EXPECT_EQ(x.y(), 0.0);
+            EXPECT_EQ(x.z(), 0.0);
+            EXPECT_LT(L.dofs.u_dof(v, 1), 0);
+            EXPECT_LT(L.dofs.u_dof(v, 2), 0);
+        }
+        EXPECT_EQ(sizes[static_cast<size_t>(l)].unknowns, static_cast<double>(L.dofs.n_dofs()))
+            << "level " << l;
+    }
+    // Loads need faces: the curve's tag is no load tag; a support tag on nothing is refused.
+    mesh::testing::expect_invalid(
+        [&] { g.parse(std::string(kGmshScene) + "[[load]]\ntag = \"edge\"\npressure = 1.0\n"); },
+        {"unknown boundary tag 'edge'"});
+    mesh::testing::expect_invalid(
+        [&] { g.parse(std::string(kGmshScene) + "[[support]]\ntag = \"roof\"\nux = 0.0\n"); },
+        {"unknown boundary or line tag 'roof'", "edge"});
 }
 
 TEST(Scene3, ALineOffTheEdgesOrWithoutVertexEndsIsRefused) {

@@ -22,6 +22,7 @@ struct MshSpec {
     std::vector<Vec3> nodes;                                   ///< node id = index + 1
     std::vector<std::pair<int, std::array<int, 3>>> triangles; ///< (physical tag, node ids)
     std::vector<std::pair<int, std::array<int, 4>>> tets;      ///< (physical tag, node ids)
+    std::vector<std::pair<int, std::array<int, 2>>> lines;     ///< (physical tag, node ids)
     std::vector<std::string> names; ///< "dim tag \"name\"" lines of $PhysicalNames
 };
 
@@ -71,8 +72,10 @@ inline std::string msh22(const MshSpec& s) {
     for (std::size_t i = 0; i < s.nodes.size(); ++i)
         os << i + 1 << " " << s.nodes[i].x() << " " << s.nodes[i].y() << " " << s.nodes[i].z()
            << "\n";
-    os << "$EndNodes\n$Elements\n" << s.triangles.size() + s.tets.size() << "\n";
+    os << "$EndNodes\n$Elements\n" << s.lines.size() + s.triangles.size() + s.tets.size() << "\n";
     int id = 1;
+    for (const auto& [p, k] : s.lines)
+        os << id++ << " 1 2 " << p << " " << p << " " << k[0] << " " << k[1] << "\n";
     for (const auto& [p, k] : s.triangles)
         os << id++ << " 2 2 " << p << " " << p << " " << k[0] << " " << k[1] << " " << k[2] << "\n";
     for (const auto& [p, k] : s.tets)
@@ -85,19 +88,24 @@ inline std::string msh22(const MshSpec& s) {
 /// The .msh text of `s` in format 4.1: one entity per physical group (entity tag = physical
 /// tag), all nodes in one block of volume 1.
 inline std::string msh41(const MshSpec& s) {
-    std::vector<int> surfaces, volumes;
+    std::vector<int> curves, surfaces, volumes;
+    for (const auto& t : s.lines)
+        curves.push_back(t.first);
     for (const auto& t : s.triangles)
         surfaces.push_back(t.first);
     for (const auto& t : s.tets)
         volumes.push_back(t.first);
-    for (auto* v : {&surfaces, &volumes}) {
+    for (auto* v : {&curves, &surfaces, &volumes}) {
         std::sort(v->begin(), v->end());
         v->erase(std::unique(v->begin(), v->end()), v->end());
     }
     std::ostringstream os;
     os.precision(17);
     write_names_and_format(os, s, "4.1");
-    os << "$Entities\n0 0 " << surfaces.size() << " " << volumes.size() << "\n";
+    os << "$Entities\n0 " << curves.size() << " " << surfaces.size() << " " << volumes.size()
+       << "\n";
+    for (int p : curves)
+        os << p << " -1 -1 -1 2 2 2 1 " << p << " 0\n";
     for (int p : surfaces)
         os << p << " -1 -1 -1 2 2 2 1 " << p << " 0\n";
     for (int p : volumes)
@@ -108,10 +116,19 @@ inline std::string msh41(const MshSpec& s) {
         os << i + 1 << "\n";
     for (const auto& x : s.nodes)
         os << x.x() << " " << x.y() << " " << x.z() << "\n";
+    const std::size_t n_elements = s.lines.size() + s.triangles.size() + s.tets.size();
     os << "$EndNodes\n$Elements\n"
-       << surfaces.size() + volumes.size() << " " << s.triangles.size() + s.tets.size() << " 1 "
-       << s.triangles.size() + s.tets.size() << "\n";
+       << curves.size() + surfaces.size() + volumes.size() << " " << n_elements << " 1 "
+       << n_elements << "\n";
     int id = 1;
+    for (int p : curves) {
+        std::vector<std::array<int, 2>> block;
+        for (const auto& [q, k] : s.lines)
+            if (q == p) block.push_back(k);
+        os << "1 " << p << " 1 " << block.size() << "\n";
+        for (const auto& k : block)
+            os << id++ << " " << k[0] << " " << k[1] << "\n";
+    }
     for (int p : surfaces) {
         std::vector<std::array<int, 3>> block;
         for (const auto& [q, k] : s.triangles)
