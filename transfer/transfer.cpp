@@ -74,29 +74,18 @@ std::vector<int> node_of_vertex(const ContactNodes& c, const fem::DofMap& dofs, 
     return of;
 }
 
-/// The meshes and numberings nest: the fine mesh refines the coarse one (parents of every new
-/// vertex), the numberings have the meshes' vertex counts, and the supports nest.
+/// The numberings nest: they have the meshes' vertex counts, and the supports nest (that the fine
+/// mesh refines the coarse one, vertex_prolongation checks).
 void check_levels_nest(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
                        const fem::DofMap& fine_dofs) {
     const int nf = fine.n_vertices();
     const int nc = fine.n_coarse_vertices;
-    MLC_CHECK(nc > 0 && static_cast<int>(fine.parents.size()) == nf - nc,
-              "build_transfer: the fine mesh must come from mesh::refine; found "
-                  << nc << " coarse vertices, " << nf << " vertices and " << fine.parents.size()
-                  << " parent pairs");
     MLC_CHECK(coarse_dofs.n_vertices() == nc, "build_transfer: coarse numbering has "
                                                   << coarse_dofs.n_vertices()
                                                   << " vertices, the coarse mesh " << nc);
     MLC_CHECK(fine_dofs.n_vertices() == nf, "build_transfer: fine numbering has "
                                                 << fine_dofs.n_vertices()
                                                 << " vertices, the fine mesh " << nf);
-    for (int m = nc; m < nf; ++m) {
-        const auto& pr = fine.parents[static_cast<size_t>(m - nc)];
-        MLC_CHECK(pr[0] >= 0 && pr[0] < nc && pr[1] >= 0 && pr[1] < nc && pr[0] != pr[1],
-                  "build_transfer: new vertex " << m << " has parents (" << pr[0] << ", " << pr[1]
-                                                << "), expected two distinct coarse vertices in 0.."
-                                                << nc - 1);
-    }
     for (int v = 0; v < nc; ++v)
         for (int c = 0; c < 2; ++c)
             MLC_CHECK((coarse_dofs.u_dof(v, c) < 0) == (fine_dofs.u_dof(v, c) < 0),
@@ -281,14 +270,14 @@ Eigen::Vector2d multiplier_resultant(const ContactNodes& nodes, const Vector& x)
 LevelTransfer build_transfer(const mesh::Mesh& fine, const fem::DofMap& coarse_dofs,
                              const fem::DofMap& fine_dofs, const ContactNodes& coarse_contacts,
                              const ContactNodes& fine_contacts, QRule rule) {
+    LevelTransfer tr;
+    tr.P_vertex = vertex_prolongation(fine); // checks the parents of every new vertex
     check_levels_nest(fine, coarse_dofs, fine_dofs);
     const int nc = fine.n_coarse_vertices;
     const std::vector<int> cnode = node_of_vertex(coarse_contacts, coarse_dofs, "coarse");
     const std::vector<int> fnode = node_of_vertex(fine_contacts, fine_dofs, "fine");
     check_contacts_nest(nc, cnode, fnode, coarse_contacts, fine_contacts);
-    LevelTransfer tr;
     tr.rule = rule;
-    tr.P_vertex = vertex_prolongation(fine);
     tr.P_nodal = expand_components(tr.P_vertex, 2);
     const std::vector<Triplet> tq =
         multiplier_rows(fine, cnode, coarse_contacts, fine_contacts, rule);

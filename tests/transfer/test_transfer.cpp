@@ -661,3 +661,31 @@ TEST(Transfer, RejectsLevelsThatDoNotNest) {
     Vector x = Vector::Zero(C.n_unknowns());
     EXPECT_THROW(tr.prolongate(x, x), InvalidInput);
 }
+
+TEST(Transfer, LevelsThatDoNotNestAreRefusedNamingTheDefect) {
+    const mesh::Mesh m0 = mesh::structured_rectangle(Vec2(0.0, 0.0), Vec2(1.0, 1.0), 2, 2);
+    mesh::Mesh m1 = mesh::refine(m0);
+    auto plain = [](const mesh::Mesh& m) {
+        return fem::DofMap(std::vector<std::array<bool, 2>>(static_cast<size_t>(m.n_vertices())),
+                           std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
+    };
+    auto message = [&](const mesh::Mesh& fine, const mesh::Mesh& coarse) {
+        try {
+            transfer::build_transfer(fine, plain(coarse), plain(fine), {}, {});
+        } catch (const InvalidInput& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    // A level-0 mesh is no refinement; a new vertex with one parent twice is no edge midpoint;
+    // a coarse numbering of another mesh does not nest.
+    EXPECT_NE(message(m0, m0).find("must come from mesh::refine"), std::string::npos);
+    mesh::Mesh bad = m1;
+    bad.parents[3] = {bad.parents[3][0], bad.parents[3][0]};
+    EXPECT_NE(
+        message(bad, m0).find("new vertex " + std::to_string(m0.n_vertices() + 3) + " has parents"),
+        std::string::npos)
+        << message(bad, m0);
+    EXPECT_NE(message(m1, m1).find("coarse numbering has"), std::string::npos);
+    EXPECT_EQ(message(m1, m0), "accepted");
+}
