@@ -51,11 +51,11 @@ std::string mg_cycle() {
 }
 
 /// mg-CG: the multigrid set up anew in every repetition (its setup timed), CG to rel_tol.
-Run3 run_mg(const levels::ElasticHierarchy3& h, const Vector& b, const BenchElasticOptions& opt,
+Run3 run_mg(const levels::Hierarchy3& h, const Vector& b, const BenchElasticOptions& opt,
             Vector& x) {
     Run3 r;
     r.name = "mg-cg";
-    const SparseMatrix& K = h.finest().system.K;
+    const SparseMatrix& K = h.finest().elastic.K;
     for (int rep = 0; rep < opt.repeat; ++rep) {
         const double t0 = wall_seconds();
         const auto mg = levels::elastic3_multigrid(h);
@@ -72,11 +72,11 @@ Run3 run_mg(const levels::ElasticHierarchy3& h, const Vector& b, const BenchElas
 }
 
 /// BoomerAMG-PCG with hypre's elasticity settings and the three rotational rigid-body modes.
-Run3 run_amg(const levels::ElasticHierarchy3& h, const Vector& b, const BenchElasticOptions& opt,
+Run3 run_amg(const levels::Hierarchy3& h, const Vector& b, const BenchElasticOptions& opt,
              Vector& x) {
     Run3 r;
     r.name = "boomeramg-pcg";
-    const SparseMatrix& K = h.finest().system.K;
+    const SparseMatrix& K = h.finest().elastic.K;
     // The rotations: hypre's unknown-based interpolation reproduces the translations already.
     const std::vector<Vector> all = levels::rigid_body_modes3(h.finest());
     const std::vector<Vector> modes(all.begin() + 3, all.end());
@@ -100,11 +100,10 @@ struct ThreadsFor {
 };
 
 void write_json3(std::ostream& js, const BenchElasticOptions& opt, int L,
-                 const levels::ElasticHierarchy3& h,
-                 const std::vector<levels::ElasticLevelSize3>& sizes,
+                 const levels::Hierarchy3& h, const std::vector<levels::ElasticLevelSize3>& sizes,
                  const levels::ElasticMemory3& mem, const std::vector<Run3>& runs, double ratio,
                  double diff, int threads, double hierarchy_s) {
-    const auto& K = h.finest().system.K;
+    const auto& K = h.finest().elastic.K;
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"dimension\": 3"
        << ",\n  \"level\": " << L << ",\n  \"unknowns\": " << K.rows()
        << ",\n  \"nonzeros\": " << K.nonZeros()
@@ -119,8 +118,8 @@ void write_json3(std::ostream& js, const BenchElasticOptions& opt, int L,
        << ",\n  \"levels\": [";
     for (size_t l = 0; l < h.levels.size(); ++l)
         js << (l ? ", " : "") << "{\"level\": " << l
-           << ", \"unknowns\": " << h.levels[l].system.K.rows()
-           << ", \"nonzeros\": " << h.levels[l].system.K.nonZeros() << "}";
+           << ", \"unknowns\": " << h.levels[l].elastic.K.rows()
+           << ", \"nonzeros\": " << h.levels[l].elastic.K.nonZeros() << "}";
     js << "],\n  \"solvers\": [";
     for (size_t k = 0; k < runs.size(); ++k) {
         const Run3& r = runs[k];
@@ -159,10 +158,10 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
     const int threads = solvers::hypre_threads();
     const ThreadsFor set_threads(threads);
     const double th0 = wall_seconds();
-    const levels::ElasticHierarchy3 h = levels::build_elastic_hierarchy3(p, L);
+    const levels::Hierarchy3 h = levels::build_hierarchy(p, L);
     const double hierarchy_s = wall_seconds() - th0;
-    const SparseMatrix& K = h.finest().system.K;
-    const Vector& b = h.finest().system.f;
+    const SparseMatrix& K = h.finest().elastic.K;
+    const Vector& b = h.finest().elastic.f;
     MLC_CHECK(b.norm() > 0, "bench elastic: the scene has no load on the free unknowns");
     os << "bench elastic: " << opt.scene << " (3D) level " << L << ", elastic block " << K.rows()
        << " unknowns (predicted " << std::setprecision(7) << sizes.back().unknowns

@@ -4,7 +4,7 @@
 #include "levels/elastic3d_levels.hpp"
 
 #include "core/check.hpp"
-#include "fem/elastic3d.hpp"
+#include "fem/assembly.hpp"
 #include "mesh/tet_refine.hpp"
 #include "transfer/prolongation.hpp"
 
@@ -145,18 +145,11 @@ void ElasticProblem3::validate() const {
 
 // ------------------------------------------------------------------------------------------
 
-std::vector<int> ElasticLevel3::vertex_of_dof() const {
-    std::vector<int> out(static_cast<size_t>(dofs.n_dofs()));
-    for (Index i = 0; i < dofs.n_dofs(); ++i)
-        out[static_cast<size_t>(i)] = dofs.vertex_of(i);
-    return out;
-}
-
-ElasticLevel3 build_elastic_level3(const ElasticProblem3& p, mesh::TetMesh m) {
-    ElasticLevel3 L;
-    std::vector<fem::VertexSupport> vs;
+Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
+    Level3 L;
+    std::vector<fem::VertexSupport3> vs;
     for (const Support3& s : p.supports) {
-        fem::VertexSupport v;
+        fem::VertexSupport3 v;
         v.vertices = support_vertices(p, s, m);
         for (int c = 0; c < 3; ++c) {
             v.components[static_cast<size_t>(c)] = s.u[static_cast<size_t>(c)].has_value();
@@ -165,50 +158,49 @@ ElasticLevel3 build_elastic_level3(const ElasticProblem3& p, mesh::TetMesh m) {
         vs.push_back(std::move(v));
     }
     fem::Supports3 sup = fem::collect_supports(m, vs);
-    L.dofs = fem::DofMap3(sup.fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
+    L.fixed = std::move(sup.fixed);
+    L.dofs = fem::DofMap3(L.fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
     L.u_fixed = std::move(sup.u_fixed);
     std::vector<fem::Traction3> tr;
     for (const FaceLoad3& l : p.loads)
         tr.push_back({m.tag(l.tag), l.pressure, l.traction});
     std::vector<Vec3> bf;
-    std::vector<fem::Material> mats;
     bool any_force = false;
     for (const Body3& b : p.bodies) {
         bf.push_back(b.body_force);
-        mats.push_back(b.material);
+        L.materials.push_back(b.material);
         any_force = any_force || !b.body_force.isZero(0.0);
     }
     const Vector F = fem::nodal_loads(m, tr, any_force ? bf : std::vector<Vec3>{});
-    L.system = fem::assemble_elastic(m, mats, L.dofs, F, L.u_fixed);
+    L.elastic = fem::assemble_elastic(m, L.materials, L.dofs, F, L.u_fixed);
     L.mesh = std::move(m);
     return L;
 }
 
-ElasticHierarchy3 build_elastic_hierarchy3(const ElasticProblem3& p, int levels) {
+Hierarchy3 build_hierarchy(const ElasticProblem3& p, int levels) {
     p.validate();
     MLC_CHECK(levels >= 0 && levels <= kMaxLevels3,
               "levels must lie in [0, " << kMaxLevels3 << "], found " << levels);
-    ElasticHierarchy3 h;
-    h.levels.push_back(build_elastic_level3(p, p.mesh0));
-    h.T.emplace_back();
-    h.R.emplace_back();
+    Hierarchy3 h;
+    h.levels.push_back(build_level(p, p.mesh0));
     for (int l = 1; l <= levels; ++l) {
         mesh::TetMesh fine = mesh::refine(h.levels.back().mesh);
         mesh::check_refined_quality(fine);
-        const SparseMatrix Pv = transfer::vertex_prolongation(fine);
-        ElasticLevel3 L = build_elastic_level3(p, std::move(fine));
-        const ElasticLevel3& C = h.levels.back();
-        SparseMatrix T = transfer::restrict_to_unknowns(
-            Pv, 3, transfer::vertex_unknowns(C.dofs, 3), static_cast<int>(C.dofs.n_dofs()),
+        transfer::LevelTransfer t;
+        t.P_vertex = transfer::vertex_prolongation(fine);
+        Level3 L = build_level(p, std::move(fine));
+        const Level3& C = h.levels.back();
+        t.T = transfer::restrict_to_unknowns(
+            t.P_vertex, 3, transfer::vertex_unknowns(C.dofs, 3), static_cast<int>(C.dofs.n_dofs()),
             transfer::vertex_unknowns(L.dofs, 3), static_cast<int>(L.dofs.n_dofs()));
-        h.R.emplace_back(T.transpose());
-        h.T.push_back(std::move(T));
+        t.R = SparseMatrix(t.T.transpose());
+        h.transfers.push_back(std::move(t));
         h.levels.push_back(std::move(L));
     }
     return h;
 }
 
-std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h,
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const Hierarchy3& h,
                                                        solvers::MultigridParams params) {
     MLC_CHECK(h.levels.size() >= 2,
               "the 3D multigrid needs at least two levels (levels >= 1), found "
@@ -220,15 +212,15 @@ std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& 
     std::vector<solvers::MultigridLevelData> data(n);
     for (size_t l = 0; l < n; ++l) {
         if (l > 0) {
-            data[l].T = &h.T[l];
-            data[l].R = &h.R[l];
+            data[l].T = &h.transfers[l - 1].T;
+            data[l].R = &h.transfers[l - 1].R;
         }
         data[l].block_starts = solvers::vertex_block_starts(h.levels[l].vertex_of_dof());
     }
     auto mg = std::make_unique<solvers::Multigrid>(std::move(data), params);
     for (size_t l = 0; l + 1 < n; ++l)
-        mg->set_operator(static_cast<int>(l), h.levels[l].system.K);
-    mg->setup(h.levels[n - 1].system.K);
+        mg->set_operator(static_cast<int>(l), h.levels[l].elastic.K);
+    mg->setup(h.levels[n - 1].elastic.K);
     return mg;
 }
 
@@ -240,11 +232,11 @@ solvers::MultigridParams elastic3_mg_params() {
     return p;
 }
 
-std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h) {
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const Hierarchy3& h) {
     return elastic3_multigrid(h, elastic3_mg_params());
 }
 
-std::vector<Vector> rigid_body_modes3(const ElasticLevel3& L) {
+std::vector<Vector> rigid_body_modes3(const Level3& L) {
     const mesh::TetMesh& m = L.mesh;
     Vec3 lo = m.vertices.front(), hi = m.vertices.front();
     for (const Vec3& x : m.vertices) {
@@ -369,11 +361,11 @@ std::vector<ElasticLevelSize3> predict_elastic3_sizes(const ElasticProblem3& p, 
     MLC_CHECK(levels >= 0 && levels <= kMaxLevels3,
               "levels must lie in [0, " << kMaxLevels3 << "], found " << levels);
     const std::vector<mesh::TetLevelSize> ms = mesh::predict_tet_level_sizes(p.mesh0, levels);
-    const ElasticLevel3 L0 = build_elastic_level3(p, p.mesh0);
+    const Level3 L0 = build_level(p, p.mesh0);
     const std::vector<double> fixed = predict_fixed_components(p, levels);
     const double V0 = ms[0].vertices, E0 = ms[0].edges;
     // The nonzeros the fixed components remove, per fixed component (level 0's ratio).
-    const double deficit0 = 9 * (V0 + 2 * E0) - static_cast<double>(L0.system.K.nonZeros());
+    const double deficit0 = 9 * (V0 + 2 * E0) - static_cast<double>(L0.elastic.K.nonZeros());
     const double per_fixed = fixed[0] > 0 ? deficit0 / fixed[0] : 0.0;
     std::vector<ElasticLevelSize3> out;
     for (const mesh::TetLevelSize& s : ms) {
@@ -388,7 +380,7 @@ std::vector<ElasticLevelSize3> predict_elastic3_sizes(const ElasticProblem3& p, 
         out.push_back(e);
     }
     out[0].unknowns = static_cast<double>(L0.dofs.n_dofs());
-    out[0].k_nonzeros = static_cast<double>(L0.system.K.nonZeros());
+    out[0].k_nonzeros = static_cast<double>(L0.elastic.K.nonZeros());
     return out;
 }
 

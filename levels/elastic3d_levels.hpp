@@ -10,6 +10,8 @@
 #include "fem/assembly.hpp"
 #include "fem/dof_map.hpp"
 #include "fem/elasticity.hpp"
+#include "levels/hierarchy.hpp"
+#include "levels/level.hpp"
 #include "levels/resources.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "solvers/mg.hpp"
@@ -110,40 +112,25 @@ ElasticMemory3 estimate_elastic3_memory(const std::vector<ElasticLevelSize3>& si
 void check_elastic3_fits(const ElasticMemory3& e, const MemoryLimit& limit,
                          const std::vector<ElasticLevelSize3>& sizes);
 
-/// One level: its mesh, numbering (free components interleaved by vertex), the prescribed
-/// values (3 per vertex) and the assembled system (K on the unknowns, f for the full load).
-struct ElasticLevel3 {
-    mesh::TetMesh mesh;
-    fem::DofMap3 dofs;
-    Vector u_fixed;
-    fem::ElasticSystem system;
-    /// Vertex of each unknown (the smoother's 3 x 3 blocks).
-    std::vector<int> vertex_of_dof() const;
-};
+/// Builds one 3D level on mesh `m` (a refinement of p.mesh0, or p.mesh0): supports
+/// (Level3::fixed, u_fixed), numbering (free components interleaved by vertex), materials, loads
+/// and the assembled system (K on the unknowns, f for the full load). No contact elements.
+Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m);
 
-/// Builds one level on mesh `m` (supports, loads, assembly).
-ElasticLevel3 build_elastic_level3(const ElasticProblem3& p, mesh::TetMesh m);
-
-/// Levels 0..L (coarsest first) and the transfers between them: T[l] (l >= 1) the linear
-/// interpolation from level l-1 to level l on the free unknowns (transfer::restrict_to_unknowns
-/// of the vertex prolongation), R[l] = T[l]^T; T[0], R[0] empty.
-struct ElasticHierarchy3 {
-    std::vector<ElasticLevel3> levels;
-    std::vector<SparseMatrix> T, R;
-    const ElasticLevel3& finest() const { return levels.back(); }
-};
-
-/// Refines p.mesh0 `levels` times (mesh::refine) and builds every level and transfer.
-ElasticHierarchy3 build_elastic_hierarchy3(const ElasticProblem3& p, int levels);
+/// Refines p.mesh0 `levels` times (mesh::refine) and builds every level and transfer: transfers[l]
+/// from level l to l + 1 holds P_vertex (linear interpolation through the 1->8 refinement), T
+/// (P_vertex on the free unknowns, transfer::restrict_to_unknowns) and R = T^T; P_nodal, Q and the
+/// coarse/fine splitting, which contact levels use, stay empty.
+Hierarchy3 build_hierarchy(const ElasticProblem3& p, int levels);
 
 /// The geometric multigrid on a hierarchy of at least two levels: rediscretized operators (each
 /// level's K), smoother blocks of the 3 components of a vertex, T and R of the hierarchy
 /// (borrowed: `h` must outlive it), sparse LU on level 0. With the default params
 /// (elastic3_mg_params), a symmetric W(2,2) cycle (forward pre-sweeps, backward post-sweeps)
 /// that preconditions CG. The lattice smoother is 2D-only and refused (InvalidInput).
-std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h,
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const Hierarchy3& h,
                                                        solvers::MultigridParams params);
-std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const ElasticHierarchy3& h);
+std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const Hierarchy3& h);
 
 /// The default cycle of the 3D elastic multigrid: W(2,2). The V(1,1) cycle of the 2D runs needs
 /// more CG iterations as the levels grow (box3d: 13, 15, 17, 18, 18 on levels 1-5); two sweeps
@@ -154,6 +141,6 @@ solvers::MultigridParams elastic3_mg_params();
 
 /// The rigid-body modes of a level on its unknowns: the translations along x, y, z and the
 /// rotations about the x, y, z axes through the centre of the mesh's bounding box (6 vectors).
-std::vector<Vector> rigid_body_modes3(const ElasticLevel3& L);
+std::vector<Vector> rigid_body_modes3(const Level3& L);
 
 } // namespace mlc::levels

@@ -43,14 +43,15 @@ Hierarchy build_hierarchy(const Problem& problem, transfer::QRule rule, Timings*
     return h;
 }
 
-void Hierarchy::report(std::ostream& os) const {
+template <int dim> void BasicHierarchy<dim>::report(std::ostream& os) const {
     long total = 0;
     for (const auto& L : levels)
         total += L.elastic.K.nonZeros();
-    os << "  level  vertices  triangles  unknowns  contact nodes  nnz(K)\n";
+    os << "  level  vertices  " << (dim == 2 ? "triangles" : "tetrahedra")
+       << "  unknowns  contact nodes  nnz(K)\n";
     for (size_t l = 0; l < levels.size(); ++l) {
         const auto& L = levels[l];
-        os << std::setw(7) << l << std::setw(10) << L.mesh.n_vertices() << std::setw(11)
+        os << std::setw(7) << l << std::setw(10) << L.mesh.n_vertices() << std::setw(dim + 9)
            << L.mesh.n_cells() << std::setw(10) << L.n_unknowns() << std::setw(15)
            << L.n_contact_nodes() << std::setw(9) << L.elastic.K.nonZeros() << "\n";
     }
@@ -58,5 +59,8 @@ void Hierarchy::report(std::ostream& os) const {
        << static_cast<double>(total) / static_cast<double>(finest().elastic.K.nonZeros())
        << std::defaultfloat << "\n";
 }
+
+template struct BasicHierarchy<2>;
+template struct BasicHierarchy<3>;
 
 } // namespace mlc::levels

@@ -126,21 +126,30 @@ void pin_held_components(const Problem& problem, Level& L) {
 
 } // namespace
 
-Vector Level::u_fixed_at(double s) const {
+template <int dim> Vector BasicLevel<dim>::u_fixed_at(double s) const {
     return path_at(path_u_fixed, u_fixed, s);
 }
-Vector Level::f_at(double s) const {
+template <int dim> Vector BasicLevel<dim>::f_at(double s) const {
     return path_at(path_f, elastic.f, s);
 }
-Vector Level::f_nodal_at(double s) const {
+template <int dim> Vector BasicLevel<dim>::f_nodal_at(double s) const {
     return path_at(path_f_nodal, elastic.f_nodal_full, s);
 }
-void Level::u_fixed_at(double s, Vector& out) const {
+template <int dim> void BasicLevel<dim>::u_fixed_at(double s, Vector& out) const {
     path_at(path_u_fixed, u_fixed, s, out);
 }
-void Level::f_at(double s, Vector& out) const {
+template <int dim> void BasicLevel<dim>::f_at(double s, Vector& out) const {
     path_at(path_f, elastic.f, s, out);
 }
+template <int dim> std::vector<int> BasicLevel<dim>::vertex_of_dof() const {
+    std::vector<int> out(static_cast<size_t>(dofs.n_dofs()));
+    for (Index i = 0; i < dofs.n_dofs(); ++i)
+        out[static_cast<size_t>(i)] = dofs.vertex_of(i);
+    return out;
+}
+
+template struct BasicLevel<2>;
+template struct BasicLevel<3>;
 
 Level build_level(const Problem& problem, mesh::Mesh m) {
     return build_level(problem, std::move(m), nullptr);

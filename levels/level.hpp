@@ -9,8 +9,10 @@
 #include "levels/problem.hpp"
 #include "mesh/lattice.hpp"
 #include "mesh/mesh.hpp"
+#include "mesh/simplex_mesh.hpp"
 #include "smoothers/lattice_gs.hpp"
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -18,17 +20,19 @@
 
 namespace mlc::levels {
 
-/// Everything one mesh level needs to solve. Built by `build_level`; immutable afterwards.
-struct Level {
-    mesh::Mesh mesh;
-    std::vector<fem::Material> materials;   ///< per body (triangle attribute)
-    std::vector<std::array<bool, 2>> fixed; ///< per vertex and component
-    Vector u_fixed;                         ///< prescribed displacements at load factor 1
-    fem::DofMap dofs;
-    fem::ElasticSystem elastic;                    ///< K and f at load factor 1
-    std::vector<contact::ContactElement> contacts; ///< one per contactor node
-    std::vector<int> lambda_dof;                   ///< first multiplier unknown of each element
-    std::vector<int> contact_of_vertex;            ///< element index of a contactor vertex, or -1
+/// Everything one mesh level needs to solve, in `dim` dimensions (`Level` in 2D, `Level3` in
+/// 3D). Built by `build_level` (2D) or `build_level3` (3D); immutable afterwards.
+template <int dim> struct BasicLevel {
+    static constexpr int dimension = dim;
+    mesh::SimplexMesh<dim> mesh;
+    std::vector<fem::Material> materials;     ///< per body (cell attribute)
+    std::vector<std::array<bool, dim>> fixed; ///< per vertex and component
+    Vector u_fixed;                           ///< prescribed displacements at load factor 1
+    fem::BasicDofMap<dim> dofs;
+    fem::ElasticSystem elastic;                              ///< K and f at load factor 1
+    std::vector<contact::BasicContactElement<dim>> contacts; ///< one per contactor node
+    std::vector<int> lambda_dof;        ///< first multiplier unknown of each element
+    std::vector<int> contact_of_vertex; ///< element index of a contactor vertex, or -1
     /// Per contact pair: contactor vertices left out because the search found no target facet
     /// (node_on_facet) or no coincident target vertex (node_on_node). Empty for rigid pairs.
     std::vector<std::vector<int>> not_found;
@@ -38,14 +42,15 @@ struct Level {
     /// may own), built here as their owners build them, so that the owned rows of the residual
     /// and the Jacobian are complete without sending contributions. Their multiplier rows are
     /// their owners'; they count in no status, norm or output.
-    std::vector<contact::ContactElement> ghost_contacts;
+    std::vector<contact::BasicContactElement<dim>> ghost_contacts;
     std::vector<int> ghost_lambda_dof; ///< first multiplier unknown of each ghost element
 
-    /// Loading path (Problem::n_path_points K): prescribed displacements (2 per vertex), loads on
-    /// the unknowns (f = F_free - K_(free,fixed) u_fixed) and nodal loads (2 per vertex) at path
-    /// points k = 1..K, entry k-1. The last entries equal u_fixed, elastic.f, elastic.f_nodal_full.
-    /// Empty with one path point (proportional loading; build_level leaves them empty then) and
-    /// in a level assembled by hand: the loading is then proportional to those.
+    /// Loading path (Problem::n_path_points K): prescribed displacements (dim per vertex), loads
+    /// on the unknowns (f = F_free - K_(free,fixed) u_fixed) and nodal loads (dim per vertex) at
+    /// path points k = 1..K, entry k-1. The last entries equal u_fixed, elastic.f,
+    /// elastic.f_nodal_full. Empty with one path point (proportional loading; build_level leaves
+    /// them empty then) and in a level assembled by hand: the loading is then proportional to
+    /// those.
     std::vector<Vector> path_u_fixed, path_f, path_f_nodal;
 
     /// Prescribed displacements at path parameter s in [0, 1] (s = step / load_steps): linear
@@ -53,19 +58,30 @@ struct Level {
     Vector u_fixed_at(double s) const;
     /// Loads on the unknowns at path parameter s (s * elastic.f for proportional loading).
     Vector f_at(double s) const;
-    /// Nodal loads (2 per vertex) at path parameter s (s * elastic.f_nodal_full if proportional).
+    /// Nodal loads (dim per vertex) at path parameter s (s * elastic.f_nodal_full if
+    /// proportional).
     Vector f_nodal_at(double s) const;
     /// u_fixed_at(s) and f_at(s) written into `out` (resized; no allocation when it has the size).
     void u_fixed_at(double s, Vector& out) const;
     void f_at(double s, Vector& out) const;
 
-    /// With Problem::Numbering::lattice on a level that is 4 or more refinements of mesh0: the
-    /// rows of its macro triangles' interiors (mg:smoother=lattice); null otherwise.
+    /// 2D only (null in 3D): with Problem::Numbering::lattice on a level that is 4 or more
+    /// refinements of mesh0, the rows of its macro triangles' interiors (mg:smoother=lattice).
     std::shared_ptr<const smoothers::LatticeRows> lattice;
 
     Index n_unknowns() const { return dofs.n_dofs(); }
     int n_contact_nodes() const { return static_cast<int>(contacts.size()); }
+    /// Vertex of each unknown (the smoothers' vertex blocks).
+    std::vector<int> vertex_of_dof() const;
 };
+
+extern template struct BasicLevel<2>;
+extern template struct BasicLevel<3>;
+
+/// A 2D level (triangles).
+using Level = BasicLevel<2>;
+/// A 3D level (tetrahedra).
+using Level3 = BasicLevel<3>;
 
 /// Builds a level from the problem and a mesh of it (level 0 or a refinement of
 /// problem.mesh0).

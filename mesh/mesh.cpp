@@ -165,19 +165,10 @@ Mesh structured_rectangle(Vec2 corner, Vec2 size, int nx, int ny, Diagonal diago
 }
 
 VertexTriangles vertex_triangles(const Mesh& m) {
-    const size_t nv = m.vertices.size();
+    VertexCells c = vertex_cells(m);
     VertexTriangles r;
-    r.offset.assign(nv + 1, 0);
-    for (const auto& tri : m.cells)
-        for (int v : tri)
-            ++r.offset[static_cast<size_t>(v) + 1];
-    for (size_t v = 0; v < nv; ++v)
-        r.offset[v + 1] += r.offset[v];
-    r.triangles.resize(static_cast<size_t>(r.offset.back()));
-    std::vector<int> fill(r.offset.begin(), r.offset.end() - 1);
-    for (size_t t = 0; t < m.cells.size(); ++t) // ascending per vertex
-        for (int v : m.cells[t])
-            r.triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(t);
+    r.offset = std::move(c.offset);
+    r.triangles = std::move(c.cells);
     return r;
 }
 

@@ -126,7 +126,29 @@ template <int dim> int SimplexMesh<dim>::nearest_vertex(const Point& p) const {
     return best;
 }
 
+template <int dim> VertexCells vertex_cells(const SimplexMesh<dim>& m) {
+    const size_t nv = m.vertices.size();
+    VertexCells r;
+    r.offset.assign(nv + 1, 0);
+    for (const auto& cell : m.cells)
+        for (int v : cell) {
+            MLC_CHECK(v >= 0 && static_cast<size_t>(v) < nv,
+                      SimplexTraits<dim>::cell_name << " vertex " << v << " out of range");
+            ++r.offset[static_cast<size_t>(v) + 1];
+        }
+    for (size_t v = 0; v < nv; ++v)
+        r.offset[v + 1] += r.offset[v];
+    r.cells.resize(static_cast<size_t>(r.offset.back()));
+    std::vector<int> fill(r.offset.begin(), r.offset.end() - 1);
+    for (size_t t = 0; t < m.cells.size(); ++t) // ascending per vertex
+        for (int v : m.cells[t])
+            r.cells[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(t);
+    return r;
+}
+
 template struct SimplexMesh<2>;
 template struct SimplexMesh<3>;
+template VertexCells vertex_cells(const SimplexMesh<2>&);
+template VertexCells vertex_cells(const SimplexMesh<3>&);
 
 } // namespace mlc::mesh

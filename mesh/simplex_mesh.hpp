@@ -158,6 +158,17 @@ template <int dim> struct SimplexMesh {
 extern template struct SimplexMesh<2>;
 extern template struct SimplexMesh<3>;
 
+/// The cells of every vertex (CSR): those of vertex v are cells[offset[v] .. offset[v + 1]), in
+/// ascending cell order.
+struct VertexCells {
+    std::vector<int> offset; ///< n_vertices + 1 entries
+    std::vector<int> cells;  ///< (dim + 1) n_cells entries
+};
+/// The VertexCells of m. Throws InvalidInput for a cell vertex out of range.
+template <int dim> VertexCells vertex_cells(const SimplexMesh<dim>& m);
+extern template VertexCells vertex_cells(const SimplexMesh<2>&);
+extern template VertexCells vertex_cells(const SimplexMesh<3>&);
+
 /// The 2D mesh (triangles); its algorithms are in mesh/mesh.hpp.
 using Mesh = SimplexMesh<2>;
 /// The 3D mesh (tetrahedra); its algorithms are in mesh/tet_mesh.hpp.

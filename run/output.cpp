@@ -39,7 +39,7 @@ void require_finite(double v, const std::string& what) {
 
 SolutionFields solution_fields(const levels::Level& L, const Vector& u_full,
                                const std::vector<levels::ContactNodeState>& nodes) {
-    const auto stresses = fem::triangle_stresses(L.mesh, L.materials, u_full);
+    const auto stresses = fem::cell_stresses(L.mesh, L.materials, u_full);
     for (double v : stresses)
         require_finite(v, "stress");
     const int nv = L.mesh.n_vertices();

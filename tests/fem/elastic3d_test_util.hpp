@@ -3,7 +3,7 @@
 /// vertices of every box face, and a perturbed box read through the Gmsh reader.
 #pragma once
 
-#include "fem/elastic3d.hpp"
+#include "fem/assembly.hpp"
 #include "mesh/io/gmsh_tet.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "solvers/cholesky.hpp"
@@ -25,7 +25,7 @@ inline const char* const kBoxTags[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", 
 /// Solves the elastic problem with every listed support, the given nodal loads and materials;
 /// returns the full displacement (3 per vertex).
 inline Vector solve_elastic(const mesh::TetMesh& m, const std::vector<Material>& materials,
-                            const std::vector<VertexSupport>& supports, const Vector& loads) {
+                            const std::vector<VertexSupport3>& supports, const Vector& loads) {
     const Supports3 s = collect_supports(m, supports);
     const DofMap3 dofs(s.fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
     const ElasticSystem sys = assemble_elastic(m, materials, dofs, loads, s.u_fixed);
@@ -51,7 +51,7 @@ inline Vector solve_elastic(const mesh::TetMesh& m, const std::vector<Material>&
 inline std::vector<int> box_boundary_vertices(const mesh::TetMesh& m) {
     std::vector<int> all;
     for (const char* tag : kBoxTags) {
-        const auto v = face_vertices(m, m.tag(tag));
+        const auto v = facet_vertices(m, m.tag(tag));
         all.insert(all.end(), v.begin(), v.end());
     }
     std::sort(all.begin(), all.end());

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // P1 elasticity on tetrahedra against a manufactured smooth solution on the unit cube: order 1
 // in the energy norm and 2 in L2 over levels 0..3 of a refined Kuhn box.
-#include "fem/elastic3d.hpp"
+#include "fem/assembly.hpp"
 #include "fem/simplex.hpp"
 #include "mesh/tet_refine.hpp"
 #include "tests/fem/elastic3d_test_util.hpp"
@@ -133,7 +133,7 @@ TEST(Elastic3dConvergence, ManufacturedSolutionOrderOneInEnergyTwoInL2) {
     std::vector<double> e_energy, e_l2;
     for (int level = 0; level <= 3; ++level) {
         if (level > 0) m = mesh::refine(m);
-        std::vector<fem::VertexSupport> supports;
+        std::vector<fem::VertexSupport3> supports;
         for (int v : fem::testing::box_boundary_vertices(m))
             supports.push_back({{v}, {true, true, true}, s.u(m.vertices[static_cast<size_t>(v)])});
         const Vector F =

@@ -149,7 +149,7 @@ TEST(Assembly, UniaxialTractionGivesTheClosedFormExtension) {
         EXPECT_NEAR(u[2 * v], p * x.x() / mat.E, 1e-13);
         EXPECT_NEAR(u[2 * v + 1], -mat.nu * p * x.y() / mat.E, 1e-13);
     }
-    const auto s = fem::triangle_stresses(m, {mat}, u);
+    const auto s = fem::cell_stresses(m, {mat}, u);
     for (int t = 0; t < m.n_cells(); ++t) {
         EXPECT_NEAR(s[static_cast<size_t>(3 * t)], p, 1e-11);
         EXPECT_NEAR(s[static_cast<size_t>(3 * t + 1)], 0.0, 1e-11);
@@ -257,4 +257,47 @@ TEST(DofMap, NumbersVerticesInTheGivenOrderWithMultipliersAfterTheirDisplacement
     EXPECT_THROW(fem::DofMap(fixed, extra, {0, 1}), InvalidInput);    // too short
     EXPECT_THROW(fem::DofMap(fixed, extra, {0, 1, 1}), InvalidInput); // not a permutation
     EXPECT_THROW(fem::DofMap(fixed, extra, {0, 1, 3}), InvalidInput); // out of range
+}
+
+TEST(Assembly2D, TheDimensionGenericSupportsAndLoadsSolveTheLinearPatchExactly) {
+    // The 2D instances of the supports and loads written for both dimensions: u = A x + c held
+    // on the whole boundary (collect_supports over facet_vertices of every tag) is reproduced at
+    // the interior vertices, and the body-force rule of degree 2 integrates b(x) = (x, x y)
+    // exactly: the resultant is (int x, int x y) over [0, 2] x [0, 1] = (2, 1).
+    mesh::Mesh m = mesh::structured_rectangle(Vec2(0, 0), Vec2(2, 1), 6, 3);
+    Eigen::Matrix2d A;
+    A << 0.01, -0.02, 0.03, 0.015;
+    const Vec2 c(0.1, -0.2);
+    std::vector<fem::VertexSupport2> supports;
+    for (const char* tag : {"left", "right", "bottom", "top"})
+        for (int v : fem::facet_vertices(m, m.tag(tag))) {
+            const Vec2 x = m.vertices[static_cast<size_t>(v)];
+            supports.push_back({.vertices = {v}, .value = A * x + c});
+        }
+    const fem::BasicSupports<2> s = fem::collect_supports(m, supports);
+    const fem::DofMap dofs(s.fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
+    ASSERT_GT(dofs.n_dofs(), 0);
+    const fem::Material mat{.E = 3.0, .nu = 0.25};
+    const auto sys =
+        fem::assemble_elastic(m, {mat}, dofs, Vector::Zero(2 * m.n_vertices()), s.u_fixed);
+    Eigen::SparseLU<SparseMatrixCol> lu(SparseMatrixCol(sys.K));
+    Vector u;
+    dofs.expand(lu.solve(sys.f), s.u_fixed, u);
+    for (int v = 0; v < m.n_vertices(); ++v) {
+        const Vec2 x = m.vertices[static_cast<size_t>(v)];
+        EXPECT_NEAR((u.segment<2>(2 * v) - (A * x + c)).norm(), 0.0, 1e-14);
+    }
+    // Reactions balance: the internal forces of the exact field sum to zero.
+    const Vector r = fem::internal_forces(m, {mat}, u);
+    EXPECT_NEAR(r(Eigen::seq(0, Eigen::last, 2)).sum(), 0.0, 1e-13);
+    EXPECT_NEAR(r(Eigen::seq(1, Eigen::last, 2)).sum(), 0.0, 1e-13);
+
+    const Vector F =
+        fem::body_force_loads(m, [](const Vec2& x) { return Vec2(x.x(), x.x() * x.y()); });
+    EXPECT_NEAR(F(Eigen::seq(0, Eigen::last, 2)).sum(), 2.0, 1e-14);
+    EXPECT_NEAR(F(Eigen::seq(1, Eigen::last, 2)).sum(), 1.0, 1e-14);
+    // A constant body force: the same loads as nodal_loads' area / 3 per vertex.
+    const Vector Fc = fem::body_force_loads(m, [](const Vec2&) { return Vec2(0.5, -1.5); });
+    const Vector Fn = fem::nodal_loads(m, {}, {Vec2(0.5, -1.5)});
+    EXPECT_LE((Fc - Fn).norm(), 1e-15 * Fn.norm() * m.n_vertices());
 }

@@ -22,25 +22,25 @@ namespace {
 using mesh::Vec3;
 
 // mg-CG from zero to rel_tol on the finest level of h; returns the iterations, the solution in x.
-int mg_cg_iterations(const levels::ElasticHierarchy3& h, Vector& x, double rel_tol = 1e-8) {
+int mg_cg_iterations(const levels::Hierarchy3& h, Vector& x, double rel_tol = 1e-8) {
     const auto mg = levels::elastic3_multigrid(h);
-    const SparseMatrix& K = h.finest().system.K;
+    const SparseMatrix& K = h.finest().elastic.K;
     x = Vector::Zero(K.rows());
     solvers::KrylovParams kp;
     kp.rel_tol = rel_tol;
     kp.max_iter = 200;
-    const SolveResult r = solvers::cg(MatrixOperator(K), *mg, h.finest().system.f, x, kp);
+    const SolveResult r = solvers::cg(MatrixOperator(K), *mg, h.finest().elastic.f, x, kp);
     EXPECT_TRUE(r.converged);
     EXPECT_LE(r.relative_residual, rel_tol);
     return r.iterations;
 }
 
 // The direct solution of a level's system (SimplicialLDLT).
-Vector direct_solve(const levels::ElasticLevel3& L) {
-    const SparseMatrixCol K = L.system.K;
+Vector direct_solve(const levels::Level3& L) {
+    const SparseMatrixCol K = L.elastic.K;
     Eigen::SimplicialLDLT<SparseMatrixCol> ldlt(K);
     EXPECT_EQ(ldlt.info(), Eigen::Success);
-    return ldlt.solve(L.system.f);
+    return ldlt.solve(L.elastic.f);
 }
 
 // mg-CG's iterations on levels 1..3 (returned), and the level 1 and 2 solutions against the
@@ -48,7 +48,7 @@ Vector direct_solve(const levels::ElasticLevel3& L) {
 std::vector<int> check_levels(const levels::ElasticProblem3& p) {
     std::vector<int> its;
     for (int L = 1; L <= 3; ++L) {
-        const levels::ElasticHierarchy3 h = levels::build_elastic_hierarchy3(p, L);
+        const levels::Hierarchy3 h = levels::build_hierarchy(p, L);
         Vector x;
         its.push_back(mg_cg_iterations(h, x));
         if (L <= 2) {
@@ -186,15 +186,15 @@ TEST(Elastic3dLevels, PredictedSizesAgainstTheBuiltLevels) {
                                                              {g.parse(kGmshScene), 0}};
     for (const auto& [p, axis] : cases) {
         const auto sizes = levels::predict_elastic3_sizes(p, 3);
-        const levels::ElasticHierarchy3 h = levels::build_elastic_hierarchy3(p, 3);
+        const levels::Hierarchy3 h = levels::build_hierarchy(p, 3);
         for (int l = 0; l <= 3; ++l) {
             const auto& L = h.levels[static_cast<size_t>(l)];
             EXPECT_EQ(sizes[static_cast<size_t>(l)].vertices, L.mesh.n_vertices());
             EXPECT_EQ(sizes[static_cast<size_t>(l)].unknowns, static_cast<double>(L.dofs.n_dofs()))
                 << p.name << " level " << l;
             EXPECT_NEAR(sizes[static_cast<size_t>(l)].k_nonzeros,
-                        static_cast<double>(L.system.K.nonZeros()),
-                        0.03 * static_cast<double>(L.system.K.nonZeros()))
+                        static_cast<double>(L.elastic.K.nonZeros()),
+                        0.03 * static_cast<double>(L.elastic.K.nonZeros()))
                 << p.name << " level " << l;
             // T interpolates: a linear field that vanishes on the support (T maps corrections,
             // 0 where prescribed) on the coarse unknowns is the same field on the fine ones.
@@ -205,7 +205,7 @@ TEST(Elastic3dLevels, PredictedSizesAgainstTheBuiltLevels) {
                 for (int c = 0; c < 3; ++c)
                     if (const int d = C.dofs.u_dof(v, c); d >= 0)
                         uc[d] = (c + 1) * C.mesh.vertices[static_cast<size_t>(v)][axis];
-            const Vector uf = h.T[static_cast<size_t>(l)] * uc;
+            const Vector uf = h.transfers[static_cast<size_t>(l - 1)].T * uc;
             for (int v = 0; v < L.mesh.n_vertices(); ++v)
                 for (int c = 0; c < 3; ++c)
                     if (const int d = L.dofs.u_dof(v, c); d >= 0) {
@@ -219,11 +219,11 @@ TEST(Elastic3dLevels, PredictedSizesAgainstTheBuiltLevels) {
 TEST(Elastic3dLevels, RigidBodyModesAreInTheKernelOfTheUnsupportedStiffness) {
     levels::ElasticProblem3 p = scene::load_scene3("box3d");
     p.supports.clear();
-    const levels::ElasticLevel3 L = levels::build_elastic_level3(p, p.mesh0);
+    const levels::Level3 L = levels::build_level(p, p.mesh0);
     const auto modes = levels::rigid_body_modes3(L);
     ASSERT_EQ(modes.size(), 6u);
     for (const Vector& m : modes)
-        EXPECT_LE((L.system.K * m).norm(), 1e-12 * m.norm()) << m.head(6).transpose();
+        EXPECT_LE((L.elastic.K * m).norm(), 1e-12 * m.norm()) << m.head(6).transpose();
 }
 
 TEST(Elastic3dLevels, ARunThatCannotFitIsRefusedNamingSizeAndLimit) {
@@ -242,8 +242,7 @@ TEST(Elastic3dLevels, ARunThatCannotFitIsRefusedNamingSizeAndLimit) {
 }
 
 TEST(Elastic3dLevels, TheLatticeSmootherIsRefusedIn3D) {
-    const levels::ElasticHierarchy3 h =
-        levels::build_elastic_hierarchy3(scene::load_scene3("box3d"), 1);
+    const levels::Hierarchy3 h = levels::build_hierarchy(scene::load_scene3("box3d"), 1);
     solvers::MultigridParams mp;
     mp.smoother = solvers::MultigridParams::Smoother::lattice;
     mesh::testing::expect_invalid([&] { levels::elastic3_multigrid(h, mp); },
@@ -308,7 +307,7 @@ TEST(Scene3, LineSupportsHoldTheVerticesOnTheirSegmentOnEveryLevel) {
     ASSERT_EQ(p.supports.size(), 3u);
     ASSERT_TRUE(p.supports[1].line.has_value());
     const auto sizes = levels::predict_elastic3_sizes(p, 3);
-    const levels::ElasticHierarchy3 h = levels::build_elastic_hierarchy3(p, 3);
+    const levels::Hierarchy3 h = levels::build_hierarchy(p, 3);
     for (int l = 0; l <= 3; ++l) {
         const auto& L = h.levels[static_cast<size_t>(l)];
         const int n = 2 << l; // edges along a unit side of level l
@@ -364,8 +363,8 @@ TEST(Scene3, ASupportOnATaggedLineHoldsWhatTheSameLineByItsEndsHolds) {
     by_tag.supports[1].tag = "edge";
     by_tag.validate();
     const auto predicted = levels::predict_elastic3_sizes(by_tag, 2);
-    const auto h_ends = levels::build_elastic_hierarchy3(by_ends, 2);
-    const auto h_tag = levels::build_elastic_hierarchy3(by_tag, 2);
+    const auto h_ends = levels::build_hierarchy(by_ends, 2);
+    const auto h_tag = levels::build_hierarchy(by_tag, 2);
     for (int l = 0; l <= 2; ++l) {
         const auto& a = h_ends.levels[static_cast<size_t>(l)];
         const auto& b = h_tag.levels[static_cast<size_t>(l)];
@@ -397,7 +396,7 @@ TEST(Scene3, AGmshPhysicalCurveIsASupportTag) {
     ASSERT_EQ(p.supports.back().tag, "edge");
     const int edge = p.mesh0.tag("edge");
     const auto sizes = levels::predict_elastic3_sizes(p, 2);
-    const auto h = levels::build_elastic_hierarchy3(p, 2);
+    const auto h = levels::build_hierarchy(p, 2);
     for (int l = 0; l <= 2; ++l) {
         const auto& L = h.levels[static_cast<size_t>(l)];
         const std::vector<int> on = L.mesh.vertices_on_tag(edge);
