@@ -5,6 +5,7 @@
 
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
+#include "solvers/pc_spec.hpp"
 #include "mesh/tet_refine.hpp"
 #include "transfer/prolongation.hpp"
 
@@ -205,9 +206,11 @@ std::unique_ptr<solvers::Multigrid> elastic3_multigrid(const Hierarchy3& h,
     MLC_CHECK(h.levels.size() >= 2,
               "the 3D multigrid needs at least two levels (levels >= 1), found "
                   << h.levels.size());
-    MLC_CHECK(params.smoother != solvers::MultigridParams::Smoother::lattice,
-              "mg:smoother=lattice sweeps the lattices of 2D macro triangles (2D-only); a 3D "
-              "hierarchy is swept by vertex blocks (smoother=block)");
+    // What runs in 3D is the registry's to say (PreconditionerEntry::dimensions).
+    solvers::MgOptions as_mg;
+    as_mg.smoother = params.smoother;
+    const std::string why = solvers::preconditioner_entry("mg")->dimension_reason(as_mg, 3);
+    MLC_CHECK(why.empty(), why);
     const size_t n = h.levels.size();
     std::vector<solvers::MultigridLevelData> data(n);
     for (size_t l = 0; l < n; ++l) {

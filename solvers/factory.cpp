@@ -270,6 +270,29 @@ std::string mg_distributed(const PcOptions& o) {
     return {};
 }
 
+std::string mg_dimensions(const PcOptions& o, int dim) {
+    if (dim == 3 && std::get<MgOptions>(o).smoother == MultigridParams::Smoother::lattice)
+        return "mg:smoother=lattice sweeps the lattices of 2D macro triangles (2D-only); a 3D "
+               "level is swept by vertex blocks (smoother=block, the default)";
+    return "";
+}
+
+std::string ebe_dimensions(const PcOptions&, int dim) {
+    if (dim == 3)
+        return "ebe factors the element matrices of triangles (2D-only); on a 3D level use mg, or "
+               "a preconditioner of the matrix alone (ilu, sor, ...)";
+    return "";
+}
+
+std::string amg_dimensions(const PcOptions& o, int dim) {
+    const int fn = std::get<AmgOptions>(o).num_functions;
+    if (fn != 1 && fn != dim)
+        return "amg:fn=" + std::to_string(fn) + " groups " + std::to_string(fn) +
+               " interleaved components per vertex, but a level of " + std::to_string(dim) +
+               " dimensions has " + std::to_string(dim) + ": amg:fn=" + std::to_string(dim);
+    return "";
+}
+
 bool mg_lattice(const PcOptions& o) {
     return std::get<MgOptions>(o).smoother == MultigridParams::Smoother::lattice;
 }
@@ -339,7 +362,8 @@ std::deque<PreconditionerEntry> builtin_entries() {
                  .build = &build_ebe,
                  .level_aware = true,
                  .element_matrices = true,
-                 .distributed = &everywhere});
+                 .distributed = &everywhere,
+                 .dimensions = &ebe_dimensions});
     t.push_back(
         {.name = "mg",
          .summary =
@@ -358,14 +382,16 @@ std::deque<PreconditionerEntry> builtin_entries() {
          .needs_level_below = true,
          .single_level_too = true,
          .lattice_numbering = &mg_lattice,
-         .distributed = &mg_distributed});
+         .distributed = &mg_distributed,
+         .dimensions = &mg_dimensions});
     t.push_back({.name = "amg",
                  .summary = "hypre BoomerAMG V-cycle, for the elastic block: symmetric positive "
                             "definite, fn interleaved components per vertex",
                  .defaults = AmgOptions{},
                  .fields = &amg_fields,
                  .build = &build_amg,
-                 .distributed = &everywhere});
+                 .distributed = &everywhere,
+                 .dimensions = &amg_dimensions});
     t.push_back({.name = "mgr",
                  .summary = "hypre MGR on the whole Newton system: global ILU(0) sweep, F = "
                             "displacements relaxed by a BoomerAMG V-cycle, C = multipliers, "

@@ -300,6 +300,16 @@ std::string PcSpec::distributed() const {
     return entry->distributed_reason(options);
 }
 
+std::string PreconditionerEntry::dimension_reason(const PcOptions& options, int dim) const {
+    MLC_CHECK(dim == 2 || dim == 3, "a level has 2 or 3 dimensions, found " << dim);
+    return dimensions ? dimensions(options, dim) : std::string();
+}
+
+std::string PcSpec::dimension_reason(int dim) const {
+    MLC_CHECK(entry != nullptr, "an empty preconditioner spec");
+    return entry->dimension_reason(options, dim);
+}
+
 bool PcSpec::operator==(const PcSpec& other) const {
     if (entry != other.entry) return false;
     if (entry == nullptr) return true;

@@ -200,6 +200,11 @@ struct PreconditionerEntry {
     /// Whether these options run on several processes: "" when they do, else the reason they
     /// do not, naming what does. Empty function: the entry has no distributed form at all.
     std::function<std::string(const PcOptions&)> distributed;
+    /// Whether these options run on a level of `dim` dimensions (2 or 3): "" when they do, else
+    /// the reason, naming what does. Empty function: both (an entry that reads only the matrix,
+    /// its vertex blocks and the transfers). What is 2D-only says so here: the lattice sweep of
+    /// macro triangles, EBE's triangle element matrices.
+    std::function<std::string(const PcOptions&, int dim)> dimensions;
 
     /// Its keys with their placeholders, defaults and alternative values, in order.
     std::vector<PcKey> keys() const;
@@ -207,6 +212,9 @@ struct PreconditionerEntry {
     std::string usage() const;
     /// The distributed capability of `options` ("" = ok).
     std::string distributed_reason(const PcOptions& options) const;
+    /// The dimension capability of `options` on a level of `dim` dimensions ("" = ok). Throws
+    /// InvalidInput for a dim other than 2 or 3.
+    std::string dimension_reason(const PcOptions& options, int dim) const;
 };
 
 /// A preconditioner with its typed options.
@@ -226,6 +234,8 @@ struct PcSpec {
     bool lattice_numbering() const;
     /// "" when it runs on several processes, else why not.
     std::string distributed() const;
+    /// "" when it runs on a level of `dim` dimensions, else why not.
+    std::string dimension_reason(int dim) const;
     /// Same entry and every option equal (compared on their text, key by key).
     bool operator==(const PcSpec& other) const;
 };

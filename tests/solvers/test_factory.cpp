@@ -151,6 +151,28 @@ TEST(Factory, CapabilitiesAreDeclaredOnTheEntry) {
               std::string::npos);
 }
 
+TEST(Factory, WhatIs2DOnlySaysSoThroughTheRegistry) {
+    // Every built-in entry runs on a 2D level with its defaults and any options.
+    for (const auto& e : preconditioner_registry())
+        EXPECT_EQ(e.dimension_reason(e.defaults, 2), "") << e.name;
+    for (const char* ok2 : {"mg:smoother=lattice", "amg:fn=2", "ebe"})
+        EXPECT_EQ(parse_pc(ok2).dimension_reason(2), "") << ok2;
+    // On a 3D level: mg's block sweep, the matrix-alone ones, the coarse/fine ones (they read
+    // the transfers' coarse/fine splitting), amg with 3 (or 1) components per vertex; not the
+    // lattice sweep of 2D macro triangles, ebe's triangle element matrices, amg:fn=2.
+    for (const char* ok : {"mg", "mg:pre=2,post=2", "mg:coarse=aggregation", "ilu:1", "diag",
+                           "sor", "none", "cf", "sorcf", "mgr", "amg:fn=3", "amg:fn=1"})
+        EXPECT_EQ(parse_pc(ok).dimension_reason(3), "") << ok;
+    const std::pair<const char*, const char*> no[] = {
+        {"mg:smoother=lattice", "sweeps the lattices of 2D macro triangles (2D-only)"},
+        {"ebe", "element matrices of triangles (2D-only)"},
+        {"amg", "amg:fn=2 groups 2 interleaved components per vertex, but a level of 3 "
+                "dimensions has 3: amg:fn=3"}};
+    for (const auto& [text, why] : no)
+        EXPECT_NE(parse_pc(text).dimension_reason(3).find(why), std::string::npos) << text;
+    EXPECT_THROW(parse_pc("mg").dimension_reason(4), InvalidInput);
+}
+
 TEST(Factory, MethodNamesReadBack) {
     for (Method m : {Method::schur, Method::lu, Method::krylov})
         EXPECT_EQ(parse_method(to_string(m)), m);
