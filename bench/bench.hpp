@@ -96,6 +96,9 @@ struct BenchElasticOptions {
     std::filesystem::path out;
     /// A 3D scene: take the finest level from its [scene].levels (no --levels given).
     bool levels_from_scene = false;
+    /// A 3D scene: also the direct solve (CHOLMOD's Cholesky factor in its fill-reducing order),
+    /// refused when its estimated memory does not fit. A 2D scene refuses it.
+    bool direct = false;
 };
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every solve converged).

@@ -68,6 +68,9 @@ Action add_elastic(CLI::App& bel) {
     bel.add_option("--max-iter", a->o.max_iter, "iterations of every solve (default 1000)");
     bel.add_option("--repeat", a->o.repeat, "runs per solver, times are medians (default 1)");
     bel.add_option("--out,-o", a->out, "JSON file (default out/bench/elastic_<scene>_L<L>.json)");
+    bel.add_flag("--direct", a->o.direct,
+                 "a 3D scene: also the direct solve, CHOLMOD's Cholesky factor in its "
+                 "fill-reducing order (refused when its estimated memory does not fit)");
     return [a, levels](const Launch& at) {
         a->o.out = a->out;
         a->o.levels_from_scene = levels->count() == 0;

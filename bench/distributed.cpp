@@ -318,6 +318,8 @@ int bench_elastic_distributed(const BenchElasticOptions& opt, const Communicator
     std::ostream null_stream(nullptr);
     const bool root = comm.rank() == 0;
     std::ostream& os = root ? out : null_stream;
+    MLC_CHECK(!opt.direct, "bench elastic: --direct runs on one process (a 3D scene's direct "
+                           "solve); run it without mpirun");
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 8,
               "bench elastic: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench elastic: --repeat must be >= 1, found " << opt.repeat);

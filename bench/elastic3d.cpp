@@ -12,6 +12,7 @@
 #include "core/timer.hpp"
 #include "levels/elastic3d_levels.hpp"
 #include "scene/scene3.hpp"
+#include "solvers/cholesky.hpp"
 #include "solvers/hypre/boomeramg.hpp"
 #include "solvers/krylov.hpp"
 
@@ -90,6 +91,43 @@ Run3 run_amg(const levels::Hierarchy3& h, const Vector& b, const BenchElasticOpt
     return r;
 }
 
+/// The direct solve: CHOLMOD's supernodal Cholesky factor of K in its fill-reducing order (AMD or
+/// METIS nested dissection), then the two triangular solves; the order and the factor are the
+/// setup, timed in every repetition. One "iteration".
+Run3 run_direct(const levels::Hierarchy3& h, const Vector& b, const BenchElasticOptions& opt,
+                Vector& x, double& factor_nonzeros) {
+    Run3 r;
+    r.name = "cholmod";
+    const SparseMatrix& K = h.finest().elastic.K;
+    const Index n = K.rows();
+    for (int rep = 0; rep < opt.repeat; ++rep) {
+        const double t0 = wall_seconds();
+        const SparseMatrixCol Kc(K);
+        const std::vector<int> order = solvers::SparseCholesky::fill_reducing_order(Kc);
+        Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> perm(n); // perm[old] = new
+        for (Index k = 0; k < n; ++k)
+            perm.indices()[order[static_cast<size_t>(k)]] = static_cast<int>(k);
+        SparseMatrixCol Kp(n, n);
+        Kp.selfadjointView<Eigen::Lower>() = Kc.selfadjointView<Eigen::Lower>().twistedBy(perm);
+        solvers::SparseCholesky chol;
+        chol.factor(Kp);
+        factor_nonzeros = chol.factor_nonzeros();
+        const double t1 = wall_seconds();
+        Vector xp;
+        chol.solve(perm * b, xp);
+        x = perm.inverse() * xp;
+        const double t2 = wall_seconds();
+        SolveResult s;
+        s.iterations = 1;
+        s.solve_seconds = t2 - t1;
+        s.relative_residual = (b - K * x).norm() / b.norm();
+        s.converged = std::isfinite(s.relative_residual) && s.relative_residual <= opt.rel_tol;
+        r.add(t1 - t0, s);
+    }
+    r.x_norm = x.norm();
+    return r;
+}
+
 /// Sets the thread count for the bench and restores it after.
 struct ThreadsFor {
     int was;
@@ -102,7 +140,7 @@ struct ThreadsFor {
 void write_json3(std::ostream& js, const BenchElasticOptions& opt, int L,
                  const levels::Hierarchy3& h, const std::vector<levels::ElasticLevelSize3>& sizes,
                  const levels::ElasticMemory3& mem, const std::vector<Run3>& runs, double ratio,
-                 double diff, int threads, double hierarchy_s) {
+                 double diff, int threads, double hierarchy_s, double factor_nonzeros) {
     const auto& K = h.finest().elastic.K;
     js << "{\n  \"scene\": " << json_string(opt.scene) << ",\n  \"dimension\": 3"
        << ",\n  \"level\": " << L << ",\n  \"unknowns\": " << K.rows()
@@ -114,8 +152,9 @@ void write_json3(std::ostream& js, const BenchElasticOptions& opt, int L,
        << ",\n  \"memory_estimate_mib\": " << mem.bytes() / kMiB
        << ",\n  \"peak_rss_mib\": " << peak_rss_mib()
        << ",\n  \"mg_cycle\": " << json_string(mg_cycle())
-       << ",\n  \"time_ratio_mg_over_amg\": " << ratio << ",\n  \"solution_difference\": " << diff
-       << ",\n  \"levels\": [";
+       << ",\n  \"time_ratio_mg_over_amg\": " << ratio;
+    if (factor_nonzeros > 0) js << ",\n  \"cholmod_factor_nonzeros\": " << factor_nonzeros;
+    js << ",\n  \"solution_difference\": " << diff << ",\n  \"levels\": [";
     for (size_t l = 0; l < h.levels.size(); ++l)
         js << (l ? ", " : "") << "{\"level\": " << l
            << ", \"unknowns\": " << h.levels[l].elastic.K.rows()
@@ -153,7 +192,20 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
     // Sizes and memory first: a run that cannot fit is refused before anything is built.
     const auto sizes = levels::predict_elastic3_sizes(p, L);
     const levels::ElasticMemory3 mem = levels::estimate_elastic3_memory(sizes);
-    levels::check_elastic3_fits(mem, levels::process_memory_limit(), sizes);
+    const levels::MemoryLimit limit = levels::process_memory_limit();
+    levels::check_elastic3_fits(mem, limit, sizes);
+    // The direct solve runs after the others, beside the hierarchy alone.
+    const double direct_peak =
+        mem.baseline_bytes + mem.hierarchy_bytes + levels::estimate_direct3_bytes(sizes.back());
+    if (opt.direct && direct_peak > limit.bytes)
+        throw InvalidInput("bench elastic --direct: the direct solve of level " +
+                           std::to_string(L) + " (" +
+                           std::to_string(static_cast<long>(sizes.back().unknowns)) +
+                           " unknowns) needs an estimated " + levels::format_bytes(direct_peak) +
+                           " (its Cholesky factor grows like unknowns^1.39) but this process "
+                           "may use " +
+                           levels::format_bytes(std::max(0.0, limit.bytes)) + " (" + limit.source +
+                           "): drop --direct or use fewer --levels");
     // Equal cores: hypre's thread count for both.
     const int threads = solvers::hypre_threads();
     const ThreadsFor set_threads(threads);
@@ -178,13 +230,21 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
     runs.push_back(run_amg(h, b, opt, x_amg));
     runs.back().peak_rss_mib = peak_rss_mib();
     runs.back().estimate_mib = mem.bytes() / kMiB;
+    double factor_nonzeros = 0;
+    if (opt.direct) {
+        Vector x_direct;
+        runs.push_back(run_direct(h, b, opt, x_direct, factor_nonzeros));
+        runs.back().peak_rss_mib = peak_rss_mib();
+        runs.back().estimate_mib = direct_peak / kMiB;
+    }
     const double diff = (x_amg - x_mg).norm() / std::max(x_amg.norm(), 1e-300);
     const auto total = [](const Run3& r) { return median(r.setup) + median(r.solve); };
     const double ratio = total(runs[1]) > 0 ? total(runs[0]) / total(runs[1]) : 0.0;
 
     const std::filesystem::path out = bench_json_path(opt.out, "elastic_", opt.scene, L);
     AtomicOfstream js = open_json(out);
-    write_json3(js, opt, L, h, sizes, mem, runs, ratio, diff, threads, hierarchy_s);
+    write_json3(js, opt, L, h, sizes, mem, runs, ratio, diff, threads, hierarchy_s,
+                factor_nonzeros);
     os << std::setw(16) << "solver" << std::setw(10) << "unknowns" << std::setw(6) << "its"
        << std::setw(10) << "setup s" << std::setw(10) << "solve s" << std::setw(10) << "total s"
        << std::setw(11) << "rel.res" << std::setw(14) << "peak RSS MiB" << std::setw(14)
@@ -201,6 +261,12 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
            << r.estimate_mib << std::defaultfloat << (r.converged ? "" : "  NOT CONVERGED") << "\n";
     }
     os << "mg-cg: " << mg_cycle() << " cycle, vertex-block Gauss-Seidel\n";
+    if (opt.direct)
+        os << "cholmod: " << std::setprecision(3) << factor_nonzeros
+           << " nonzeros in the Cholesky factor (" << factor_nonzeros / K.nonZeros()
+           << " times K's); time ratio mg-cg / cholmod " << std::fixed
+           << (total(runs[2]) > 0 ? total(runs[0]) / total(runs[2]) : 0.0) << std::defaultfloat
+           << std::setprecision(6) << "\n";
     os << "time ratio mg-cg / boomeramg-pcg: " << std::fixed << std::setprecision(3) << ratio
        << std::defaultfloat
        << "\nrelative difference of the AMG and mg solutions: " << std::scientific

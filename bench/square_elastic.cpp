@@ -518,6 +518,8 @@ struct ElasticResult {
 
 int bench_elastic(const BenchElasticOptions& opt, std::ostream& os) {
     if (scene::scene_dimension(opt.scene) == 3) return bench_elastic3d(opt, os);
+    MLC_CHECK(!opt.direct, "bench elastic: --direct is for 3D scenes; on a 2D scene the exact "
+                           "solver is `bench square --pc schur` or `run --linear schur`");
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 8,
               "bench elastic: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench elastic: --repeat must be >= 1, found " << opt.repeat);

@@ -5,8 +5,8 @@
 
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
-#include "solvers/pc_spec.hpp"
 #include "mesh/tet_refine.hpp"
+#include "solvers/pc_spec.hpp"
 #include "transfer/prolongation.hpp"
 
 #include <algorithm>
@@ -401,6 +401,15 @@ ElasticMemory3 estimate_elastic3_memory(const std::vector<ElasticLevelSize3>& si
     const ElasticLevelSize3& f = sizes.back();
     e.amg_bytes = kAmgPerNonzero3 * f.k_nonzeros + kAmgPerUnknown3 * f.unknowns;
     return e;
+}
+
+double estimate_direct3_bytes(const ElasticLevelSize3& finest) {
+    // Factor nonzeros: box3d level 4's, scaled by (n / n4)^1.394, the exponent of levels 3 to 4.
+    constexpr double kFactorNonzeros4 = 5.4e8, kUnknowns4 = 405600, kExponent = 1.394;
+    constexpr double kBytesPerFactorNonzero = 12, kBytesPerKNonzero = 24;
+    const double factor =
+        kFactorNonzeros4 * std::pow(std::max(finest.unknowns, 1.0) / kUnknowns4, kExponent);
+    return kBytesPerFactorNonzero * factor + kBytesPerKNonzero * finest.k_nonzeros;
 }
 
 void check_elastic3_fits(const ElasticMemory3& e, const MemoryLimit& limit,

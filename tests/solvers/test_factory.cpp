@@ -160,8 +160,8 @@ TEST(Factory, WhatIs2DOnlySaysSoThroughTheRegistry) {
     // On a 3D level: mg's block sweep, the matrix-alone ones, the coarse/fine ones (they read
     // the transfers' coarse/fine splitting), amg with 3 (or 1) components per vertex; not the
     // lattice sweep of 2D macro triangles, ebe's triangle element matrices, amg:fn=2.
-    for (const char* ok : {"mg", "mg:pre=2,post=2", "mg:coarse=aggregation", "ilu:1", "diag",
-                           "sor", "none", "cf", "sorcf", "mgr", "amg:fn=3", "amg:fn=1"})
+    for (const char* ok : {"mg", "mg:pre=2,post=2", "mg:coarse=aggregation", "ilu:1", "diag", "sor",
+                           "none", "cf", "sorcf", "mgr", "amg:fn=3", "amg:fn=1"})
         EXPECT_EQ(parse_pc(ok).dimension_reason(3), "") << ok;
     const std::pair<const char*, const char*> no[] = {
         {"mg:smoother=lattice", "sweeps the lattices of 2D macro triangles (2D-only)"},
