@@ -151,8 +151,13 @@ void write_json3(std::ostream& js, const BenchElasticOptions& opt, int L,
        << ",\n  \"hierarchy_seconds\": " << hierarchy_s
        << ",\n  \"memory_estimate_mib\": " << mem.bytes() / kMiB
        << ",\n  \"peak_rss_mib\": " << peak_rss_mib()
-       << ",\n  \"mg_cycle\": " << json_string(mg_cycle())
-       << ",\n  \"time_ratio_mg_over_amg\": " << ratio;
+       << ",\n  \"mg_cycle\": " << (ratio < 0 ? std::string("null") : json_string(mg_cycle()))
+       << ",\n  \"plan\": " << json_string(ratio < 0 ? "cholmod" : "mg-cg")
+       << ",\n  \"time_ratio_mg_over_amg\": ";
+    if (ratio < 0)
+        js << "null";
+    else
+        js << ratio;
     if (factor_nonzeros > 0) js << ",\n  \"cholmod_factor_nonzeros\": " << factor_nonzeros;
     js << ",\n  \"solution_difference\": " << diff << ",\n  \"levels\": [";
     for (size_t l = 0; l < h.levels.size(); ++l)
@@ -184,11 +189,11 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
               "bench elastic: --tol must be in (0, 1), found " << opt.rel_tol);
     const levels::ElasticProblem3 p = scene::load_scene3(opt.scene);
     const int L = opt.levels_from_scene ? p.levels : opt.levels;
-    MLC_CHECK(L >= 1 && L <= levels::kMaxLevels3, "bench elastic: a 3D scene's level must be in 1.."
-                                                      << levels::kMaxLevels3
-                                                      << " (the multigrid needs the "
-                                                         "level below), found "
-                                                      << L);
+    MLC_CHECK(L >= 0 && L <= levels::kMaxLevels3, "bench elastic: a 3D scene's level must be in 0.."
+                                                      << levels::kMaxLevels3 << ", found " << L);
+    // The planner's solver: the multigrid when a level below exists, else the direct factor.
+    const levels::ElasticPlan3 plan = levels::plan_elastic3(L);
+    const bool direct = opt.direct || !plan.multigrid;
     // Sizes and memory first: a run that cannot fit is refused before anything is built.
     const auto sizes = levels::predict_elastic3_sizes(p, L);
     const levels::ElasticMemory3 mem = levels::estimate_elastic3_memory(sizes);
@@ -197,7 +202,7 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
     // The direct solve runs after the others, beside the hierarchy alone.
     const double direct_peak =
         mem.baseline_bytes + mem.hierarchy_bytes + levels::estimate_direct3_bytes(sizes.back());
-    if (opt.direct && direct_peak > limit.bytes)
+    if (direct && direct_peak > limit.bytes)
         throw InvalidInput("bench elastic --direct: the direct solve of level " +
                            std::to_string(L) + " (" +
                            std::to_string(static_cast<long>(sizes.back().unknowns)) +
@@ -221,25 +226,34 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
        << ", " << threads << " thread(s) each, times are medians of " << opt.repeat
        << " run(s) (hierarchy built in " << std::fixed << std::setprecision(2) << hierarchy_s
        << std::defaultfloat << " s; memory estimate " << levels::format_bytes(mem.bytes()) << ")\n";
+    os << "plan: " << plan.reason << "\n";
     std::vector<Run3> runs;
-    Vector x_mg, x_amg;
-    // mg first (its peak is the hierarchy and the multigrid), then BoomerAMG.
-    runs.push_back(run_mg(h, b, opt, x_mg));
-    runs.back().peak_rss_mib = peak_rss_mib();
-    runs.back().estimate_mib = mem.mg_peak() / kMiB;
+    Vector x_mg, x_amg, x_direct;
+    // mg first (its peak is the hierarchy and the multigrid), then BoomerAMG, then the direct
+    // solve beside the hierarchy alone.
+    if (plan.multigrid) {
+        runs.push_back(run_mg(h, b, opt, x_mg));
+        runs.back().peak_rss_mib = peak_rss_mib();
+        runs.back().estimate_mib = mem.mg_peak() / kMiB;
+    }
     runs.push_back(run_amg(h, b, opt, x_amg));
     runs.back().peak_rss_mib = peak_rss_mib();
     runs.back().estimate_mib = mem.bytes() / kMiB;
     double factor_nonzeros = 0;
-    if (opt.direct) {
-        Vector x_direct;
+    if (direct) {
         runs.push_back(run_direct(h, b, opt, x_direct, factor_nonzeros));
         runs.back().peak_rss_mib = peak_rss_mib();
         runs.back().estimate_mib = direct_peak / kMiB;
     }
-    const double diff = (x_amg - x_mg).norm() / std::max(x_amg.norm(), 1e-300);
+    const Run3& planned = runs.front(); // mg-cg, or the direct solve on level 0
+    const Run3& amg = plan.multigrid ? runs[1] : runs[0];
+    const Vector& x_planned = plan.multigrid ? x_mg : x_direct;
+    const double diff = (x_amg - x_planned).norm() / std::max(x_amg.norm(), 1e-300);
     const auto total = [](const Run3& r) { return median(r.setup) + median(r.solve); };
-    const double ratio = total(runs[1]) > 0 ? total(runs[0]) / total(runs[1]) : 0.0;
+    // mg-cg / boomeramg-pcg; on level 0 (no multigrid) -1, written as null.
+    const double ratio = !plan.multigrid  ? -1.0
+                         : total(amg) > 0 ? total(planned) / total(amg)
+                                          : 0.0;
 
     const std::filesystem::path out = bench_json_path(opt.out, "elastic_", opt.scene, L);
     AtomicOfstream js = open_json(out);
@@ -260,17 +274,26 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
            << std::setprecision(0) << std::setw(14) << r.peak_rss_mib << std::setw(14)
            << r.estimate_mib << std::defaultfloat << (r.converged ? "" : "  NOT CONVERGED") << "\n";
     }
-    os << "mg-cg: " << mg_cycle() << " cycle, vertex-block Gauss-Seidel\n";
-    if (opt.direct)
+    if (plan.multigrid) os << "mg-cg: " << mg_cycle() << " cycle, vertex-block Gauss-Seidel\n";
+    if (direct) {
         os << "cholmod: " << std::setprecision(3) << factor_nonzeros
            << " nonzeros in the Cholesky factor (" << factor_nonzeros / K.nonZeros()
-           << " times K's); time ratio mg-cg / cholmod " << std::fixed
-           << (total(runs[2]) > 0 ? total(runs[0]) / total(runs[2]) : 0.0) << std::defaultfloat
-           << std::setprecision(6) << "\n";
-    os << "time ratio mg-cg / boomeramg-pcg: " << std::fixed << std::setprecision(3) << ratio
-       << std::defaultfloat
-       << "\nrelative difference of the AMG and mg solutions: " << std::scientific
-       << std::setprecision(2) << diff << std::defaultfloat << "\nwrote " << out.string() << "\n";
+           << " times K's)";
+        if (plan.multigrid)
+            os << "; time ratio mg-cg / cholmod " << std::fixed
+               << (total(runs.back()) > 0 ? total(planned) / total(runs.back()) : 0.0)
+               << std::defaultfloat;
+        os << std::setprecision(6) << "\n";
+    }
+    if (plan.multigrid)
+        os << "time ratio mg-cg / boomeramg-pcg: " << std::fixed << std::setprecision(3) << ratio
+           << std::defaultfloat;
+    else
+        os << "time ratio cholmod / boomeramg-pcg: " << std::fixed << std::setprecision(3)
+           << (total(amg) > 0 ? total(planned) / total(amg) : 0.0) << std::defaultfloat;
+    os << "\nrelative difference of the AMG and " << (plan.multigrid ? "mg" : "direct")
+       << " solutions: " << std::scientific << std::setprecision(2) << diff << std::defaultfloat
+       << "\nwrote " << out.string() << "\n";
     return code;
 }
 

@@ -403,6 +403,16 @@ ElasticMemory3 estimate_elastic3_memory(const std::vector<ElasticLevelSize3>& si
     return e;
 }
 
+ElasticPlan3 plan_elastic3(int finest_level) {
+    MLC_CHECK(finest_level >= 0, "a level is >= 0, found " << finest_level);
+    ElasticPlan3 p;
+    p.multigrid = finest_level >= 1;
+    p.reason = p.multigrid ? "mg-CG: in 3D the multigrid beats the direct factor from the first "
+                             "refinement on"
+                           : "the direct factor: level 0 has no level below for the multigrid";
+    return p;
+}
+
 double estimate_direct3_bytes(const ElasticLevelSize3& finest) {
     // Factor nonzeros: box3d level 4's, scaled by (n / n4)^1.394, the exponent of levels 3 to 4.
     constexpr double kFactorNonzeros4 = 5.4e8, kUnknowns4 = 405600, kExponent = 1.394;

@@ -107,6 +107,17 @@ struct ElasticMemory3 {
 };
 ElasticMemory3 estimate_elastic3_memory(const std::vector<ElasticLevelSize3>& sizes);
 
+/// The solver of a 3D elastic level: the multigrid (mg-CG, elastic3_multigrid) whenever a level
+/// below exists, and the direct factor only on a single level. This is the 3D crossover
+/// (docs/results/benchmarks.md#results-3d-direct): mg-CG beats the direct factor from the first
+/// refinement on, where the 2D planner keeps the exact solver up to a few thousand unknowns
+/// (kMgCrossoverOneBody).
+struct ElasticPlan3 {
+    bool multigrid = true;
+    std::string reason; ///< one sentence, for the bench's output
+};
+ElasticPlan3 plan_elastic3(int finest_level);
+
 /// Estimated memory of the direct solve of a 3D elastic level beside its hierarchy (`bench elastic
 /// --direct`): CHOLMOD's supernodal factor in its fill-reducing order, whose nonzeros grow like
 /// unknowns^1.39 on box3d's levels 3 and 4 (faster than nested dissection's unknowns^(4/3) bound
