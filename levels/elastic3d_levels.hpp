@@ -122,8 +122,8 @@ ElasticPlan3 plan_elastic3(int finest_level);
 /// --direct`): CHOLMOD's supernodal factor in its fill-reducing order, whose nonzeros grow like
 /// unknowns^1.39 on box3d's levels 3 and 4 (faster than nested dissection's unknowns^(4/3) bound
 /// at these sizes), at 12 bytes per factor nonzero, and the two copies of K the ordering makes.
-/// Within 15 % of the measured peaks of box3d's levels 2-4, above them from level 3 on
-/// (docs/results/benchmarks.md#results-3d-direct); fitted on box3d alone.
+/// Fitted on box3d's levels 3 and 4 alone; its error against the measured peaks is in
+/// docs/results/benchmarks.md#results-3d-direct.
 double estimate_direct3_bytes(const ElasticLevelSize3& finest);
 
 /// Throws InvalidInput when `e` does not fit in `limit`: the finest level, its unknowns, the
