@@ -87,7 +87,7 @@ double true_relres(const SparseMatrix& J, const Vector& b, const Vector& x) {
 class CoarseSetupTimer final : public levels::ForwardingSystemSolver {
 public:
     CoarseSetupTimer(std::unique_ptr<levels::NewtonSystemSolver> inner, double* slot)
-        : ForwardingSystemSolver(std::move(inner)), slot_(slot) {}
+        : levels::ForwardingSystemSolver(std::move(inner)), slot_(slot) {}
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
                       double forcing) override {
         SolveResult r = inner().solve(M, b, dx, forcing);
@@ -118,7 +118,7 @@ public:
                          const levels::Level& level, const BenchNewtonOptions& opt,
                          const NewtonBenchPass& pass, const std::vector<double>* coarse_setups,
                          std::vector<NewtonSystemRow>& rows)
-        : ForwardingSystemSolver(std::move(inner)), level_(level), jac_(level), opt_(opt),
+        : levels::ForwardingSystemSolver(std::move(inner)), level_(level), jac_(level), opt_(opt),
           pass_(pass), coarse_setups_(coarse_setups), rows_(rows) {
         params_.rel_tol = opt.rel_tol;
         params_.max_iter = opt.max_iter;

@@ -74,7 +74,7 @@ class TrafficRecorder final : public levels::ForwardingSystemSolver {
 public:
     TrafficRecorder(std::unique_ptr<levels::NewtonSystemSolver> inner, LevelTraffic* slot,
                     int* depth, double rss_before_build, std::vector<Eigen::Matrix2d>* last_M)
-        : ForwardingSystemSolver(std::move(inner)), slot_(slot), depth_(depth), last_M_(last_M) {
+        : levels::ForwardingSystemSolver(std::move(inner)), slot_(slot), depth_(depth), last_M_(last_M) {
         slot_->rss_at_build = current_rss_bytes();
         slot_->rss_growth = slot_->rss_at_build - rss_before_build;
     }

@@ -59,6 +59,17 @@ struct Support3 {
 /// it from line[0].
 std::vector<int> line_vertices(const mesh::TetMesh& m, const std::array<Vec3, 2>& line);
 
+/// One contact pair of a 3D problem: the contactor nodes on a tagged boundary (inside `region`,
+/// if given) against a rigid obstacle (node-on-rigid elements).
+struct ContactPair3 {
+    std::string name;
+    std::string contactor; ///< boundary face tag of the contactor nodes
+    std::optional<Box3> region;
+    contact::BasicObstacle<3> obstacle;
+    double mu = 0.0; ///< Coulomb coefficient >= 0
+    double r = 0.0;  ///< augmentation parameter > 0 (force / length in 3D)
+};
+
 /// A 3D elastic problem: the level-0 mesh (attribute = body index), bodies, loads and supports,
 /// and the finest level.
 struct ElasticProblem3 {
@@ -67,6 +78,9 @@ struct ElasticProblem3 {
     std::vector<Body3> bodies;
     std::vector<FaceLoad3> loads;
     std::vector<Support3> supports;
+    std::vector<ContactPair3> contacts;
+    int load_steps = 1;
+    NewtonParams newton;
     int levels = 0;
     /// Throws InvalidInput naming the first defect: no body, an attribute without a body, a bad
     /// material, a support tag no boundary face or tagged line carries (a

@@ -36,14 +36,15 @@ void StatusCounts::add(contact::Status s) {
 }
 
 // ---------------------------------------------------------------------------------------------
-ContactNewton::ContactNewton(const Level& level, NewtonParams params,
-                             std::unique_ptr<NewtonSystemSolver> solver, Timings* timings)
+template <int dim>
+BasicContactNewton<dim>::BasicContactNewton(const Level& level, NewtonParams params,
+                                            std::unique_ptr<Solver> solver, Timings* timings)
     : level_(level), params_(params), solver_(std::move(solver)), timings_(timings) {
     params_.validate();
     MLC_CHECK(solver_ != nullptr, "ContactNewton needs a linear solver");
 }
 
-void ContactNewton::set_distribution(NewtonDistribution d) {
+template <int dim> void BasicContactNewton<dim>::set_distribution(NewtonDistribution d) {
     MLC_CHECK(!d.comm || (d.K && d.n_owned >= 0 && d.n_owned <= level_.n_unknowns() &&
                           d.K->rows() == d.n_owned),
               "ContactNewton: inconsistent distribution (" << d.n_owned << " owned unknowns of "
@@ -51,7 +52,8 @@ void ContactNewton::set_distribution(NewtonDistribution d) {
     dist_ = d;
 }
 
-const Vector& ContactNewton::padded(const Vector& x, Vector& work) const {
+template <int dim>
+const Vector& BasicContactNewton<dim>::padded(const Vector& x, Vector& work) const {
     if (!dist_.comm) return x;
     work = Vector::Zero(level_.n_unknowns());
     work.head(x.size()) = x;
@@ -59,9 +61,10 @@ const Vector& ContactNewton::padded(const Vector& x, Vector& work) const {
     return work;
 }
 
-double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector& x, Vector& R,
-                               std::vector<contact::Status>* st, std::vector<Eigen::Matrix2d>* M,
-                               double* scale) const {
+template <int dim>
+double BasicContactNewton<dim>::residual(double s, const Vector& u_prev_full, const Vector& x,
+                                         Vector& R, std::vector<contact::Status>* st,
+                                         std::vector<Matrix>* M, double* scale) const {
     const Level& L = level_;
     // Level-size work vectors, written over the threads (core/first_touch).
     struct {
@@ -136,15 +139,17 @@ double ContactNewton::residual(double s, const Vector& u_prev_full, const Vector
     return std::sqrt(ru2 + lambda_res2);
 }
 
-std::vector<contact::Status> ContactNewton::statuses(double s, const Vector& u_prev_full,
-                                                     const Vector& x) const {
+template <int dim>
+std::vector<contact::Status> BasicContactNewton<dim>::statuses(double s, const Vector& u_prev_full,
+                                                               const Vector& x) const {
     Vector R(x.size());
     std::vector<contact::Status> st;
     residual(s, u_prev_full, x, R, &st, nullptr, nullptr);
     return st;
 }
 
-double ContactNewton::forcing_term(int k, double norm, double scale) const {
+template <int dim>
+double BasicContactNewton<dim>::forcing_term(int k, double norm, double scale) const {
     if (params_.forcing <= 0.0) return 0.0;
     if (k == 0) return params_.forcing;
     // Enough to reach the tolerance if the statuses stay (a margin of 10 for the Krylov norm,
@@ -153,11 +158,13 @@ double ContactNewton::forcing_term(int k, double norm, double scale) const {
     return std::min(0.5, target);
 }
 
-StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x) {
+template <int dim>
+StepReport BasicContactNewton<dim>::solve(double s, const Vector& u_prev_full, Vector& x) {
     return solve(s, u_prev_full, x, params_.max_iter);
 }
 
-StepReport ContactNewton::check(double s, const Vector& u_prev_full, Vector& x) {
+template <int dim>
+StepReport BasicContactNewton<dim>::check(double s, const Vector& u_prev_full, Vector& x) {
     return solve(s, u_prev_full, x, 0);
 }
 
@@ -176,7 +183,8 @@ bool statuses_cycle(const std::vector<std::vector<contact::Status>>& history,
 
 } // namespace
 
-bool ContactNewton::stop_test(int k, int max_iter, double norm, double scale, int changes,
+template <int dim>
+bool BasicContactNewton<dim>::stop_test(int k, int max_iter, double norm, double scale, int changes,
                               StepReport& rep) const {
     const double rel = rep.residuals.back();
     if (!std::isfinite(norm)) {
@@ -221,7 +229,8 @@ bool ContactNewton::stop_test(int k, int max_iter, double norm, double scale, in
     return false;
 }
 
-bool ContactNewton::solve_system(int k, const std::vector<Eigen::Matrix2d>& M, const Vector& b,
+template <int dim>
+bool BasicContactNewton<dim>::solve_system(int k, const std::vector<Matrix>& M, const Vector& b,
                                  Vector& dx, double forcing, StepReport& rep) {
     SolveResult lin;
     {
@@ -286,7 +295,8 @@ bool ContactNewton::solve_system(int k, const std::vector<Eigen::Matrix2d>& M, c
     return true;
 }
 
-void ContactNewton::damped_step(double s, const Vector& u_prev_full, const Vector& dx, double norm,
+template <int dim>
+void BasicContactNewton<dim>::damped_step(double s, const Vector& u_prev_full, const Vector& dx, double norm,
                                 Vector& x) const {
     // Backtracking on the residual norm: halve the step until ||R|| decreases (at most
     // 30 halvings; the last trial is taken whatever it gives).
@@ -301,7 +311,9 @@ void ContactNewton::damped_step(double s, const Vector& u_prev_full, const Vecto
     x = trial;
 }
 
-StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x, int max_iter) {
+template <int dim>
+StepReport BasicContactNewton<dim>::solve(double s, const Vector& u_prev_full, Vector& x,
+                                          int max_iter) {
     const double t_start = wall_seconds();
     StepReport rep;
     rep.load_factor = s;
@@ -309,7 +321,7 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x, 
     MLC_CHECK(x.size() == n, "Newton initial guess has " << x.size() << " entries, expected " << n);
     Vector R(n), dx(n);
     std::vector<contact::Status> st, st_prev;
-    std::vector<Eigen::Matrix2d> M;
+    std::vector<Matrix> M;
     std::vector<std::vector<contact::Status>> history; // status vectors of the iterates
     bool damped = false;
     for (int k = 0;; ++k) {
@@ -355,8 +367,9 @@ StepReport ContactNewton::solve(double s, const Vector& u_prev_full, Vector& x, 
     return rep;
 }
 
-std::vector<ContactNodeState> ContactNewton::node_states(double s, const Vector& u_prev_full,
-                                                         const Vector& x) const {
+template <int dim>
+std::vector<BasicContactNodeState<dim>>
+BasicContactNewton<dim>::node_states(double s, const Vector& u_prev_full, const Vector& x) const {
     const Level& L = level_;
     Vector u_full, work;
     const Vector& xl = padded(x, work);
@@ -365,30 +378,53 @@ std::vector<ContactNodeState> ContactNewton::node_states(double s, const Vector&
     // displacement of the step (no absolute tolerance).
     double umax = (u_full - u_prev_full).cwiseAbs().maxCoeff();
     if (dist_.comm) umax = dist_.comm->max(umax);
-    std::vector<ContactNodeState> out;
+    std::vector<NodeState> out;
     out.reserve(L.contacts.size());
     for (size_t e = 0; e < L.contacts.size(); ++e) {
         const auto& el = L.contacts[e];
         const auto es = contact::evaluate(el, u_full, u_prev_full, xl, L.lambda_dof[e]);
-        ContactNodeState ns;
+        NodeState ns;
         ns.vertex = el.vertex[0];
         ns.x = L.mesh.vertices[static_cast<size_t>(ns.vertex)];
-        ns.u = u_full.segment<2>(2 * ns.vertex);
-        ns.lambda_t = es.lambda[0];
-        ns.lambda_n = es.lambda[1];
+        ns.u = u_full.template segment<dim>(dim * ns.vertex);
+        ns.n = el.n;
+        ns.t = el.t;
+        ns.lambda_n = es.lambda[dim - 1];
         ns.d_n = es.d_n;
-        ns.d_t = es.d_t[0];
         ns.status = es.proj.status;
-        if (ns.status == contact::Status::gap) ns.lambda_t = ns.lambda_n = 0.0;
-        if (!el.frictional() && ns.status != contact::Status::gap) {
-            if (es.d_t[0] > 1e-9 * umax)
-                ns.status = contact::Status::slip_forward;
-            else if (es.d_t[0] < -1e-9 * umax)
-                ns.status = contact::Status::slip_backward;
+        if constexpr (dim == 2) {
+            ns.lambda_t = es.lambda[0];
+            ns.d_t = es.d_t[0];
+            if (ns.status == contact::Status::gap) ns.lambda_t = ns.lambda_n = 0.0;
+            if (!el.frictional() && ns.status != contact::Status::gap) {
+                if (es.d_t[0] > 1e-9 * umax)
+                    ns.status = contact::Status::slip_forward;
+                else if (es.d_t[0] < -1e-9 * umax)
+                    ns.status = contact::Status::slip_backward;
+            }
+        } else {
+            ns.lambda_t = es.lambda.template head<dim - 1>();
+            ns.d_t = es.d_t;
+            ns.slip_direction = es.proj.slip_direction;
+            if (ns.status == contact::Status::gap) {
+                ns.lambda_t.setZero();
+                ns.lambda_n = 0.0;
+            }
+            // A frictionless node in contact slips when it moved along the plane.
+            if (!el.frictional() && ns.status != contact::Status::gap) {
+                const double slip = es.d_t.norm();
+                if (slip > 1e-9 * umax) {
+                    ns.status = contact::Status::slip;
+                    ns.slip_direction = es.d_t / slip;
+                }
+            }
         }
         out.push_back(ns);
     }
     return out;
 }
+
+template class BasicContactNewton<2>;
+template class BasicContactNewton<3>;
 
 } // namespace mlc::levels

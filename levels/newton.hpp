@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace mlc::levels {
@@ -59,15 +60,32 @@ struct StepReport {
     bool stopped = false; ///< stopped on request (ContactNewton::set_stop), not converged
 };
 
-/// The full state of a converged (or last) iterate, for reports and output.
-struct ContactNodeState {
+/// The full state of a contact node at a converged (or last) iterate, for reports and output,
+/// in `dim` dimensions. A tangential quantity is a number in 2D (along t) and a 2-vector in 3D
+/// (along t1, t2: contact::tangent_basis).
+template <int dim> struct BasicContactNodeState {
+    using Point = Eigen::Matrix<double, dim, 1>;
+    using Tangential = std::conditional_t<dim == 2, double, Eigen::Matrix<double, dim - 1, 1>>;
     int vertex = -1;
-    Vec2 x = Vec2::Zero(); ///< reference position
-    Vec2 u = Vec2::Zero(); ///< displacement (global axes)
-    double lambda_t = 0.0, lambda_n = 0.0;
-    double d_n = 0.0, d_t = 0.0; ///< gap and slip increment of the step
+    Point x = Point::Zero(); ///< reference position
+    Point u = Point::Zero(); ///< displacement (global axes)
+    Tangential lambda_t = Tangential{}; ///< tangential multiplier(s) in the tangent basis
+    double lambda_n = 0.0;
+    double d_n = 0.0;              ///< gap
+    Tangential d_t = Tangential{}; ///< slip increment of the step in the tangent basis
     contact::Status status = contact::Status::gap;
+    /// 3D, status slip: the unit slip direction sigma_t / |sigma_t| in the tangent basis (the
+    /// projection's; 0 otherwise). Unused in 2D (the status says forward or backward).
+    Tangential slip_direction = Tangential{};
+    /// The contact frame: n and the tangents (columns) of the element.
+    Point n = Point::Zero();
+    Eigen::Matrix<double, dim, dim - 1> t = Eigen::Matrix<double, dim, dim - 1>::Zero();
 };
+
+/// The 2D contact node state.
+using ContactNodeState = BasicContactNodeState<2>;
+/// The 3D contact node state.
+using ContactNodeState3 = BasicContactNodeState<3>;
 
 /// One process's share of the Newton of a distributed level (levels/distributed.hpp): the
 /// level is this process's part, whose first `n_owned` unknowns are the ones it owns (its contact
@@ -86,12 +104,18 @@ struct NewtonDistribution {
     std::function<void(Vector&)> fill_ghosts;
 };
 
-/// Generalized Newton on one level.
-class ContactNewton {
+/// Generalized Newton on one level in `dim` dimensions (`ContactNewton` in 2D, `ContactNewton3`
+/// in 3D; the distribution is 2D so far).
+template <int dim> class BasicContactNewton {
 public:
+    using Level = BasicLevel<dim>;
+    using Matrix = StatusMatrix<dim>;
+    using Solver = BasicNewtonSystemSolver<dim>;
+    using NodeState = BasicContactNodeState<dim>;
+
     /// `level` must outlive this object. `timings` may be null.
-    ContactNewton(const Level& level, NewtonParams params,
-                  std::unique_ptr<NewtonSystemSolver> solver, Timings* timings = nullptr);
+    BasicContactNewton(const Level& level, NewtonParams params, std::unique_ptr<Solver> solver,
+                       Timings* timings = nullptr);
 
     /// Runs Newton for load factor `s` from the initial guess x (updated in place), with the
     /// slip increment measured from `u_prev_full` (full nodal displacements of the previous
@@ -111,8 +135,8 @@ public:
     /// slip_forward/backward by the sign of its slip increment, or stick if it did not move).
     /// A gap node reports lambda = (0, 0) exactly, the value of the projection at the converged
     /// state (the iterate carries round-off such as 1e-111).
-    std::vector<ContactNodeState> node_states(double s, const Vector& u_prev_full,
-                                              const Vector& x) const;
+    std::vector<NodeState> node_states(double s, const Vector& u_prev_full,
+                                       const Vector& x) const;
 
     /// The relative tolerance asked of the iterative solver at Newton iteration k with residual
     /// norm `norm` (NewtonParams::forcing); 0: the solver's own.
@@ -122,14 +146,14 @@ public:
     /// (one per element of level().contacts) and the status matrices M (one per element of
     /// level().contacts, then one per element of level().ghost_contacts).
     double residual(double s, const Vector& u_prev_full, const Vector& x, Vector& R,
-                    std::vector<contact::Status>* st, std::vector<Eigen::Matrix2d>* M,
+                    std::vector<contact::Status>* st, std::vector<Matrix>* M,
                     double* scale) const;
 
     const Level& level() const { return level_; }
     /// Makes this Newton one process's share of a distributed level's (see NewtonDistribution).
     void set_distribution(NewtonDistribution d);
     /// Hands the Newton-system solver back (this object cannot solve afterwards).
-    std::unique_ptr<NewtonSystemSolver> release_solver() { return std::move(solver_); }
+    std::unique_ptr<Solver> release_solver() { return std::move(solver_); }
 
     /// A fallback for the Newton systems the solver fails on (a Krylov solve that neither
     /// converged nor reduced the residual by half, or a numerical breakdown): `make` builds it on
@@ -138,7 +162,7 @@ public:
     /// it; the later systems of this level are then solved by it directly (a preconditioner
     /// that failed once on a level is not tried again there). Counted in
     /// StepReport::fallback_solves. Without one (default) the failure ends the step.
-    void set_fallback(std::function<std::unique_ptr<NewtonSystemSolver>()> make) {
+    void set_fallback(std::function<std::unique_ptr<Solver>()> make) {
         make_fallback_ = std::move(make);
     }
     /// Polled after every Newton iteration: once it returns true, solve() returns after the
@@ -156,17 +180,17 @@ private:
                    StepReport& rep) const;
     // The Newton system J(M) dx = b, with the exact fallback when the solver fails; false (and
     // rep.message) when no usable step came out of it.
-    bool solve_system(int k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+    bool solve_system(int k, const std::vector<Matrix>& M, const Vector& b, Vector& dx,
                       double forcing, StepReport& rep);
     // x += alpha dx with alpha halved until ||R|| falls below `norm` (after status cycling).
     void damped_step(double s, const Vector& u_prev_full, const Vector& dx, double norm,
                      Vector& x) const;
     const Level& level_;
     NewtonParams params_;
-    std::unique_ptr<NewtonSystemSolver> solver_;
+    std::unique_ptr<Solver> solver_;
     Timings* timings_;
-    std::function<std::unique_ptr<NewtonSystemSolver>()> make_fallback_;
-    std::unique_ptr<NewtonSystemSolver> fallback_;
+    std::function<std::unique_ptr<Solver>()> make_fallback_;
+    std::unique_ptr<Solver> fallback_;
     std::function<bool()> stop_;
     std::function<bool()> interrupt_;
     NewtonDistribution dist_;
@@ -174,5 +198,12 @@ private:
     // The iterate padded to the level's unknowns (zeros past the owned ones) when distributed.
     const Vector& padded(const Vector& x, Vector& work) const;
 };
+
+extern template class BasicContactNewton<2>;
+extern template class BasicContactNewton<3>;
+/// Generalized Newton on a 2D level.
+using ContactNewton = BasicContactNewton<2>;
+/// Generalized Newton on a 3D level.
+using ContactNewton3 = BasicContactNewton<3>;
 
 } // namespace mlc::levels

@@ -15,7 +15,8 @@
 namespace mlc::levels {
 
 // ---------------------------------------------------------------------------------------------
-JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
+template <int dim>
+BasicJacobianAssembler<dim>::BasicJacobianAssembler(const BasicLevel<dim>& level) : level_(level) {
     // J's pattern is K's plus the contact tangent entries: each row of J is K's row merged with
     // that row's contact columns, written straight into CSR (triplets and setFromTriplets took
     // 16 bytes per entry, a column-major copy and a sort: about 1 s and 0.8 GB at level 6).
@@ -23,7 +24,7 @@ JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
     const Index n = level.n_unknowns();
     MLC_ASSERT(K.isCompressed() && K.rows() <= n, "K must be compressed, at most n rows");
     std::vector<std::pair<int, int>> centries;
-    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+    const StatusMatrix<dim> I = StatusMatrix<dim>::Identity();
     for (size_t e = 0; e < level.contacts.size(); ++e)
         contact::for_each_tangent_entry(
             level.contacts[e], I, level.dofs, level.lambda_dof[e],
@@ -107,7 +108,7 @@ JacobianAssembler::JacobianAssembler(const Level& level) : level_(level) {
                         contact_rows_.end());
 }
 
-void JacobianAssembler::reset_row(int i) {
+template <int dim> void BasicJacobianAssembler<dim>::reset_row(int i) {
     // Row i of J back to K's row i (zero in the columns only contact has).
     const SparseMatrix& K = level_.elastic.K;
     const int* ko = K.outerIndexPtr();
@@ -127,7 +128,8 @@ void JacobianAssembler::reset_row(int i) {
         v[*kp++] = kv[p];
 }
 
-void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
+template <int dim>
+void BasicJacobianAssembler<dim>::assemble(const std::vector<StatusMatrix<dim>>& M) {
     // J holds K plus the last tangents: the rows holding contact entries go back to K's.
     double* v = J_.valuePtr();
     for (int i : contact_rows_)
@@ -137,6 +139,9 @@ void JacobianAssembler::assemble(const std::vector<Eigen::Matrix2d>& M) {
         contact::for_each_tangent_entry(level_.contacts[e], M[e], level_.dofs, level_.lambda_dof[e],
                                         [&](int, int, double value) { v[cpos_[c++]] += value; });
 }
+
+template class BasicJacobianAssembler<2>;
+template class BasicJacobianAssembler<3>;
 
 // ---------------------------------------------------------------------------------------------
 namespace {
@@ -172,13 +177,15 @@ private:
     bool first_ = true;
 };
 
-class AssembledSystemSolver final : public NewtonSystemSolver {
+template <int dim> class AssembledSystemSolver final : public BasicNewtonSystemSolver<dim> {
 public:
-    AssembledSystemSolver(const Level& level, std::unique_ptr<LinearSolver> solver)
+    using Matrix = StatusMatrix<dim>;
+    AssembledSystemSolver(const BasicLevel<dim>& level, std::unique_ptr<LinearSolver> solver)
         : jac_(level), solver_(std::move(solver)) {
         MLC_CHECK(solver_ != nullptr, "no linear solver given");
     }
-    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+    using BasicNewtonSystemSolver<dim>::solve;
+    SolveResult solve(const std::vector<Matrix>& M, const Vector& b, Vector& dx,
                       double) override {
         const double t0 = wall_seconds();
         jac_.assemble(M);
@@ -192,13 +199,15 @@ public:
     std::string name() const override { return solver_->name(); }
 
 private:
-    JacobianAssembler jac_;
+    BasicJacobianAssembler<dim> jac_;
     std::unique_ptr<LinearSolver> solver_;
 };
 
-class SchurSystemSolver final : public NewtonSystemSolver {
+template <int dim> class SchurSystemSolver final : public BasicNewtonSystemSolver<dim> {
 public:
-    explicit SchurSystemSolver(const Level& level) : level_(level) {
+    using Matrix = StatusMatrix<dim>;
+    using Point = Eigen::Matrix<double, dim, 1>;
+    explicit SchurSystemSolver(const BasicLevel<dim>& level) : level_(level) {
         const double t0 = wall_seconds();
         const auto& dofs = level.dofs;
         const Index n = level.n_unknowns();
@@ -216,9 +225,10 @@ public:
             comp_.push_back(m_);
             const int me = e.n_multipliers();
             for (int q = 0; q < me; ++q) {
-                const Vec2 g = (me == 2 && q == 0) ? e.t : e.n;
+                // The frame's direction of component q: the tangents, then the normal.
+                const Point g = (me == dim && q < dim - 1) ? Point(e.t.col(q)) : e.n;
                 for (int j = 0; j < e.n_nodes; ++j)
-                    for (int a = 0; a < 2; ++a) {
+                    for (int a = 0; a < dim; ++a) {
                         const int d = dofs.u_dof(e.vertex[static_cast<size_t>(j)], a);
                         if (d >= 0)
                             bt.emplace_back(m_ + q, u_of_dof_[static_cast<size_t>(d)],
@@ -333,10 +343,11 @@ public:
         bl_.resize(m_);
     }
 
-    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+    using BasicNewtonSystemSolver<dim>::solve;
+    SolveResult solve(const std::vector<Matrix>& M, const Vector& b, Vector& dx,
                       double) override {
         const double t0 = wall_seconds();
-        const Level& L = level_;
+        const BasicLevel<dim>& L = level_;
         const Index nu = static_cast<Index>(dof_of_u_.size());
         for (Index k = 0; k < nu; ++k)
             bu_[newpos_[static_cast<size_t>(k)]] = b[dof_of_u_[static_cast<size_t>(k)]];
@@ -348,7 +359,7 @@ public:
         sys_ = S_;
         for (size_t e = 0; e < L.contacts.size(); ++e) {
             const auto& el = L.contacts[e];
-            const int me = el.n_multipliers(), c = comp_[e], q0 = me == 2 ? 0 : 1;
+            const int me = el.n_multipliers(), c = comp_[e], q0 = me == dim ? 0 : dim - 1;
             const Eigen::MatrixXd Me = M[e].block(q0, q0, me, me);
             sys_.block(c, c, me, me) -= (Eigen::MatrixXd::Identity(me, me) - Me) / el.r;
             for (int q = 0; q < me; ++q)
@@ -380,7 +391,7 @@ public:
     std::string name() const override { return "schur"; }
 
 private:
-    const Level& level_;
+    const BasicLevel<dim>& level_;
     std::vector<int> u_of_dof_, dof_of_u_;
     std::vector<int> newpos_;   ///< compact displacement index -> position in the factor
     std::vector<int> comp_;     ///< first contact component of each element
@@ -403,11 +414,20 @@ std::unique_ptr<LinearSolver> make_sparse_lu_solver() {
 
 std::unique_ptr<NewtonSystemSolver>
 make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> solver) {
-    return std::make_unique<AssembledSystemSolver>(level, std::move(solver));
+    return std::make_unique<AssembledSystemSolver<2>>(level, std::move(solver));
+}
+
+std::unique_ptr<NewtonSystemSolver3>
+make_assembled_system_solver(const Level3& level, std::unique_ptr<LinearSolver> solver) {
+    return std::make_unique<AssembledSystemSolver<3>>(level, std::move(solver));
 }
 
 std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level) {
-    return std::make_unique<SchurSystemSolver>(level);
+    return std::make_unique<SchurSystemSolver<2>>(level);
+}
+
+std::unique_ptr<NewtonSystemSolver3> make_schur_system_solver(const Level3& level) {
+    return std::make_unique<SchurSystemSolver<3>>(level);
 }
 
 void LinearSolverSpec::validate() const {

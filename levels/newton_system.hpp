@@ -17,20 +17,24 @@
 
 namespace mlc::levels {
 
+/// The status matrix of one contact element in `dim` dimensions (contact::LawProjection::M): rows
+/// and columns the tangents, then the normal.
+template <int dim> using StatusMatrix = Eigen::Matrix<double, dim, dim>;
+
 /// Assembles J = K + sum of contact tangents into a CSR matrix whose pattern is built once, so
 /// values are refreshed in place and a direct solver's symbolic analysis can be reused.
-class JacobianAssembler {
+template <int dim> class BasicJacobianAssembler {
 public:
     /// `level` must outlive this object.
-    explicit JacobianAssembler(const Level& level);
+    explicit BasicJacobianAssembler(const BasicLevel<dim>& level);
     /// Fills the values for the given per-element M matrices.
-    void assemble(const std::vector<Eigen::Matrix2d>& M);
+    void assemble(const std::vector<StatusMatrix<dim>>& M);
     const SparseMatrix& matrix() const { return J_; }
 
 private:
     void reset_row(int i);
 
-    const Level& level_;
+    const BasicLevel<dim>& level_;
     SparseMatrix J_;
     std::vector<int> merged_rows_;   ///< rows where contact adds columns K lacks (sorted)
     std::vector<size_t> kpos_start_; ///< per merged row, its first entry in kpos_
@@ -38,6 +42,11 @@ private:
     std::vector<int> contact_rows_;  ///< rows holding a contact tangent entry (sorted)
     std::vector<int> cpos_;          ///< position of each contact tangent entry, in visiting order
 };
+
+extern template class BasicJacobianAssembler<2>;
+extern template class BasicJacobianAssembler<3>;
+/// The 2D assembler.
+using JacobianAssembler = BasicJacobianAssembler<2>;
 
 /// Solves J x = b for an assembled matrix.
 class LinearSolver {
@@ -54,17 +63,20 @@ public:
 std::unique_ptr<LinearSolver> make_sparse_lu_solver();
 
 /// Strategy for one Newton linear system J(M) dx = b on a level.
-class NewtonSystemSolver {
+template <int dim> class BasicNewtonSystemSolver {
 public:
-    virtual ~NewtonSystemSolver() = default;
+    /// The status matrix of one element.
+    using Matrix = StatusMatrix<dim>;
+
+    virtual ~BasicNewtonSystemSolver() = default;
     /// dx = J(M)^{-1} b. dx is resized; its content on entry is the initial guess of an
     /// iterative method (zero is fine). `forcing` is the inexact-Newton tolerance of this solve:
     /// an iterative solver stops at the relative residual max(forcing, its own rel_tol); direct
     /// solvers ignore it (they are exact).
-    virtual SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+    virtual SolveResult solve(const std::vector<Matrix>& M, const Vector& b, Vector& dx,
                               double forcing) = 0;
     /// An exact-as-configured solve (forcing 0).
-    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx) {
+    SolveResult solve(const std::vector<Matrix>& M, const Vector& b, Vector& dx) {
         return solve(M, b, dx, 0.0);
     }
     /// "lu", "schur", or the Krylov/preconditioner pair.
@@ -72,43 +84,56 @@ public:
     /// The converged statuses of the level below for the current load step. The driver calls
     /// this after every load step of the level below, before this level's solves; solvers
     /// whose preconditioner uses the level below (cf, sorcf, mg) need it, the others ignore it.
-    virtual void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) { (void)M; }
+    virtual void set_coarse_statuses(const std::vector<Matrix>& M) { (void)M; }
     /// Assembles J(M) and sets the preconditioner up on it, unless M is the last call's: the
     /// level above's multigrid, which shares this level's, calls it with this level's
     /// converged statuses. Direct solvers have nothing to prepare.
-    virtual void prepare(const std::vector<Eigen::Matrix2d>& M) { (void)M; }
+    virtual void prepare(const std::vector<Matrix>& M) { (void)M; }
     /// The multigrid preconditioner this solver uses (null when it has none).
     virtual const solvers::Multigrid* multigrid() const { return nullptr; }
 };
 
+/// The 2D Newton-system solver (every preconditioner of the registry).
+using NewtonSystemSolver = BasicNewtonSystemSolver<2>;
+/// The 3D Newton-system solver.
+using NewtonSystemSolver3 = BasicNewtonSystemSolver<3>;
+
 /// A NewtonSystemSolver that hands everything to another one: derive from it and override what
 /// to watch (bench newton's recorder, the setup timer of the coarser levels, test captures).
-class ForwardingSystemSolver : public NewtonSystemSolver {
+template <int dim> class BasicForwardingSystemSolver : public BasicNewtonSystemSolver<dim> {
 public:
-    explicit ForwardingSystemSolver(std::unique_ptr<NewtonSystemSolver> inner)
+    using Matrix = StatusMatrix<dim>;
+    using Solver = BasicNewtonSystemSolver<dim>;
+
+    explicit BasicForwardingSystemSolver(std::unique_ptr<Solver> inner)
         : inner_(std::move(inner)) {}
-    using NewtonSystemSolver::solve;
-    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+    using Solver::solve;
+    SolveResult solve(const std::vector<Matrix>& M, const Vector& b, Vector& dx,
                       double forcing) override {
         return inner_->solve(M, b, dx, forcing);
     }
     std::string name() const override { return inner_->name(); }
-    void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) override {
+    void set_coarse_statuses(const std::vector<Matrix>& M) override {
         inner_->set_coarse_statuses(M);
     }
-    void prepare(const std::vector<Eigen::Matrix2d>& M) override { inner_->prepare(M); }
+    void prepare(const std::vector<Matrix>& M) override { inner_->prepare(M); }
     const solvers::Multigrid* multigrid() const override { return inner_->multigrid(); }
 
 protected:
-    NewtonSystemSolver& inner() { return *inner_; }
+    Solver& inner() { return *inner_; }
 
 private:
-    std::unique_ptr<NewtonSystemSolver> inner_;
+    std::unique_ptr<Solver> inner_;
 };
+
+using ForwardingSystemSolver = BasicForwardingSystemSolver<2>;
 
 /// Assembles J(M) (pattern fixed per level) and calls `solver` on it. `level` must outlive it.
 std::unique_ptr<NewtonSystemSolver>
 make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> solver);
+/// The same for a 3D level.
+std::unique_ptr<NewtonSystemSolver3>
+make_assembled_system_solver(const Level3& level, std::unique_ptr<LinearSolver> solver);
 
 /// Exact solve by condensation on the contact components ("schur").
 ///
@@ -124,6 +149,8 @@ make_assembled_system_solver(const Level& level, std::unique_ptr<LinearSolver> s
 /// Two sparse triangular solve pairs and one dense LU of size m per Newton step; nothing sparse
 /// is refactored when statuses change. Setup: one Cholesky and m solves for S per level.
 std::unique_ptr<NewtonSystemSolver> make_schur_system_solver(const Level& level);
+/// The same for a 3D level (B maps to (t1, t2, n) per frictional node, n per frictionless one).
+std::unique_ptr<NewtonSystemSolver3> make_schur_system_solver(const Level3& level);
 
 /// The Krylov iteration budget with an exact fallback: a solve projected to need more
 /// iterations than this (at its observed rate) is given up and the system solved exactly. The

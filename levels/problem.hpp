@@ -18,14 +18,21 @@
 
 namespace mlc::levels {
 
-/// Axis-aligned box used to select vertices.
-struct Box {
-    Vec2 lo = Vec2::Constant(-1e300);
-    Vec2 hi = Vec2::Constant(1e300);
-    bool contains(const Vec2& p) const {
-        return p.x() >= lo.x() && p.x() <= hi.x() && p.y() >= lo.y() && p.y() <= hi.y();
+/// Axis-aligned box used to select vertices, in `dim` dimensions.
+template <int dim> struct BasicBox {
+    using Point = Eigen::Matrix<double, dim, 1>;
+    Point lo = Point::Constant(-1e300);
+    Point hi = Point::Constant(1e300);
+    bool contains(const Point& p) const {
+        for (int c = 0; c < dim; ++c)
+            if (!(p[c] >= lo[c] && p[c] <= hi[c])) return false;
+        return true;
     }
 };
+/// The 2D box.
+using Box = BasicBox<2>;
+/// The 3D box.
+using Box3 = BasicBox<3>;
 
 /// A body: one material region of the merged mesh (triangle attribute = body index).
 struct Body {

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // `mlcontact run`.
 #include "run/run.hpp"
+#include "run/run3.hpp"
+#include "scene/scene3.hpp"
 
 #include "core/check.hpp"
 #include "core/memory.hpp"
@@ -162,6 +164,7 @@ int print_stopped(std::ostream& os, const levels::RunResult& r, const SummarySta
 } // namespace
 
 int run_scene(const RunOptions& opt, std::ostream& os) {
+    if (scene::scene_dimension(opt.scene) == 3) return run_scene3(opt, os);
     // A signal while the scene's domains are meshed stops the meshing; nothing is written.
     std::optional<levels::Problem> loaded;
     try {

@@ -93,7 +93,7 @@ class Probe final : public levels::ForwardingSystemSolver {
 public:
     Probe(std::unique_ptr<levels::NewtonSystemSolver> inner, const levels::Level& level, int reps,
           std::map<std::string, Stat>& out)
-        : ForwardingSystemSolver(std::move(inner)), reps_(reps), out_(out),
+        : levels::ForwardingSystemSolver(std::move(inner)), reps_(reps), out_(out),
           lattice_(level.lattice) {
         std::vector<int> owner(static_cast<size_t>(level.n_unknowns()));
         for (Index i = 0; i < level.n_unknowns(); ++i)

@@ -27,7 +27,7 @@ class Capture final : public levels::ForwardingSystemSolver {
 public:
     Capture(std::unique_ptr<levels::NewtonSystemSolver> inner, const levels::Level& L,
             std::vector<CapturedSystem>& out)
-        : ForwardingSystemSolver(std::move(inner)), jac_(L), out_(out) {}
+        : levels::ForwardingSystemSolver(std::move(inner)), jac_(L), out_(out) {}
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
                       double forcing) override {
         jac_.assemble(M);
