@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
-// 3D elastic levels: sizes and memory predicted from level 0, the levels and transfers, and the
-// multigrid on them.
+// 3D levels: the problem's checks, the levels (supports, contact elements, numbering, assembly)
+// and transfers, and the multigrid on them (sizes and memory: elastic3d_sizes.cpp).
 #include "levels/elastic3d_levels.hpp"
 
+#include "levels/elastic3d_detail.hpp"
+
+#include "contact/element.hpp"
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 #include "mesh/tet_refine.hpp"
@@ -44,13 +47,6 @@ std::string point_text(const Vec3& x) {
     return os.str();
 }
 
-/// The edges of m (mesh::tet_edges, smaller vertex first), sorted.
-std::vector<std::array<int, 2>> sorted_edges(const mesh::TetMesh& m) {
-    std::vector<std::array<int, 2>> e = mesh::tet_edges(m).edges;
-    std::sort(e.begin(), e.end());
-    return e;
-}
-
 /// Throws InvalidInput unless x is a vertex of the level-0 mesh m0 (within kPointTol of its
 /// diameter); `what` names x in the message ("support point", "support line: its end").
 void check_vertex0(const mesh::TetMesh& m0, const Vec3& x, const std::string& what) {
@@ -61,12 +57,40 @@ void check_vertex0(const mesh::TetMesh& m0, const Vec3& x, const std::string& wh
                    << "vertex lies " << d << " away)");
 }
 
-/// The level-0 edges of a line support (pairs of vertices, smaller first), after checking that
-/// its ends are level-0 vertices and its segment runs along level-0 edges (`edges`: those of
-/// sorted_edges(m0)).
-std::vector<std::pair<int, int>> line_edges0(const mesh::TetMesh& m0,
-                                             const std::vector<std::array<int, 2>>& edges,
-                                             const std::array<Vec3, 2>& line) {
+/// The names of the tags some boundary face of m carries, "a, b, c" ("none" without any).
+std::string face_tags(const mesh::TetMesh& m) {
+    std::string s;
+    for (const auto& [name, id] : m.tag_names)
+        if (m.is_boundary_tag(id)) s += (s.empty() ? "" : ", ") + name;
+    return s.empty() ? "none" : s;
+}
+
+/// "u_x", "u_x and u_z", "u_x, u_y and u_z": the components of `held` that are true.
+std::string component_list(const std::array<bool, 3>& held) {
+    std::vector<std::string> names;
+    for (int c = 0; c < 3; ++c)
+        if (held[static_cast<size_t>(c)]) names.push_back(std::string("u_") + "xyz"[c]);
+    std::string s;
+    for (size_t k = 0; k < names.size(); ++k)
+        s += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+    return s;
+}
+
+} // namespace
+
+// The edges of m (mesh::tet_edges, smaller vertex first), sorted.
+std::vector<std::array<int, 2>> detail::sorted_edges(const mesh::TetMesh& m) {
+    std::vector<std::array<int, 2>> e = mesh::tet_edges(m).edges;
+    std::sort(e.begin(), e.end());
+    return e;
+}
+
+// The level-0 edges of a line support (pairs of vertices, smaller first), after checking that
+// its ends are level-0 vertices and its segment runs along level-0 edges (`edges`: those of
+// sorted_edges(m0)).
+std::vector<std::pair<int, int>> detail::line_edges0(const mesh::TetMesh& m0,
+                                                     const std::vector<std::array<int, 2>>& edges,
+                                                     const std::array<Vec3, 2>& line) {
     for (const Vec3& x : line)
         check_vertex0(m0, x, "support line: its end");
     MLC_CHECK((line[1] - line[0]).norm() > kPointTol * m0.diameter(),
@@ -87,7 +111,24 @@ std::vector<std::pair<int, int>> line_edges0(const mesh::TetMesh& m0,
     return out;
 }
 
-} // namespace
+double mean_face_edge_length(const mesh::TetMesh& m, const std::string& tag) {
+    const auto id = m.find_tag(tag);
+    MLC_CHECK(id && m.is_boundary_tag(*id),
+              "no boundary face carries the tag '"
+                  << tag << "' (the boundary face tags are: " << face_tags(m) << ")");
+    std::set<std::pair<int, int>> edges;
+    for (const mesh::BoundaryFace& f : m.boundary) {
+        if (f.tag != *id) continue;
+        for (int i = 0; i < 3; ++i) {
+            const int a = f.v[static_cast<size_t>(i)], b = f.v[static_cast<size_t>((i + 1) % 3)];
+            edges.insert({std::min(a, b), std::max(a, b)});
+        }
+    }
+    double sum = 0.0;
+    for (const auto& [a, b] : edges)
+        sum += (m.vertices[static_cast<size_t>(a)] - m.vertices[static_cast<size_t>(b)]).norm();
+    return sum / static_cast<double>(edges.size());
+}
 
 std::vector<int> line_vertices(const mesh::TetMesh& m, const std::array<Vec3, 2>& line) {
     const double tol = kPointTol * m.diameter();
@@ -133,7 +174,7 @@ void ElasticProblem3::validate() const {
         MLC_CHECK(int(!s.tag.empty()) + int(s.point.has_value()) + int(s.line.has_value()) == 1,
                   "a support takes one of a tag, a line or a point");
         if (s.line) {
-            line_edges0(mesh0, sorted_edges(mesh0), *s.line);
+            detail::line_edges0(mesh0, detail::sorted_edges(mesh0), *s.line);
         } else if (!s.tag.empty()) {
             const auto id = mesh0.find_tag(s.tag);
             MLC_CHECK(id && !mesh0.vertices_on_tag(*id).empty(),
@@ -142,9 +183,107 @@ void ElasticProblem3::validate() const {
             check_vertex0(mesh0, *s.point, "support point");
         }
     }
+    MLC_CHECK(load_steps >= 1, "load_steps must be at least 1, found " << load_steps);
+    newton.validate();
+    for (const ContactPair3& c : contacts) {
+        const std::string w = "contact '" + c.name + "'";
+        const auto id = mesh0.find_tag(c.contactor);
+        MLC_CHECK(id && mesh0.is_boundary_tag(*id),
+                  w << ": the contactor tag '" << c.contactor
+                    << "' is a tag of no boundary face (the boundary face tags are: "
+                    << face_tags(mesh0) << ")");
+        MLC_CHECK(std::isfinite(c.mu) && c.mu >= 0,
+                  w << ": the friction coefficient mu must be >= 0, found " << c.mu);
+        MLC_CHECK(std::isfinite(c.r) && c.r > 0,
+                  w << ": the augmentation parameter r must be > 0, found " << c.r);
+        if (c.region)
+            MLC_CHECK((c.region->lo.array() <= c.region->hi.array()).all(),
+                      w << ": the region's min " << point_text(c.region->lo) << " exceeds its max "
+                        << point_text(c.region->hi) << " in some coordinate");
+        contact::BasicObstacle<3> o = c.obstacle;
+        try {
+            o.validate();
+        } catch (const InvalidInput& e) {
+            throw InvalidInput(w + ": " + e.what());
+        }
+    }
 }
 
 // ------------------------------------------------------------------------------------------
+
+namespace {
+
+/// The contact elements of every pair (Level3::contacts, contact_of_vertex, not_found) and the
+/// multipliers of each vertex (n_extra, sized to the vertices); L.fixed is set.
+void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& n_extra) {
+    const mesh::TetMesh& m = L.mesh;
+    const auto nv = static_cast<size_t>(m.n_vertices());
+    L.contact_of_vertex.assign(nv, -1);
+    L.not_found.assign(p.contacts.size(), {});
+    n_extra.assign(nv, 0);
+    for (size_t k = 0; k < p.contacts.size(); ++k) {
+        const ContactPair3& pair = p.contacts[k];
+        std::vector<int> nodes;
+        const std::vector<int> on_tag = m.vertices_with_tag(m.tag(pair.contactor));
+        int outside = 0, fixed = 0, claimed = 0;
+        for (int v : on_tag) {
+            const auto vi = static_cast<size_t>(v);
+            if (pair.region && !pair.region->contains(m.vertices[vi])) {
+                ++outside;
+            } else if (L.fixed[vi][0] && L.fixed[vi][1] && L.fixed[vi][2]) {
+                ++fixed;
+            } else if (L.contact_of_vertex[vi] >= 0) {
+                ++claimed;
+            } else {
+                nodes.push_back(v);
+                L.contact_of_vertex[vi] = -2; // claimed; the element index is set below
+            }
+        }
+        MLC_CHECK(!nodes.empty(), "contact '" << pair.name << "' has no contactor node on '"
+                                              << pair.contactor << "': of its " << on_tag.size()
+                                              << " vertices, " << outside
+                                              << " lie outside the region, " << fixed
+                                              << " have all three components fixed by supports and "
+                                              << claimed << " belong to an earlier contact pair");
+        for (const auto& e : contact::node_on_rigid<3>(m, nodes, pair.obstacle, pair.mu, pair.r,
+                                                       static_cast<int>(k))) {
+            L.contact_of_vertex[static_cast<size_t>(e.vertex[0])] =
+                static_cast<int>(L.contacts.size());
+            n_extra[static_cast<size_t>(e.vertex[0])] = e.n_multipliers();
+            L.contacts.push_back(e);
+        }
+    }
+}
+
+/// Sets ContactElement3::pinned of every element from the fixed components of its vertex
+/// (contact::held_components); throws InvalidInput for an element whose supports hold a
+/// direction its frame meets only in part.
+void pin_held_components3(const ElasticProblem3& p, Level3& L) {
+    for (auto& e : L.contacts) {
+        const auto h = contact::held_components<3>(e, L.fixed);
+        const int v = e.vertex[0];
+        const std::array<bool, 3>& held = L.fixed[static_cast<size_t>(v)];
+        MLC_CHECK(
+            !h.ambiguous,
+            "contact '" << p.contacts[static_cast<size_t>(e.pair)].name << "': contactor vertex "
+                        << v << " at " << point_text(L.mesh.vertices[static_cast<size_t>(v)])
+                        << " has " << component_list(held)
+                        << " prescribed by a support, but its contact frame there, normal "
+                        << point_text(e.n) << " with tangents " << point_text(e.t.col(0)) << " and "
+                        << point_text(e.t.col(1))
+                        << ", meets the held directions only in part (a tangent or the normal "
+                           "neither along nor across them): with friction the support and the "
+                           "contact would share a force direction and their reactions would not be "
+                           "unique (a node's tangential multipliers are pinned together or not at "
+                           "all). Prescribe all three components of that vertex, release its "
+                        << component_list(held)
+                        << ", make the pair frictionless (mu = 0), or leave the vertex out of the "
+                           "contact (its region)");
+        e.pinned = h.pinned;
+    }
+}
+
+} // namespace
 
 Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
     Level3 L;
@@ -160,11 +299,18 @@ Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
     }
     fem::Supports3 sup = fem::collect_supports(m, vs);
     L.fixed = std::move(sup.fixed);
-    L.dofs = fem::DofMap3(L.fixed, std::vector<int>(static_cast<size_t>(m.n_vertices()), 0));
+    L.mesh = std::move(m);
+    std::vector<int> n_extra;
+    find_contact_nodes3(p, L, n_extra);
+    pin_held_components3(p, L);
+    L.dofs = fem::DofMap3(L.fixed, n_extra);
+    L.lambda_dof.reserve(L.contacts.size());
+    for (const auto& e : L.contacts)
+        L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
     L.u_fixed = std::move(sup.u_fixed);
     std::vector<fem::Traction3> tr;
     for (const FaceLoad3& l : p.loads)
-        tr.push_back({m.tag(l.tag), l.pressure, l.traction});
+        tr.push_back({L.mesh.tag(l.tag), l.pressure, l.traction});
     std::vector<Vec3> bf;
     bool any_force = false;
     for (const Body3& b : p.bodies) {
@@ -172,9 +318,8 @@ Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
         L.materials.push_back(b.material);
         any_force = any_force || !b.body_force.isZero(0.0);
     }
-    const Vector F = fem::nodal_loads(m, tr, any_force ? bf : std::vector<Vec3>{});
-    L.elastic = fem::assemble_elastic(m, L.materials, L.dofs, F, L.u_fixed);
-    L.mesh = std::move(m);
+    const Vector F = fem::nodal_loads(L.mesh, tr, any_force ? bf : std::vector<Vec3>{});
+    L.elastic = fem::assemble_elastic(L.mesh, L.materials, L.dofs, F, L.u_fixed);
     return L;
 }
 
@@ -262,178 +407,6 @@ std::vector<Vector> rigid_body_modes3(const Level3& L) {
         }
     }
     return modes;
-}
-
-// ------------------------------------------------------------------------------------------
-// Sizes and memory.
-
-namespace {
-
-/// Bytes per unit, fitted on the peak resident memory of `bench elastic` on box3d (levels 3
-/// and 4) and rounded up.
-constexpr double kBaseline3 = 16.0 * (1 << 20);
-// The hierarchy: per nonzero of K (its CSR) and per unknown (the DofMap3, loads, the two
-// transfers T and R, mesh arrays per vertex folded in).
-constexpr double kHierarchyPerNonzero3 = 12.5;
-constexpr double kHierarchyPerUnknown3 = 150.0;
-// The multigrid over all levels: smoother data and work vectors per unknown and nonzero.
-constexpr double kMgPerNonzero3 = 5.0;
-constexpr double kMgPerUnknown3 = 50.0;
-// BoomerAMG-PCG on the finest level (solvers::boomeramg_elasticity3d): hypre's copy of K and its
-// AMG hierarchy.
-constexpr double kAmgPerNonzero3 = 40.0;
-constexpr double kAmgPerUnknown3 = 0.0;
-
-} // namespace
-
-namespace {
-
-/// Fixed components on level l: per component, the vertices of the faces whose tags hold it and
-/// of the lines that hold it, line supports and the tags' tagged lines (V' = V + E + E_l,
-/// E' = 2 E + 3 F, F' = 4 F over those faces, E_l' = 2 E_l over the line edges that are no edges
-/// of those faces), and the point supports' vertices (kept by refinement) off them.
-std::vector<double> predict_fixed_components(const ElasticProblem3& p, int levels) {
-    std::vector<double> fixed(static_cast<size_t>(levels) + 1, 0.0);
-    // The level-0 edges of each line support, found once for the three components.
-    std::vector<std::vector<std::pair<int, int>>> line_edges_of(p.supports.size());
-    const auto has_line = [](const Support3& s) { return s.line.has_value(); };
-    if (std::any_of(p.supports.begin(), p.supports.end(), has_line)) {
-        const std::vector<std::array<int, 2>> edges0 = sorted_edges(p.mesh0);
-        for (size_t k = 0; k < p.supports.size(); ++k)
-            if (p.supports[k].line)
-                line_edges_of[k] = line_edges0(p.mesh0, edges0, *p.supports[k].line);
-    }
-    for (int c = 0; c < 3; ++c) {
-        std::set<int> tags;
-        std::set<int> points;
-        std::set<std::pair<int, int>> line_edges;
-        for (size_t k = 0; k < p.supports.size(); ++k) {
-            const Support3& s = p.supports[k];
-            if (!s.u[static_cast<size_t>(c)]) continue;
-            if (!s.tag.empty()) {
-                const int tag = p.mesh0.tag(s.tag);
-                tags.insert(tag);
-                for (const mesh::BoundaryEdge& l : p.mesh0.lines) // the tag's lines
-                    if (l.tag == tag)
-                        line_edges.insert({std::min(l.v0, l.v1), std::max(l.v0, l.v1)});
-            } else if (s.line)
-                line_edges.insert(line_edges_of[k].begin(), line_edges_of[k].end());
-            else
-                points.insert(p.mesh0.nearest_vertex(*s.point));
-        }
-        std::set<std::array<int, 3>> faces;
-        std::set<std::pair<int, int>> edges;
-        std::set<int> verts;
-        for (const mesh::BoundaryFace& f : p.mesh0.boundary) {
-            if (!tags.count(f.tag)) continue;
-            std::array<int, 3> k = f.v;
-            std::sort(k.begin(), k.end());
-            if (!faces.insert(k).second) continue;
-            edges.insert({k[0], k[1]});
-            edges.insert({k[0], k[2]});
-            edges.insert({k[1], k[2]});
-            verts.insert(k.begin(), k.end());
-        }
-        double El = 0;
-        for (const auto& e : line_edges) {
-            if (edges.count(e)) continue;
-            El += 1;
-            verts.insert(e.first);
-            verts.insert(e.second);
-        }
-        double off = 0;
-        for (int v : points)
-            off += verts.count(v) ? 0.0 : 1.0;
-        double V = static_cast<double>(verts.size()), E = static_cast<double>(edges.size()),
-               F = static_cast<double>(faces.size());
-        for (int l = 0; l <= levels; ++l) {
-            fixed[static_cast<size_t>(l)] += V + off;
-            const double V1 = V + E + El, E1 = 2 * E + 3 * F, F1 = 4 * F;
-            V = V1;
-            E = E1;
-            F = F1;
-            El = 2 * El;
-        }
-    }
-    return fixed;
-}
-
-} // namespace
-
-std::vector<ElasticLevelSize3> predict_elastic3_sizes(const ElasticProblem3& p, int levels) {
-    MLC_CHECK(levels >= 0 && levels <= kMaxLevels3,
-              "levels must lie in [0, " << kMaxLevels3 << "], found " << levels);
-    const std::vector<mesh::TetLevelSize> ms = mesh::predict_tet_level_sizes(p.mesh0, levels);
-    const Level3 L0 = build_level(p, p.mesh0);
-    const std::vector<double> fixed = predict_fixed_components(p, levels);
-    const double V0 = ms[0].vertices, E0 = ms[0].edges;
-    // The nonzeros the fixed components remove, per fixed component (level 0's ratio).
-    const double deficit0 = 9 * (V0 + 2 * E0) - static_cast<double>(L0.elastic.K.nonZeros());
-    const double per_fixed = fixed[0] > 0 ? deficit0 / fixed[0] : 0.0;
-    std::vector<ElasticLevelSize3> out;
-    for (const mesh::TetLevelSize& s : ms) {
-        ElasticLevelSize3 e;
-        e.level = s.level;
-        e.vertices = s.vertices;
-        e.edges = s.edges;
-        e.tetrahedra = s.tetrahedra;
-        const double f = fixed[static_cast<size_t>(s.level)];
-        e.unknowns = std::max(0.0, 3 * s.vertices - f);
-        e.k_nonzeros = std::max(0.0, 9 * (s.vertices + 2 * s.edges) - per_fixed * f);
-        out.push_back(e);
-    }
-    out[0].unknowns = static_cast<double>(L0.dofs.n_dofs());
-    out[0].k_nonzeros = static_cast<double>(L0.elastic.K.nonZeros());
-    return out;
-}
-
-ElasticMemory3 estimate_elastic3_memory(const std::vector<ElasticLevelSize3>& sizes) {
-    MLC_CHECK(!sizes.empty(), "estimate_elastic3_memory: no levels");
-    ElasticMemory3 e;
-    e.baseline_bytes = kBaseline3;
-    for (const ElasticLevelSize3& s : sizes) {
-        e.hierarchy_bytes +=
-            kHierarchyPerNonzero3 * s.k_nonzeros + kHierarchyPerUnknown3 * s.unknowns;
-        e.mg_bytes += kMgPerNonzero3 * s.k_nonzeros + kMgPerUnknown3 * s.unknowns;
-    }
-    // The coarse LU of level 0 (a small multiple of its nonzeros).
-    e.mg_bytes += 120.0 * sizes.front().k_nonzeros;
-    const ElasticLevelSize3& f = sizes.back();
-    e.amg_bytes = kAmgPerNonzero3 * f.k_nonzeros + kAmgPerUnknown3 * f.unknowns;
-    return e;
-}
-
-ElasticPlan3 plan_elastic3(int finest_level) {
-    MLC_CHECK(finest_level >= 0, "a level is >= 0, found " << finest_level);
-    ElasticPlan3 p;
-    p.multigrid = finest_level >= 1;
-    p.reason = p.multigrid ? "mg-CG: in 3D the multigrid beats the direct factor from the first "
-                             "refinement on"
-                           : "the direct factor: level 0 has no level below for the multigrid";
-    return p;
-}
-
-double estimate_direct3_bytes(const ElasticLevelSize3& finest) {
-    // Factor nonzeros: box3d level 4's, scaled by (n / n4)^1.394, the exponent of levels 3 to 4.
-    constexpr double kFactorNonzeros4 = 5.4e8, kUnknowns4 = 405600, kExponent = 1.394;
-    constexpr double kBytesPerFactorNonzero = 12, kBytesPerKNonzero = 24;
-    const double factor =
-        kFactorNonzeros4 * std::pow(std::max(finest.unknowns, 1.0) / kUnknowns4, kExponent);
-    return kBytesPerFactorNonzero * factor + kBytesPerKNonzero * finest.k_nonzeros;
-}
-
-void check_elastic3_fits(const ElasticMemory3& e, const MemoryLimit& limit,
-                         const std::vector<ElasticLevelSize3>& sizes) {
-    if (e.bytes() <= limit.bytes) return;
-    const ElasticLevelSize3& f = sizes.back();
-    std::ostringstream os;
-    os << std::setprecision(3) << "the 3D elastic bench needs an estimated "
-       << format_bytes(e.bytes()) << " (finest level " << f.level << ": " << f.unknowns
-       << " unknowns, " << f.k_nonzeros << " nonzeros of K; multigrid " << format_bytes(e.mg_peak())
-       << ", BoomerAMG-PCG " << format_bytes(e.amg_peak()) << ") but this process may use "
-       << format_bytes(std::max(0.0, limit.bytes)) << " (" << limit.source
-       << "): use fewer --levels";
-    throw InvalidInput(os.str());
 }
 
 } // namespace mlc::levels

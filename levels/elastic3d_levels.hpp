@@ -63,15 +63,17 @@ std::vector<int> line_vertices(const mesh::TetMesh& m, const std::array<Vec3, 2>
 /// if given) against a rigid obstacle (node-on-rigid elements).
 struct ContactPair3 {
     std::string name;
-    std::string contactor; ///< boundary face tag of the contactor nodes
-    std::optional<Box3> region;
+    std::string contactor;      ///< boundary face tag of the contactor nodes
+    std::optional<Box3> region; ///< keep only contactor vertices inside this box
     contact::BasicObstacle<3> obstacle;
     double mu = 0.0; ///< Coulomb coefficient >= 0
-    double r = 0.0;  ///< augmentation parameter > 0 (force / length in 3D)
+    /// Augmentation parameter > 0. A 3D multiplier is a nodal force, so r has the units of a
+    /// force per length (E times a length; scene/scene3.hpp's default r_over_E E h0).
+    double r = 0.0;
 };
 
-/// A 3D elastic problem: the level-0 mesh (attribute = body index), bodies, loads and supports,
-/// and the finest level.
+/// A 3D problem: the level-0 mesh (attribute = body index), bodies, loads and supports, the
+/// contact pairs (rigid obstacles), load stepping, Newton settings and the finest level.
 struct ElasticProblem3 {
     std::string name, description, units;
     mesh::TetMesh mesh0;
@@ -79,6 +81,7 @@ struct ElasticProblem3 {
     std::vector<FaceLoad3> loads;
     std::vector<Support3> supports;
     std::vector<ContactPair3> contacts;
+    /// Load steps: step j solves at the load factor j / load_steps (proportional loading).
     int load_steps = 1;
     NewtonParams newton;
     int levels = 0;
@@ -86,9 +89,17 @@ struct ElasticProblem3 {
     /// material, a support tag no boundary face or tagged line carries (a
     /// load tag no boundary face carries), a point that is no level-0 vertex, a line whose
     /// ends are no level-0 vertices or whose segment does not run along level-0 edges, a support
-    /// that fixes nothing, levels outside 0..12.
+    /// that fixes nothing, levels outside 0..12, load_steps < 1, bad Newton settings
+    /// (NewtonParams::validate), and per contact pair: a contactor tag on no boundary face
+    /// (naming it and the face tags there are), mu < 0 or not finite, r not > 0 or not finite,
+    /// a region with min > max, a bad obstacle (BasicObstacle::validate).
     void validate() const;
 };
+
+/// The mean length of the level-0 edges of the boundary faces tagged `tag` (each edge once):
+/// the length h0 of the default augmentation r = r_over_E E h0 of a 3D pair. Throws
+/// InvalidInput when no boundary face carries the tag.
+double mean_face_edge_length(const mesh::TetMesh& m, const std::string& tag);
 
 /// Largest finest level of a 3D problem.
 inline constexpr int kMaxLevels3 = 12;
@@ -97,8 +108,9 @@ inline constexpr int kMaxLevels3 = 12;
 struct ElasticLevelSize3 {
     int level = 0;
     double vertices = 0, edges = 0, tetrahedra = 0;
-    double unknowns = 0;   ///< free displacement components
-    double k_nonzeros = 0; ///< of K on the unknowns
+    double unknowns = 0;    ///< free displacement components
+    double multipliers = 0; ///< contact multipliers (3 per frictional, 1 per frictionless node)
+    double k_nonzeros = 0;  ///< of K on the unknowns
 };
 
 /// Sizes of levels 0..levels from the level-0 mesh alone (mesh::predict_tet_level_sizes; level
@@ -106,6 +118,19 @@ struct ElasticLevelSize3 {
 /// component the vertices of the supported faces refine as V' = V + E, E' = 2 E + 3 F,
 /// F' = 4 F, and point supports stay. The nonzeros of K are 9 (V + 2 E) less level 0's deficit
 /// per fixed component times the fixed components.
+///
+/// Multipliers: the contact nodes of a level are the points of the refined contactor faces, each
+/// counted once: a level-0 vertex, the 2^l - 1 points refinement puts inside a level-0 edge and
+/// the (2^l - 1)(2^l - 2) / 2 inside a level-0 face, less those whose three components are
+/// fixed (a level-0 edge's points are fixed in a component when a face or line support of that
+/// component holds the edge, a face's when a support holds the face), 3 per node of a
+/// frictional pair and 1 of a frictionless one. Exact without a region. With a region: exact for
+/// the edges and faces whose level-0 vertices all lie inside it (a box holds a flat face with
+/// its corners) and for those whose bounding box misses it; those it cuts have their points
+/// counted at their positions on the level-0 face (refinement moves the points of a curved
+/// surface onto it: there the count near the region's boundary is an estimate). An edge or face
+/// shared by two pairs counts for the first that holds all its vertices (one that the first
+/// pair's region cuts counts for both: an overestimate).
 std::vector<ElasticLevelSize3> predict_elastic3_sizes(const ElasticProblem3& p, int levels);
 
 /// Estimated peak resident memory of `bench elastic` on a 3D problem: the hierarchy (meshes,
@@ -146,14 +171,26 @@ void check_elastic3_fits(const ElasticMemory3& e, const MemoryLimit& limit,
                          const std::vector<ElasticLevelSize3>& sizes);
 
 /// Builds one 3D level on mesh `m` (a refinement of p.mesh0, or p.mesh0): supports
-/// (Level3::fixed, u_fixed), numbering (free components interleaved by vertex), materials, loads
-/// and the assembled system (K on the unknowns, f for the full load). No contact elements.
+/// (Level3::fixed, u_fixed), contact elements, numbering (by vertex index: the free components
+/// of a vertex, then its multipliers), materials, loads and the assembled system (K on the
+/// unknowns, its multiplier rows and columns empty; f for the full load).
+///
+/// Contactor nodes, pair by pair: the vertices of the boundary faces with the pair's contactor
+/// tag, inside its region (if any), not fully fixed (all three components) and not claimed by
+/// an earlier pair; each gets a node-on-rigid element (contact::node_on_rigid, Level3::contacts
+/// in pair order, contact_of_vertex) and its multipliers (n_multipliers: 3 frictional, 1
+/// frictionless) right after its displacements (lambda_dof: the first of them). not_found
+/// holds one empty list per pair. Components held by supports are pinned
+/// (contact::held_components). Throws InvalidInput for a pair with no contact node, and for a
+/// node whose supports hold a direction its contact frame meets only in part (`ambiguous`),
+/// naming the pair, the vertex, its position, the held components, the frame and the fixes.
 Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m);
 
 /// Refines p.mesh0 `levels` times (mesh::refine) and builds every level and transfer: transfers[l]
 /// from level l to l + 1 holds P_vertex (linear interpolation through the 1->8 refinement), T
-/// (P_vertex on the free unknowns, transfer::restrict_to_unknowns) and R = T^T; P_nodal, Q and the
-/// coarse/fine splitting, which contact levels use, stay empty.
+/// (P_vertex on the free displacement unknowns, transfer::restrict_to_unknowns; n_dofs x n_dofs
+/// of the two levels, the rows and columns of multipliers empty) and R = T^T; P_nodal, Q and the
+/// coarse/fine splitting, which contact levels use, stay empty (Q: transfer/surface_q.hpp).
 Hierarchy3 build_hierarchy(const ElasticProblem3& p, int levels);
 
 /// The geometric multigrid on a hierarchy of at least two levels: rediscretized operators (each

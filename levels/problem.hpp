@@ -18,18 +18,22 @@
 
 namespace mlc::levels {
 
-/// Axis-aligned box used to select vertices, in `dim` dimensions.
+/// Axis-aligned box in `dim` dimensions used to select vertices (the closed box [lo, hi]; the
+/// defaults hold every point).
 template <int dim> struct BasicBox {
+    static_assert(dim == 2 || dim == 3, "BasicBox: dim is 2 or 3");
     using Point = Eigen::Matrix<double, dim, 1>;
     Point lo = Point::Constant(-1e300);
     Point hi = Point::Constant(1e300);
+    /// Whether lo <= p <= hi in every coordinate.
     bool contains(const Point& p) const {
         for (int c = 0; c < dim; ++c)
             if (!(p[c] >= lo[c] && p[c] <= hi[c])) return false;
         return true;
     }
 };
-/// The 2D box.
+
+/// The 2D box (a rectangle).
 using Box = BasicBox<2>;
 /// The 3D box.
 using Box3 = BasicBox<3>;
