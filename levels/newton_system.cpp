@@ -353,6 +353,12 @@ public:
             bu_[newpos_[static_cast<size_t>(k)]] = b[dof_of_u_[static_cast<size_t>(k)]];
         chol_.solve(bu_, du_);
         const Eigen::VectorXd w = B_ * du_;
+        if constexpr (dim == 3) {
+            // 3D slip's M is no projector (M^2 != M): the general reduction.
+            for (size_t e = 0; e < L.contacts.size(); ++e)
+                if ((M[e] * M[e] - M[e]).norm() > 1e-12 * (1.0 + M[e].norm()))
+                    return solve_general(M, b, w, dx, t0);
+        }
         // Reduced system on the contact components (M is a projector, M^2 = M, so the 2m x 2m
         // system [I + S D1, S D2; D2, D3] of the header collapses): with y = r (M - I) z + M dl,
         //   (S - (I - M) / r) y = w - M b_lambda,  z = w - S y,  dl = y + r (z - b_lambda).
@@ -391,6 +397,56 @@ public:
     std::string name() const override { return "schur"; }
 
 private:
+    /// The reduction for any M (3D slip): with y = r (M - I) z + M dl and z = B du = w - S y,
+    ///   [I + r (M - I) S,  -M         ] [y ]   [r (M - I) w]
+    ///   [-M S,             (M - I) / r] [dl] = [b_l - M w  ],
+    /// a dense system of twice the contact components, then du = K0^{-1} (b_u - B^T y).
+    SolveResult solve_general(const std::vector<Matrix>& M, const Vector& b,
+                              const Eigen::VectorXd& w, Vector& dx, double t0) {
+        const BasicLevel<dim>& L = level_;
+        const Index nu = static_cast<Index>(dof_of_u_.size());
+        Eigen::MatrixXd Mb = Eigen::MatrixXd::Zero(m_, m_), Mr = Eigen::MatrixXd::Zero(m_, m_);
+        Eigen::MatrixXd A22 = Eigen::MatrixXd::Zero(m_, m_);
+        for (size_t e = 0; e < L.contacts.size(); ++e) {
+            const auto& el = L.contacts[e];
+            const int me = el.n_multipliers(), c = comp_[e], q0 = me == dim ? 0 : dim - 1;
+            const Eigen::MatrixXd Me = M[e].block(q0, q0, me, me);
+            const Eigen::MatrixXd Ie = Eigen::MatrixXd::Identity(me, me);
+            Mb.block(c, c, me, me) = Me;
+            Mr.block(c, c, me, me) = el.r * (Me - Ie);
+            A22.block(c, c, me, me) = (Me - Ie) / el.r;
+            for (int q = 0; q < me; ++q)
+                bl_[c + q] = b[L.lambda_dof[e] + q];
+        }
+        Eigen::MatrixXd A(2 * m_, 2 * m_);
+        A.topLeftCorner(m_, m_) = Eigen::MatrixXd::Identity(m_, m_) + Mr * S_;
+        A.topRightCorner(m_, m_) = -Mb;
+        A.bottomLeftCorner(m_, m_) = -Mb * S_;
+        A.bottomRightCorner(m_, m_) = A22;
+        Eigen::VectorXd rhs(2 * m_);
+        rhs.head(m_) = Mr * w;
+        rhs.tail(m_) = bl_ - Mb * w;
+        const Eigen::VectorXd sol = Eigen::PartialPivLU<Eigen::MatrixXd>(A).solve(rhs);
+        const Eigen::VectorXd y = sol.head(m_);
+        bu_ -= B_.transpose() * y;
+        chol_.solve(bu_, du_);
+        dx.setZero(b.size());
+        for (Index k = 0; k < nu; ++k)
+            dx[dof_of_u_[static_cast<size_t>(k)]] = du_[newpos_[static_cast<size_t>(k)]];
+        for (size_t e = 0; e < L.contacts.size(); ++e)
+            for (int q = 0; q < L.contacts[e].n_multipliers(); ++q)
+                dx[L.lambda_dof[e] + q] = sol[m_ + comp_[e] + q];
+        SolveResult res;
+        res.converged = dx.allFinite();
+        res.reason = res.converged ? StopReason::converged : StopReason::breakdown;
+        if (!res.converged) res.message = "the condensed contact system is singular";
+        res.setup_seconds = first_ ? setup_seconds_ : 0.0;
+        first_ = false;
+        res.solve_seconds = wall_seconds() - t0;
+        res.initial_residual = b.norm();
+        return res;
+    }
+
     const BasicLevel<dim>& level_;
     std::vector<int> u_of_dof_, dof_of_u_;
     std::vector<int> newpos_;   ///< compact displacement index -> position in the factor

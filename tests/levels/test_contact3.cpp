@@ -1,0 +1,171 @@
+// SPDX-License-Identifier: MIT
+// 3D contact runs (levels/solve3): a block on a frictionless rigid plane under uniform pressure
+// (the exact P1 solution: uniform pressure, linear displacements) on levels 0-2 with every
+// Newton-system solver, the multiplier transfer's conservation, coarse-to-fine against cold, and
+// a frictional case whose Newton must converge in 3D slip.
+#include "levels/solve3.hpp"
+#include "mesh/tet_mesh.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace mlc {
+namespace {
+
+using mesh::Vec3;
+
+constexpr double kE = 1.0, kNu = 0.3, kP = 0.01;
+
+// A unit cube on the rigid plane z = 0 (frictionless unless mu > 0), pressed by kP on its top,
+// held by ux = 0 on x = 0 and uy = 0 on y = 0 only.
+levels::ElasticProblem3 punch(int levels, double mu = 0.0, int n = 2) {
+    levels::ElasticProblem3 p;
+    p.name = "punch";
+    p.mesh0 = mesh::structured_box(Vec3::Zero(), Vec3::Ones(), n, n, n);
+    levels::Body3 b;
+    b.name = "block";
+    b.material.E = kE;
+    b.material.nu = kNu;
+    p.bodies = {b};
+    levels::FaceLoad3 load;
+    load.tag = "zmax";
+    load.pressure = kP;
+    p.loads = {load};
+    levels::Support3 sx, sy;
+    sx.tag = "xmin";
+    sx.u[0] = 0.0;
+    sy.tag = "ymin";
+    sy.u[1] = 0.0;
+    p.supports = {sx, sy};
+    levels::ContactPair3 c;
+    c.name = "floor";
+    c.contactor = "zmin";
+    c.obstacle.kind = contact::BasicObstacle<3>::Kind::plane;
+    c.obstacle.point = Vec3::Zero();
+    c.obstacle.normal = Vec3::UnitZ();
+    c.mu = mu;
+    c.r = 0.1 * kE / n;
+    p.contacts = {c};
+    p.levels = levels;
+    return p;
+}
+
+// Pressure -lambda_n / area at every contact node equals kP, and the displacements are the
+// exact u = (nu p x, nu p y, -p z) / E, both to `tol` relative.
+void expect_exact_punch(const levels::ElasticProblem3& p, const levels::RunResult3& r,
+                        double tol) {
+    ASSERT_TRUE(r.converged) << r.failure;
+    const auto& L = r.finest();
+    const auto areas = levels::contact_areas(p, L);
+    ASSERT_EQ(r.nodes.size(), L.contacts.size());
+    ASSERT_GT(r.nodes.size(), 0u);
+    for (size_t e = 0; e < r.nodes.size(); ++e) {
+        EXPECT_NEAR(-r.nodes[e].lambda_n / areas[e], kP, tol * kP) << "node " << e;
+        EXPECT_NE(r.nodes[e].status, contact::Status::gap);
+    }
+    double err = 0.0;
+    for (int v = 0; v < L.mesh.n_vertices(); ++v) {
+        const Vec3& x = L.mesh.vertices[static_cast<size_t>(v)];
+        const Vec3 exact(kNu * kP * x.x() / kE, kNu * kP * x.y() / kE, -kP * x.z() / kE);
+        err = std::max(err, (r.u_full.segment<3>(3 * v) - exact).cwiseAbs().maxCoeff());
+    }
+    EXPECT_LE(err, tol * kP);
+}
+
+TEST(Contact3, PunchUniformPressureExactOnLevels0To2EverySolver) {
+    for (auto m : {levels::Method3::schur, levels::Method3::lu, levels::Method3::mg})
+        for (int l = 0; l <= 2; ++l) {
+            SCOPED_TRACE(std::string(levels::to_string(m)) + " level " + std::to_string(l));
+            const auto p = punch(l);
+            levels::SolveOptions3 so;
+            so.upper = m;
+            if (m != levels::Method3::mg) so.level0 = m;
+            so.krylov_rel_tol = 1e-12;
+            expect_exact_punch(p, levels::solve(p, so), 1e-10);
+        }
+}
+
+TEST(Contact3, MultiplierTransferConservesTheTotalForce) {
+    const auto p = punch(1);
+    const auto H = levels::build_hierarchy(p, 1);
+    const auto& C = H.levels[0];
+    const auto& F = H.levels[1];
+    const levels::MultiplierTransfer3 q(C, F, levels::contactor_faces(p, C),
+                                        levels::contactor_faces(p, F));
+    // Arbitrary normal multipliers on the coarse nodes; the fine ones must sum to the same force.
+    Vector xc = Vector::Zero(C.n_unknowns()), xf = Vector::Zero(F.n_unknowns());
+    double total = 0.0;
+    for (size_t e = 0; e < C.contacts.size(); ++e) {
+        const double v = -1.0 - 0.37 * static_cast<double>(e) + 0.01 * static_cast<double>(e * e);
+        xc[C.lambda_dof[e]] = v;
+        total += v;
+    }
+    q.apply(xc, xf);
+    double fine_total = 0.0;
+    for (size_t e = 0; e < F.contacts.size(); ++e)
+        fine_total += xf[F.lambda_dof[e]];
+    EXPECT_NEAR(fine_total, total, 1e-12 * std::abs(total));
+    // The multigrid's T carries the same multiplier block.
+    const SparseMatrix T = levels::full_prolongation3(H.transfers[0].T, q);
+    const Vector xt = T * xc;
+    for (size_t e = 0; e < F.contacts.size(); ++e)
+        EXPECT_NEAR(xt[F.lambda_dof[e]], xf[F.lambda_dof[e]], 1e-14);
+}
+
+TEST(Contact3, CoarseToFinePredictsThePunchStatusesAndNeedsFewerFinestIterations) {
+    const auto p = punch(2);
+    levels::SolveOptions3 warm, cold;
+    cold.coarse_to_fine = false;
+    const auto rw = levels::solve(p, warm);
+    const auto rc = levels::solve(p, cold);
+    ASSERT_TRUE(rw.converged && rc.converged);
+    const auto& top = rw.level_steps.back().front();
+    EXPECT_TRUE(top.predicted);
+    EXPECT_DOUBLE_EQ(top.agreement(), 1.0);
+    EXPECT_LE(rw.steps.front().iterations, rc.steps.front().iterations);
+    // The same answer either way.
+    EXPECT_LE((rw.u_full - rc.u_full).cwiseAbs().maxCoeff(), 1e-10 * kP);
+}
+
+TEST(Contact3, FrictionalPunchConvergesWithSlipAndTheCoulombDisc) {
+    // With friction the bottom's lateral expansion is resisted: nodes near the centre stick,
+    // those at the edges slip outwards. Every converged node satisfies |lambda_t| <= mu |lambda_n|,
+    // with equality in slip, and the slip direction is a unit vector.
+    // No supports: friction alone holds the block in its plane (the symmetry supports would meet
+    // the contact frame in one tangent only, which frictional 3D nodes refuse).
+    const double mu = 0.2;
+    auto p = punch(1, mu);
+    p.supports.clear();
+    for (auto m : {levels::Method3::schur, levels::Method3::lu, levels::Method3::mg}) {
+    SCOPED_TRACE(levels::to_string(m));
+    levels::SolveOptions3 so;
+    so.level0 = m == levels::Method3::mg ? levels::Method3::schur : m;
+    so.upper = m;
+    so.krylov_rel_tol = 1e-12;
+    const auto r = levels::solve(p, so);
+    ASSERT_TRUE(r.converged) << r.failure;
+    int slip = 0, stick = 0;
+    for (const auto& n : r.nodes) {
+        const double lt = n.lambda_t.norm(), ln = std::abs(n.lambda_n);
+        EXPECT_LE(lt, mu * ln * (1 + 1e-9) + 1e-15);
+        if (n.status == contact::Status::slip) {
+            ++slip;
+            EXPECT_NEAR(lt, mu * ln, 1e-8 * ln);
+            EXPECT_NEAR(n.slip_direction.norm(), 1.0, 1e-12);
+        } else if (n.status == contact::Status::stick) {
+            ++stick;
+        }
+    }
+    EXPECT_GT(slip, 0);
+    EXPECT_GT(stick + slip, 0);
+    // Vertical equilibrium: the floor carries the load kP on the unit top face.
+    double fz = 0.0;
+    for (const auto& n : r.nodes)
+        fz -= (n.t.col(0) * n.lambda_t[0] + n.t.col(1) * n.lambda_t[1] + n.n * n.lambda_n).z();
+    EXPECT_NEAR(fz, kP, 1e-9 * kP);
+    }
+}
+
+} // namespace
+} // namespace mlc
