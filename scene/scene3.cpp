@@ -1,15 +1,21 @@
 // SPDX-License-Identifier: MIT
-// 3D scenes ([scene] dimension = 3): a box or a Gmsh tetrahedral mesh, bodies, face loads and
-// supports, read with the Reader of the 2D scenes; keys of 2D scenes are refused as 2D-only.
+// 3D scenes ([scene] dimension = 3): a box or a Gmsh tetrahedral mesh (its curved surfaces
+// declared), bodies, face loads, supports, contact pairs with rigid obstacles, load steps and
+// Newton settings, read with the Reader of the 2D scenes; keys of 2D scenes are refused as
+// 2D-only.
 #include "scene/scene3.hpp"
 
+#include "contact/obstacle.hpp"
 #include "core/check.hpp"
+#include "levels/diagnoses.hpp"
 #include "mesh/io/gmsh_tet.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "scene/reader.hpp"
 
 #include <algorithm>
 #include <fstream>
+#include <iomanip>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -72,14 +78,19 @@ void check_tag3(const Reader& rd, const mesh::TetMesh& m, const toml::table& t,
                                   ")");
 }
 
-/// [scene]: name, description, units, dimension, levels.
+/// [scene]: name, description, units, dimension, load_steps, levels.
 void read_scene3_table(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
     const toml::table& s = rd.table(rd.need(root, "scene", "the scene"), "[scene]");
-    refuse_2d_only(rd, s, {"plane", "load_steps", "recover_levels"}, "[scene]");
-    rd.check_keys(s, {"name", "description", "units", "dimension", "levels"}, "[scene]");
+    refuse_2d_only(rd, s, {"plane", "recover_levels"}, "[scene]");
+    rd.check_keys(s, {"name", "description", "units", "dimension", "load_steps", "levels"},
+                  "[scene]");
     p.name = rd.string(s, "name", "[scene]");
     p.description = rd.string_or(s, "description", "", "[scene]");
     p.units = rd.string_or(s, "units", "", "[scene]");
+    p.load_steps = rd.integer_or(s, "load_steps", 1, "[scene]");
+    if (p.load_steps < 1)
+        rd.fail(s.get("load_steps"),
+                "[scene].load_steps must be at least 1, found " + std::to_string(p.load_steps));
     p.levels = rd.integer_or(s, "levels", 0, "[scene]");
     if (p.levels < 0 || p.levels > levels::kMaxLevels3)
         rd.fail(s.get("levels"), "[scene].levels must lie in [0, 12]");
@@ -121,13 +132,60 @@ std::pair<std::string, std::string> gmsh_text(const Reader& rd, const toml::tabl
     return {ss.str(), file.string()};
 }
 
-/// The bodies' meshes: one box, or the physical volumes of one Gmsh file (a body each).
+/// A curved surface a Gmsh mesh table declares (`surface`), attached once the mesh is read.
+struct DeclaredSurface {
+    const toml::node* node = nullptr; ///< its entry, for messages
+    std::string tag;
+    mesh::CurvedSurface surface;
+};
+
+/// `surface = [{ tag, type = "sphere" | "cylinder", center, radius (, axis) }, ...]` of a Gmsh
+/// mesh table, appended to `out`.
+void read_surfaces(const Reader& rd, const toml::table& mt, const std::string& mw,
+                   std::vector<DeclaredSurface>& out) {
+    const toml::node* n = mt.get("surface");
+    if (!n) return;
+    const toml::array* a = n->as_array();
+    if (!a)
+        rd.fail(n, mw + ".surface declares the curved faces of a 3D mesh: an array of tables "
+                        "{ tag, type = \"sphere\" or \"cylinder\", center, radius (, axis) } (a "
+                        "3D body selects its physical volume with `volume`)");
+    for (size_t i = 0; i < a->size(); ++i) {
+        const std::string w = mw + ".surface[" + std::to_string(i) + "]";
+        const toml::table& t = rd.table(a->get(i), w);
+        DeclaredSurface d;
+        d.node = a->get(i);
+        d.tag = rd.string(t, "tag", w);
+        const std::string type = rd.string(t, "type", w);
+        if (type == "sphere") {
+            rd.check_keys(t, {"tag", "type", "center", "radius"}, w);
+            d.surface.kind = mesh::CurvedSurface::Kind::sphere;
+        } else if (type == "cylinder") {
+            rd.check_keys(t, {"tag", "type", "center", "axis", "radius"}, w);
+            d.surface.kind = mesh::CurvedSurface::Kind::cylinder;
+            d.surface.axis = vec3(rd, t, "axis", w);
+        } else {
+            rd.fail(t.get("type"),
+                    w + ".type must be \"sphere\" or \"cylinder\", found \"" + type + "\"");
+        }
+        d.surface.center = vec3(rd, t, "center", w);
+        d.surface.radius = rd.number(t, "radius", w);
+        if (!(d.surface.radius > 0))
+            rd.fail(t.get("radius"),
+                    w + ".radius must be > 0, found " + std::to_string(d.surface.radius));
+        out.push_back(std::move(d));
+    }
+}
+
+/// The bodies' meshes: one box, or the physical volumes of one Gmsh file (a body each), with
+/// the curved surfaces their tables declare attached.
 void read_bodies3(const Reader& rd, const toml::table& root, const std::filesystem::path& base,
                   ElasticProblem3& p) {
     const auto bodies = rd.tables(root, "body", "the scene");
     if (bodies.empty()) rd.fail(&root, "the scene defines no [[body]]");
     std::string file_text, file_name;
     std::map<int, int> body_of_volume; // physical volume tag -> body index
+    std::vector<DeclaredSurface> surfaces;
     for (size_t i = 0; i < bodies.size(); ++i) {
         const toml::table& b = *bodies[i];
         const std::string w = "[[body]] " + std::to_string(i + 1);
@@ -154,9 +212,11 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
                                              "physical volumes of one Gmsh file");
             p.mesh0 = read_box(rd, mt, mw);
         } else if (type == "gmsh") {
-            refuse_2d_only(rd, mt, {"surface", "transform", "arcs"}, mw,
-                           "a 3D body selects a physical volume with `volume`");
-            rd.check_keys(mt, {"type", "file", "volume"}, mw);
+            refuse_2d_only(rd, mt, {"transform", "arcs"}, mw,
+                           "a 3D body selects a physical volume with `volume` and declares its "
+                           "curved faces with `surface`");
+            rd.check_keys(mt, {"type", "file", "volume", "surface"}, mw);
+            read_surfaces(rd, mt, mw, surfaces);
             const auto file = gmsh_text(rd, mt, mw, base);
             std::string text = file.first, name = file.second;
             if (!file_name.empty() && name != file_name)
@@ -184,6 +244,11 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
     }
     if (file_name.empty()) return;
     p.mesh0 = at(rd, &root, [&] { return mesh::read_gmsh_tet_text(file_text, file_name, ""); });
+    for (const DeclaredSurface& d : surfaces)
+        at(rd, d.node, [&] {
+            mesh::attach_surface(p.mesh0, d.tag, d.surface);
+            return 0;
+        });
     if (body_of_volume.empty()) {
         p.mesh0.attribute.clear();
         return;
@@ -202,7 +267,8 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
 void read_loads3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
     for (const toml::table* lt : rd.tables(root, "load", "the scene")) {
         const std::string w = "[[load]]";
-        refuse_2d_only(rd, *lt, {"factors"}, w, "its load is applied at once");
+        refuse_2d_only(rd, *lt, {"factors"}, w,
+                       "its loads grow in proportion to the load factor j / load_steps");
         rd.check_keys(*lt, {"tag", "pressure", "traction"}, w);
         levels::FaceLoad3 ld;
         ld.tag = rd.string(*lt, "tag", w);
@@ -261,6 +327,214 @@ void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& 
             });
         p.supports.push_back(s);
     }
+}
+
+/// The signed distance of x from obstacle o, positive on the side its normal points to (the
+/// body's side).
+double obstacle_side(const contact::BasicObstacle<3>& o, const Vec3& x) {
+    using Kind = contact::BasicObstacle<3>::Kind;
+    if (o.kind == Kind::plane) return o.normal.dot(x - o.point);
+    Vec3 d = x - o.center;
+    if (o.kind == Kind::cylinder) d -= d.dot(o.axis) * o.axis;
+    return o.body_outside ? d.norm() - o.radius : o.radius - d.norm();
+}
+
+/// Empty, or why obstacle `o` (validated) of a pair whose contactor tag is `tag` faces away from
+/// the body: more than half of the volume of a body holding a contactor vertex lies on the
+/// obstacle's far side (behind a plane, against its normal; inside a sphere or cylinder the body
+/// should be outside of, or the reverse). Its contact would then hold the body from the wrong
+/// side.
+std::string obstacle_faces_away(const ElasticProblem3& p, const std::string& tag,
+                                const contact::BasicObstacle<3>& o) {
+    const mesh::TetMesh& m = p.mesh0;
+    const int tid = m.tag(tag);
+    const auto body_of = [&](int t) {
+        return m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
+    };
+    std::vector<int> vbody(static_cast<size_t>(m.n_vertices()), -1);
+    for (int t = 0; t < m.n_cells(); ++t)
+        for (int v : m.cells[static_cast<size_t>(t)])
+            vbody[static_cast<size_t>(v)] = body_of(t);
+    std::set<int> bodies;
+    for (int v : m.vertices_with_tag(tid))
+        bodies.insert(vbody[static_cast<size_t>(v)]);
+    for (int b : bodies) {
+        double total = 0.0, behind = 0.0;
+        for (int t = 0; t < m.n_cells(); ++t) {
+            if (body_of(t) != b) continue;
+            Vec3 c = Vec3::Zero();
+            for (int v : m.cells[static_cast<size_t>(t)])
+                c += m.vertices[static_cast<size_t>(v)] / 4.0;
+            const double vol = std::abs(m.signed_measure(t));
+            total += vol;
+            if (obstacle_side(o, c) < 0) behind += vol;
+        }
+        if (!(total > 0) || behind <= 0.5 * total) continue;
+        const std::string name = b >= 0 && b < static_cast<int>(p.bodies.size())
+                                     ? p.bodies[static_cast<size_t>(b)].name
+                                     : std::to_string(b);
+        std::ostringstream os;
+        os << std::setprecision(3) << 100.0 * behind / total << "% of the volume of body '" << name
+           << "' lies ";
+        if (o.kind == contact::BasicObstacle<3>::Kind::plane)
+            os << "behind the plane (against its normal [" << o.normal.x() << ", " << o.normal.y()
+               << ", " << o.normal.z()
+               << "]): the normal points away from the body; it must point from the obstacle "
+                  "into the body: normal = ["
+               << -o.normal.x() + 0.0 << ", " << -o.normal.y() + 0.0 << ", " << -o.normal.z() + 0.0
+               << "]";
+        else
+            os << (o.body_outside ? "inside" : "outside") << " the "
+               << (o.kind == contact::BasicObstacle<3>::Kind::sphere ? "sphere" : "cylinder")
+               << ", but side = \"" << (o.body_outside ? "outside" : "inside")
+               << "\" puts the body there: the obstacle's normal points away from the body; use "
+                  "side = \""
+               << (o.body_outside ? "inside" : "outside") << "\"";
+        return os.str();
+    }
+    return {};
+}
+
+/// A pair's rigid obstacle: a plane (point, normal), a sphere (center, radius, side) or a
+/// cylinder (center, axis, radius, side), validated and facing the body.
+contact::BasicObstacle<3> read_obstacle3(const Reader& rd, const toml::table& ct,
+                                         const std::string& w, const ElasticProblem3& p,
+                                         const std::string& contactor) {
+    using Kind = contact::BasicObstacle<3>::Kind;
+    const std::string ow = w + ".obstacle";
+    const toml::table& ot = rd.table(rd.need(ct, "obstacle", w), ow);
+    const std::string type = rd.string(ot, "type", ow);
+    contact::BasicObstacle<3> o;
+    const toml::node* bad = &ot; // where validate's complaint points
+    if (type == "plane") {
+        rd.check_keys(ot, {"type", "point", "normal"}, ow);
+        o.kind = Kind::plane;
+        o.point = vec3(rd, ot, "point", ow);
+        o.normal = vec3(rd, ot, "normal", ow);
+        bad = ot.get("normal");
+    } else if (type == "sphere" || type == "cylinder") {
+        if (type == "sphere") {
+            rd.check_keys(ot, {"type", "center", "radius", "side"}, ow);
+            o.kind = Kind::sphere;
+        } else {
+            rd.check_keys(ot, {"type", "center", "axis", "radius", "side"}, ow);
+            o.kind = Kind::cylinder;
+            o.axis = vec3(rd, ot, "axis", ow);
+        }
+        o.center = vec3(rd, ot, "center", ow);
+        o.radius = rd.number(ot, "radius", ow);
+        const std::string side = rd.string_or(ot, "side", "outside", ow);
+        if (side != "outside" && side != "inside")
+            rd.fail(ot.get("side"),
+                    ow + ".side must be \"outside\" or \"inside\", found \"" + side + "\"");
+        o.body_outside = side == "outside";
+        bad = o.radius > 0 && type == "cylinder" ? ot.get("axis") : ot.get("radius");
+    } else if (type == "line" || type == "circle") {
+        rd.fail(ot.get("type"), ow + ".type \"" + type + "\" is 2D-only: a 3D obstacle is " +
+                                    (type == "line" ? "a \"plane\" (point, normal)"
+                                                    : "a \"sphere\" or a \"cylinder\"") +
+                                    " (a 3D scene, [scene] dimension = 3)");
+    } else {
+        rd.fail(ot.get("type"), ow +
+                                    ".type must be \"plane\", \"sphere\" or \"cylinder\", "
+                                    "found \"" +
+                                    type + "\"");
+    }
+    at(rd, bad, [&] {
+        o.validate();
+        return 0;
+    });
+    if (const std::string why = obstacle_faces_away(p, contactor, o); !why.empty())
+        rd.fail(&ot, ow + ": " + why);
+    return o;
+}
+
+/// The pair's augmentation parameter: r, or r_over_E (default 0.1) times E h0, E the smallest
+/// Young's modulus of the scene and h0 the mean level-0 edge of the contactor's faces (a 3D
+/// multiplier is a nodal force: r is a force per length); refused when not > 0 or out of the
+/// scale of E h0 (levels::kMinROverE .. kMaxROverE).
+double read_r3(const Reader& rd, const toml::table& ct, const std::string& w, double Emin,
+               double h0) {
+    if (ct.get("r") && ct.get("r_over_E")) rd.fail(&ct, w + " takes r or r_over_E, not both");
+    const toml::node* n = ct.get("r") ? ct.get("r") : ct.get("r_over_E");
+    const std::string units =
+        " (in 3D a multiplier is a nodal force and r a force per length: r_over_E gives r = "
+        "r_over_E E h0, E the smallest Young's modulus of the scene and h0 the mean length of the "
+        "level-0 edges of the contactor's faces)";
+    const double r =
+        ct.get("r") ? rd.number(ct, "r", w) : rd.number_or(ct, "r_over_E", 0.1, w) * Emin * h0;
+    if (!(r > 0))
+        rd.fail(n, w + ": augmentation parameter " + (ct.get("r") ? "r" : "r_over_E") +
+                       " must be > 0" + units);
+    const double ratio = r / (Emin * h0);
+    if (!(ratio >= levels::kMinROverE && ratio <= levels::kMaxROverE)) {
+        std::ostringstream os;
+        os << std::setprecision(3) << w << ": augmentation parameter r = " << r << " is " << ratio
+           << " times E h0 = " << Emin * h0 << " (E = " << Emin << ", h0 = " << h0 << ")" << units
+           << ", outside [" << levels::kMinROverE << ", " << levels::kMaxROverE
+           << "] E h0: use r of the order of E h0 (r_over_E = 0.1, the default)";
+        rd.fail(n, os.str());
+    }
+    return r;
+}
+
+/// [[contact]]: a contactor tag (inside a region) against a rigid obstacle; two-body keys are
+/// refused (two-body contact in 3D is not available yet).
+void read_contacts3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
+    double Emin = std::numeric_limits<double>::infinity();
+    for (const levels::Body3& b : p.bodies)
+        Emin = std::min(Emin, b.material.E);
+    for (const toml::table* ct : rd.tables(root, "contact", "the scene")) {
+        const std::string w = "[[contact]]";
+        for (const char* k :
+             {"target", "element", "integration", "search_radius", "match_tolerance"})
+            if (const toml::node* n = ct->get(k))
+                rd.fail(n, w + "." + k +
+                               " is 2D-only: two-body contact in 3D is not available yet (a 3D "
+                               "pair presses its contactor on a rigid obstacle)");
+        rd.check_keys(*ct, {"name", "contactor", "region", "mu", "r", "r_over_E", "obstacle"}, w);
+        levels::ContactPair3 c;
+        c.name = rd.string_or(*ct, "name", "contact" + std::to_string(p.contacts.size() + 1), w);
+        c.contactor = rd.string(*ct, "contactor", w);
+        const auto id = p.mesh0.find_tag(c.contactor);
+        if (!id || !p.mesh0.is_boundary_tag(*id))
+            rd.fail(ct->get("contactor"), w + ": unknown contactor tag '" + c.contactor +
+                                              "': no boundary face carries it (the boundary "
+                                              "face tags are: " +
+                                              known_tags(p.mesh0, false) + ")");
+        c.mu = rd.number(*ct, "mu", w);
+        if (c.mu < 0)
+            rd.fail(ct->get("mu"),
+                    w + ": friction coefficient mu must be >= 0, found " + std::to_string(c.mu));
+        c.r = read_r3(rd, *ct, w, Emin, levels::mean_face_edge_length(p.mesh0, c.contactor));
+        if (const toml::node* rn = ct->get("region")) {
+            const toml::table& rt = rd.table(rn, w + ".region");
+            rd.check_keys(rt, {"min", "max"}, w + ".region");
+            levels::Box3 box;
+            if (rt.get("min")) box.lo = vec3(rd, rt, "min", w + ".region");
+            if (rt.get("max")) box.hi = vec3(rd, rt, "max", w + ".region");
+            if (!(box.lo.array() <= box.hi.array()).all())
+                rd.fail(rn, w + ".region: its min exceeds its max in some coordinate");
+            c.region = box;
+        }
+        c.obstacle = read_obstacle3(rd, *ct, w, p, c.contactor);
+        p.contacts.push_back(std::move(c));
+    }
+}
+
+/// [newton]: rel_tol, max_iter, forcing (as in 2D scenes).
+void read_newton3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
+    const toml::node* nn = root.get("newton");
+    if (!nn) return;
+    const toml::table& nt = rd.table(nn, "[newton]");
+    rd.check_keys(nt, {"rel_tol", "max_iter", "forcing"}, "[newton]");
+    p.newton.rel_tol = rd.number_or(nt, "rel_tol", p.newton.rel_tol, "[newton]");
+    p.newton.max_iter = rd.integer_or(nt, "max_iter", p.newton.max_iter, "[newton]");
+    p.newton.forcing = rd.number_or(nt, "forcing", p.newton.forcing, "[newton]");
+    at(rd, nn, [&] {
+        p.newton.validate();
+        return 0;
+    });
 }
 
 std::string read_text(const std::filesystem::path& path) {
@@ -325,14 +599,14 @@ levels::ElasticProblem3 parse_scene3(const std::string& text, const std::string&
         if (rd.integer(d, "[scene].dimension") != 3)
             rd.fail(d, "[scene].dimension of a 3D scene must be 3");
     }
-    refuse_2d_only(rd, root, {"contact", "newton"}, "",
-                   "3D contact is not available yet; the 3D elastic problem is linear");
-    rd.check_keys(root, {"scene", "body", "load", "support"}, "the scene");
+    rd.check_keys(root, {"scene", "body", "load", "support", "contact", "newton"}, "the scene");
     ElasticProblem3 p;
     read_scene3_table(rd, root, p);
     read_bodies3(rd, root, base_dir, p);
     read_loads3(rd, root, p);
     read_supports3(rd, root, p);
+    read_contacts3(rd, root, p);
+    read_newton3(rd, root, p);
     at(rd, &root, [&] {
         p.validate();
         return 0;

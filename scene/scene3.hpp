@@ -2,7 +2,19 @@
 /// @file 3D scene files (TOML, `[scene] dimension = 3`) -> levels::ElasticProblem3, validated as
 /// strictly as the 2D scenes (scene/scene.hpp): unknown keys, wrong types and out-of-range values
 /// are refused with the file, line and key, and a key that only makes sense in 2D with a message
-/// saying so. 3D scenes run with `mlcontact bench elastic`; scene::parse_scene refuses them.
+/// saying so. scene::parse_scene refuses them.
+///
+/// Beside the elastic keys: `[scene] load_steps`, `[newton]` (rel_tol, max_iter, forcing, as in
+/// 2D), a Gmsh mesh's curved faces (`surface = [{ tag, type = "sphere", center, radius }, { tag,
+/// type = "cylinder", center, axis, radius }]`, mesh::attach_surface), and `[[contact]]` pairs
+/// against a rigid obstacle: name, contactor (a boundary face tag), region = { min = [x, y, z],
+/// max = [x, y, z] }, mu, r or r_over_E, obstacle = { type = "plane", point, normal } |
+/// { type = "sphere", center, radius, side = "outside" | "inside" } | { type = "cylinder",
+/// center, axis, radius, side }. A 3D multiplier is a nodal force, so r is a force per length:
+/// r_over_E (default 0.1) gives r = r_over_E E h0, E the smallest Young's modulus and h0 the mean
+/// length of the level-0 edges of the contactor's faces (levels::mean_face_edge_length). The
+/// two-body keys of 2D pairs (target, element, integration, search_radius, match_tolerance) and
+/// the 2D obstacles (line, circle) are refused: two-body contact in 3D is not available yet.
 #pragma once
 
 #include "levels/elastic3d_levels.hpp"
