@@ -128,9 +128,9 @@ struct ElasticLevelSize3 {
 /// the edges and faces whose level-0 vertices all lie inside it (a box holds a flat face with
 /// its corners) and for those whose bounding box misses it; those it cuts have their points
 /// counted at their positions on the level-0 face (refinement moves the points of a curved
-/// surface onto it: there the count near the region's boundary is an estimate). An edge or face
-/// shared by two pairs counts for the first that holds all its vertices (one that the first
-/// pair's region cuts counts for both: an overestimate).
+/// surface onto it: there the count near the region's boundary is an estimate). A point on the
+/// contactor faces of two pairs counts for the first whose region holds it, as build_level
+/// claims it.
 std::vector<ElasticLevelSize3> predict_elastic3_sizes(const ElasticProblem3& p, int levels);
 
 /// Estimated peak resident memory of `bench elastic` on a 3D problem: the hierarchy (meshes,

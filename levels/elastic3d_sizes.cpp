@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -128,30 +129,45 @@ std::vector<double> predict_fixed_components(const std::array<HeldCells, 3>& hel
 }
 
 /// Lattice size above which the points of a face cut by a region are counted on this lattice
-/// and scaled (predict_contact_nodes).
+/// and scaled (predict_multipliers).
 constexpr long kMaxCutLattice = 256;
 
-/// The points inside `box` of the n-lattice inside the level-0 edge (a, b) (k = 1 .. n - 1).
-double edge_points_in(const Vec3& a, const Vec3& b, long n, const Box3& box) {
+/// A pair's claim on the points of a level-0 edge or face: those inside `region` (every point
+/// when null) and outside the regions of the earlier pairs that cut the cell (`earlier`; the
+/// points inside them are theirs).
+struct Claim {
+    const Box3* region = nullptr;
+    std::vector<const Box3*> earlier;
+    bool holds(const Vec3& x) const {
+        if (region && !region->contains(x)) return false;
+        for (const Box3* e : earlier)
+            if (e->contains(x)) return false;
+        return true;
+    }
+};
+
+/// The points of the n-lattice inside the level-0 edge (a, b) (k = 1 .. n - 1) that `claim`
+/// holds.
+double edge_points_in(const Vec3& a, const Vec3& b, long n, const Claim& claim) {
     double in = 0;
     for (long k = 1; k < n; ++k) {
         const double t = static_cast<double>(k), u = static_cast<double>(n - k);
-        in += box.contains((u * a + t * b) / static_cast<double>(n)) ? 1.0 : 0.0;
+        in += claim.holds((u * a + t * b) / static_cast<double>(n)) ? 1.0 : 0.0;
     }
     return in;
 }
 
-/// The points inside `box` of the n-lattice inside the level-0 face (a, b, c) (i, j >= 1,
-/// i + j <= n - 1): counted on the lattice itself up to kMaxCutLattice, above it on that
+/// The points of the n-lattice inside the level-0 face (a, b, c) (i, j >= 1, i + j <= n - 1)
+/// that `claim` holds: counted on the lattice itself up to kMaxCutLattice, above it on that
 /// lattice and scaled to (n - 1)(n - 2) / 2.
-double face_points_in(const Vec3& a, const Vec3& b, const Vec3& c, long n, const Box3& box) {
+double face_points_in(const Vec3& a, const Vec3& b, const Vec3& c, long n, const Claim& claim) {
     const long m = std::min(n, kMaxCutLattice);
     double in = 0;
     for (long i = 1; i < m; ++i)
         for (long j = 1; i + j < m; ++j) {
             const double di = static_cast<double>(i), dj = static_cast<double>(j),
                          dk = static_cast<double>(m - i - j);
-            in += box.contains((dk * a + di * b + dj * c) / static_cast<double>(m)) ? 1.0 : 0.0;
+            in += claim.holds((dk * a + di * b + dj * c) / static_cast<double>(m)) ? 1.0 : 0.0;
         }
     if (m == n) return in;
     const double total_m = static_cast<double>((m - 1) * (m - 2)) / 2;
@@ -169,22 +185,78 @@ bool misses(const std::vector<Vec3>& x, const Box3& box) {
     return (hi.array() < box.lo.array()).any() || (lo.array() > box.hi.array()).any();
 }
 
+/// What the pairs so far claimed of a level-0 cell (edge or face): all of it (`whole`: a pair
+/// without a region, or whose region holds its vertices), or the points inside the regions
+/// that cut it.
+struct CellClaims {
+    bool whole = false;
+    std::vector<const Box3*> cut_by;
+};
+
+/// The contact nodes a pair claims inside level-0 cells (edges or faces) with the given
+/// vertices, per level 0..levels: `inner(n)` points inside a cell on the n-lattice (n = 2^l),
+/// `count(n, claim)` those a claim holds. Cells whose points are all fixed are skipped
+/// (`all_fixed`); `claims` records what this pair takes.
+template <size_t k, class Inner, class Count, class AllFixed>
+void claim_cells(const std::set<std::array<int, k>>& cells, const ContactPair3& pair,
+                 const mesh::TetMesh& m0, std::map<std::array<int, k>, CellClaims>& claims,
+                 Inner&& inner, Count&& count, AllFixed&& all_fixed, double per_node,
+                 std::vector<double>& out) {
+    const Box3* region = pair.region ? &*pair.region : nullptr;
+    for (const auto& cell : cells) {
+        CellClaims& cc = claims[cell];
+        if (cc.whole || all_fixed(cell)) continue;
+        std::vector<Vec3> x;
+        bool all_in = true;
+        for (int v : cell) {
+            x.push_back(m0.vertices[static_cast<size_t>(v)]);
+            all_in = all_in && (!region || region->contains(x.back()));
+        }
+        if (!all_in && misses(x, *region)) continue;
+        const Claim claim{all_in ? nullptr : region, cc.cut_by};
+        for (size_t l = 1; l < out.size(); ++l) {
+            const long n = 1L << l;
+            out[l] +=
+                per_node * (claim.region || !claim.earlier.empty() ? count(x, n, claim) : inner(n));
+        }
+        if (all_in)
+            cc.whole = true;
+        else
+            cc.cut_by.push_back(region);
+    }
+}
+
 /// Contact multipliers of levels 0..levels (predict_elastic3_sizes): the points of the refined
 /// contactor faces, level-0 vertices, edge and face interiors counted apart.
 std::vector<double> predict_multipliers(const ElasticProblem3& p, const Level3& L0,
                                         const std::array<HeldCells, 3>& held, int levels) {
     std::vector<double> out(static_cast<size_t>(levels) + 1, 0.0);
     const mesh::TetMesh& m0 = p.mesh0;
-    const auto x = [&](int v) -> const Vec3& { return m0.vertices[static_cast<size_t>(v)]; };
-    std::set<std::pair<int, int>> taken_edges; // held entirely by an earlier pair
-    std::set<std::array<int, 3>> taken_faces;
+    std::map<std::array<int, 2>, CellClaims> edge_claims;
+    std::map<std::array<int, 3>, CellClaims> face_claims;
     std::vector<char> taken_vertex(static_cast<size_t>(m0.n_vertices()), 0);
+    const auto edge_fixed = [&](const std::array<int, 2>& e) {
+        const std::pair<int, int> q{e[0], e[1]};
+        return held[0].holds_edge(q) && held[1].holds_edge(q) && held[2].holds_edge(q);
+    };
+    const auto face_fixed = [&](const std::array<int, 3>& f) {
+        return held[0].faces.count(f) && held[1].faces.count(f) && held[2].faces.count(f);
+    };
+    const auto edge_inner = [](long n) { return static_cast<double>(n - 1); };
+    const auto face_inner = [](long n) {
+        return static_cast<double>(n - 1) * static_cast<double>(n - 2) / 2;
+    };
+    const auto edge_count = [](const std::vector<Vec3>& x, long n, const Claim& c) {
+        return edge_points_in(x[0], x[1], n, c);
+    };
+    const auto face_count = [](const std::vector<Vec3>& x, long n, const Claim& c) {
+        return face_points_in(x[0], x[1], x[2], n, c);
+    };
     for (const ContactPair3& pair : p.contacts) {
         const double per_node = pair.mu > 0 ? 3.0 : 1.0;
         const int tag = m0.tag(pair.contactor);
-        const auto inside = [&](int v) { return !pair.region || pair.region->contains(x(v)); };
         std::set<std::array<int, 3>> faces;
-        std::set<std::pair<int, int>> edges;
+        std::set<std::array<int, 2>> edges;
         std::set<int> verts;
         for (const mesh::BoundaryFace& f : m0.boundary) {
             if (f.tag != tag) continue;
@@ -200,41 +272,18 @@ std::vector<double> predict_multipliers(const ElasticProblem3& p, const Level3& 
         double nodes0 = 0;
         for (int v : verts) {
             const std::array<bool, 3>& f = L0.fixed[static_cast<size_t>(v)];
-            if (!inside(v) || (f[0] && f[1] && f[2]) || taken_vertex[static_cast<size_t>(v)])
-                continue;
+            const bool inside =
+                !pair.region || pair.region->contains(m0.vertices[static_cast<size_t>(v)]);
+            if (!inside || (f[0] && f[1] && f[2]) || taken_vertex[static_cast<size_t>(v)]) continue;
             taken_vertex[static_cast<size_t>(v)] = 1;
             nodes0 += 1;
         }
-        for (int l = 0; l <= levels; ++l)
-            out[static_cast<size_t>(l)] += per_node * nodes0;
-        for (const auto& e : edges) {
-            if (taken_edges.count(e)) continue;
-            if (held[0].holds_edge(e) && held[1].holds_edge(e) && held[2].holds_edge(e)) continue;
-            const bool all_in = inside(e.first) && inside(e.second);
-            if (all_in) taken_edges.insert(e);
-            if (!all_in && misses({x(e.first), x(e.second)}, *pair.region)) continue;
-            for (int l = 1; l <= levels; ++l) {
-                const long n = 1L << l;
-                out[static_cast<size_t>(l)] +=
-                    per_node * (all_in ? static_cast<double>(n - 1)
-                                       : edge_points_in(x(e.first), x(e.second), n, *pair.region));
-            }
-        }
-        for (const auto& f : faces) {
-            if (taken_faces.count(f)) continue;
-            if (held[0].faces.count(f) && held[1].faces.count(f) && held[2].faces.count(f))
-                continue;
-            const bool all_in = inside(f[0]) && inside(f[1]) && inside(f[2]);
-            if (all_in) taken_faces.insert(f);
-            if (!all_in && misses({x(f[0]), x(f[1]), x(f[2])}, *pair.region)) continue;
-            for (int l = 2; l <= levels; ++l) {
-                const long n = 1L << l;
-                out[static_cast<size_t>(l)] +=
-                    per_node * (all_in
-                                    ? static_cast<double>(n - 1) * static_cast<double>(n - 2) / 2
-                                    : face_points_in(x(f[0]), x(f[1]), x(f[2]), n, *pair.region));
-            }
-        }
+        for (double& o : out)
+            o += per_node * nodes0;
+        claim_cells(edges, pair, m0, edge_claims, edge_inner, edge_count, edge_fixed, per_node,
+                    out);
+        claim_cells(faces, pair, m0, face_claims, face_inner, face_count, face_fixed, per_node,
+                    out);
     }
     return out;
 }
