@@ -270,6 +270,89 @@ std::vector<AccuracyValue> accuracy_values(const levels::Problem& p, const level
     return out;
 }
 
+void print_accuracy_level(const std::vector<AccuracyRow>& rows, std::ostream& os) {
+    using Row = AccuracyRow;
+    const int l = rows.back().level;
+    const double sec = rows.back().seconds;
+    const Row& row = rows.back();
+        os << "\nlevel " << l << ": " << row.unknowns << " unknowns, " << row.contacts
+           << " contact nodes, " << std::fixed << std::setprecision(2) << sec << " s"
+           << std::defaultfloat << "\n";
+        os << "  quantity                         value          closed form    error       "
+              "order\n";
+        for (size_t q = 0; q < row.values.size(); ++q) {
+            const auto& v = row.values[q];
+            os << "  " << std::left << std::setw(30) << v.name << std::right << std::scientific
+               << std::setprecision(5) << std::setw(14) << v.value << " " << std::setw(14)
+               << v.reference << " ";
+            if (std::isnan(v.error))
+                os << std::setw(11) << "-";
+            else
+                os << std::setw(11) << std::setprecision(3) << v.error;
+            if (rows.size() > 1 && !std::isnan(v.error)) {
+                const double e0 = std::abs(rows[rows.size() - 2].values[q].error);
+                const double e1 = std::abs(v.error);
+                if (e0 > 0 && e1 > 0)
+                    os << std::fixed << std::setprecision(2) << std::setw(10) << std::log2(e0 / e1);
+            }
+            os << std::defaultfloat << "\n";
+        }
+}
+
+void write_accuracy_files(const std::string& scene, const std::vector<AccuracyRow>& rows,
+                          const std::filesystem::path& dir, bool plot, std::ostream& os) {
+    using Row = AccuracyRow;
+    // CSV (long format) and JSON.
+    AtomicOfstream csv(dir / "accuracy.csv");
+    csv << "level,unknowns,contact_nodes,seconds,quantity,value,reference,error,order\n"
+        << std::setprecision(12);
+    toml::array jl;
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const Row& row = rows[i];
+        toml::table t;
+        t.insert("level", static_cast<int64_t>(row.level));
+        t.insert("unknowns", static_cast<int64_t>(row.unknowns));
+        t.insert("contact_nodes", static_cast<int64_t>(row.contacts));
+        t.insert("seconds", row.seconds);
+        toml::table qs;
+        for (size_t q = 0; q < row.values.size(); ++q) {
+            const auto& v = row.values[q];
+            double order = kNaN;
+            if (i > 0 && !std::isnan(v.error)) {
+                const double e0 = std::abs(rows[i - 1].values[q].error), e1 = std::abs(v.error);
+                if (e0 > 0 && e1 > 0) order = std::log2(e0 / e1);
+            }
+            csv << row.level << "," << row.unknowns << "," << row.contacts << "," << row.seconds
+                << "," << v.name << "," << v.value << "," << v.reference << ",";
+            if (!std::isnan(v.error)) csv << v.error;
+            csv << ",";
+            if (!std::isnan(order)) csv << order;
+            csv << "\n";
+            toml::table jq;
+            jq.insert("value", v.value);
+            jq.insert("reference", v.reference);
+            if (!std::isnan(v.error)) jq.insert("error", v.error);
+            if (!std::isnan(order)) jq.insert("order", order);
+            jq.insert("note", v.note);
+            qs.insert(v.name, jq);
+        }
+        t.insert("quantities", qs);
+        jl.push_back(t);
+    }
+    toml::table root;
+    root.insert("scene", scene);
+    root.insert("levels", jl);
+    AtomicOfstream js(dir / "accuracy.json");
+    js << toml::json_formatter{root} << "\n";
+    csv.close();
+    js.close();
+    MLC_CHECK(csv.good() && js.good(),
+              "cannot write the accuracy study's files in " << dir.string());
+    os << "\nwrote " << (dir / "accuracy.csv").string() << ", accuracy.json\n";
+    if (plot && run_plot_script("plot_accuracy.py", dir, os))
+        os << "wrote " << (dir / "accuracy.png").string() << "\n";
+}
+
 int study_accuracy(const levels::Problem& problem_in, const AccuracyOptions& opt,
                    std::ostream& os) {
     MLC_CHECK(opt.levels >= 0 && opt.levels <= 8,
@@ -280,13 +363,7 @@ int study_accuracy(const levels::Problem& problem_in, const AccuracyOptions& opt
     std::filesystem::create_directories(dir);
     os << "accuracy study: scene '" << problem.name << "', levels 0.." << opt.levels
        << " (each solved coarse-to-fine from level 0)\n";
-    struct Row {
-        int level;
-        Index unknowns;
-        int contacts;
-        double seconds;
-        std::vector<AccuracyValue> values;
-    };
+    using Row = AccuracyRow;
     std::vector<Row> rows;
     // The scene with its node-on-facet pairs in each other integration, to compare.
     std::vector<std::pair<std::string, levels::Problem>> others;
@@ -340,79 +417,9 @@ int study_accuracy(const levels::Problem& problem_in, const AccuracyOptions& opt
                 rows.back().values.push_back(v);
             }
         }
-        const Row& row = rows.back();
-        os << "\nlevel " << l << ": " << row.unknowns << " unknowns, " << row.contacts
-           << " contact nodes, " << std::fixed << std::setprecision(2) << sec << " s"
-           << std::defaultfloat << "\n";
-        os << "  quantity                         value          closed form    error       "
-              "order\n";
-        for (size_t q = 0; q < row.values.size(); ++q) {
-            const auto& v = row.values[q];
-            os << "  " << std::left << std::setw(30) << v.name << std::right << std::scientific
-               << std::setprecision(5) << std::setw(14) << v.value << " " << std::setw(14)
-               << v.reference << " ";
-            if (std::isnan(v.error))
-                os << std::setw(11) << "-";
-            else
-                os << std::setw(11) << std::setprecision(3) << v.error;
-            if (l > 0 && !std::isnan(v.error)) {
-                const double e0 = std::abs(rows[rows.size() - 2].values[q].error);
-                const double e1 = std::abs(v.error);
-                if (e0 > 0 && e1 > 0)
-                    os << std::fixed << std::setprecision(2) << std::setw(10) << std::log2(e0 / e1);
-            }
-            os << std::defaultfloat << "\n";
-        }
+        print_accuracy_level(rows, os);
     }
-    // CSV (long format) and JSON.
-    AtomicOfstream csv(dir / "accuracy.csv");
-    csv << "level,unknowns,contact_nodes,seconds,quantity,value,reference,error,order\n"
-        << std::setprecision(12);
-    toml::array jl;
-    for (size_t i = 0; i < rows.size(); ++i) {
-        const Row& row = rows[i];
-        toml::table t;
-        t.insert("level", static_cast<int64_t>(row.level));
-        t.insert("unknowns", static_cast<int64_t>(row.unknowns));
-        t.insert("contact_nodes", static_cast<int64_t>(row.contacts));
-        t.insert("seconds", row.seconds);
-        toml::table qs;
-        for (size_t q = 0; q < row.values.size(); ++q) {
-            const auto& v = row.values[q];
-            double order = kNaN;
-            if (i > 0 && !std::isnan(v.error)) {
-                const double e0 = std::abs(rows[i - 1].values[q].error), e1 = std::abs(v.error);
-                if (e0 > 0 && e1 > 0) order = std::log2(e0 / e1);
-            }
-            csv << row.level << "," << row.unknowns << "," << row.contacts << "," << row.seconds
-                << "," << v.name << "," << v.value << "," << v.reference << ",";
-            if (!std::isnan(v.error)) csv << v.error;
-            csv << ",";
-            if (!std::isnan(order)) csv << order;
-            csv << "\n";
-            toml::table jq;
-            jq.insert("value", v.value);
-            jq.insert("reference", v.reference);
-            if (!std::isnan(v.error)) jq.insert("error", v.error);
-            if (!std::isnan(order)) jq.insert("order", order);
-            jq.insert("note", v.note);
-            qs.insert(v.name, jq);
-        }
-        t.insert("quantities", qs);
-        jl.push_back(t);
-    }
-    toml::table root;
-    root.insert("scene", problem.name);
-    root.insert("levels", jl);
-    AtomicOfstream js(dir / "accuracy.json");
-    js << toml::json_formatter{root} << "\n";
-    csv.close();
-    js.close();
-    MLC_CHECK(csv.good() && js.good(),
-              "cannot write the accuracy study's files in " << dir.string());
-    os << "\nwrote " << (dir / "accuracy.csv").string() << ", accuracy.json\n";
-    if (opt.plot && run_plot_script("plot_accuracy.py", dir, os))
-        os << "wrote " << (dir / "accuracy.png").string() << "\n";
+    write_accuracy_files(problem.name, rows, dir, opt.plot, os);
     return 0;
 }
 

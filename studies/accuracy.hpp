@@ -5,6 +5,7 @@
 
 #include "levels/problem.hpp"
 #include "levels/solve.hpp"
+#include "levels/solve3.hpp"
 
 #include <filesystem>
 #include <ostream>
@@ -62,6 +63,24 @@ struct MindlinMeasures {
     int n_stick = 0, n_slip = 0, n_closed = 0;
 };
 
+/// One level of an accuracy study: its size, time and measured quantities.
+struct AccuracyRow {
+    int level = 0;
+    Index unknowns = 0;
+    int contacts = 0;
+    double seconds = 0.0;
+    std::vector<AccuracyValue> values;
+};
+
+/// Prints the last row of `rows` as a table (quantity, value, closed form, error, and the
+/// observed order against the row before).
+void print_accuracy_level(const std::vector<AccuracyRow>& rows, std::ostream& os);
+
+/// accuracy.csv (long format) and accuracy.json of an accuracy study into `dir`, and
+/// accuracy.png (scripts/plot_accuracy.py) when `plot`.
+void write_accuracy_files(const std::string& scene, const std::vector<AccuracyRow>& rows,
+                          const std::filesystem::path& dir, bool plot, std::ostream& os);
+
 /// Measures a Mindlin run. `r` must come from levels::solve with keep_step_states (step 1 is
 /// read from r.step_nodes[0]) and at least two load steps. E and nu are the first body's, mu
 /// the first pair's, R the radius of the circle the contactor boundary lies on.
@@ -94,5 +113,19 @@ std::vector<AccuracyValue> accuracy_values(const levels::Problem& p, const level
 /// quantity: level, unknowns, contact_nodes, seconds, quantity, value, reference, error, order),
 /// accuracy.json and accuracy.png. Returns 0, or 2 if a level did not converge.
 int study_accuracy(const levels::Problem& problem, const AccuracyOptions& opt, std::ostream& os);
+
+/// The closed-form quantities of a converged 3D run: hertz3d and sphere_punch (P, the contact
+/// radius a against (3 P R / (4 E*))^(1/3) with 1/E* = (1 - nu^2) / E, the pressure of the node
+/// nearest the axis against p0 = 3 P / (2 pi a^2), the rms of p - p0 sqrt(1 - r^2 / a^2) over
+/// r < 0.9 a relative to p0; pressures -lambda_n / int N_i dA), punch3d (the largest relative
+/// error of the pressure against the load's, and of the resultant). Throws InvalidInput for
+/// another scene.
+std::vector<AccuracyValue> accuracy_values3(const levels::ElasticProblem3& p,
+                                            const levels::RunResult3& r);
+
+/// The accuracy study of a 3D scene: levels 0..opt.levels, each coarse-to-fine, the same table
+/// and files as in 2D.
+int study_accuracy3(const levels::ElasticProblem3& problem, const AccuracyOptions& opt,
+                    std::ostream& os);
 
 } // namespace mlc::apps

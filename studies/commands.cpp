@@ -4,6 +4,7 @@
 
 #include "run/preconditioners.hpp"
 #include "scene/scene.hpp"
+#include "scene/scene3.hpp"
 #include "studies/accuracy.hpp"
 #include "studies/error_vs_time.hpp"
 #include "studies/extremes.hpp"
@@ -134,8 +135,14 @@ Action add_accuracy(CLI::App& ac) {
     ac.add_flag("!--no-plot", a->o.plot, "do not draw the PNG");
     ac.add_flag("!--no-compare", a->o.compare_integration,
                 "node-on-facet scenes: do not also solve with the other integration variants");
-    return [a](const Launch& at) {
+    return [a, &ac](const Launch& at) {
         a->o.out = a->out;
+        if (scene::scene_dimension(a->scene) == 3) {
+            if (ac.count("--no-compare") > 0)
+                throw InvalidInput("--no-compare applies to 2D node-on-facet scenes; a 3D scene "
+                                   "has rigid obstacles only");
+            return study_accuracy3(scene::load_scene3(a->scene), a->o, at.os);
+        }
         return study_accuracy(scene::load_scene(a->scene), a->o, at.os);
     };
 }
