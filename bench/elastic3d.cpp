@@ -188,7 +188,14 @@ int bench_elastic3d(const BenchElasticOptions& opt, std::ostream& os) {
     MLC_CHECK(opt.repeat >= 1, "bench elastic: --repeat must be >= 1, found " << opt.repeat);
     MLC_CHECK(opt.rel_tol > 0 && opt.rel_tol < 1,
               "bench elastic: --tol must be in (0, 1), found " << opt.rel_tol);
-    const levels::ElasticProblem3 p = scene::load_scene3(opt.scene);
+    // A contact scene's elastic block: its stiffness on the displacements alone, the contact
+    // pairs left out (the system `mlcontact run`'s Newton solves adds their rows and columns).
+    levels::ElasticProblem3 p = scene::load_scene3(opt.scene);
+    const size_t n_pairs = p.contacts.size();
+    p.contacts.clear();
+    if (n_pairs > 0)
+        os << "bench elastic: '" << p.name << "' has " << n_pairs
+           << " contact pair(s); the elastic block is its stiffness on the displacements alone\n";
     const int L = opt.levels_from_scene ? p.levels : opt.levels;
     MLC_CHECK(L >= 0 && L <= levels::kMaxLevels3, "bench elastic: a 3D scene's level must be in 0.."
                                                       << levels::kMaxLevels3 << ", found " << L);

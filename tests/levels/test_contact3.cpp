@@ -5,6 +5,9 @@
 // a frictional case whose Newton must converge in 3D slip.
 #include "levels/solve3.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "scene/scene3.hpp"
+
+#include <algorithm>
 
 #include <gtest/gtest.h>
 
@@ -165,6 +168,54 @@ TEST(Contact3, FrictionalPunchConvergesWithSlipAndTheCoulombDisc) {
         fz -= (n.t.col(0) * n.lambda_t[0] + n.t.col(1) * n.lambda_t[1] + n.n * n.lambda_n).z();
     EXPECT_NEAR(fz, kP, 1e-9 * kP);
     }
+}
+
+} // namespace
+} // namespace mlc
+
+namespace mlc {
+namespace {
+
+// block3d (the square test in 3D, mu = 1, 5 steps) on level 2: GMRES + mg takes a median of at
+// most 12 and at most 20 iterations per Newton system on every level >= 1, and coarse-to-fine
+// takes at most half the finest level's Newton iterations of the cold solve, with the same
+// answer.
+TEST(Contact3, Block3dMultigridIterationsAndCoarseToFineAgainstCold) {
+    auto p = scene::load_scene3("block3d");
+    p.levels = 2;
+    levels::SolveOptions3 warm, cold;
+    cold.coarse_to_fine = false;
+    const auto rw = levels::solve(p, warm);
+    const auto rc = levels::solve(p, cold);
+    ASSERT_TRUE(rw.converged) << rw.failure;
+    ASSERT_TRUE(rc.converged) << rc.failure;
+    for (int l = 1; l <= 2; ++l) {
+        std::vector<int> its;
+        for (const auto& st : rw.level_steps[static_cast<size_t>(l)])
+            its.insert(its.end(), st.report.linear_iterations_per_newton.begin(),
+                       st.report.linear_iterations_per_newton.end());
+        ASSERT_FALSE(its.empty());
+        std::sort(its.begin(), its.end());
+        EXPECT_LE(its[its.size() / 2], 12) << "level " << l;
+        EXPECT_LE(its.back(), 20) << "level " << l;
+        EXPECT_GT(its.front(), 0) << "level " << l;
+    }
+    int warm_its = 0, cold_its = 0;
+    for (const auto& s : rw.steps)
+        warm_its += s.iterations;
+    for (const auto& s : rc.steps)
+        cold_its += s.iterations;
+    EXPECT_LE(2 * warm_its, cold_its);
+    const double scale = rc.u_full.cwiseAbs().maxCoeff();
+    EXPECT_LE((rw.u_full - rc.u_full).cwiseAbs().maxCoeff(), 1e-8 * scale);
+    // Slip nodes in 3D: some, with unit slip directions.
+    int slip = 0;
+    for (const auto& n : rw.nodes)
+        if (n.status == contact::Status::slip) {
+            ++slip;
+            EXPECT_NEAR(n.slip_direction.norm(), 1.0, 1e-12);
+        }
+    EXPECT_GT(slip, 0);
 }
 
 } // namespace
