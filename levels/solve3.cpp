@@ -44,6 +44,41 @@ double LevelStep3::agreement() const {
     return static_cast<double>(same) / static_cast<double>(final_statuses.size());
 }
 
+double estimate_contact3_bytes(const std::vector<ElasticLevelSize3>& sizes, Method3 level0,
+                               Method3 upper) {
+    MLC_CHECK(!sizes.empty(), "estimate_contact3_bytes: no level");
+    const ElasticMemory3 elastic = estimate_elastic3_memory(sizes);
+    double bytes = elastic.mg_peak();
+    for (const auto& s : sizes)
+        bytes += 24.0 * s.k_nonzeros;
+    const auto& top = sizes.back();
+    bytes += 51.0 * 8.0 * (top.unknowns + top.multipliers);
+    auto schur = [](const ElasticLevelSize3& s) {
+        return 48.0 * s.multipliers * s.multipliers + estimate_direct3_bytes(s);
+    };
+    if (level0 == Method3::schur) bytes += schur(sizes.front());
+    if (upper == Method3::schur && sizes.size() > 1) bytes += schur(top);
+    return bytes;
+}
+
+void check_contact3_fits(const ElasticProblem3& problem, Method3 level0, Method3 upper,
+                         const MemoryLimit& limit) {
+    const auto sizes = predict_elastic3_sizes(problem, problem.levels);
+    const double bytes = estimate_contact3_bytes(sizes, level0, upper);
+    const auto& top = sizes.back();
+    const double gib = 1024.0 * 1024.0 * 1024.0;
+    MLC_CHECK(limit.bytes <= 0 || bytes <= limit.bytes,
+              "the run does not fit in memory: level " << top.level << " has "
+                  << static_cast<long long>(top.unknowns) << " displacement unknowns and "
+                  << static_cast<long long>(top.multipliers) << " contact multipliers, and the run "
+                  << "is estimated at " << bytes / gib << " GiB against the " << limit.bytes / gib
+                  << " GiB this process may use (" << limit.source << "); use fewer levels"
+                  << (upper == Method3::schur ? ", or the multigrid instead of --linear schur (its "
+                                                "dense contact systems grow as the square of the "
+                                                "multipliers)"
+                                              : ""));
+}
+
 transfer::SurfaceFacets<3> contactor_faces(const ElasticProblem3& problem, const Level3& L) {
     std::set<int> tags;
     for (const auto& pair : problem.contacts)

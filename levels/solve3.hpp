@@ -86,6 +86,21 @@ struct RunResult3 {
     const Level3& finest() const { return hierarchy.finest(); }
 };
 
+/// Estimated peak memory of a 3D contact run (bytes), from the predicted sizes of its levels
+/// (predict_elastic3_sizes): the elastic hierarchy and its multigrid (estimate_elastic3_memory),
+/// per level the Jacobian and its Galerkin operator (24 bytes per nonzero of K), GMRES(50)'s
+/// 51 vectors on the finest level, and for each level solved by `schur` its dense systems on the
+/// contact components m (48 m^2 bytes: S, the reduced system and, in 3D slip, the doubled one)
+/// and the Cholesky factor of its regularized stiffness (estimate_direct3_bytes).
+double estimate_contact3_bytes(const std::vector<ElasticLevelSize3>& sizes, Method3 level0,
+                               Method3 upper);
+
+/// Throws InvalidInput when estimate_contact3_bytes of `problem`'s levels with these solvers
+/// exceeds `limit`, naming the finest level, its unknowns and contact components, the estimate
+/// and the limit, and what to change (fewer levels, or the multigrid instead of schur).
+void check_contact3_fits(const ElasticProblem3& problem, Method3 level0, Method3 upper,
+                         const MemoryLimit& limit);
+
 /// Builds the hierarchy of `problem` (problem.levels refinements) and solves every load step.
 /// Stops at the first level and step that does not converge (converged false, failure set).
 RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options = {});

@@ -289,6 +289,8 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
     so.coarse_to_fine = !opt.cold;
     if (opt.linear) so.upper = *opt.linear == "lu" ? levels::Method3::lu : levels::Method3::schur;
     if (opt.linear) so.level0 = so.upper;
+    // A run that cannot fit is refused before anything is built.
+    levels::check_contact3_fits(p, so.level0, so.upper, levels::process_memory_limit());
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
     OutputFolder folder(dir);
     if (opt.stop) so.interrupt = [&] { return opt.stop->load(); };

@@ -34,9 +34,13 @@ system (a RuntimeError; the driver exits 3 for the same condition)."""
 #: Status codes of Result.status: STATUS_NAMES[code].
 STATUS_NAMES = tuple(_core.status_names)
 GAP, STICK, SLIP_FORWARD, SLIP_BACKWARD = range(4)
+#: Status codes of a 3D run's files (contact.csv's status_code, the VTU's contact_status):
+#: STATUS_NAMES_3D[code]; a 3D node slips in a direction, given apart.
+STATUS_NAMES_3D = tuple(_core.status_names_3d)
 
 __all__ = ["Scene", "Result", "TetMesh", "write_pvd", "solve", "NotConverged", "SolverBreakdown", "UnknownKey", "BadType",
-           "study_status_transfer", "study_accuracy", "tractions", "STATUS_NAMES", "__version__"]
+           "study_status_transfer", "study_accuracy", "tractions", "STATUS_NAMES", "STATUS_NAMES_3D",
+           "__version__"]
 
 
 class NotConverged(RuntimeError):

@@ -288,6 +288,9 @@ def test_status_table_is_status_names():
     assert int(rows[0][0]) == -1  # VTU: not a contact node
     assert (mlcontact.GAP, mlcontact.STICK, mlcontact.SLIP_FORWARD, mlcontact.SLIP_BACKWARD) == (
         0, 1, 2, 3)
+    rows3 = table_after(codes_page(), "status-codes-3d")
+    assert {int(r[0]): r[1].strip("`") for r in rows3 if r[1]} == dict(
+        enumerate(mlcontact.STATUS_NAMES_3D))
     for page in ("guide/outputs.md", "guide/python.md"):
         assert "{ref}`status-codes`" in read(os.path.join(DOCS, page)), page
     assert "{ref}`exit-codes`" in read(os.path.join(DOCS, "guide", "cli.md"))
