@@ -63,8 +63,8 @@ out=$dir/ctest.log
 # damped two-body default on the dovetail, the lattice transfer products, the lattice and
 # single-precision multigrids against their references, the recovered levels, the held corner and
 # the held Hertz half model, the coarse/fine variants of the Krylov system, mg inside each Krylov
-# method and its exact fallback, the dovetail on levels 0-2, and the 3D manufactured solution over
-# levels 0-3.
+# method and its exact fallback, the dovetail on levels 0-2, the 3D manufactured solution over
+# levels 0-3, hertz3d on level 2 against Hertz and block3d's multigrid and cold runs on level 2.
 # What they run is covered here by the unit tests of the same code (levels, solvers, contact,
 # smoothers, transfer, the hierarchy tests); this keeps .ci/run well under 40 minutes
 # (docs/testing.md#testing-hostile).
@@ -74,7 +74,8 @@ heavy+="|LatticeTransfer\.TAndRThroughTheLatticeAreTheirCsrProductsBitForBit|Lat
 heavy+="|RecoveredLevels\.TheExportedSquareSolvesAsTheRefinedSquareDoes|HeldSupports\.SquareWithItsContactCornerHeldInUxSolvesAlikeByEverySolver"
 heavy+="|KrylovSystem\.CoarseFineVariantsSolveTheFineSystem|MultilevelPreconditioner\.WorksInsideCgsBicgstabAndGmres|MultilevelPreconditioner\.TheExactFallbackSolvesWhatTheMultigridCannot"
 heavy+="|HeldSupports\.FrictionalHertzHalfModelCarriesTheLoadAndSolvesAlikeByEverySolver|Dovetail\.EquilibriumMirrorSymmetryAndCoulombOnLevels0To2"
-heavy+="|Elastic3dConvergence\.ManufacturedSolutionOrderOneInEnergyTwoInL2)$"
+heavy+="|Elastic3dConvergence\.ManufacturedSolutionOrderOneInEnergyTwoInL2"
+heavy+="|Accuracy3\.Hertz3dLevel2AgainstHertz|Contact3\.Block3dMultigridIterationsAndCoarseToFineAgainstCold)$"
 if ctest --test-dir "$dir" -LE "^(slow|cli)$" -E "$heavy" -j"$jobs" --output-on-failure > "$out" 2>&1; then
   n=$(grep -oE "out of [0-9]+" "$out" | tail -n 1 | grep -oE "[0-9]+")
   echo "sanitize: ${n:-?} tests passed under address+undefined ($cxx, build-asan;" \

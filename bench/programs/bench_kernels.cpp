@@ -100,7 +100,7 @@ public:
             owner[static_cast<size_t>(i)] = level.dofs.vertex_of(i);
         block_starts_ = solvers::vertex_block_starts(owner);
     }
-    using NewtonSystemSolver::solve;
+    using levels::NewtonSystemSolver::solve;
     SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
                       double forcing) override {
         SolveResult r = inner().solve(M, b, dx, forcing);
