@@ -31,9 +31,16 @@ Action add_status_transfer(CLI::App& st) {
     st.add_flag("--increment", a->o.increment,
                 "warm start = own previous state + interpolated coarse increment");
     st.add_flag("!--no-plot", a->o.plot, "do not draw the PNG");
-    return [a](const Launch& at) {
+    return [a, &st](const Launch& at) {
         a->o.out = a->out;
         a->o.q_rule = a->q == "paper" ? transfer::QRule::paper : transfer::QRule::conservative;
+        if (scene::scene_dimension(a->scene) == 3) {
+            if (st.count("--q-rule") > 0 || a->o.increment)
+                throw InvalidInput(std::string(st.count("--q-rule") > 0 ? "--q-rule" : "--increment") +
+                                   " applies to 2D scenes: 3D multipliers travel by the surface Q, "
+                                   "from the level below's state of the same step");
+            return study_status_transfer3(scene::load_scene3(a->scene), a->o, at.os);
+        }
         return study_status_transfer(scene::load_scene(a->scene), a->o, at.os);
     };
 }

@@ -7,6 +7,8 @@
 #include "transfer/transfer.hpp"
 
 #include <filesystem>
+#include "levels/solve3.hpp"
+
 #include <ostream>
 #include <string>
 
@@ -29,5 +31,11 @@ struct StatusTransferOptions {
 /// status_transfer.json, statuses.csv and status_transfer.png. Returns the exit code.
 int study_status_transfer(const levels::Problem& problem, const StatusTransferOptions& opt,
                           std::ostream& os);
+
+/// The same study of a 3D scene (levels 1..4): the per-level table, the 3 x 3 confusion tables
+/// of the 3D status codes (gap, stick, slip), status_transfer.csv and status_transfer.json. The
+/// multipliers travel by the surface Q (no Q rule to choose, no increment start).
+int study_status_transfer3(const levels::ElasticProblem3& problem,
+                           const StatusTransferOptions& opt, std::ostream& os);
 
 } // namespace mlc::apps
