@@ -377,22 +377,9 @@ public:
         const Eigen::VectorXd z = w - S_ * y;
         bu_ -= B_.transpose() * y;
         chol_.solve(bu_, du_);
-        dx.setZero(b.size());
-        for (Index k = 0; k < nu; ++k)
-            dx[dof_of_u_[static_cast<size_t>(k)]] = du_[newpos_[static_cast<size_t>(k)]];
-        for (size_t e = 0; e < L.contacts.size(); ++e)
-            for (int q = 0; q < L.contacts[e].n_multipliers(); ++q)
-                dx[L.lambda_dof[e] + q] =
-                    y[comp_[e] + q] + L.contacts[e].r * (z[comp_[e] + q] - bl_[comp_[e] + q]);
-        SolveResult res;
-        res.converged = dx.allFinite();
-        res.reason = res.converged ? StopReason::converged : StopReason::breakdown;
-        if (!res.converged) res.message = "the condensed contact system is singular";
-        res.setup_seconds = first_ ? setup_seconds_ : 0.0;
-        first_ = false;
-        res.solve_seconds = wall_seconds() - t0;
-        res.initial_residual = b.norm();
-        return res;
+        return finish(b, dx, t0, [&](size_t e, int q) {
+            return y[comp_[e] + q] + L.contacts[e].r * (z[comp_[e] + q] - bl_[comp_[e] + q]);
+        });
     }
     std::string name() const override { return "schur"; }
 
@@ -404,7 +391,6 @@ private:
     SolveResult solve_general(const std::vector<Matrix>& M, const Vector& b,
                               const Eigen::VectorXd& w, Vector& dx, double t0) {
         const BasicLevel<dim>& L = level_;
-        const Index nu = static_cast<Index>(dof_of_u_.size());
         Eigen::MatrixXd Mb = Eigen::MatrixXd::Zero(m_, m_), Mr = Eigen::MatrixXd::Zero(m_, m_);
         Eigen::MatrixXd A22 = Eigen::MatrixXd::Zero(m_, m_);
         for (size_t e = 0; e < L.contacts.size(); ++e) {
@@ -430,12 +416,21 @@ private:
         const Eigen::VectorXd y = sol.head(m_);
         bu_ -= B_.transpose() * y;
         chol_.solve(bu_, du_);
+        return finish(b, dx, t0, [&](size_t e, int q) { return sol[m_ + comp_[e] + q]; });
+    }
+
+    /// dx from du_ (the factor's numbering) and the multiplier increments `dl(e, q)`, and the
+    /// solve's result (started at t0).
+    template <class Dl>
+    SolveResult finish(const Vector& b, Vector& dx, double t0, Dl&& dl) {
+        const BasicLevel<dim>& L = level_;
+        const Index nu = static_cast<Index>(dof_of_u_.size());
         dx.setZero(b.size());
         for (Index k = 0; k < nu; ++k)
             dx[dof_of_u_[static_cast<size_t>(k)]] = du_[newpos_[static_cast<size_t>(k)]];
         for (size_t e = 0; e < L.contacts.size(); ++e)
             for (int q = 0; q < L.contacts[e].n_multipliers(); ++q)
-                dx[L.lambda_dof[e] + q] = sol[m_ + comp_[e] + q];
+                dx[L.lambda_dof[e] + q] = dl(e, q);
         SolveResult res;
         res.converged = dx.allFinite();
         res.reason = res.converged ? StopReason::converged : StopReason::breakdown;
