@@ -95,6 +95,29 @@ void csr_multiply_in_order(const SparseMatrix& A, const Vector& x, Vector& y) {
                        });
 }
 
+void csr_residual_in_order(const SparseMatrix& A, const Vector& b, const Vector& x, Vector& res) {
+    MLC_CHECK(A.isCompressed(), "csr_residual_in_order: A must be compressed");
+    MLC_CHECK(x.size() == A.cols() && b.size() == A.rows(),
+              "csr_residual_in_order: A is " << A.rows() << " x " << A.cols() << ", x has "
+                                             << x.size() << ", b has " << b.size());
+    res.resize(A.rows());
+    const int* outer = A.outerIndexPtr();
+    const int* inner = A.innerIndexPtr();
+    const double* val = A.valuePtr();
+    const double* xp = x.data();
+    const double* bp = b.data();
+    double* rp = res.data();
+    parallel::for_rows(static_cast<size_t>(A.rows()), static_cast<size_t>(kMinRowsPerThread),
+                       [&](size_t i0, size_t i1) {
+                           for (size_t i = i0; i < i1; ++i) {
+                               double s = 0.0;
+                               for (int k = outer[i]; k < outer[i + 1]; ++k)
+                                   s += val[k] * xp[inner[k]];
+                               rp[i] = bp[i] - s;
+                           }
+                       });
+}
+
 template <class Value>
 void csr_residual(const CsrArrays<Value>& A, const Vector& b, const Vector& x, Vector& res,
                   traffic::Kind kind) {

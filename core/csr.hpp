@@ -93,6 +93,12 @@ void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add = 
 /// pass; the Newton residual is outside the linear solves the bandwidth account covers).
 void csr_multiply_in_order(const SparseMatrix& A, const Vector& x, Vector& y);
 
+/// res = b - A x for a compressed CSR matrix, each row's product summed in storage order with one
+/// accumulator: bit for bit Eigen's serial `res = b; res.noalias() -= A * x`, with the rows split
+/// over core/parallel's threads (Eigen's own product would start OpenMP threads that spin against
+/// them). res is resized; counts no traffic (callers count their own pass).
+void csr_residual_in_order(const SparseMatrix& A, const Vector& b, const Vector& x, Vector& res);
+
 /// Precision in which a preconditioner stores its matrix data (values, block inverses, transfers);
 /// its vectors and the Krylov method stay double either way.
 enum class Precision {

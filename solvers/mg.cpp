@@ -104,8 +104,7 @@ struct Multigrid::Level final : CycleOperator, CycleSmoother, CycleTransfer {
         }
         const traffic::Pass pass(traffic::Kind::matvec,
                                  traffic::csr_bytes(A->rows(), A->cols(), A->nonZeros(), true));
-        out = r;
-        out.noalias() -= *A * z;
+        csr_residual_in_order(*A, r, z, out);
     }
     void forward_from_zero(const Vector& r, Vector& z, Vector& out) const override {
         if (lattice)
