@@ -53,7 +53,7 @@ template <int dim> void BasicHierarchy<dim>::report(std::ostream& os) const {
         const auto& L = levels[l];
         os << std::setw(7) << l << std::setw(10) << L.mesh.n_vertices() << std::setw(dim + 9)
            << L.mesh.n_cells() << std::setw(10) << L.n_unknowns() << std::setw(15)
-           << L.n_contact_nodes() << std::setw(9) << L.elastic.K.nonZeros() << "\n";
+           << L.n_contact_nodes() << " " << std::setw(8) << L.elastic.K.nonZeros() << "\n";
     }
     os << "  operator complexity " << std::setprecision(3)
        << static_cast<double>(total) / static_cast<double>(finest().elastic.K.nonZeros())

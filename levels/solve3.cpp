@@ -305,6 +305,8 @@ make_solver3(const Hierarchy3& H, int l, Method3 m, double rel_tol,
 struct LevelRun {
     std::unique_ptr<ContactNewton3> newton;
     Vector x;            ///< unknowns at the last converged step
+    Vector x_before;     ///< unknowns at the converged step before it (zero before step 2)
+    Vector start;        ///< this step's own start: x, or its secant extrapolation
     Vector u_prev_full;  ///< nodal displacements at the last converged step
     Vector x_step_start; ///< the level's unknowns of the previous step (cold start)
 };
@@ -354,6 +356,7 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
                 &out.timings);
             if (options.interrupt) run.newton->set_interrupt(options.interrupt);
             run.x = Vector::Zero(L.n_unknowns());
+            run.x_before = Vector::Zero(L.n_unknowns());
             run.u_prev_full = Vector::Zero(3 * L.mesh.n_vertices());
         }
     }
@@ -366,17 +369,29 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
             auto& run = runs[static_cast<size_t>(l)];
             LevelStep3 ls;
             ls.level = l;
-            Vector x0 = run.x;
+            // The level's own start: its last state, or the secant extrapolation of its last two
+            // (steps of equal size: s_k - s_{k-1} = s_{k-1} - s_{k-2}).
+            run.start = run.x;
+            if (options.extrapolate && k >= 2) run.start += run.x - run.x_before;
+            Vector x0 = run.start;
             if (options.coarse_to_fine && l > first) {
-                // The level below's converged state of this step, interpolated.
                 const auto& below = runs[static_cast<size_t>(l - 1)];
                 const Level3& C = H.levels[static_cast<size_t>(l - 1)];
+                const bool correct = options.extrapolate && k >= 2;
+                // Interpolated: the level below's converged state of this step, or (secant
+                // predictor) what it changed from its own start, added to this level's start.
                 Vector uc;
-                C.dofs.expand(below.x, C.u_fixed_at(s), uc);
+                const Vector xc = correct ? Vector(below.x - below.start) : below.x;
+                if (correct)
+                    C.dofs.expand(xc, Vector::Zero(C.u_fixed_at(s).size()), uc);
+                else
+                    C.dofs.expand(xc, C.u_fixed_at(s), uc);
                 const Vector uf = interpolate_nodal(
                     H.transfers[static_cast<size_t>(l - 1)].P_vertex, uc);
-                gather_displacements(L, uf, x0);
-                qs[static_cast<size_t>(l)]->apply(below.x, x0);
+                Vector xi = correct ? Vector(Vector::Zero(x0.size())) : x0;
+                gather_displacements(L, uf, xi);
+                qs[static_cast<size_t>(l)]->apply(xc, xi);
+                x0 = correct ? Vector(x0 + xi) : xi;
                 ls.predicted = true;
                 ls.predicted_statuses = run.newton->statuses(s, run.u_prev_full, x0);
             }
@@ -394,6 +409,7 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
                     out.step_nodes.push_back(run.newton->node_states(s, run.u_prev_full, x0));
                     out.nodes = out.step_nodes.back();
                 }
+                run.x_before = run.x;
                 run.x = x0;
                 L.dofs.expand(run.x, L.u_fixed_at(s), run.u_prev_full);
                 if (l == finest) out.step_u_full.push_back(run.u_prev_full);

@@ -43,6 +43,17 @@ struct SolveOptions3 {
     bool coarse_to_fine = true;
     /// Solve every level also in cold mode (the status-transfer study compares per level).
     bool solve_all_levels = false;
+    /// Secant predictor: from the second load step on, each level starts from its last two
+    /// converged states extrapolated linearly in the load factor,
+    /// E = x_{k-1} + (s_k - s_{k-1}) / (s_{k-1} - s_{k-2}) (x_{k-1} - x_{k-2}), with the unloaded
+    /// state x_0 = 0 at s_0 = 0. Coarse to fine, a level above the first then starts from
+    /// E + I (x_below - E_below): its own extrapolation corrected by what the level below changed
+    /// from its extrapolation, interpolated (P on displacements, Q on multipliers). Under
+    /// proportional loading with unchanged statuses and slip directions the solution is linear in
+    /// the load factor and E is exact; 3D slip makes Newton end only asymptotically, so this is
+    /// where the Newton iterations of steps 2, 3, ... go. Off: each level starts from its previous
+    /// step (cold) or from the level below's state of this step, interpolated (coarse to fine).
+    bool extrapolate = true;
     /// The Newton systems of level 0 and of the levels above.
     Method3 level0 = Method3::schur;
     Method3 upper = Method3::mg;

@@ -32,8 +32,9 @@ void refuse_2d_options(const RunOptions& opt) {
         if (given)
             throw InvalidInput(option + " does not apply to a 3D scene: " + why);
     };
-    const std::string krylov = "3D contact levels are solved by the exact schur or lu solvers so "
-                               "far (--linear schur|lu)";
+    const std::string krylov = "3D contact levels are solved by schur on level 0 and GMRES with "
+                               "the Galerkin vertex-block multigrid above, or exactly on every "
+                               "level with --linear schur|lu";
     refuse(opt.krylov.has_value(), "--krylov", krylov);
     refuse(opt.pc.has_value(), "--pc", krylov);
     refuse(opt.linear_rel_tol.has_value(), "--linear-tol", krylov);
@@ -43,8 +44,6 @@ void refuse_2d_options(const RunOptions& opt) {
            "3D levels number their vertices along a Hilbert curve only");
     refuse(opt.no_continuation, "--no-continuation",
            "3D runs have no r continuation to turn off");
-    refuse(opt.no_extrapolation, "--no-extrapolation",
-           "3D runs have no load-step extrapolation to turn off");
     refuse(opt.every_step || opt.every_level, opt.every_step ? "--every-step" : "--every-level",
            "3D runs write the final state's solution.vtu and every step's contact_steps.csv");
     refuse(opt.plot, "--plot", "the contact plot draws 2D contact lines");
@@ -287,6 +286,7 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
     MLC_CHECK(opt.vtu == "binary", "--vtu ascii is 2D-only: 3D runs write binary VTU");
     levels::SolveOptions3 so;
     so.coarse_to_fine = !opt.cold;
+    so.extrapolate = !opt.no_extrapolation;
     if (opt.linear) so.upper = *opt.linear == "lu" ? levels::Method3::lu : levels::Method3::schur;
     if (opt.linear) so.level0 = so.upper;
     // A run that cannot fit is refused before anything is built.

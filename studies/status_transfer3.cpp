@@ -27,7 +27,7 @@ int study_status_transfer3(const levels::ElasticProblem3& problem_in,
     cold_opt.solve_all_levels = true;
     os << "  solving coarse-to-fine ...\n" << std::flush;
     const levels::RunResult3 warm = levels::solve(problem, warm_opt);
-    os << "  solving cold (every level from its previous load step) ...\n" << std::flush;
+    os << "  solving cold (every level from its own previous load steps) ...\n" << std::flush;
     const levels::RunResult3 cold = levels::solve(problem, cold_opt);
     if (!warm.converged) {
         os << "error: coarse-to-fine run failed: " << warm.failure << "\n";

@@ -33,8 +33,9 @@ void expect_hertz3(const std::string& scene, bool peak_improves) {
     EXPECT_LE(e2.at("profile_rms"), 0.03);
     EXPECT_LT(std::abs(e2.at("radius")), std::abs(e0.at("radius")));
     EXPECT_LT(e2.at("profile_rms"), e0.at("profile_rms"));
-    if (peak_improves)
+    if (peak_improves) {
         EXPECT_LT(std::abs(e2.at("peak_pressure")), std::abs(e0.at("peak_pressure")));
+    }
 }
 
 TEST(Accuracy3, Hertz3dLevel2AgainstHertz) { expect_hertz3("hertz3d", true); }
