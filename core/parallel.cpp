@@ -12,6 +12,8 @@
 #include "core/parallel.hpp"
 #include "core/check.hpp"
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -247,7 +249,22 @@ Pool& pool() {
     return p;
 }
 
+// Eigen on one thread from the library's load on (EigenThreadsScope lends it more).
+const bool eigen_single_threaded = [] {
+    Eigen::setNbThreads(1);
+    return true;
+}();
+
 } // namespace
+
+EigenThreadsScope::EigenThreadsScope() {
+    (void)eigen_single_threaded;
+    Eigen::setNbThreads(num_threads());
+}
+
+EigenThreadsScope::~EigenThreadsScope() {
+    Eigen::setNbThreads(1);
+}
 
 int default_num_threads() {
     if (const char* s = std::getenv("OMP_NUM_THREADS")) {

@@ -48,6 +48,21 @@ std::string blas_library();
 /// cores this process may run on (sched_getaffinity).
 int default_num_threads();
 
+/// Eigen's own threads. Eigen parallelizes its dense products and its row-major sparse-dense
+/// products with OpenMP when built with it, and after each such region OpenMP's threads spin,
+/// against this pool's workers, for the cores both need: on two cores a small dense product per
+/// Newton iteration made a 3D schur run seven times slower. So Eigen runs on one thread in every
+/// process that links this library (set when the library loads), and a scope that makes a large
+/// product, where the threads pay (a schur set-up's S = X^T X), lends Eigen this pool's thread
+/// count for its duration. Not to be nested or used from several threads at once.
+class EigenThreadsScope {
+public:
+    EigenThreadsScope();
+    ~EigenThreadsScope();
+    EigenThreadsScope(const EigenThreadsScope&) = delete;
+    EigenThreadsScope& operator=(const EigenThreadsScope&) = delete;
+};
+
 namespace detail {
 using ChunkFn = void (*)(void* ctx, std::size_t chunk);
 void run(std::size_t n_chunks, ChunkFn fn, void* ctx);

@@ -326,8 +326,12 @@ public:
         for (int i = 0; i < B_.outerSize(); ++i)
             for (SparseMatrix::InnerIterator it(B_, i); it; ++it)
                 X(newpos_[static_cast<size_t>(it.col())] - ni, i) = it.value();
-        Lcc.triangularView<Eigen::Lower>().solveInPlace(X);
-        S_.noalias() = X.transpose() * X;
+        {
+            // The set-up's large dense products: worth Eigen's threads.
+            const parallel::EigenThreadsScope eigen_threads;
+            Lcc.triangularView<Eigen::Lower>().solveInPlace(X);
+            S_.noalias() = X.transpose() * X;
+        }
         // From here on displacement vectors live in the factor's (permuted) numbering.
         std::vector<Triplet> bp;
         for (int i = 0; i < B_.outerSize(); ++i)
@@ -404,10 +408,16 @@ private:
             for (int q = 0; q < me; ++q)
                 bl_[c + q] = b[L.lambda_dof[e] + q];
         }
-        Eigen::MatrixXd A(2 * m_, 2 * m_);
-        A.topLeftCorner(m_, m_) = Eigen::MatrixXd::Identity(m_, m_) + Mr * S_;
+        // Mb and Mr are block diagonal (one block per element): their products with S are
+        // formed block row by block row, O(m^2) rather than a dense O(m^3) product.
+        Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * m_, 2 * m_);
+        for (size_t e = 0; e < L.contacts.size(); ++e) {
+            const int me = L.contacts[e].n_multipliers(), c = comp_[e];
+            A.block(c, 0, me, m_).noalias() = Mr.block(c, c, me, me) * S_.middleRows(c, me);
+            A.block(m_ + c, 0, me, m_).noalias() = -Mb.block(c, c, me, me) * S_.middleRows(c, me);
+        }
+        A.topLeftCorner(m_, m_).diagonal().array() += 1.0;
         A.topRightCorner(m_, m_) = -Mb;
-        A.bottomLeftCorner(m_, m_) = -Mb * S_;
         A.bottomRightCorner(m_, m_) = A22;
         Eigen::VectorXd rhs(2 * m_);
         rhs.head(m_) = Mr * w;
