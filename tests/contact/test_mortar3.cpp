@@ -7,6 +7,7 @@
 #include "contact/mortar3.hpp"
 #include "core/check.hpp"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -112,6 +113,16 @@ double apply(const contact::MortarWeights3& w, const Grid& target,
     for (size_t k = 0; k < w.targets.size(); ++k)
         s += w.weights[k] * f(target.at(w.targets[k]));
     return s;
+}
+
+/// `g` turned by R and shifted: x -> R x + shift.
+Grid moved(Grid g, const Eigen::Matrix3d& R, const Vec3& shift) {
+    for (Vec3& x : g.x)
+        x = R * x + shift;
+    for (auto& t : g.tris)
+        for (size_t k = 0; k < 3; ++k)
+            t.x[k] = g.at(t.v[k]);
+    return g;
 }
 
 } // namespace mortar3_tests
@@ -260,6 +271,41 @@ TEST(Mortar3Weights, MatchingMeshesGiveTheMassRowAndTheDualIdentity) {
     EXPECT_NEAR(wc.at(t.id(1, 1)), -0.25, 1e-15);
     EXPECT_NEAR(wc.at(t.id(1, 0)), -0.125, 1e-15);
     EXPECT_NEAR(wc.at(t.id(0, 1)), -0.125, 1e-15);
+}
+
+TEST(Mortar3Weights, MatchingMeshesInGeneralPositionHaveNoRoundOffPieces) {
+    // The matching pair of the test above turned out of the coordinate planes, so that the
+    // projections coincide to round-off only: overlaps of neighbouring triangles that meet in an
+    // edge (slivers of round-off area) must not count.
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const Vec3 n = R * Vec3::UnitZ();
+    const Grid c = moved(make_grid(4, 4, 0.25, Vec2(0, 0), 0.3, flat, 0, false), R, 0.02 * n);
+    const Grid t = moved(make_grid(4, 4, 0.25, Vec2(0, 0), 0.3, flat, 100, true), R, Vec3::Zero());
+    const int i = c.id(2, 2);
+    const auto seg = contact::mortar_weights3(i, c.patch(i), n, t.tris, FacetIntegration::segment);
+    EXPECT_EQ(seg.pieces, 6);
+    const auto ws = weight_map(seg);
+    ASSERT_EQ(ws.size(), 7u);
+    EXPECT_NEAR(ws.at(t.id(2, 2)), -0.5, 1e-14);
+    for (auto [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, -1}})
+        EXPECT_NEAR(ws.at(t.id(2 + di, 2 + dj)), -1.0 / 12, 1e-14) << di << " " << dj;
+    const auto dual = contact::mortar_weights3(i, c.patch(i), n, t.tris, FacetIntegration::dual);
+    EXPECT_EQ(dual.pieces, 6);
+    EXPECT_TRUE(dual.dual);
+    EXPECT_LE(dual.targets.size(), 7u);
+    for (const auto& [k, w] : weight_map(dual))
+        EXPECT_NEAR(w, k == t.id(2, 2) ? -1.0 : 0.0, 1e-14) << k;
+    const int o = c.id(0, 0);
+    EXPECT_EQ(contact::mortar_weights3(o, c.patch(o), n, t.tris, FacetIntegration::dual).pieces, 2);
+    // The target moved by 3e-14 in the plane: the neighbours' overlaps, slivers of that width,
+    // lie below 1e-12 of a triangle's area and do not count either.
+    const Grid shifted = moved(t, Eigen::Matrix3d::Identity(), R * Vec3(3e-14, 1.5e-14, 0));
+    const auto near =
+        contact::mortar_weights3(i, c.patch(i), n, shifted.tris, FacetIntegration::segment);
+    EXPECT_EQ(near.pieces, 6);
+    EXPECT_EQ(near.targets, seg.targets);
+    for (size_t k = 0; k < seg.weights.size(); ++k)
+        EXPECT_NEAR(near.weights[k], seg.weights[k], 1e-12);
 }
 
 namespace mortar3_tests {
