@@ -67,20 +67,21 @@ struct MortarWeights3 {
 /// (contact/search.hpp), after Puso & Laursen 2004.
 ///
 /// `patch` are the contactor boundary triangles that have `node` as a vertex (the support of its
-/// linear shape function N_i on the contactor surface), `n` the node's contact normal as in
-/// BasicContactElement: the target's normal toward the contactor (normalized here), and
-/// `targets` the candidate target boundary triangles, oriented as mesh::BoundaryFace. Every
-/// triangle is projected along n onto the plane through the node orthogonal to n. A target
-/// triangle counts for a contactor triangle when it faces the same way as n (its outward normal
-/// n_t has n_t . n > 0, as the facets in 2D; more than 1e-12, since a triangle parallel to n
-/// projects on a line), has no vertex in common with it (a contactor
-/// triangle on the target surface itself), and the two projections overlap in more than 1e-12
-/// of the smaller one's projected area; with a finite `reach`, also when the distance along n
-/// between the two triangles is at most `reach` at some vertex of the overlap. A contactor
-/// triangle nearly parallel to n (|n_c . n| <= 1e-12) has no pieces. Each overlap (a piece) is
-/// cut into triangles from its centroid, and on those the shape functions (the barycentric
-/// coordinates of the contactor triangle, N_i, and of the target triangle, N_k, at the
-/// projections) are linear, so that integrate_linear_products_on_triangle is exact:
+/// linear shape function N_i on the contactor surface; the node's position is taken from the
+/// first), `n` the node's contact normal as in BasicContactElement: the target's normal toward
+/// the contactor (normalized here), and `targets` the candidate target boundary triangles,
+/// oriented as mesh::BoundaryFace (every pair is tried: the caller picks the candidates, e.g.
+/// those within the node's search distance). Every triangle is projected along n onto the plane
+/// through the node orthogonal to n. A target triangle counts for a contactor triangle when it
+/// faces the same way as n (its outward normal n_t has n_t . n > 0, as the facets in 2D; more
+/// than 1e-12, since a triangle parallel to n projects on a line), has no vertex in common with
+/// it (a contactor triangle on the target surface itself), and the two projections overlap in
+/// more than 1e-12 of the smaller one's projected area; with a finite `reach`, also when the
+/// distance along n between the two triangles is at most `reach` at some vertex of the overlap.
+/// A contactor triangle nearly parallel to n (|n_c . n| <= 1e-12) has no pieces. Each overlap
+/// (a piece) is cut into triangles from its centroid, and on those the shape functions (the
+/// barycentric coordinates of the contactor triangle, N_i, and of the target triangle, N_k, at
+/// the projections) are linear, so that integrate_linear_products_on_triangle is exact:
 ///   D_i = int N_i dA over the patch,  M_ik = int N_i N_k dA,  D_i^cov = int N_i dA,
 /// the last two over the pieces, dA the area of the contactor (the projected area divided by
 /// |n_c . n|, n_c the contactor triangle's unit normal). Weights (1, -M_ik / D_i^cov): since
@@ -90,10 +91,11 @@ struct MortarWeights3 {
 ///
 /// FacetIntegration::dual uses psi_i = 4 N_i - 1 on each contactor triangle in place of N_i in
 /// M_ik and D_i^cov (biorthogonal on linear triangles: int_T psi_i N_j = delta_ij int_T N_j),
-/// which gives the weights (1, -1) on a matching interface; as in 2D, only when the patch is
-/// entirely covered (D_i^cov > (1 - 1e-9) D_i), otherwise the weights are the segment ones
-/// (MortarWeights3::dual says which). When nothing is covered the result has no pieces, no
-/// targets and D_covered = 0 (node_on_facet_search falls back to the nodal weights there).
+/// which gives the weights (1, -1) on a matching interface; sum_i psi_i = 1 on a triangle keeps
+/// the patch test. As in 2D, only when the patch is entirely covered (D_i^cov > (1 - 1e-9)
+/// D_i), otherwise the weights are the segment ones (MortarWeights3::dual says which). When
+/// nothing is covered the result has no pieces, no targets and D_covered = 0
+/// (node_on_facet_search falls back to the nodal weights there).
 ///
 /// Throws InvalidInput for an integration other than segment or dual, an empty patch, a patch
 /// triangle without `node`, a zero or non-finite n, or a triangle of zero area (contactor or
