@@ -56,14 +56,19 @@ double estimate_contact3_bytes(const std::vector<ElasticLevelSize3>& sizes, Meth
     auto schur = [](const ElasticLevelSize3& s) {
         return 48.0 * s.multipliers * s.multipliers + estimate_direct3_bytes(s);
     };
+    // Sparse LU of the whole Jacobian: about twice a Cholesky factor of K (L and U).
+    auto lu = [](const ElasticLevelSize3& s) { return 2.0 * estimate_direct3_bytes(s); };
     if (level0 == Method3::schur) bytes += schur(sizes.front());
+    if (level0 == Method3::lu) bytes += lu(sizes.front());
     if (upper == Method3::schur && sizes.size() > 1) bytes += schur(top);
+    if (upper == Method3::lu && sizes.size() > 1) bytes += lu(top);
     return bytes;
 }
 
-void check_contact3_fits(const ElasticProblem3& problem, Method3 level0, Method3 upper,
-                         const MemoryLimit& limit) {
-    const auto sizes = predict_elastic3_sizes(problem, problem.levels);
+namespace {
+
+void check_fits(const std::vector<ElasticLevelSize3>& sizes, Method3 level0, Method3 upper,
+                const MemoryLimit& limit) {
     const double bytes = estimate_contact3_bytes(sizes, level0, upper);
     const auto& top = sizes.back();
     const double gib = 1024.0 * 1024.0 * 1024.0;
@@ -77,6 +82,48 @@ void check_contact3_fits(const ElasticProblem3& problem, Method3 level0, Method3
                                                 "dense contact systems grow as the square of the "
                                                 "multipliers)"
                                               : ""));
+}
+
+} // namespace
+
+void check_contact3_fits(const ElasticProblem3& problem, Method3 level0, Method3 upper,
+                         const MemoryLimit& limit) {
+    check_fits(predict_elastic3_sizes(problem, problem.levels), level0, upper, limit);
+}
+
+Plan3 plan_contact3(const std::vector<ElasticLevelSize3>& sizes, std::optional<Method3> forced,
+                    const MemoryLimit& limit) {
+    MLC_CHECK(!sizes.empty(), "plan_contact3: no level");
+    Plan3 plan;
+    std::ostringstream why;
+    const double m0 = sizes.front().multipliers;
+    if (forced) {
+        MLC_CHECK(*forced != Method3::mg, "plan_contact3: mg cannot solve level 0");
+        plan.level0 = plan.upper = *forced;
+        why << "--linear " << to_string(*forced) << ": exact on every level";
+    } else {
+        plan.upper = Method3::mg;
+        const bool fits_schur =
+            limit.bytes <= 0 ||
+            estimate_contact3_bytes(sizes, Method3::schur, plan.upper) <= limit.bytes;
+        if (m0 <= kSchurMaxComponents3 && fits_schur) {
+            plan.level0 = Method3::schur;
+            why << "level 0 schur (" << m0 << " contact components, at most "
+                << kSchurMaxComponents3 << ": its dense reduction is the cheaper exact solve)";
+        } else {
+            plan.level0 = Method3::lu;
+            why << "level 0 lu (" << m0 << " contact components: "
+                << (m0 > kSchurMaxComponents3 ? "past " + std::to_string(static_cast<int>(
+                                                              kSchurMaxComponents3)) +
+                                                      ", schur's dense reduction costs more"
+                                              : std::string("schur's dense systems do not fit"))
+                << ")";
+        }
+        if (sizes.size() > 1) why << ", gmres + mg above";
+    }
+    check_fits(sizes, plan.level0, plan.upper, limit);
+    plan.why = why.str();
+    return plan;
 }
 
 transfer::SurfaceFacets<3> contactor_faces(const ElasticProblem3& problem, const Level3& L) {

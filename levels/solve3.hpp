@@ -12,6 +12,7 @@
 
 #include <array>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -105,6 +106,27 @@ struct RunResult3 {
 /// and the Cholesky factor of its regularized stiffness (estimate_direct3_bytes).
 double estimate_contact3_bytes(const std::vector<ElasticLevelSize3>& sizes, Method3 level0,
                                Method3 upper);
+
+/// Level 0's contact components up to which the default plan solves level 0 by `schur`: its
+/// dense reduction (2m unknowns in 3D slip) costs O(m^3) per Newton system and overtakes the
+/// sparse LU of the level's whole Jacobian past about this many (block3d-like boxes at level 0,
+/// docs/results/contact3d.md#results-contact3d-plan).
+inline constexpr double kSchurMaxComponents3 = 1500;
+
+/// The Newton-system solvers of a 3D contact run and why.
+struct Plan3 {
+    Method3 level0 = Method3::schur; ///< level 0 (the exact solve below the multigrid)
+    Method3 upper = Method3::mg;     ///< the levels above
+    std::string why;                 ///< one line for the run report
+};
+
+/// The plan for levels of these sizes (predict_elastic3_sizes). `forced` (--linear schur|lu):
+/// that exact solver on every level. Otherwise the multigrid above level 0, and on level 0
+/// `schur` while its contact components are at most kSchurMaxComponents3 and the sparse `lu`
+/// past them, or when schur's dense systems would not fit in `limit` where lu's would. Throws
+/// InvalidInput, as check_contact3_fits, when the planned run does not fit.
+Plan3 plan_contact3(const std::vector<ElasticLevelSize3>& sizes, std::optional<Method3> forced,
+                    const MemoryLimit& limit);
 
 /// Throws InvalidInput when estimate_contact3_bytes of `problem`'s levels with these solvers
 /// exceeds `limit`, naming the finest level, its unknowns and contact components, the estimate

@@ -163,7 +163,7 @@ std::vector<std::pair<Vec3, int>> resultants(const ElasticProblem3& p, const Lev
 }
 
 void print_header3(std::ostream& os, const ElasticProblem3& p, const RunResult3& r,
-                   const levels::SolveOptions3& so) {
+                   const levels::SolveOptions3& so, const levels::Plan3& plan) {
     os << "scene      " << p.name << ": " << p.description << "\n";
     if (!p.units.empty()) os << "units      " << p.units << "\n";
     r.hierarchy.report(os);
@@ -175,6 +175,7 @@ void print_header3(std::ostream& os, const ElasticProblem3& p, const RunResult3&
     os << "solve      " << (so.coarse_to_fine ? "coarse-to-fine" : "cold (finest level alone)")
        << "; Newton systems: level 0 " << levels::to_string(so.level0) << ", levels above "
        << levels::to_string(so.upper) << "\n";
+    os << "plan       " << plan.why << "\n";
 }
 
 void print_steps3(std::ostream& os, const RunResult3& r) {
@@ -208,7 +209,7 @@ void write_iterations3(const std::filesystem::path& file, const RunResult3& r) {
 
 void write_summary3(const std::filesystem::path& dir, const ElasticProblem3& p,
                     const RunResult3& r, const std::vector<std::string>& files,
-                    const levels::SolveOptions3& so) {
+                    const levels::SolveOptions3& so, const levels::Plan3& plan) {
     toml::table root;
     root.insert("complete", true);
     root.insert("scene", p.name);
@@ -219,6 +220,9 @@ void write_summary3(const std::filesystem::path& dir, const ElasticProblem3& p,
     root.insert("load_steps", static_cast<int64_t>(p.load_steps));
     root.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
     root.insert("coarse_to_fine", so.coarse_to_fine);
+    root.insert("solver_level0", std::string(levels::to_string(so.level0)));
+    root.insert("solver_upper", std::string(levels::to_string(so.upper)));
+    root.insert("plan", plan.why);
     root.insert("unknowns", static_cast<int64_t>(r.finest().n_unknowns()));
     root.insert("contact_nodes", static_cast<int64_t>(r.finest().n_contact_nodes()));
     toml::array steps;
@@ -287,10 +291,14 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
     levels::SolveOptions3 so;
     so.coarse_to_fine = !opt.cold;
     so.extrapolate = !opt.no_extrapolation;
-    if (opt.linear) so.upper = *opt.linear == "lu" ? levels::Method3::lu : levels::Method3::schur;
-    if (opt.linear) so.level0 = so.upper;
-    // A run that cannot fit is refused before anything is built.
-    levels::check_contact3_fits(p, so.level0, so.upper, levels::process_memory_limit());
+    std::optional<levels::Method3> forced;
+    if (opt.linear) forced = *opt.linear == "lu" ? levels::Method3::lu : levels::Method3::schur;
+    // The solvers by the levels' predicted sizes; a run that cannot fit is refused before
+    // anything is built.
+    const levels::Plan3 plan = levels::plan_contact3(levels::predict_elastic3_sizes(p, p.levels),
+                                                     forced, levels::process_memory_limit());
+    so.level0 = plan.level0;
+    so.upper = plan.upper;
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
     OutputFolder folder(dir);
     if (opt.stop) so.interrupt = [&] { return opt.stop->load(); };
@@ -313,7 +321,7 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
         return 128 + (sig > 0 ? sig : 2);
     }
     os << "\n";
-    print_header3(os, p, r, so);
+    print_header3(os, p, r, so, plan);
     print_steps3(os, r);
     if (!r.converged) {
         os << "\nerror: " << r.failure << "\n";
@@ -353,7 +361,7 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
     files.push_back("iterations.csv");
     for (const auto& f : files)
         folder.add(f);
-    write_summary3(dir, p, r, files, so);
+    write_summary3(dir, p, r, files, so, plan);
     os << "\nwrote";
     for (const auto& f : files)
         os << " " << (dir / f).string() << ",";

@@ -3,6 +3,7 @@
 // (the exact P1 solution: uniform pressure, linear displacements) on levels 0-2 with every
 // Newton-system solver, the multiplier transfer's conservation, coarse-to-fine against cold, and
 // a frictional case whose Newton must converge in 3D slip.
+#include "core/check.hpp"
 #include "levels/solve3.hpp"
 #include "mesh/tet_mesh.hpp"
 #include "scene/scene3.hpp"
@@ -201,6 +202,42 @@ TEST(Contact3, SecantPredictorExactUnderProportionalLoading) {
         const double xs = ro.x.cwiseAbs().maxCoeff();
         EXPECT_LE((rw.x - ro.x).cwiseAbs().maxCoeff(), 1e-8 * xs);
     }
+}
+
+// The 3D plan: schur on level 0 up to kSchurMaxComponents3 contact components, lu past them,
+// mg above; --linear forces one exact solver everywhere; a plan that does not fit is refused.
+TEST(Contact3, PlanChoosesTheLevel0SolverBySizeAndMemory) {
+    auto p = scene::load_scene3("block3d");
+    p.levels = 2;
+    auto sizes = levels::predict_elastic3_sizes(p, p.levels);
+    const levels::MemoryLimit none{};
+    auto plan = levels::plan_contact3(sizes, std::nullopt, none);
+    EXPECT_EQ(plan.level0, levels::Method3::schur);
+    EXPECT_EQ(plan.upper, levels::Method3::mg);
+    EXPECT_NE(plan.why.find("level 0 schur (60 contact components"), std::string::npos) << plan.why;
+    sizes.front().multipliers = levels::kSchurMaxComponents3 + 3;
+    plan = levels::plan_contact3(sizes, std::nullopt, none);
+    EXPECT_EQ(plan.level0, levels::Method3::lu);
+    EXPECT_EQ(plan.upper, levels::Method3::mg);
+    plan = levels::plan_contact3(sizes, levels::Method3::schur, none);
+    EXPECT_EQ(plan.level0, levels::Method3::schur);
+    EXPECT_EQ(plan.upper, levels::Method3::schur);
+    // schur's dense systems of level 0 alone beyond the limit: lu instead, when lu fits.
+    sizes.front().multipliers = 1000;
+    const double with_schur =
+        levels::estimate_contact3_bytes(sizes, levels::Method3::schur, levels::Method3::mg);
+    const double with_lu =
+        levels::estimate_contact3_bytes(sizes, levels::Method3::lu, levels::Method3::mg);
+    ASSERT_LT(with_lu, with_schur);
+    levels::MemoryLimit between;
+    between.bytes = 0.5 * (with_lu + with_schur);
+    between.source = "test";
+    plan = levels::plan_contact3(sizes, std::nullopt, between);
+    EXPECT_EQ(plan.level0, levels::Method3::lu);
+    levels::MemoryLimit tiny;
+    tiny.bytes = 0.5 * with_lu;
+    tiny.source = "test";
+    EXPECT_THROW(levels::plan_contact3(sizes, std::nullopt, tiny), mlc::InvalidInput);
 }
 
 } // namespace
