@@ -11,8 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
+#include <utility>
 
 namespace mlc {
 namespace {
@@ -217,22 +219,90 @@ TEST(Contact3Scenes, Hertz3dSphereIsAttachedAndRefinementPutsItsVerticesOnIt) {
                 0.05 * L.n_contact_nodes());
 }
 
-TEST(Contact3Scenes, SpherePunchClosedFormAndRegion) {
+TEST(Contact3Scenes, SpherePunchBlockGradingClosedFormAndRegion) {
     const levels::ElasticProblem3 p = scene::load_scene3("sphere_punch");
-    const levels::Level3 L = levels::build_level(p, p.mesh0);
-    EXPECT_LE(L.mesh.n_vertices(), 6000);
-    // The top face's vertices with x, y <= 0.3: 7 x 7; gaps sqrt(1 + x^2 + y^2) - 1.
-    ASSERT_EQ(L.n_contact_nodes(), 49);
+    const mesh::TetMesh& m = p.mesh0;
+    // sphere_punch.msh: the quarter [0, 2] x [0, 2] x [-4, 0], 2185 vertices; each physical
+    // surface on its plane.
+    EXPECT_EQ(m.n_vertices(), 2185);
+    Vec3 lo = m.vertices[0], hi = m.vertices[0];
+    for (const Vec3& x : m.vertices) {
+        lo = lo.cwiseMin(x);
+        hi = hi.cwiseMax(x);
+    }
+    EXPECT_EQ(lo, Vec3(0, 0, -4));
+    EXPECT_EQ(hi, Vec3(2, 2, 0));
+    struct Plane {
+        std::string tag;
+        int axis;
+        double value;
+    };
+    for (const Plane& pl : {Plane{"sym_x", 0, 0.0}, Plane{"sym_y", 1, 0.0},
+                            Plane{"bottom", 2, -4.0}, Plane{"top", 2, 0.0}}) {
+        SCOPED_TRACE(pl.tag);
+        const std::vector<int> vs = m.vertices_with_tag(m.tag(pl.tag));
+        EXPECT_GT(vs.size(), 10u);
+        for (int v : vs)
+            EXPECT_EQ(m.vertices[static_cast<size_t>(v)][pl.axis], pl.value) << "vertex " << v;
+    }
+    // The scene comment's closed form: P = 4 p (2 x 2) (the quarter's bottom), a = 0.0994
+    // (a / R <= 0.1), p0; the block is more than 40 a wide and deep.
+    ASSERT_EQ(p.loads.size(), 1u);
+    EXPECT_EQ(p.loads[0].tag, "bottom");
+    const double E_star = 1.0 / (1 - 0.3 * 0.3), P = 4 * p.loads[0].pressure * hi.x() * hi.y();
+    EXPECT_NEAR(P, 1.44e-3, 1e-15);
+    const double a = std::cbrt(3 * P * 1.0 / (4 * E_star));
+    EXPECT_NEAR(a, 0.09942, 1e-5);
+    EXPECT_NEAR(3 * P / (2 * M_PI * a * a), 0.06955, 1e-5);
+    EXPECT_GT(2 * hi.x() / a, 40.0);
+    EXPECT_GT(-lo.z() / a, 40.0);
+    // Graded: the top face's edges within 1.5 a of the origin between a / 8 and a / 6 on
+    // average, none longer than a / 5; those beyond 1 from it longer than a.
+    std::set<std::pair<int, int>> edges;
+    const int top = m.tag("top");
+    for (const auto& f : m.boundary)
+        if (f.tag == top)
+            for (int i = 0; i < 3; ++i)
+                edges.insert(std::minmax(f.v[static_cast<size_t>(i)],
+                                         f.v[static_cast<size_t>((i + 1) % 3)]));
+    double near_sum = 0.0, near_max = 0.0, far_min = 1e300;
+    int near_count = 0;
+    for (const auto& [u, w] : edges) {
+        const Vec3& xu = m.vertices[static_cast<size_t>(u)];
+        const Vec3& xw = m.vertices[static_cast<size_t>(w)];
+        const double len = (xu - xw).norm(), r = (0.5 * (xu + xw)).norm();
+        if (r < 1.5 * a) {
+            near_sum += len;
+            near_max = std::max(near_max, len);
+            ++near_count;
+        } else if (r > 1.0) {
+            far_min = std::min(far_min, len);
+        }
+    }
+    ASSERT_GT(near_count, 0);
+    EXPECT_GT(near_sum / near_count, a / 8);
+    EXPECT_LT(near_sum / near_count, a / 6);
+    EXPECT_LT(near_max, a / 5);
+    EXPECT_GT(far_min, a);
+    // The contact nodes: the top face's vertices with x, y <= 0.3 (3 a), with the origin; gaps
+    // sqrt(1 + x^2 + y^2) - 1 along the sphere's normal.
+    const levels::Level3 L = levels::build_level(p, m);
+    std::set<int> expected;
+    for (int v : m.vertices_with_tag(top))
+        if (m.vertices[static_cast<size_t>(v)].x() <= 0.3 &&
+            m.vertices[static_cast<size_t>(v)].y() <= 0.3)
+            expected.insert(v);
+    std::set<int> got;
     for (const auto& e : L.contacts) {
+        got.insert(e.vertex[0]);
         const Vec3& x = L.mesh.vertices[static_cast<size_t>(e.vertex[0])];
         EXPECT_NEAR(e.g0, std::sqrt(1 + x.x() * x.x() + x.y() * x.y()) - 1, 1e-14);
         EXPECT_NEAR((e.n - (x - Vec3(0, 0, 1)).normalized()).norm(), 0.0, 1e-14);
     }
-    // The scene comment's a = 0.0994: the level-0 edge is a / 2.
-    const double E_star = 1.0 / (1 - 0.3 * 0.3), P = 4 * 1e-3 * 0.36;
-    const double a = std::cbrt(3 * P * 1.0 / (4 * E_star));
-    EXPECT_NEAR(a, 0.09942, 1e-5);
-    EXPECT_NEAR(3 * P / (2 * M_PI * a * a), 0.06955, 1e-5);
+    EXPECT_EQ(got, expected);
+    const int origin = m.nearest_vertex(Vec3::Zero());
+    EXPECT_EQ(m.vertices[static_cast<size_t>(origin)], Vec3::Zero());
+    EXPECT_TRUE(got.count(origin));
 }
 
 // ---------------------------------------------------------------------------------------------
