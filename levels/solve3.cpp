@@ -106,19 +106,9 @@ Plan3 plan_contact3(const std::vector<ElasticLevelSize3>& sizes, std::optional<M
         const bool fits_schur =
             limit.bytes <= 0 ||
             estimate_contact3_bytes(sizes, Method3::schur, plan.upper) <= limit.bytes;
-        if (m0 <= kSchurMaxComponents3 && fits_schur) {
-            plan.level0 = Method3::schur;
-            why << "level 0 schur (" << m0 << " contact components, at most "
-                << kSchurMaxComponents3 << ": its dense reduction is the cheaper exact solve)";
-        } else {
-            plan.level0 = Method3::lu;
-            why << "level 0 lu (" << m0 << " contact components: "
-                << (m0 > kSchurMaxComponents3 ? "past " + std::to_string(static_cast<int>(
-                                                              kSchurMaxComponents3)) +
-                                                      ", schur's dense reduction costs more"
-                                              : std::string("schur's dense systems do not fit"))
-                << ")";
-        }
+        plan.level0 = fits_schur ? Method3::schur : Method3::lu;
+        why << "level 0 " << to_string(plan.level0) << " (" << m0 << " contact components"
+            << (fits_schur ? "" : ": schur's dense systems do not fit") << ")";
         if (sizes.size() > 1) why << ", gmres + mg above";
     }
     check_fits(sizes, plan.level0, plan.upper, limit);

@@ -107,12 +107,6 @@ struct RunResult3 {
 double estimate_contact3_bytes(const std::vector<ElasticLevelSize3>& sizes, Method3 level0,
                                Method3 upper);
 
-/// Level 0's contact components up to which the default plan solves level 0 by `schur`: its
-/// dense reduction (2m unknowns in 3D slip) costs O(m^3) per Newton system and overtakes the
-/// sparse LU of the level's whole Jacobian past about this many (block3d-like boxes at level 0,
-/// docs/results/contact3d.md#results-contact3d-plan).
-inline constexpr double kSchurMaxComponents3 = 1500;
-
 /// The Newton-system solvers of a 3D contact run and why.
 struct Plan3 {
     Method3 level0 = Method3::schur; ///< level 0 (the exact solve below the multigrid)
@@ -122,8 +116,10 @@ struct Plan3 {
 
 /// The plan for levels of these sizes (predict_elastic3_sizes). `forced` (--linear schur|lu):
 /// that exact solver on every level. Otherwise the multigrid above level 0, and on level 0
-/// `schur` while its contact components are at most kSchurMaxComponents3 and the sparse `lu`
-/// past them, or when schur's dense systems would not fit in `limit` where lu's would. Throws
+/// `schur` when the run fits in `limit` with it (its dense systems grow as the square of the
+/// level's contact components), else the sparse `lu`. schur is the faster exact solve at every
+/// size measured (up to 1 800 contact components, 2.6 times faster than lu there:
+/// docs/results/contact3d.md#results-contact3d-plan), so memory alone decides. Throws
 /// InvalidInput, as check_contact3_fits, when the planned run does not fit.
 Plan3 plan_contact3(const std::vector<ElasticLevelSize3>& sizes, std::optional<Method3> forced,
                     const MemoryLimit& limit);

@@ -204,8 +204,8 @@ TEST(Contact3, SecantPredictorExactUnderProportionalLoading) {
     }
 }
 
-// The 3D plan: schur on level 0 up to kSchurMaxComponents3 contact components, lu past them,
-// mg above; --linear forces one exact solver everywhere; a plan that does not fit is refused.
+// The 3D plan: schur on level 0 when it fits, lu when only lu fits, mg above; --linear forces
+// one exact solver everywhere; a plan that does not fit is refused.
 TEST(Contact3, PlanChoosesTheLevel0SolverBySizeAndMemory) {
     auto p = scene::load_scene3("block3d");
     p.levels = 2;
@@ -214,11 +214,7 @@ TEST(Contact3, PlanChoosesTheLevel0SolverBySizeAndMemory) {
     auto plan = levels::plan_contact3(sizes, std::nullopt, none);
     EXPECT_EQ(plan.level0, levels::Method3::schur);
     EXPECT_EQ(plan.upper, levels::Method3::mg);
-    EXPECT_NE(plan.why.find("level 0 schur (60 contact components"), std::string::npos) << plan.why;
-    sizes.front().multipliers = levels::kSchurMaxComponents3 + 3;
-    plan = levels::plan_contact3(sizes, std::nullopt, none);
-    EXPECT_EQ(plan.level0, levels::Method3::lu);
-    EXPECT_EQ(plan.upper, levels::Method3::mg);
+    EXPECT_EQ(plan.why, "level 0 schur (60 contact components), gmres + mg above");
     plan = levels::plan_contact3(sizes, levels::Method3::schur, none);
     EXPECT_EQ(plan.level0, levels::Method3::schur);
     EXPECT_EQ(plan.upper, levels::Method3::schur);
@@ -234,6 +230,10 @@ TEST(Contact3, PlanChoosesTheLevel0SolverBySizeAndMemory) {
     between.source = "test";
     plan = levels::plan_contact3(sizes, std::nullopt, between);
     EXPECT_EQ(plan.level0, levels::Method3::lu);
+    EXPECT_EQ(plan.why, "level 0 lu (1000 contact components: schur's dense systems do not fit), "
+                        "gmres + mg above");
+    plan = levels::plan_contact3(sizes, std::nullopt, none);
+    EXPECT_EQ(plan.level0, levels::Method3::schur);
     levels::MemoryLimit tiny;
     tiny.bytes = 0.5 * with_lu;
     tiny.source = "test";
