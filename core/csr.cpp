@@ -74,6 +74,19 @@ void csr_multiply(const SparseMatrix& A, const Vector& x, Vector& y, bool add, t
     csr_multiply(csr_arrays(A, A.valuePtr()), x, y, add, kind);
 }
 
+namespace {
+
+/// Row i of A x summed in storage order with one accumulator (Eigen's serial order).
+inline double row_sum_in_order(const int* outer, const int* inner, const double* val,
+                               const double* x, size_t i) {
+    double s = 0.0;
+    for (int k = outer[i]; k < outer[i + 1]; ++k)
+        s += val[k] * x[inner[k]];
+    return s;
+}
+
+} // namespace
+
 void csr_multiply_in_order(const SparseMatrix& A, const Vector& x, Vector& y) {
     MLC_CHECK(A.isCompressed(), "csr_multiply_in_order: A must be compressed");
     MLC_CHECK(x.size() == A.cols(), "csr_multiply_in_order: A is " << A.rows() << " x " << A.cols()
@@ -86,12 +99,8 @@ void csr_multiply_in_order(const SparseMatrix& A, const Vector& x, Vector& y) {
     double* yp = y.data();
     parallel::for_rows(static_cast<size_t>(A.rows()), static_cast<size_t>(kMinRowsPerThread),
                        [&](size_t i0, size_t i1) {
-                           for (size_t i = i0; i < i1; ++i) {
-                               double s = 0.0;
-                               for (int k = outer[i]; k < outer[i + 1]; ++k)
-                                   s += val[k] * xp[inner[k]];
-                               yp[i] = s;
-                           }
+                           for (size_t i = i0; i < i1; ++i)
+                               yp[i] = row_sum_in_order(outer, inner, val, xp, i);
                        });
 }
 
@@ -109,12 +118,8 @@ void csr_residual_in_order(const SparseMatrix& A, const Vector& b, const Vector&
     double* rp = res.data();
     parallel::for_rows(static_cast<size_t>(A.rows()), static_cast<size_t>(kMinRowsPerThread),
                        [&](size_t i0, size_t i1) {
-                           for (size_t i = i0; i < i1; ++i) {
-                               double s = 0.0;
-                               for (int k = outer[i]; k < outer[i + 1]; ++k)
-                                   s += val[k] * xp[inner[k]];
-                               rp[i] = bp[i] - s;
-                           }
+                           for (size_t i = i0; i < i1; ++i)
+                               rp[i] = bp[i] - row_sum_in_order(outer, inner, val, xp, i);
                        });
 }
 
