@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace mlc::contact {
 
@@ -28,10 +29,8 @@ node_on_rigid(const mesh::SimplexMesh<dim>& m, const std::vector<int>& contactor
     std::vector<BasicContactElement<dim>> out;
     out.reserve(contactors.size());
     for (int v : contactors) {
-        BasicContactElement<dim> e;
-        e.n_nodes = 1;
+        BasicContactElement<dim> e; // vertex {-1}, weight {1}
         e.vertex[0] = v;
-        e.weight[0] = 1.0;
         obstacle.frame(m.vertices[static_cast<size_t>(v)], e.n, e.g0);
         e.t = tangent_basis<dim>(e.n);
         e.mu = mu;
@@ -43,11 +42,14 @@ node_on_rigid(const mesh::SimplexMesh<dim>& m, const std::vector<int>& contactor
 }
 
 namespace {
-/// Sets the local frame (n, t = (n_y, -n_x)), initial gap and pair data of a two-body element.
-ContactElement with_frame(ContactElement e, const Vec2& n, double g0, double mu, double r,
-                          int pair) {
+/// Sets the local frame (n, t = tangent_basis(n): 2D (n_y, -n_x)), initial gap and pair data of
+/// a two-body element.
+template <int dim>
+BasicContactElement<dim> with_frame(BasicContactElement<dim> e,
+                                    const Eigen::Matrix<double, dim, 1>& n, double g0, double mu,
+                                    double r, int pair) {
     e.n = n;
-    e.t = Vec2(n.y(), -n.x());
+    e.t = tangent_basis<dim>(n);
     e.g0 = g0;
     e.mu = mu;
     e.r = r;
@@ -65,36 +67,27 @@ ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, d
     MLC_CHECK(c != a && c != b,
               "node_on_facet: contactor vertex " << c << " is an end of its facet");
     ContactElement e;
-    e.n_nodes = 3;
-    e.vertex[0] = c;
-    e.vertex[1] = a;
-    e.vertex[2] = b;
-    e.weight[0] = 1.0;
-    e.weight[1] = -(1.0 - alpha);
-    e.weight[2] = -alpha;
-    return with_frame(e, n, g0, mu, r, pair);
+    e.vertex = {c, a, b};
+    e.weight = {1.0, -(1.0 - alpha), -alpha};
+    return with_frame<2>(std::move(e), n, g0, mu, r, pair);
 }
 
-ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
-                                      const std::vector<double>& weights, const Vec2& n, double g0,
-                                      double mu, double r, int pair) {
-    constexpr int max_targets = ContactElement::kMaxNodes - 1;
+template <int dim>
+BasicContactElement<dim> node_on_facet_weighted(int c, const std::vector<int>& targets,
+                                                const std::vector<double>& weights,
+                                                const Eigen::Matrix<double, dim, 1>& n, double g0,
+                                                double mu, double r, int pair) {
     MLC_CHECK(targets.size() == weights.size(),
               "node_on_facet_weighted: " << targets.size() << " target vertices but "
                                          << weights.size() << " weights");
-    MLC_CHECK(!targets.empty() && static_cast<int>(targets.size()) <= max_targets,
-              "node on facet (segment integration): contactor vertex "
-                  << c << " touches " << targets.size() << " target vertices, at most "
-                  << max_targets
-                  << " are supported (the target mesh is much finer than the contactor's there: "
-                     "refine the contactor, swap contactor and target, or use integration = "
-                     "\"nodal\")");
+    MLC_CHECK(!targets.empty(),
+              "node_on_facet_weighted: contactor vertex " << c << " has no target vertex");
     MLC_CHECK(std::abs(n.norm() - 1.0) < 1e-12,
               "node_on_facet_weighted: the normal must have unit length, found |n| = " << n.norm());
-    ContactElement e;
-    e.n_nodes = 1 + static_cast<int>(targets.size());
+    BasicContactElement<dim> e;
+    e.vertex.reserve(1 + targets.size());
+    e.weight.reserve(1 + targets.size());
     e.vertex[0] = c;
-    e.weight[0] = 1.0;
     double sum = 0.0;
     for (size_t k = 0; k < targets.size(); ++k) {
         MLC_CHECK(targets[k] != c,
@@ -104,26 +97,25 @@ ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
                       "node_on_facet_weighted: target vertex " << targets[k] << " repeats");
         MLC_CHECK(std::isfinite(weights[k]), "node_on_facet_weighted: weight of target vertex "
                                                  << targets[k] << " is not finite");
-        e.vertex[k + 1] = targets[k];
-        e.weight[k + 1] = weights[k];
+        e.vertex.push_back(targets[k]);
+        e.weight.push_back(weights[k]);
         sum += weights[k];
     }
     MLC_CHECK(std::abs(sum + 1.0) < 1e-10,
               "node_on_facet_weighted: the target weights sum to " << sum << ", not -1");
-    return with_frame(e, n, g0, mu, r, pair);
+    return with_frame<dim>(std::move(e), n, g0, mu, r, pair);
 }
 
-ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, double r, int pair) {
+template <int dim>
+BasicContactElement<dim> node_on_node(int c, int a, const Eigen::Matrix<double, dim, 1>& n,
+                                      double g0, double mu, double r, int pair) {
     MLC_CHECK(std::abs(n.norm() - 1.0) < 1e-12,
               "node_on_node: the normal must have unit length, found |n| = " << n.norm());
     MLC_CHECK(c != a, "node_on_node: contactor vertex " << c << " is its own target");
-    ContactElement e;
-    e.n_nodes = 2;
-    e.vertex[0] = c;
-    e.vertex[1] = a;
-    e.weight[0] = 1.0;
-    e.weight[1] = -1.0;
-    return with_frame(e, n, g0, mu, r, pair);
+    BasicContactElement<dim> e;
+    e.vertex = {c, a};
+    e.weight = {1.0, -1.0};
+    return with_frame<dim>(std::move(e), n, g0, mu, r, pair);
 }
 
 template <int dim>
@@ -133,7 +125,7 @@ held_components(const BasicContactElement<dim>& e,
     using Element = BasicContactElement<dim>;
     std::array<bool, dim> held; // components prescribed at every vertex
     held.fill(true);
-    for (int j = 0; j < e.n_nodes; ++j) {
+    for (int j = 0; j < e.n_nodes(); ++j) {
         if (e.weight[static_cast<size_t>(j)] == 0.0) continue;
         const auto& f = fixed[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])];
         for (size_t c = 0; c < dim; ++c)
@@ -172,7 +164,7 @@ BasicElementState<dim> evaluate(const BasicContactElement<dim>& e, const Vector&
     using Element = BasicContactElement<dim>;
     using Point = typename Element::Point;
     Point du = Point::Zero(), du_prev = Point::Zero();
-    for (int j = 0; j < e.n_nodes; ++j) {
+    for (int j = 0; j < e.n_nodes(); ++j) {
         const int v = e.vertex[static_cast<size_t>(j)];
         du += e.weight[static_cast<size_t>(j)] * u_full.segment<dim>(dim * v);
         du_prev += e.weight[static_cast<size_t>(j)] * u_prev_full.segment<dim>(dim * v);
@@ -215,7 +207,7 @@ void add_residual(const BasicContactElement<dim>& e, const BasicElementState<dim
     Point force = s.proj.phi[dim - 1] * e.n;
     for (int c = 0; c < dim - 1; ++c)
         force += s.proj.phi[c] * e.t.col(c);
-    for (int j = 0; j < e.n_nodes; ++j) {
+    for (int j = 0; j < e.n_nodes(); ++j) {
         const int v = e.vertex[static_cast<size_t>(j)];
         for (int a = 0; a < dim; ++a)
             if (int d = dofs.u_dof(v, a); d >= 0)
@@ -240,7 +232,12 @@ void add_residual(const BasicContactElement<dim>& e, const BasicElementState<dim
                                                   const Vector&, const Vector&, int);              \
     template void add_residual<dim>(const BasicContactElement<dim>&,                               \
                                     const BasicElementState<dim>&, const fem::BasicDofMap<dim>&,   \
-                                    int, Vector&);
+                                    int, Vector&);                                                 \
+    template BasicContactElement<dim> node_on_facet_weighted<dim>(                                 \
+        int, const std::vector<int>&, const std::vector<double>&,                                  \
+        const Eigen::Matrix<double, dim, 1>&, double, double, double, int);                        \
+    template BasicContactElement<dim> node_on_node<dim>(                                           \
+        int, int, const Eigen::Matrix<double, dim, 1>&, double, double, double, int);
 MLC_CONTACT_ELEMENT(2)
 MLC_CONTACT_ELEMENT(3)
 #undef MLC_CONTACT_ELEMENT

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 /// @file Contact elements (node on rigid, node on node, node on facet): relative displacement in
 /// the local frame (the tangents t, then the normal n), the Alart–Curnier residual, and the
-/// element tangent A_ce, in 2D and 3D (the dimension a template parameter; the two-body element
-/// builders are 2D so far).
+/// element tangent A_ce, in 2D and 3D (the dimension a template parameter; of the element
+/// builders only node_on_facet, with its two target vertices, is 2D alone).
 #pragma once
 
 #include "contact/law.hpp"
@@ -36,34 +36,25 @@ enum class FacetIntegration {
 /// "nodal", "segment", "dual".
 std::string_view to_string(FacetIntegration f);
 
-namespace detail {
-template <size_t N> constexpr std::array<int, N> filled_minus_one() {
-    std::array<int, N> a{};
-    for (auto& v : a)
-        v = -1;
-    return a;
-}
-} // namespace detail
-
-/// One contact element in `dim` dimensions: a contactor vertex and up to kMaxNodes - 1 target
-/// vertices with weights w so that the relative displacement is u_rel = sum_j w_j u_(vertex j)
+/// One contact element in `dim` dimensions: a contactor vertex and any number of target vertices
+/// with weights w so that the relative displacement is u_rel = sum_j w_j u_(vertex j)
 /// (docs/theory.md#theory-contact-elements): node on rigid (1), node on node (1, -1), node on
 /// facet (1, -(1-alpha), -alpha), segment-integrated node on facet (1, -M_i1 / D_i, ...,
-/// -M_im / D_i). Entries at and beyond n_nodes are unused. The frame: n the unit normal of the
-/// target toward the contactor and the dim - 1 tangents t (columns; contact::tangent_basis: 2D
-/// t = (n_y, -n_x), 3D t1 = normalize(e x n) with e the axis least aligned with n, t2 = n x t1).
-/// Frictional elements carry dim multipliers (the tangents' then the normal's), frictionless ones
-/// lambda_n only.
+/// -M_im / D_i). `vertex` and `weight` have one entry per node of the element (n_nodes(), at
+/// least 1): vertex[0] the contactor with weight[0] = 1, then the targets. A default-constructed
+/// element is a node on rigid whose contactor is not set yet: vertex {-1}, weight {1}. The
+/// frame: n the unit normal of the target toward the contactor and the dim - 1 tangents t
+/// (columns; contact::tangent_basis: 2D t = (n_y, -n_x), 3D t1 = normalize(e x n) with e the
+/// axis least aligned with n, t2 = n x t1). Frictional elements carry dim multipliers (the
+/// tangents' then the normal's), frictionless ones lambda_n only.
 template <int dim> struct BasicContactElement {
     static_assert(dim == 2 || dim == 3, "contact elements are for dim = 2 or 3");
     using Point = Eigen::Matrix<double, dim, 1>;
     using Tangents = Eigen::Matrix<double, dim, dim - 1>; ///< 2D: a Vec2
-    static constexpr int kMaxNodes = 8;
-    int n_nodes = 1; ///< 1 .. kMaxNodes
-    /// vertex[0] is the contactor node; unused entries are -1.
-    std::array<int, kMaxNodes> vertex = detail::filled_minus_one<kMaxNodes>();
-    /// weight[0] = 1; unused entries 0.
-    std::array<double, kMaxNodes> weight{1.0};
+    /// The element's vertices: vertex[0] the contactor node, then the target vertices.
+    std::vector<int> vertex{-1};
+    /// One weight per vertex: weight[0] = 1 (the contactor), the targets' summing to -1.
+    std::vector<double> weight{1.0};
     Point n = Point::Unit(dim - 1);  ///< unit normal of the target, toward the contactor
     Tangents t = default_tangents(); ///< the tangents (columns)
     double g0 = 0.0;                 ///< initial normal gap (>= 0 apart)
@@ -76,6 +67,8 @@ template <int dim> struct BasicContactElement {
     /// equation reads lambda = 0, and the reaction goes to the support. A pinned normal pins
     /// every component (a contact that carries no normal force carries no friction).
     unsigned char pinned = 0;
+    /// The number of nodes: the contactor and its targets (vertex.size(), weight.size() alike).
+    int n_nodes() const { return static_cast<int>(vertex.size()); }
     /// Frictional elements carry (lambda_t, lambda_n); frictionless ones lambda_n only.
     bool frictional() const { return mu > 0.0; }
     int n_multipliers() const { return frictional() ? dim : 1; }
@@ -138,18 +131,24 @@ node_on_rigid(const mesh::SimplexMesh<dim>& m, const std::vector<int>& contactor
 ContactElement node_on_facet(int c, int a, int b, double alpha, const Vec2& n, double g0, double mu,
                              double r, int pair);
 
-/// Node-on-facet element with given target vertices and weights (segment integration):
-/// vertex c with weight 1, then targets[k] with weights[k]. Throws InvalidInput when there are
-/// more than ContactElement::kMaxNodes - 1 targets, a target is c or repeats, the weights do not
+/// Node-on-facet element with given target vertices and weights (segment integration, or the
+/// barycentric weights of a 3D facet): vertex c with weight 1, then targets[k] with weights[k],
+/// as many as given. n the unit target normal toward the contactor, t = tangent_basis(n) (2D
+/// (n_y, -n_x)), g0 the initial signed gap. Throws InvalidInput when targets and weights differ
+/// in number or are empty, a target is c or repeats, a weight is not finite, the weights do not
 /// sum to -1 (to 1e-10: rigid translations must give no gap), or the normal is not unit.
-ContactElement node_on_facet_weighted(int c, const std::vector<int>& targets,
-                                      const std::vector<double>& weights, const Vec2& n, double g0,
-                                      double mu, double r, int pair);
+template <int dim>
+BasicContactElement<dim> node_on_facet_weighted(int c, const std::vector<int>& targets,
+                                                const std::vector<double>& weights,
+                                                const Eigen::Matrix<double, dim, 1>& n, double g0,
+                                                double mu, double r, int pair);
 
 /// Node-on-node element: contactor vertex c against target vertex a (a matching interface):
-/// weights (1, -1), n the unit target normal toward the contactor, t = (n_y, -n_x).
-/// Throws InvalidInput for a normal that is not of unit length.
-ContactElement node_on_node(int c, int a, const Vec2& n, double g0, double mu, double r, int pair);
+/// weights (1, -1), n the unit target normal toward the contactor, t = tangent_basis(n) (2D
+/// (n_y, -n_x)). Throws InvalidInput for a normal that is not of unit length or c == a.
+template <int dim>
+BasicContactElement<dim> node_on_node(int c, int a, const Eigen::Matrix<double, dim, 1>& n,
+                                      double g0, double mu, double r, int pair);
 
 /// Local state of an element at (u, lambda).
 template <int dim> struct BasicElementState {
@@ -198,13 +197,13 @@ void for_each_tangent_entry(const BasicContactElement<dim>& e,
     const Mat GMGt = G * M * G.transpose();
     const Mat GM = G * M;
     const Mat MGt = M * G.transpose();
-    for (int j = 0; j < e.n_nodes; ++j) {
+    for (int j = 0; j < e.n_nodes(); ++j) {
         const int vj = e.vertex[static_cast<size_t>(j)];
         const double wj = e.weight[static_cast<size_t>(j)];
         for (int a = 0; a < dim; ++a) {
             const int row = dofs.u_dof(vj, a);
             if (row < 0) continue;
-            for (int k = 0; k < e.n_nodes; ++k) {
+            for (int k = 0; k < e.n_nodes(); ++k) {
                 const int vk = e.vertex[static_cast<size_t>(k)];
                 const double wk = e.weight[static_cast<size_t>(k)];
                 for (int b = 0; b < dim; ++b) {
@@ -218,7 +217,7 @@ void for_each_tangent_entry(const BasicContactElement<dim>& e,
     }
     for (int q = m0; q < dim; ++q) {
         const int row = lambda_dof + q - m0;
-        for (int k = 0; k < e.n_nodes; ++k) {
+        for (int k = 0; k < e.n_nodes(); ++k) {
             const int vk = e.vertex[static_cast<size_t>(k)];
             const double wk = e.weight[static_cast<size_t>(k)];
             for (int b = 0; b < dim; ++b) {

@@ -117,8 +117,7 @@ struct SearchResult {
 /// weights are, which makes tractions oscillate on similar meshes); sum psi_i = 1 keeps the
 /// patch test exact. A node whose support is only partly over the target keeps N_i (segment).
 /// Throws InvalidInput when the mesh has no facet tagged `target_tag`, or (segment, dual) when
-/// `contactor_tag` is missing or a node touches more than ContactElement::kMaxNodes - 1 target
-/// vertices.
+/// `contactor_tag` is missing.
 SearchResult node_on_facet_search(const mesh::Mesh& m, const std::vector<int>& contactors,
                                   int target_tag, const FacetIndex& reference, double search_radius,
                                   double mu, double r, int pair,

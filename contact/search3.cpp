@@ -441,13 +441,8 @@ ContactElement3 node_on_facet3(int c, const Facet3& f, const std::array<double, 
     MLC_CHECK(c != f.v[0] && c != f.v[1] && c != f.v[2],
               "node_on_facet3: contactor vertex " << c << " is a corner of its facet");
     ContactElement3 e;
-    e.n_nodes = 4;
-    e.vertex[0] = c;
-    e.weight[0] = 1.0;
-    for (size_t k = 0; k < 3; ++k) {
-        e.vertex[k + 1] = f.v[k];
-        e.weight[k + 1] = -bary[k];
-    }
+    e.vertex = {c, f.v[0], f.v[1], f.v[2]};
+    e.weight = {1.0, -bary[0], -bary[1], -bary[2]};
     return search3_with_frame(e, n, g0, mu, r, pair);
 }
 
@@ -457,11 +452,8 @@ ContactElement3 node_on_node3(int c, int a, const Vec3& n, double g0, double mu,
               "node_on_node3: the normal must have unit length, found |n| = " << n.norm());
     MLC_CHECK(c != a, "node_on_node3: contactor vertex " << c << " is its own target");
     ContactElement3 e;
-    e.n_nodes = 2;
-    e.vertex[0] = c;
-    e.vertex[1] = a;
-    e.weight[0] = 1.0;
-    e.weight[1] = -1.0;
+    e.vertex = {c, a};
+    e.weight = {1.0, -1.0};
     return search3_with_frame(e, n, g0, mu, r, pair);
 }
 

@@ -32,7 +32,7 @@ std::array<double, 5> balance_sums(const Level& level, double s, const Vector& u
     for (size_t e = 0; e < level.contacts.size(); ++e) {
         const auto& el = level.contacts[e];
         const Vec2 f = nodes[e].lambda_t * el.t + nodes[e].lambda_n * el.n;
-        for (int j = 0; j < el.n_nodes; ++j)
+        for (int j = 0; j < el.n_nodes(); ++j)
             C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
                 el.weight[static_cast<size_t>(j)] * f;
     }
@@ -42,7 +42,7 @@ std::array<double, 5> balance_sums(const Level& level, double s, const Vector& u
         const double lt = el.frictional() ? (*x)[d] : 0.0;
         const double ln = (*x)[el.frictional() ? d + 1 : d];
         const Vec2 f = lt * el.t + ln * el.n;
-        for (int j = 0; j < el.n_nodes; ++j)
+        for (int j = 0; j < el.n_nodes(); ++j)
             C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
                 el.weight[static_cast<size_t>(j)] * f;
     }

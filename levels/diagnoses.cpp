@@ -41,7 +41,7 @@ std::vector<char> two_body_bodies(const Problem& p, const Level& L, const std::v
     std::vector<char> out(p.bodies.size() + 1, 0);
     for (const auto& el : L.contacts) {
         if (p.contacts[static_cast<size_t>(el.pair)].obstacle) continue;
-        for (int j = 0; j < el.n_nodes; ++j) {
+        for (int j = 0; j < el.n_nodes(); ++j) {
             const int b = body[static_cast<size_t>(el.vertex[static_cast<size_t>(j)])];
             if (b >= 0 && static_cast<size_t>(b) < out.size()) out[static_cast<size_t>(b)] = 1;
         }

@@ -91,7 +91,7 @@ void build_ghost_contacts(const Problem& problem, Level& L, const std::vector<in
         // ghost layer holds every facet within reach of them: mesh::GhostReach).
         for (auto& e : two_body_search(problem, L.mesh, p, nodes, true).elements) {
             bool reaches = false;
-            for (int j = 1; j < e.n_nodes; ++j)
+            for (int j = 1; j < e.n_nodes(); ++j)
                 reaches = reaches || owned(e.vertex[static_cast<size_t>(j)]);
             if (reaches) L.ghost_contacts.push_back(e);
         }
@@ -113,7 +113,7 @@ void pin_held_components(const Problem& problem, Level& L) {
                   "contact '" << problem.contacts[static_cast<size_t>(e.pair)].name
                               << "': contactor vertex " << v << " at (" << x.x() << ", " << x.y()
                               << ") has " << held << " prescribed by a support"
-                              << (e.n_nodes == 1 ? "" : " (and so have its target vertices)")
+                              << (e.n_nodes() == 1 ? "" : " (and so have its target vertices)")
                               << ", but the contact normal there, (" << e.n.x() << ", " << e.n.y()
                               << "), is neither along nor across that direction: with friction the "
                                  "support and the contact would share a force direction and their "

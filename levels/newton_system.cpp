@@ -227,7 +227,7 @@ public:
             for (int q = 0; q < me; ++q) {
                 // The frame's direction of component q: the tangents, then the normal.
                 const Point g = (me == dim && q < dim - 1) ? Point(e.t.col(q)) : e.n;
-                for (int j = 0; j < e.n_nodes; ++j)
+                for (int j = 0; j < e.n_nodes(); ++j)
                     for (int a = 0; a < dim; ++a) {
                         const int d = dofs.u_dof(e.vertex[static_cast<size_t>(j)], a);
                         if (d >= 0)

@@ -123,7 +123,6 @@ ContactBoundary gather_contact_boundary(const levels::Problem& p,
     if (!rows.empty())
         for (const double* a : rows.front()) {
             contact::ContactElement e;
-            e.n_nodes = 1;
             e.pair = static_cast<int>(a[0]);
             e.vertex[0] = vertex(a[3], a[4]);
             L.contacts.push_back(e);
@@ -155,7 +154,7 @@ std::int64_t cut_elements(const levels::DistributedLevel& F) {
     std::int64_t n = 0;
     for (const auto& e : F.local.contacts) {
         bool cut = false;
-        for (int j = 1; j < e.n_nodes; ++j)
+        for (int j = 1; j < e.n_nodes(); ++j)
             cut =
                 cut || F.part.vertex_owner[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])] !=
                            F.part.vertex_owner[static_cast<size_t>(e.vertex[0])];

@@ -81,7 +81,7 @@ NodalForces nodal_forces(const levels::Level& L, double s, const Vector& u,
     for (size_t e = 0; e < L.contacts.size(); ++e) {
         const auto& el = L.contacts[e];
         const Vec2 f = nodes[e].lambda_t * el.t + nodes[e].lambda_n * el.n;
-        for (int j = 0; j < el.n_nodes; ++j)
+        for (int j = 0; j < el.n_nodes(); ++j)
             r.C.segment<2>(2 * el.vertex[static_cast<size_t>(j)]) +=
                 el.weight[static_cast<size_t>(j)] * f;
     }

@@ -43,7 +43,7 @@ TEST(PatchTest, NodeOnNodeOnMatchingMeshesIsExactToRoundOff) {
         const auto r = levels::solve(p);
         ASSERT_TRUE(r.converged) << r.failure;
         for (const auto& e : r.finest().contacts)
-            EXPECT_EQ(e.n_nodes, 2);
+            EXPECT_EQ(e.n_nodes(), 2);
         const auto m = apps::measure_patch(p, r);
         EXPECT_DOUBLE_EQ(m.p_exact, 1e5);
         EXPECT_DOUBLE_EQ(m.uy_exact, -0.05);
@@ -70,7 +70,7 @@ TEST(PatchTest, NodalNodeOnFacetOnNonMatchingMeshesMissesByMoreThanTwoPerCent) {
         const auto r = levels::solve(p);
         ASSERT_TRUE(r.converged) << r.failure;
         for (const auto& e : r.finest().contacts)
-            EXPECT_EQ(e.n_nodes, 3);
+            EXPECT_EQ(e.n_nodes(), 3);
         const auto m = apps::measure_patch(p, r);
         std::cout << "[ patch    ] nodal, level " << level << ": pressure max error "
                   << m.pressure_max_error << " (without the end nodes "
@@ -102,9 +102,9 @@ TEST(PatchTest, SegmentAndDualIntegrationAreExactOnNonMatchingMeshes) {
             const auto& L = r.finest();
             EXPECT_TRUE(L.not_found[0].empty());
             for (const auto& e : L.contacts) {
-                EXPECT_GE(e.n_nodes, 3);
+                EXPECT_GE(e.n_nodes(), 3);
                 double sum = 0;
-                for (int j = 0; j < e.n_nodes; ++j)
+                for (int j = 0; j < e.n_nodes(); ++j)
                     sum += e.weight[static_cast<size_t>(j)];
                 EXPECT_NEAR(sum, 0.0, 1e-14);
             }

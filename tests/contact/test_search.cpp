@@ -59,7 +59,7 @@ TEST(ContactSearch, NodeOnFacetElementsOnAHandMadePairOfFacets) {
     ASSERT_EQ(res.elements.size(), 2u);
     EXPECT_TRUE(res.not_found.empty());
     const auto& a = res.elements[0];
-    EXPECT_EQ(a.n_nodes, 3);
+    EXPECT_EQ(a.n_nodes(), 3);
     EXPECT_EQ(a.vertex[0], 3);
     EXPECT_EQ(a.vertex[1], 0);
     EXPECT_EQ(a.vertex[2], 1);
@@ -178,7 +178,7 @@ TEST(ContactSearch, NodeOnNodeMatchesCoincidentVerticesWithAveragedNormal) {
     ASSERT_EQ(res.not_found.size(), 1u);
     EXPECT_EQ(res.not_found[0], 5);
     const auto& a = res.elements[0];
-    EXPECT_EQ(a.n_nodes, 2);
+    EXPECT_EQ(a.n_nodes(), 2);
     EXPECT_EQ(a.vertex[1], 1);
     EXPECT_DOUBLE_EQ(a.weight[1], -1.0);
     const Vec2 expected = (Vec2(0, 1) + Vec2(1, 1) / std::sqrt(2.0)).normalized();

@@ -102,7 +102,7 @@ contact::FacetIndex3 search3_index(const mesh::TetMesh& m, const std::string& ta
 double search3_apply(const contact::ContactElement3& e, const mesh::TetMesh& m,
                      const std::function<double(const Vec3&)>& f) {
     double s = 0.0;
-    for (int j = 0; j < e.n_nodes; ++j)
+    for (int j = 0; j < e.n_nodes(); ++j)
         s += e.weight[static_cast<size_t>(j)] *
              f(m.vertices[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])]);
     return s;
@@ -304,9 +304,9 @@ TEST(Search3, FlatNonMatchingInterfaceFindsEveryNodeAndReproducesLinearFields) {
     for (size_t i = 0; i < contactors.size(); ++i) {
         const auto& e = res.elements[i];
         EXPECT_EQ(e.vertex[0], contactors[i]);
-        EXPECT_EQ(e.n_nodes, 4);
+        EXPECT_EQ(e.n_nodes(), 4);
         double sum = 0.0;
-        for (int j = 0; j < e.n_nodes; ++j)
+        for (int j = 0; j < e.n_nodes(); ++j)
             sum += e.weight[static_cast<size_t>(j)];
         EXPECT_NEAR(sum, 0.0, 1e-15) << "node " << contactors[i];
         for (int j = 1; j < 4; ++j) {
@@ -449,7 +449,7 @@ TEST(Search3, NodeOnNodeOnMatchingBoxesPairsEachNodeWithItsTwin) {
         // Lower vertex (i, j, 1) is c = (4 + j) 4 + i; its twin the upper (i, j, 0).
         const int i = c % 4, j = (c / 4) % 4;
         EXPECT_EQ(c, 16 + 4 * j + i);
-        EXPECT_EQ(e.n_nodes, 2);
+        EXPECT_EQ(e.n_nodes(), 2);
         EXPECT_EQ(e.vertex[0], c);
         EXPECT_EQ(e.vertex[1], off + 4 * j + i);
         EXPECT_EQ(e.weight[0], 1.0);
@@ -552,7 +552,7 @@ TEST(Search3, MissingTargetTagAndBadElementsAreRefused) {
         "node_on_node3: the normal must have unit length, found |n| = 2");
     // A well-formed element: weights (1, -bary), the frame of tangent_basis.
     const auto e = contact::node_on_facet3(0, f, {0.2, 0.3, 0.5}, Vec3::UnitX(), 0.1, 0.4, 3.0, 5);
-    EXPECT_EQ(e.n_nodes, 4);
+    EXPECT_EQ(e.n_nodes(), 4);
     EXPECT_EQ(e.weight[1], -0.2);
     EXPECT_EQ(e.weight[2], -0.3);
     EXPECT_EQ(e.weight[3], -0.5);

@@ -62,7 +62,7 @@ Index contact3_check_level(const levels::Level3& L, size_t n_pairs) {
     for (size_t k = 0; k < L.contacts.size(); ++k) {
         const auto& e = L.contacts[k];
         const int v = e.vertex[0];
-        EXPECT_EQ(e.n_nodes, 1);
+        EXPECT_EQ(e.n_nodes(), 1);
         EXPECT_EQ(element_of[static_cast<size_t>(v)], -1) << "vertex " << v << " twice";
         element_of[static_cast<size_t>(v)] = static_cast<int>(k);
         EXPECT_EQ(L.lambda_dof[k], L.dofs.extra_dof(v));

@@ -135,14 +135,14 @@ void expect_same_elements(const levels::Problem& prob, int p) {
         const auto it = ref.find({x.x(), x.y()});
         ASSERT_NE(it, ref.end()) << "no contact node at (" << x.x() << ", " << x.y() << ")";
         const contact::ContactElement& r = *it->second;
-        ASSERT_EQ(e.n_nodes, r.n_nodes);
+        ASSERT_EQ(e.n_nodes(), r.n_nodes());
         std::map<Point, double> wr;
-        for (int j = 1; j < r.n_nodes; ++j) {
+        for (int j = 1; j < r.n_nodes(); ++j) {
             const Vec2& y =
                 one.mesh.vertices[static_cast<size_t>(r.vertex[static_cast<size_t>(j)])];
             wr[{y.x(), y.y()}] = r.weight[static_cast<size_t>(j)];
         }
-        for (int j = 1; j < e.n_nodes; ++j) {
+        for (int j = 1; j < e.n_nodes(); ++j) {
             const Vec2& y = L.mesh.vertices[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])];
             const auto w = wr.find({y.x(), y.y()});
             ASSERT_NE(w, wr.end()) << "a target vertex the one-process element does not have";
@@ -161,7 +161,7 @@ void expect_same_elements(const levels::Problem& prob, int p) {
     std::int64_t reaching = 0;
     for (const auto& e : L.contacts) {
         std::set<int> others;
-        for (int j = 1; j < e.n_nodes; ++j) {
+        for (int j = 1; j < e.n_nodes(); ++j) {
             const int o =
                 d.part.vertex_owner[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])];
             if (o != comm.rank()) others.insert(o);
