@@ -411,21 +411,6 @@ std::optional<TriangleProjection> FacetIndex3::closest(const Vec3& x, double rad
 }
 
 // ---------------------------------------------------------------------------------------------
-namespace {
-
-/// Sets the frame (n, t = tangent_basis(n)), gap and pair data of a two-body 3D element.
-ContactElement3 search3_with_frame(ContactElement3 e, const Vec3& n, double g0, double mu, double r,
-                                   int pair) {
-    e.n = n;
-    e.t = tangent_basis<3>(n);
-    e.g0 = g0;
-    e.mu = mu;
-    e.r = r;
-    e.pair = pair;
-    return e;
-}
-
-} // namespace
 
 ContactElement3 node_on_facet3(int c, const Facet3& f, const std::array<double, 3>& bary,
                                const Vec3& n, double g0, double mu, double r, int pair) {
@@ -440,21 +425,8 @@ ContactElement3 node_on_facet3(int c, const Facet3& f, const std::array<double, 
               "node_on_facet3: the normal must have unit length, found |n| = " << n.norm());
     MLC_CHECK(c != f.v[0] && c != f.v[1] && c != f.v[2],
               "node_on_facet3: contactor vertex " << c << " is a corner of its facet");
-    ContactElement3 e;
-    e.vertex = {c, f.v[0], f.v[1], f.v[2]};
-    e.weight = {1.0, -bary[0], -bary[1], -bary[2]};
-    return search3_with_frame(e, n, g0, mu, r, pair);
-}
-
-ContactElement3 node_on_node3(int c, int a, const Vec3& n, double g0, double mu, double r,
-                              int pair) {
-    MLC_CHECK(std::abs(n.norm() - 1.0) < 1e-12,
-              "node_on_node3: the normal must have unit length, found |n| = " << n.norm());
-    MLC_CHECK(c != a, "node_on_node3: contactor vertex " << c << " is its own target");
-    ContactElement3 e;
-    e.vertex = {c, a};
-    e.weight = {1.0, -1.0};
-    return search3_with_frame(e, n, g0, mu, r, pair);
+    return node_on_facet_weighted<3>(c, {f.v[0], f.v[1], f.v[2]}, {-bary[0], -bary[1], -bary[2]}, n,
+                                     g0, mu, r, pair);
 }
 
 namespace {
@@ -541,7 +513,7 @@ SearchResult3 node_on_node_search3(const mesh::TetMesh& m, const std::vector<int
             continue;
         }
         const Vec3 n = index.vertex_normal(best);
-        res.elements.push_back(node_on_node3(
+        res.elements.push_back(node_on_node<3>(
             c, best, n, n.dot(x - m.vertices[static_cast<size_t>(best)]), mu, r, pair));
     }
     return res;

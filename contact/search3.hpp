@@ -143,18 +143,14 @@ struct SearchResult3 {
 };
 
 /// Node-on-facet element in 3D: contactor vertex c against the target triangle f, the projection
-/// of c at barycentric coordinates `bary`: weights (1, -bary[0], -bary[1], -bary[2]) on
-/// (c, f.v[0], f.v[1], f.v[2]), n the unit normal toward the contactor, t = tangent_basis(n),
-/// g0 the initial signed gap. Throws InvalidInput for a coordinate outside [0, 1], coordinates
-/// not summing to 1 (to 1e-10), a normal that is not of unit length, or c a corner of f.
+/// of c at barycentric coordinates `bary`: node_on_facet_weighted with the weights
+/// (1, -bary[0], -bary[1], -bary[2]) on (c, f.v[0], f.v[1], f.v[2]), n the unit normal toward
+/// the contactor, t = tangent_basis(n), g0 the initial signed gap. Throws InvalidInput for a
+/// coordinate outside [0, 1], coordinates not summing to 1 (to 1e-10), a normal that is not of
+/// unit length, c a corner of f, or a corner of f repeated. The node-on-node element in 3D is
+/// node_on_node<3> (contact/element.hpp).
 ContactElement3 node_on_facet3(int c, const Facet3& f, const std::array<double, 3>& bary,
                                const mesh::Vec3& n, double g0, double mu, double r, int pair);
-
-/// Node-on-node element in 3D: contactor vertex c against target vertex a (a matching
-/// interface): weights (1, -1), n the unit target normal toward the contactor,
-/// t = tangent_basis(n). Throws InvalidInput for a normal that is not of unit length or c == a.
-ContactElement3 node_on_node3(int c, int a, const mesh::Vec3& n, double g0, double mu, double r,
-                              int pair);
 
 /// Node-on-facet search in 3D (the counterpart of node_on_facet_search with its nodal weights). A
 /// contactor vertex c of `m` is a contact node when `reference` has a facet within

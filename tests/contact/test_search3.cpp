@@ -548,8 +548,13 @@ TEST(Search3, MissingTargetTagAndBadElementsAreRefused) {
               }),
               "node_on_facet3: contactor vertex 2 is a corner of its facet");
     EXPECT_EQ(
-        search3_refusal([&] { contact::node_on_node3(0, 1, Vec3(0, 0, 2), 0.0, 0.0, 1.0, 0); }),
-        "node_on_node3: the normal must have unit length, found |n| = 2");
+        search3_refusal([&] { contact::node_on_node<3>(0, 1, Vec3(0, 0, 2), 0.0, 0.0, 1.0, 0); }),
+        "node_on_node: the normal must have unit length, found |n| = 2");
+    EXPECT_EQ(search3_refusal([&] {
+                  contact::node_on_facet3(0, contact::Facet3{{1, 1, 3}}, {0.2, 0.3, 0.5},
+                                          Vec3::UnitZ(), 0.0, 0.0, 1.0, 0);
+              }),
+              "node_on_facet_weighted: target vertex 1 repeats");
     // A well-formed element: weights (1, -bary), the frame of tangent_basis.
     const auto e = contact::node_on_facet3(0, f, {0.2, 0.3, 0.5}, Vec3::UnitX(), 0.1, 0.4, 3.0, 5);
     EXPECT_EQ(e.n_nodes(), 4);
@@ -559,6 +564,12 @@ TEST(Search3, MissingTargetTagAndBadElementsAreRefused) {
     EXPECT_EQ(e.vertex[3], 3);
     EXPECT_EQ(e.t, contact::tangent_basis<3>(Vec3::UnitX()));
     EXPECT_EQ(e.n_multipliers(), 3);
+    const auto nn = contact::node_on_node<3>(0, 1, Vec3::UnitY(), 0.2, 0.0, 3.0, 5);
+    EXPECT_EQ(nn.vertex, (std::vector<int>{0, 1}));
+    EXPECT_EQ(nn.weight, (std::vector<double>{1.0, -1.0}));
+    EXPECT_EQ(nn.t, contact::tangent_basis<3>(Vec3::UnitY()));
+    EXPECT_EQ(nn.g0, 0.2);
+    EXPECT_EQ(nn.n_multipliers(), 1);
 }
 
 TEST(Search3, IndexOfOneFacetAnswersLikeTheProjection) {
