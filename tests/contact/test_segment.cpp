@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Segment-integrated (mortar-type, lumped) node-on-facet weights on a hand-made non-matching
 // pair: weights (1, -M_ik / D_i) with D_i = int N_i ds and M_ik = int N_i N_k ds computed by hand,
-// their sum zero, and the renormalisation by the covered part at an end of the target.
+// their sum zero, and the renormalisation by the covered part at an end of the target; an element
+// with twenty target vertices against the closed forms of its relative displacement, residual
+// and tangent.
 #include "contact/search.hpp"
 #include "core/check.hpp"
 
@@ -139,4 +141,100 @@ TEST(SegmentWeights, BadInputIsRejected) {
                  InvalidInput);
     EXPECT_THROW(contact::node_on_facet_weighted(4, {0, 1}, {-1.0}, Vec2(0, 1), 0.0, 0.0, 1.0, 0),
                  InvalidInput);
+}
+
+TEST(SegmentWeights, ElementWithTwentyTargetsEvaluatesAndLinearizesInClosedForm) {
+    // Contactor vertex 0, targets k = 1 .. 20 with weights w_k = -k / 210 (sum -1), the normal
+    // n = (0.6, 0.8) and so t = (n_y, -n_x) = (0.8, -0.6).
+    constexpr int m = 20;
+    std::vector<int> targets;
+    std::vector<double> w;
+    for (int k = 1; k <= m; ++k) {
+        targets.push_back(k);
+        w.push_back(-k / 210.0);
+    }
+    const Vec2 n(0.6, 0.8);
+    const double g0 = 0.05, mu = 0.5, r = 10.0;
+    const auto e = contact::node_on_facet_weighted(0, targets, w, n, g0, mu, r, 3);
+    ASSERT_EQ(e.n_nodes(), m + 1);
+    ASSERT_EQ(e.vertex.size(), e.weight.size());
+    EXPECT_EQ(e.vertex[0], 0);
+    EXPECT_EQ(e.weight[0], 1.0);
+    double sum = 0.0;
+    for (int j = 1; j <= m; ++j) {
+        EXPECT_EQ(e.vertex[static_cast<size_t>(j)], j);
+        sum += e.weight[static_cast<size_t>(j)];
+    }
+    EXPECT_NEAR(sum, -1.0, 1e-15);
+    EXPECT_EQ(e.t, Vec2(0.8, -0.6));
+    EXPECT_EQ(e.n, n);
+
+    // u_0 = (0.3, -0.2), u_k = (a k, b k^2), u_prev = 0: with sum k^2 = 2870, sum k^3 = 44100,
+    // u_rel = u_0 - (a 2870, b 44100) / 210.
+    const double a = 1e-3, b = 1e-4;
+    Vector u = Vector::Zero(2 * (m + 1));
+    u.segment<2>(0) = Vec2(0.3, -0.2);
+    for (int k = 1; k <= m; ++k)
+        u.segment<2>(2 * k) = Vec2(a * k, b * k * k);
+    const Vec2 du = Vec2(0.3, -0.2) - Vec2(a * 2870.0, b * 44100.0) / 210.0;
+    const double d_n = g0 + n.dot(du), d_t = e.t.dot(du);
+    // Every displacement free; the contactor carries (lambda_t, lambda_n).
+    std::vector<std::array<bool, 2>> fixed(m + 1, {false, false});
+    std::vector<int> extra(m + 1, 0);
+    extra[0] = 2;
+    const fem::DofMap dofs(fixed, extra);
+    const int ld = dofs.extra_dof(0);
+    Vector x = Vector::Zero(dofs.n_dofs());
+    x[ld] = 0.0;       // lambda_t
+    x[ld + 1] = -10.0; // lambda_n: sigma = (r d_t, -10 + r d_n), inside the cone (stick)
+    const auto s = contact::evaluate(e, u, Vector::Zero(u.size()), x, ld);
+    EXPECT_NEAR(s.d_n, d_n, 1e-15);
+    EXPECT_NEAR(s.d_t[0], d_t, 1e-15);
+    ASSERT_EQ(s.proj.status, contact::Status::stick);
+    EXPECT_NEAR(s.proj.phi[0], r * d_t, 1e-14);
+    EXPECT_NEAR(s.proj.phi[1], -10.0 + r * d_n, 1e-14);
+    EXPECT_EQ(s.proj.M, Eigen::Matrix2d::Identity());
+
+    // The residual: w_j (t Phi_t + n Phi_n) at vertex j, and R_lambda = -(lambda - Phi) / r.
+    Vector R = Vector::Zero(dofs.n_dofs());
+    contact::add_residual(e, s, dofs, ld, R);
+    const Vec2 force = (r * d_t) * e.t + (-10.0 + r * d_n) * n;
+    for (int j = 0; j <= m; ++j) {
+        const double wj = j == 0 ? 1.0 : -j / 210.0;
+        for (int c = 0; c < 2; ++c)
+            EXPECT_NEAR(R[dofs.u_dof(j, c)], wj * force[c], 1e-14) << "vertex " << j;
+    }
+    EXPECT_NEAR(R[ld], d_t, 1e-15);     // -(0 - r d_t) / r
+    EXPECT_NEAR(R[ld + 1], d_n, 1e-15); // -(-10 - (-10 + r d_n)) / r
+
+    // The tangent with M = I (stick): G M G^T = I, so uu = r w_j w_k delta_ab, u-lambda w_j G,
+    // lambda-u its transpose, lambda-lambda (M - I) / r = 0; every pair of the element's
+    // (2 (m + 1) + 2) unknowns appears once.
+    const int size = static_cast<int>(dofs.n_dofs());
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(size, size);
+    int calls = 0;
+    contact::for_each_tangent_entry(e, s.proj.M, dofs, ld, [&](int i, int j, double v) {
+        J(i, j) += v;
+        ++calls;
+    });
+    EXPECT_EQ(calls, (2 * (m + 1) + 2) * (2 * (m + 1) + 2));
+    Eigen::Matrix2d G;
+    G.col(0) = e.t;
+    G.col(1) = n;
+    Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(size, size);
+    for (int j = 0; j <= m; ++j) {
+        const double wj = j == 0 ? 1.0 : -j / 210.0;
+        for (int c = 0; c < 2; ++c) {
+            const int row = dofs.u_dof(j, c);
+            for (int k = 0; k <= m; ++k) {
+                const double wk = k == 0 ? 1.0 : -k / 210.0;
+                expected(row, dofs.u_dof(k, c)) = r * wj * wk;
+            }
+            for (int q = 0; q < 2; ++q) {
+                expected(row, ld + q) = wj * G(c, q);
+                expected(ld + q, row) = wj * G(c, q);
+            }
+        }
+    }
+    EXPECT_LE((J - expected).cwiseAbs().maxCoeff(), 1e-14);
 }
