@@ -3,7 +3,8 @@
 // polygons and the integral of linear products against closed forms, the weights on matching
 // meshes (the consistent mass row; the identity for the dual ones), on non-matching flat meshes
 // (sum zero, linear fields, the patch test), on curved surfaces, on a partly covered patch, and
-// the refusals.
+// the refusals; a node-on-facet element built from the weights of a node with many target
+// vertices, exact for rigid translations and linear fields.
 #include "contact/mortar3.hpp"
 #include "core/check.hpp"
 
@@ -554,4 +555,65 @@ TEST(Mortar3Weights, RefusesDegenerateTrianglesAndBadArguments) {
     EXPECT_NEAR(w.D, 1.0 / 6, 1e-16);
     // N_0 of the contactor and N_7 of the target coincide on the same triangle: M = 1/12.
     EXPECT_NEAR(weight_map(w).at(7), -0.5, 1e-15);
+}
+
+TEST(Mortar3Weights, ElementWithManyTargetsIsExactForRigidAndLinearFields) {
+    // A coarse contactor (2 x 2 cells of 0.5 over [0, 1]^2 at height h, normal down) over a fine
+    // target (cells of 0.15 turned by 17 degrees about (0.5, 0.5), at z = 0): the middle node
+    // (0.5, 0.5, h), whose patch is symmetric about it, gets many target vertices, and a
+    // node-on-facet element is built from its segment weights.
+    const double h = 0.01;
+    const Grid c = make_grid(
+        2, 2, 0.5, Vec2(0, 0), 0.0, [&](double, double) { return h; }, 0, false);
+    const double a = 17.0 * std::numbers::pi / 180, ht = 0.15;
+    const Vec2 origin = Vec2(0.5, 0.5) - Vec2(std::cos(a) * 7 * ht - std::sin(a) * 7 * ht,
+                                              std::sin(a) * 7 * ht + std::cos(a) * 7 * ht);
+    const Grid t = make_grid(14, 14, ht, origin, a, flat, 1000, true);
+    const int node = c.id(1, 1);
+    const Vec3 n = Vec3::UnitZ();
+    const auto w =
+        contact::mortar_weights3(node, c.patch(node), n, t.tris, FacetIntegration::segment);
+    ASSERT_NEAR(w.D_covered / w.D, 1.0, 1e-13); // the whole patch lies over the target
+    const double mu = 0.3, r = 5.0;
+    const auto e = contact::node_on_facet_weighted<3>(node, w.targets, w.weights, n, h, mu, r, 0);
+    ASSERT_EQ(e.n_nodes(), 1 + static_cast<int>(w.targets.size()));
+    EXPECT_GE(e.n_nodes(), 13); // more than twelve target vertices
+    EXPECT_EQ(e.vertex[0], node);
+    double sum = 0.0;
+    for (int j = 1; j < e.n_nodes(); ++j)
+        sum += e.weight[static_cast<size_t>(j)];
+    EXPECT_NEAR(sum, -1.0, 1e-14);
+    EXPECT_EQ(e.t, contact::tangent_basis<3>(n));
+
+    // Nodal displacements of the field u on every vertex; the previous step at rest.
+    const int n_vertices = t.first + static_cast<int>(t.x.size());
+    auto nodal = [&](const std::function<Vec3(const Vec3&)>& u) {
+        Vector out = Vector::Zero(3 * n_vertices);
+        for (int id = 0; id < static_cast<int>(c.x.size()); ++id)
+            out.segment<3>(3 * (c.first + id)) = u(c.x[static_cast<size_t>(id)]);
+        for (int id = 0; id < static_cast<int>(t.x.size()); ++id)
+            out.segment<3>(3 * (t.first + id)) = u(t.x[static_cast<size_t>(id)]);
+        return out;
+    };
+    const Vector rest = Vector::Zero(3 * n_vertices);
+    const Vector lambda = Vector::Zero(3);
+
+    // A rigid translation opens no gap and slips nothing.
+    const Vec3 b(0.3, -0.7, 0.2);
+    const auto s0 = contact::evaluate(e, nodal([&](const Vec3&) { return b; }), rest, lambda, 0);
+    EXPECT_NEAR(s0.d_n, h, 1e-14);
+    EXPECT_NEAR(s0.d_t.norm(), 0.0, 1e-14);
+
+    // A linear field u = A x + b: u_rel = A (x_c - p), p = (0.5, 0.5, 0) the projection of the
+    // node on the target (the N_i-weighted mean of the symmetric patch is the node itself):
+    // the relative displacement of the two material points, d_n = h + n . A (h e_z).
+    Eigen::Matrix3d A;
+    A << 0.3, -0.2, 0.5, 0.1, 0.4, -0.6, -0.7, 0.2, 0.9;
+    const auto s1 = contact::evaluate(e, nodal([&](const Vec3& x) { return Vec3(A * x + b); }),
+                                      rest, lambda, 0);
+    const Vec3 du = A * Vec3(0, 0, h);
+    EXPECT_NEAR(s1.d_n, h + n.dot(du), 1e-14);
+    EXPECT_NEAR(s1.d_t[0], e.t.col(0).dot(du), 1e-14);
+    EXPECT_NEAR(s1.d_t[1], e.t.col(1).dot(du), 1e-14);
+    EXPECT_GT(std::abs(s1.d_t[0]) + std::abs(s1.d_t[1]), 1e-3); // the field does slip
 }
