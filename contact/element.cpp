@@ -153,6 +153,19 @@ held_components(const BasicContactElement<dim>& e,
         out.pinned = Element::kPinnedT;
         return out;
     }
+    if constexpr (dim == 3) {
+        // One component c held, and n across it: the tangent along e_c carries no force (the
+        // support takes it), the other tangent n x e_c is free. The frame is turned so that t1
+        // is (the part across n of) e_c: its multiplier is pinned alone.
+        const auto n_held = std::count(held.begin(), held.end(), true);
+        for (int c = 0; c < dim; ++c)
+            if (n_held == 1 && held[static_cast<size_t>(c)] &&
+                std::abs(e.n[c]) <= kHeldDirectionTolerance) {
+                out.pinned = Element::kPinnedT1;
+                out.pinned_axis = c;
+                return out;
+            }
+    }
     // The frame spans the space: it meets the held components without lying in them.
     out.ambiguous = true;
     return out;
@@ -182,15 +195,21 @@ BasicElementState<dim> evaluate(const BasicContactElement<dim>& e, const Vector&
     using Tangential = Eigen::Matrix<double, dim - 1, 1>;
     if (e.frictional()) {
         // Pinned tangents project as sigma_t = 0: the status follows the normal alone.
+        // A pinned first tangent (3D) projects with sigma_t1 = 0: the law acts on t2 alone.
         const bool pin_t = (e.pinned & Element::kPinnedT) != 0;
-        const Tangential sigma_t =
-            pin_t ? Tangential(Tangential::Zero())
-                  : Tangential(s.lambda.template head<dim - 1>() + e.r * s.d_t);
+        const bool pin_t1 = (e.pinned & Element::kPinnedT1) != 0;
+        Tangential sigma_t = Tangential::Zero();
+        if (!pin_t) sigma_t = s.lambda.template head<dim - 1>() + e.r * s.d_t;
+        if (pin_t1) sigma_t[0] = 0.0;
         s.proj = project<dim>(sigma_t, s.lambda[dim - 1] + e.r * s.d_n, e.mu);
         if (pin_t) {
             s.proj.phi.template head<dim - 1>().setZero();
             s.proj.M.template topRows<dim - 1>().setZero();
             s.proj.M.template leftCols<dim - 1>().setZero();
+        } else if (pin_t1) {
+            s.proj.phi[0] = 0.0;
+            s.proj.M.row(0).setZero();
+            s.proj.M.col(0).setZero();
         }
     } else {
         s.proj = project<dim>(Tangential::Zero(), s.lambda[dim - 1] + e.r * s.d_n, 0.0);
@@ -219,6 +238,16 @@ void add_residual(const BasicContactElement<dim>& e, const BasicElementState<dim
     } else {
         R[lambda_dof] = -(s.lambda[dim - 1] - s.proj.phi[dim - 1]) / e.r;
     }
+}
+
+void turn_first_tangent_onto_axis(BasicContactElement<3>& e, int axis) {
+    MLC_CHECK(axis >= 0 && axis < 3, "turn_first_tangent_onto_axis: axis " << axis);
+    Eigen::Vector3d t1 = Eigen::Vector3d::Unit(axis);
+    t1 -= t1.dot(e.n) * e.n;
+    MLC_CHECK(t1.norm() > 0.5, "turn_first_tangent_onto_axis: the normal lies along axis " << axis);
+    t1.normalize();
+    e.t.col(0) = t1;
+    e.t.col(1) = e.n.cross(t1);
 }
 
 #define MLC_CONTACT_ELEMENT(dim)                                                                   \

@@ -72,8 +72,9 @@ template <int dim> struct BasicContactElement {
     /// Frictional elements carry (lambda_t, lambda_n); frictionless ones lambda_n only.
     bool frictional() const { return mu > 0.0; }
     int n_multipliers() const { return frictional() ? dim : 1; }
-    /// Bits of `pinned`: the tangential multipliers, the normal one.
-    static constexpr unsigned char kPinnedT = 1, kPinnedN = 2;
+    /// Bits of `pinned`: the tangential multipliers, the normal one, and (3D) the first tangent
+    /// alone (turn_first_tangent_onto_axis: t1 along a held axis, t2 free).
+    static constexpr unsigned char kPinnedT = 1, kPinnedN = 2, kPinnedT1 = 4;
 
 private:
     /// The tangents of the default normal e_(dim-1): 2D (1, 0), 3D tangent_basis(e_z).
@@ -97,6 +98,9 @@ inline constexpr double kHeldDirectionTolerance = 1e-8;
 /// What the supports leave of an element's multipliers (held_components).
 struct HeldComponents {
     unsigned char pinned = 0; ///< ContactElement::pinned for the element
+    /// With kPinnedT1 (3D): the held axis the element's first tangent must be turned onto
+    /// (turn_first_tangent_onto_axis) before `pinned` applies; -1 otherwise.
+    int pinned_axis = -1;
     /// true when a multiplier component the supports do not hold still has a part along a
     /// held direction (an obstacle inclined to a support's axes, with friction): the support
     /// and the contact then share a force direction and the multipliers are not unique.
@@ -109,13 +113,22 @@ struct HeldComponents {
 /// and their multiplier appears in no equation. A direction g counts as held when its part
 /// along the components some vertex leaves free has norm at most kHeldDirectionTolerance. The
 /// normal held pins every component; otherwise every tangent held pins the tangential
-/// multipliers (in 3D, one tangent held and the other not is `ambiguous`). Rigid obstacles
+/// multipliers. In 3D, when exactly one component c is held and n lies across e_c (to
+/// kHeldDirectionTolerance), the first tangent alone is pinned (kPinnedT1, pinned_axis = c: the
+/// frame must be turned with turn_first_tangent_onto_axis): a symmetry plane crossing frictional
+/// contact nodes holds their tangential force across the plane and leaves the other tangent's
+/// friction to the law (the Coulomb disc reduced to an interval). Any other frame that meets the
+/// held directions in part is `ambiguous`. Rigid obstacles
 /// (one vertex) pin where the contactor's components are held; two-body elements only where
 /// the target vertices' matching components are held too.
 template <int dim>
 HeldComponents
 held_components(const BasicContactElement<dim>& e,
                 const std::type_identity_t<std::vector<std::array<bool, dim>>>& fixed);
+
+/// Turns the tangents of 3D element `e` so that t1 is the unit part of e_axis across n and
+/// t2 = n x t1 (the frame held_components asks for with kPinnedT1).
+void turn_first_tangent_onto_axis(BasicContactElement<3>& e, int axis);
 
 /// Node-on-rigid elements for the given contactor vertices against an obstacle (frame and gap
 /// from BasicObstacle::frame and tangent_basis).

@@ -304,4 +304,31 @@ MortarWeights3 mortar_weights3(int node, const std::vector<SurfaceTriangle>& pat
     return res;
 }
 
+ContactElement3 segment_element3(const mesh::TetMesh& m, const ContactElement3& nodal,
+                                 const std::vector<SurfaceTriangle>& patch,
+                                 const FacetIndex3& index, double reach,
+                                 FacetIntegration integration) {
+    const int c = nodal.vertex[0];
+    const mesh::Vec3 xc = m.vertices[static_cast<size_t>(c)];
+    double extent = 0.0; // the patch lies within this distance of c
+    for (const SurfaceTriangle& t : patch)
+        for (const mesh::Vec3& x : t.x)
+            extent = std::max(extent, (x - xc).norm());
+    std::vector<SurfaceTriangle> targets;
+    for (int i : index.within(xc, extent + reach)) {
+        SurfaceTriangle t;
+        t.v = index.facets()[static_cast<size_t>(i)].v;
+        t.x = index.corners(i);
+        targets.push_back(t);
+    }
+    const MortarWeights3 w = mortar_weights3(c, patch, nodal.n, targets, integration, reach);
+    if (w.pieces == 0 || !(w.D_covered > 1e-12 * w.D)) return nodal;
+    ContactElement3 e = nodal;
+    e.vertex.assign(1, c);
+    e.weight.assign(1, 1.0);
+    e.vertex.insert(e.vertex.end(), w.targets.begin(), w.targets.end());
+    e.weight.insert(e.weight.end(), w.weights.begin(), w.weights.end());
+    return e;
+}
+
 } // namespace mlc::contact

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "contact/element.hpp"
+#include "contact/search3.hpp"
 #include "core/types.hpp"
 #include "mesh/simplex_mesh.hpp"
 
@@ -105,5 +106,17 @@ MortarWeights3 mortar_weights3(int node, const std::vector<SurfaceTriangle>& pat
                                const mesh::Vec3& n, const std::vector<SurfaceTriangle>& targets,
                                FacetIntegration integration,
                                double reach = std::numeric_limits<double>::infinity());
+
+/// The segment or dual node-on-facet element of contactor vertex `c` of mesh `m` (the 3D
+/// counterpart of 2D node_on_facet_search's segment elements): `nodal` is its node-on-facet
+/// element with the nodal weights (node_on_facet_search3: the normal n, the tangents and g0 are
+/// kept), `patch` the contactor faces at c (the support of its shape function), `index` the
+/// level's target faces and `reach` the search distance of c. The targets tried are the faces
+/// of `index` within reach of the patch; mortar_weights3 gives the weights (1, -M_ck / D_c^cov).
+/// A node whose patch covers nothing keeps `nodal`.
+ContactElement3 segment_element3(const mesh::TetMesh& m, const ContactElement3& nodal,
+                                 const std::vector<SurfaceTriangle>& patch,
+                                 const FacetIndex3& index, double reach,
+                                 FacetIntegration integration);
 
 } // namespace mlc::contact

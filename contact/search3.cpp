@@ -4,6 +4,8 @@
 // linearly in a build without CGAL).
 #include "contact/search3.hpp"
 
+#include "contact/mortar3.hpp"
+
 #include "core/check.hpp"
 
 #include <Eigen/Geometry>
@@ -443,8 +445,25 @@ std::vector<Facet3> search3_targets(const mesh::TetMesh& m, int target_tag) {
 
 SearchResult3 node_on_facet_search3(const mesh::TetMesh& m, const std::vector<int>& contactors,
                                     int target_tag, const FacetIndex3& reference,
-                                    double search_radius, double mu, double r, int pair) {
+                                    double search_radius, double mu, double r, int pair,
+                                    FacetIntegration integration, int contactor_tag) {
     const FacetIndex3 index(m.vertices, search3_targets(m, target_tag));
+    // Segment and dual weights: the contactor faces at each vertex (the support of its shape
+    // function on the contactor surface).
+    std::unordered_map<int, std::vector<SurfaceTriangle>> patch;
+    if (integration != FacetIntegration::nodal) {
+        MLC_CHECK(contactor_tag >= 0,
+                  "contact search: segment integration needs the contactor faces' tag");
+        for (const auto& f : m.boundary) {
+            if (f.tag != contactor_tag) continue;
+            SurfaceTriangle t;
+            t.v = f.v;
+            for (size_t k = 0; k < 3; ++k)
+                t.x[k] = m.vertices[static_cast<size_t>(f.v[k])];
+            for (int v : f.v)
+                patch[v].push_back(t);
+        }
+    }
     SearchResult3 res;
     res.elements.reserve(contactors.size());
     for (int c : contactors) {
@@ -461,8 +480,19 @@ SearchResult3 node_on_facet_search3(const mesh::TetMesh& m, const std::vector<in
             res.not_found.push_back(c);
             continue;
         }
-        res.elements.push_back(node_on_facet3(c, index.facets()[static_cast<size_t>(hit->facet)],
-                                              hit->bary, hit->n, hit->g0, mu, r, pair));
+        auto e = node_on_facet3(c, index.facets()[static_cast<size_t>(hit->facet)], hit->bary,
+                                hit->n, hit->g0, mu, r, pair);
+        if (integration != FacetIntegration::nodal) {
+            const auto it = patch.find(c);
+            MLC_CHECK(it != patch.end(),
+                      "contact search: contactor vertex "
+                          << c << " (" << x.x() << ", " << x.y() << ", " << x.z()
+                          << ") is on no face tagged '" << m.tag_name(contactor_tag)
+                          << "': segment integration needs the contactor faces");
+            e = segment_element3(m, e, it->second, index, radius + reference.max_size(),
+                                 integration);
+        }
+        res.elements.push_back(std::move(e));
     }
     return res;
 }

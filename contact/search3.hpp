@@ -162,11 +162,23 @@ ContactElement3 node_on_facet3(int c, const Facet3& f, const std::array<double, 
 /// radius plus the reference's largest facet): weights (1, -N_a, -N_b, -N_c) with N the
 /// barycentric coordinates of the closest point, the normal of the file's rule, t =
 /// tangent_basis(n), g0 = n . (x_c - p). Contactor vertices that are not contact nodes are
-/// listed in `not_found`, in input order. Throws InvalidInput when the mesh has no boundary
-/// face tagged `target_tag`, or for a degenerate target triangle.
+/// listed in `not_found`, in input order.
+///
+/// With `integration` = FacetIntegration::segment or dual (then `contactor_tag`, the tag of the
+/// contactor faces, is required) the contact nodes, n, t and g0 are the same, but the weights
+/// are those of mortar_weights3 (contact/mortar3.hpp: the node's contactor faces projected on
+/// its plane, clipped against the target faces within the node's search distance, integrated
+/// exactly; segment_element3), which pass the contact patch test on non-matching meshes. A node
+/// whose patch covers nothing keeps the nodal weights.
+///
+/// Throws InvalidInput when the mesh has no boundary face tagged `target_tag`, for a degenerate
+/// target triangle, or (segment, dual) when `contactor_tag` is missing or a contactor vertex is
+/// on no face with it.
 SearchResult3 node_on_facet_search3(const mesh::TetMesh& m, const std::vector<int>& contactors,
                                     int target_tag, const FacetIndex3& reference,
-                                    double search_radius, double mu, double r, int pair);
+                                    double search_radius, double mu, double r, int pair,
+                                    FacetIntegration integration = FacetIntegration::nodal,
+                                    int contactor_tag = -1);
 
 /// Node-on-node search in 3D for matching interfaces: for each contactor vertex c, the target
 /// vertex (a corner of a face tagged `target_tag`) nearest to c (ties to the lower index),

@@ -6,6 +6,7 @@
 #include "levels/elastic3d_detail.hpp"
 
 #include "contact/element.hpp"
+#include "contact/search3.hpp"
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 #include "mesh/tet_refine.hpp"
@@ -200,6 +201,26 @@ void ElasticProblem3::validate() const {
             MLC_CHECK((c.region->lo.array() <= c.region->hi.array()).all(),
                       w << ": the region's min " << point_text(c.region->lo) << " exceeds its max "
                         << point_text(c.region->hi) << " in some coordinate");
+        if (c.two_body()) {
+            const auto tid = mesh0.find_tag(c.target);
+            MLC_CHECK(tid && mesh0.is_boundary_tag(*tid),
+                      w << ": the target tag '" << c.target
+                        << "' is a tag of no boundary face (the boundary face tags are: "
+                        << face_tags(mesh0) << ")");
+            MLC_CHECK(c.target != c.contactor,
+                      w << ": the target and the contactor are the same tag '" << c.target
+                        << "'; a body's face cannot contact itself");
+            MLC_CHECK(std::isfinite(c.search_radius) && c.search_radius > 0,
+                      w << ": search_radius must be > 0, found " << c.search_radius);
+            MLC_CHECK(std::isfinite(c.match_tolerance) && c.match_tolerance > 0,
+                      w << ": match_tolerance must be > 0, found " << c.match_tolerance);
+            MLC_CHECK(c.element == ContactElementKind::node_on_facet ||
+                          c.integration == contact::FacetIntegration::nodal,
+                      w << ": integration = \"" << contact::to_string(c.integration)
+                        << "\" is for node_on_facet elements; node_on_node pairs have the "
+                           "weights (1, -1)");
+            continue;
+        }
         contact::BasicObstacle<3> o = c.obstacle;
         try {
             o.validate();
@@ -212,6 +233,24 @@ void ElasticProblem3::validate() const {
 // ------------------------------------------------------------------------------------------
 
 namespace {
+
+/// The two-body elements of pair k for the contactor vertices `nodes` of level mesh m. Whether a
+/// vertex is a contact node is decided on the level-0 target faces (node on facet), the same on
+/// every level, so that the contact nodes nest (transfer/ requires it).
+contact::SearchResult3 two_body_search3(const ElasticProblem3& p, const mesh::TetMesh& m,
+                                        size_t k, const std::vector<int>& nodes) {
+    const ContactPair3& pair = p.contacts[k];
+    const int ip = static_cast<int>(k);
+    if (pair.element == ContactElementKind::node_on_node)
+        return contact::node_on_node_search3(m, nodes, m.tag(pair.target), pair.match_tolerance,
+                                             pair.mu, pair.r, ip);
+    const auto& m0 = p.mesh0;
+    const contact::FacetIndex3 reference(m0.vertices,
+                                         contact::target_facets3(m0, m0.tag(pair.target)));
+    return contact::node_on_facet_search3(m, nodes, m.tag(pair.target), reference,
+                                          pair.search_radius, pair.mu, pair.r, ip,
+                                          pair.integration, m.tag(pair.contactor));
+}
 
 /// The contact elements of every pair (Level3::contacts, contact_of_vertex, not_found) and the
 /// multipliers of each vertex (n_extra, sized to the vertices); L.fixed is set.
@@ -245,8 +284,26 @@ void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& 
                                               << " lie outside the region, " << fixed
                                               << " have all three components fixed by supports and "
                                               << claimed << " belong to an earlier contact pair");
-        for (const auto& e : contact::node_on_rigid<3>(m, nodes, pair.obstacle, pair.mu, pair.r,
-                                                       static_cast<int>(k))) {
+        std::vector<contact::ContactElement3> elements;
+        if (pair.two_body()) {
+            auto found = two_body_search3(p, m, k, nodes);
+            for (int v : found.not_found)
+                L.contact_of_vertex[static_cast<size_t>(v)] = -1;
+            MLC_CHECK(!found.elements.empty(),
+                      "contact '" << pair.name << "': none of the " << nodes.size()
+                                  << " contactor vertices on '" << pair.contactor
+                                  << "' found a target on '" << pair.target << "' ("
+                                  << (pair.element == ContactElementKind::node_on_node
+                                          ? "no target vertex within match_tolerance"
+                                          : "no target face within search_radius")
+                                  << " of any of them)");
+            L.not_found[k] = std::move(found.not_found);
+            elements = std::move(found.elements);
+        } else {
+            elements = contact::node_on_rigid<3>(m, nodes, pair.obstacle, pair.mu, pair.r,
+                                                 static_cast<int>(k));
+        }
+        for (const auto& e : elements) {
             L.contact_of_vertex[static_cast<size_t>(e.vertex[0])] =
                 static_cast<int>(L.contacts.size());
             n_extra[static_cast<size_t>(e.vertex[0])] = e.n_multipliers();
@@ -255,9 +312,10 @@ void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& 
     }
 }
 
-/// Sets ContactElement3::pinned of every element from the fixed components of its vertex
-/// (contact::held_components); throws InvalidInput for an element whose supports hold a
-/// direction its frame meets only in part.
+/// Sets ContactElement3::pinned of every element from the fixed components of its vertices
+/// (contact::held_components), turning the frame of an element whose first tangent alone is
+/// pinned onto the held axis (a symmetry plane across frictional contact nodes); throws
+/// InvalidInput for an element whose supports hold a direction its frame meets only in part.
 void pin_held_components3(const ElasticProblem3& p, Level3& L) {
     for (auto& e : L.contacts) {
         const auto h = contact::held_components<3>(e, L.fixed);
@@ -279,6 +337,8 @@ void pin_held_components3(const ElasticProblem3& p, Level3& L) {
                         << component_list(held)
                         << ", make the pair frictionless (mu = 0), or leave the vertex out of the "
                            "contact (its region)");
+        if (h.pinned & contact::ContactElement3::kPinnedT1)
+            contact::turn_first_tangent_onto_axis(e, h.pinned_axis);
         e.pinned = h.pinned;
     }
 }

@@ -60,16 +60,33 @@ struct Support3 {
 std::vector<int> line_vertices(const mesh::TetMesh& m, const std::array<Vec3, 2>& line);
 
 /// One contact pair of a 3D problem: the contactor nodes on a tagged boundary (inside `region`,
-/// if given) against a rigid obstacle (node-on-rigid elements).
+/// if given) against a rigid obstacle (node-on-rigid elements) or against the boundary faces
+/// tagged `target` of another body (node on facet, node on node: contact/search3.hpp), with the
+/// keys and defaults of the 2D pairs (levels::ContactPair).
 struct ContactPair3 {
     std::string name;
     std::string contactor;      ///< boundary face tag of the contactor nodes
     std::optional<Box3> region; ///< keep only contactor vertices inside this box
-    contact::BasicObstacle<3> obstacle;
+    contact::BasicObstacle<3> obstacle; ///< node_on_rigid: the rigid target
+    std::string target; ///< node_on_facet, node_on_node: boundary face tag of the target
+    ContactElementKind element = ContactElementKind::node_on_rigid;
+    /// node_on_facet: a contactor node is kept when the level-0 target has a face within
+    /// search_radius * h0 of it, h0 the longest edge of the level-0 target face closest to it
+    /// (the same decision on every level, so that contact nodes nest), and it is not beyond the
+    /// rim of the target (contact::node_on_facet_search3).
+    double search_radius = 2.0;
+    /// node_on_node: a target vertex matches when within match_tolerance * h of the contactor
+    /// vertex, h the mean length of its target edges (contact::node_on_node_search3).
+    double match_tolerance = 1e-6;
+    /// node_on_facet: nodal (the closest point's barycentric weights), segment (mortar-type
+    /// lumped weights of the clipped contactor patch, contact::mortar_weights3: the patch test
+    /// exactly) or dual (the same with psi = 4 N - 1: identity weights on matching meshes).
+    contact::FacetIntegration integration = contact::FacetIntegration::nodal;
     double mu = 0.0; ///< Coulomb coefficient >= 0
     /// Augmentation parameter > 0. A 3D multiplier is a nodal force, so r has the units of a
     /// force per length (E times a length; scene/scene3.hpp's default r_over_E E h0).
     double r = 0.0;
+    bool two_body() const { return element != ContactElementKind::node_on_rigid; }
 };
 
 /// A 3D problem: the level-0 mesh (attribute = body index), bodies, loads and supports, the
@@ -92,7 +109,10 @@ struct ElasticProblem3 {
     /// that fixes nothing, levels outside 0..12, load_steps < 1, bad Newton settings
     /// (NewtonParams::validate), and per contact pair: a contactor tag on no boundary face
     /// (naming it and the face tags there are), mu < 0 or not finite, r not > 0 or not finite,
-    /// a region with min > max, a bad obstacle (BasicObstacle::validate).
+    /// a region with min > max, a bad obstacle (BasicObstacle::validate) of a node-on-rigid
+    /// pair; of a two-body pair a target tag on no boundary face, a target equal to the
+    /// contactor, search_radius or match_tolerance not > 0, an integration other than nodal for
+    /// node on node.
     void validate() const;
 };
 

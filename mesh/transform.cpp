@@ -100,19 +100,34 @@ void transform_mesh(Mesh& m, const RigidMotion& motion) {
         c.center = motion.apply(c.center);
 }
 
-void merge_into(Mesh& all, const Mesh& b, int body) {
+template <int dim> void merge_into(SimplexMesh<dim>& all, const SimplexMesh<dim>& b, int body) {
     const int voff = all.n_vertices();
-    const int coff = static_cast<int>(all.shapes.size());
+    const int soff = static_cast<int>(all.shapes.size());
     all.vertices.insert(all.vertices.end(), b.vertices.begin(), b.vertices.end());
     all.shapes.insert(all.shapes.end(), b.shapes.begin(), b.shapes.end());
-    for (const auto& t : b.cells)
-        all.cells.push_back({t[0] + voff, t[1] + voff, t[2] + voff});
+    for (auto c : b.cells) {
+        for (int& v : c)
+            v += voff;
+        all.cells.push_back(c);
+    }
     all.attribute.resize(all.cells.size(), body);
-    for (const auto& e : b.boundary)
-        all.boundary.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)),
-                                e.shape >= 0 ? e.shape + coff : -1});
+    for (auto f : b.boundary) {
+        if constexpr (dim == 2) {
+            f.v0 += voff;
+            f.v1 += voff;
+        } else {
+            for (int& v : f.v)
+                v += voff;
+        }
+        f.tag = all.add_tag(b.tag_name(f.tag));
+        f.shape = f.shape >= 0 ? f.shape + soff : -1;
+        all.boundary.push_back(f);
+    }
     for (const auto& e : b.lines)
         all.lines.push_back({e.v0 + voff, e.v1 + voff, all.add_tag(b.tag_name(e.tag)), -1});
 }
+
+template void merge_into(SimplexMesh<2>&, const SimplexMesh<2>&, int);
+template void merge_into(SimplexMesh<3>&, const SimplexMesh<3>&, int);
 
 } // namespace mlc::mesh

@@ -46,13 +46,15 @@ struct RigidMotion {
 /// Applies a rigid motion to every vertex and circle centre of `m`.
 void transform_mesh(Mesh& m, const RigidMotion& motion);
 
-/// Appends mesh `b` to `all` as body number `body`: b's vertices and circles are appended, its
-/// triangles and boundary edges renumbered accordingly (vertex indices shifted by the former
-/// vertex count of `all`, circle indices by its former circle count), its boundary tags merged
-/// by name (a name already in `all` keeps its id, a new one gets the next free id), and every
-/// appended triangle gets attribute `body` (b's own attributes are not kept). `all` may be empty;
-/// its existing triangles without an attribute get `body` too. Coincident vertices of two bodies
-/// stay distinct. Interior lines are appended like boundary edges. Nothing is checked.
-void merge_into(Mesh& all, const Mesh& b, int body);
+/// Appends mesh `b` to `all` as body number `body` (2D or 3D): b's vertices and shapes (circles,
+/// curved surfaces) are appended, its cells, boundary facets and lines renumbered accordingly
+/// (vertex indices shifted by the former vertex count of `all`, shape indices by its former
+/// shape count), its tags merged by name (a name already in `all` keeps its id, a new one gets
+/// the next free id), and every appended cell gets attribute `body` (b's own attributes are not
+/// kept). `all` may be empty; its existing cells without an attribute get `body` too. Coincident
+/// vertices of two bodies stay distinct. Nothing is checked.
+template <int dim> void merge_into(SimplexMesh<dim>& all, const SimplexMesh<dim>& b, int body);
+extern template void merge_into(SimplexMesh<2>&, const SimplexMesh<2>&, int);
+extern template void merge_into(SimplexMesh<3>&, const SimplexMesh<3>&, int);
 
 } // namespace mlc::mesh

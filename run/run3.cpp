@@ -167,9 +167,23 @@ void print_header3(std::ostream& os, const ElasticProblem3& p, const RunResult3&
     os << "scene      " << p.name << ": " << p.description << "\n";
     if (!p.units.empty()) os << "units      " << p.units << "\n";
     r.hierarchy.report(os);
-    for (const auto& c : p.contacts)
-        os << "contact    " << c.name << ": nodes on '" << c.contactor << "' against "
-           << c.obstacle << ", mu = " << c.mu << ", r = " << c.r << "\n";
+    const auto& L = r.finest();
+    for (size_t k = 0; k < p.contacts.size(); ++k) {
+        const auto& c = p.contacts[k];
+        os << "contact    " << c.name << ": nodes on '" << c.contactor << "' against ";
+        if (!c.two_body())
+            os << c.obstacle;
+        else
+            os << "'" << c.target << "' (" << levels::to_string(c.element)
+               << (c.element == levels::ContactElementKind::node_on_facet
+                       ? ", " + std::string(contact::to_string(c.integration)) + " integration"
+                       : std::string())
+               << ")";
+        os << ", mu = " << c.mu << ", r = " << c.r << "\n";
+        if (k < L.not_found.size() && !L.not_found[k].empty())
+            os << "           " << L.not_found[k].size() << " contactor vertices of '"
+               << c.contactor << "' found no target on the finest level and are left out\n";
+    }
     os << "loading    " << p.load_steps << " proportional load step(s); Newton rel_tol = "
        << p.newton.rel_tol << ", max_iter = " << p.newton.max_iter << "\n";
     os << "solve      " << (so.coarse_to_fine ? "coarse-to-fine" : "cold (finest level alone)")

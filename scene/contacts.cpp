@@ -124,38 +124,7 @@ void read_target(const Reader& rd, const toml::table& ct, const std::string& w,
     check_tag(rd, p.mesh0, ct, c.target, w, true, "target");
     if (c.target == c.contactor)
         rd.fail(ct.get("target"), w + ": the target tag is the contactor tag");
-    const std::string el = rd.string_or(ct, "element", "node_on_facet", w);
-    if (el == "node_on_facet")
-        c.element = levels::ContactElementKind::node_on_facet;
-    else if (el == "node_on_node")
-        c.element = levels::ContactElementKind::node_on_node;
-    else
-        rd.fail(ct.get("element"), w +
-                                       ".element must be \"node_on_facet\" or "
-                                       "\"node_on_node\", found \"" +
-                                       el + "\"");
-    const std::string integ = rd.string_or(ct, "integration", "nodal", w);
-    if (integ == "nodal")
-        c.integration = contact::FacetIntegration::nodal;
-    else if (integ == "segment")
-        c.integration = contact::FacetIntegration::segment;
-    else if (integ == "dual")
-        c.integration = contact::FacetIntegration::dual;
-    else
-        rd.fail(ct.get("integration"), w +
-                                           ".integration must be \"nodal\", "
-                                           "\"segment\" or \"dual\", found \"" +
-                                           integ + "\"");
-    if (c.integration != contact::FacetIntegration::nodal &&
-        c.element != levels::ContactElementKind::node_on_facet)
-        rd.fail(ct.get("integration"),
-                w + ".integration = \"" + integ +
-                    "\" applies to element = \"node_on_facet\" only, not to \"" + el + "\"");
-    c.search_radius = rd.number_or(ct, "search_radius", c.search_radius, w);
-    if (!(c.search_radius > 0)) rd.fail(ct.get("search_radius"), w + ".search_radius must be > 0");
-    c.match_tolerance = rd.number_or(ct, "match_tolerance", c.match_tolerance, w);
-    if (!(c.match_tolerance > 0 && c.match_tolerance < 0.5))
-        rd.fail(ct.get("match_tolerance"), w + ".match_tolerance must lie in (0, 0.5)");
+    read_two_body_keys(rd, ct, w, c);
 }
 
 /// A rigid obstacle: a line (point, normal) or a circle (center, radius, side), facing the body.

@@ -235,4 +235,79 @@ inline toml::table parse_toml(const std::string& text, const std::string& origin
     }
 }
 
+/// A body's `tags = { old = "new" }` (2D or 3D mesh): renames its tags before merging (tags merge
+/// by name).
+template <class MeshT>
+void rename_tags(const Reader& rd, const toml::node* tn, const std::string& w, MeshT& m) {
+    const toml::table& tt = rd.table(tn, w + ".tags");
+    std::map<int, std::string> new_name; // tag id -> new name
+    for (auto&& [k, v] : tt) {
+        const std::string from(k.str());
+        const std::string to = rd.string(&v, w + ".tags." + from);
+        if (!m.find_tag(from)) {
+            std::string known;
+            for (const auto& [n, id] : m.tag_names)
+                known += (known.empty() ? "" : ", ") + n;
+            rd.fail(&v,
+                    w + ".tags: the body's mesh has no tag '" + from + "' (it has: " + known + ")");
+        }
+        if (to.empty()) rd.fail(&v, w + ".tags." + from + ": the new name is empty");
+        new_name[m.tag(from)] = to;
+    }
+    // Tags that end up with one name are merged (as tags of two bodies are).
+    std::map<std::string, int> names;
+    std::map<int, int> merged; // tag id -> id it merges into
+    for (const auto& [name, id] : m.tag_names) {
+        const auto it = new_name.find(id);
+        const std::string n = it == new_name.end() ? name : it->second;
+        const auto [pos, inserted] = names.emplace(n, id);
+        if (!inserted) merged[id] = pos->second;
+    }
+    const auto retag = [&](auto& facets) {
+        for (auto& e : facets)
+            if (const auto it = merged.find(e.tag); it != merged.end()) e.tag = it->second;
+    };
+    retag(m.boundary);
+    retag(m.lines);
+    m.tag_names = std::move(names);
+}
+
+/// The keys of a two-body pair besides its target tag (2D or 3D pair): element kind, facet
+/// integration, search radius, match tolerance.
+template <class Pair>
+void read_two_body_keys(const Reader& rd, const toml::table& ct, const std::string& w, Pair& c) {
+    const std::string el = rd.string_or(ct, "element", "node_on_facet", w);
+    if (el == "node_on_facet")
+        c.element = levels::ContactElementKind::node_on_facet;
+    else if (el == "node_on_node")
+        c.element = levels::ContactElementKind::node_on_node;
+    else
+        rd.fail(ct.get("element"), w +
+                                       ".element must be \"node_on_facet\" or "
+                                       "\"node_on_node\", found \"" +
+                                       el + "\"");
+    const std::string integ = rd.string_or(ct, "integration", "nodal", w);
+    if (integ == "nodal")
+        c.integration = contact::FacetIntegration::nodal;
+    else if (integ == "segment")
+        c.integration = contact::FacetIntegration::segment;
+    else if (integ == "dual")
+        c.integration = contact::FacetIntegration::dual;
+    else
+        rd.fail(ct.get("integration"), w +
+                                           ".integration must be \"nodal\", "
+                                           "\"segment\" or \"dual\", found \"" +
+                                           integ + "\"");
+    if (c.integration != contact::FacetIntegration::nodal &&
+        c.element != levels::ContactElementKind::node_on_facet)
+        rd.fail(ct.get("integration"),
+                w + ".integration = \"" + integ +
+                    "\" applies to element = \"node_on_facet\" only, not to \"" + el + "\"");
+    c.search_radius = rd.number_or(ct, "search_radius", c.search_radius, w);
+    if (!(c.search_radius > 0)) rd.fail(ct.get("search_radius"), w + ".search_radius must be > 0");
+    c.match_tolerance = rd.number_or(ct, "match_tolerance", c.match_tolerance, w);
+    if (!(c.match_tolerance > 0 && c.match_tolerance < 0.5))
+        rd.fail(ct.get("match_tolerance"), w + ".match_tolerance must lie in (0, 0.5)");
+}
+
 } // namespace mlc::scene::detail

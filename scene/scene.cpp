@@ -85,38 +85,6 @@ void read_scene_table(SceneParse& sp, const toml::table& root) {
         rd.fail(s.get("levels"), "[scene].levels must lie in [0, 12]");
 }
 
-/// A body's `tags = { old = "new" }`: renames its tags before merging (tags merge by name).
-void rename_tags(const Reader& rd, const toml::node* tn, const std::string& w, mesh::Mesh& m) {
-    const toml::table& tt = rd.table(tn, w + ".tags");
-    std::map<int, std::string> new_name; // tag id -> new name
-    for (auto&& [k, v] : tt) {
-        const std::string from(k.str());
-        const std::string to = rd.string(&v, w + ".tags." + from);
-        if (!m.find_tag(from)) {
-            std::string known;
-            for (const auto& [n, id] : m.tag_names)
-                known += (known.empty() ? "" : ", ") + n;
-            rd.fail(&v,
-                    w + ".tags: the body's mesh has no tag '" + from + "' (it has: " + known + ")");
-        }
-        if (to.empty()) rd.fail(&v, w + ".tags." + from + ": the new name is empty");
-        new_name[m.tag(from)] = to;
-    }
-    // Tags that end up with one name are merged (as tags of two bodies are).
-    std::map<std::string, int> names;
-    std::map<int, int> merged; // tag id -> id it merges into
-    for (const auto& [name, id] : m.tag_names) {
-        const auto it = new_name.find(id);
-        const std::string n = it == new_name.end() ? name : it->second;
-        const auto [pos, inserted] = names.emplace(n, id);
-        if (!inserted) merged[id] = pos->second;
-    }
-    for (auto* edges : {&m.boundary, &m.lines})
-        for (auto& e : *edges)
-            if (const auto it = merged.find(e.tag); it != merged.end()) e.tag = it->second;
-    m.tag_names = std::move(names);
-}
-
 /// [[body]]: material, body force, mesh and tag renames; the bodies' meshes merged into mesh0.
 void read_bodies(SceneParse& sp, const toml::table& root) {
     const Reader& rd = sp.rd;

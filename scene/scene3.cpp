@@ -10,6 +10,7 @@
 #include "levels/diagnoses.hpp"
 #include "mesh/io/gmsh_tet.hpp"
 #include "mesh/tet_mesh.hpp"
+#include "mesh/transform.hpp"
 #include "scene/reader.hpp"
 
 #include <algorithm>
@@ -177,8 +178,9 @@ void read_surfaces(const Reader& rd, const toml::table& mt, const std::string& m
     }
 }
 
-/// The bodies' meshes: one box, or the physical volumes of one Gmsh file (a body each), with
-/// the curved surfaces their tables declare attached.
+/// The bodies' meshes: boxes (their faces renamed by `tags`, merged in body order: coincident
+/// vertices of two boxes stay distinct), or the physical volumes of one Gmsh file (a body each),
+/// with the curved surfaces their tables declare attached.
 void read_bodies3(const Reader& rd, const toml::table& root, const std::filesystem::path& base,
                   ElasticProblem3& p) {
     const auto bodies = rd.tables(root, "body", "the scene");
@@ -186,11 +188,11 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
     std::string file_text, file_name;
     std::map<int, int> body_of_volume; // physical volume tag -> body index
     std::vector<DeclaredSurface> surfaces;
+    bool boxes = false; // some body is a box (then all are)
     for (size_t i = 0; i < bodies.size(); ++i) {
         const toml::table& b = *bodies[i];
         const std::string w = "[[body]] " + std::to_string(i + 1);
-        refuse_2d_only(rd, b, {"tags"}, w);
-        rd.check_keys(b, {"name", "E", "nu", "body_force", "mesh"}, w);
+        rd.check_keys(b, {"name", "E", "nu", "body_force", "mesh", "tags"}, w);
         levels::Body3 body;
         body.name = rd.string_or(b, "name", "body" + std::to_string(i + 1), w);
         body.material.E = rd.number(b, "E", w);
@@ -206,12 +208,22 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
         if (type == "rectangle" || type == "domain")
             rd.fail(mt.get("type"), mw + ".type \"" + type +
                                         "\" is 2D-only: a 3D body's mesh is \"box\" or \"gmsh\"");
+        if ((type == "box" && !file_name.empty()) || (type == "gmsh" && boxes))
+            rd.fail(mt.get("type"), mw + ": the bodies of a 3D scene are either boxes or the "
+                                         "physical volumes of one Gmsh file, not both");
         if (type == "box") {
-            if (bodies.size() > 1)
-                rd.fail(mt.get("type"), mw + ": a box is one body; several bodies are the "
-                                             "physical volumes of one Gmsh file");
-            p.mesh0 = read_box(rd, mt, mw);
+            mesh::TetMesh m = read_box(rd, mt, mw);
+            if (const toml::node* tn = b.get("tags")) rename_tags(rd, tn, w, m);
+            if (bodies.size() == 1)
+                p.mesh0 = std::move(m);
+            else
+                mesh::merge_into(p.mesh0, m, static_cast<int>(i));
+            boxes = true;
         } else if (type == "gmsh") {
+            if (b.get("tags"))
+                rd.fail(b.get("tags"), w + ".tags renames the faces of a box; a Gmsh body's "
+                                           "faces carry the names of the file's physical "
+                                           "surfaces");
             refuse_2d_only(rd, mt, {"transform", "arcs"}, mw,
                            "a 3D body selects a physical volume with `volume` and declares its "
                            "curved faces with `surface`");
@@ -242,6 +254,11 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
         }
         p.bodies.push_back(body);
     }
+    if (boxes && bodies.size() > 1)
+        at(rd, &root, [&] {
+            mesh::check_quality(p.mesh0);
+            return 0;
+        });
     if (file_name.empty()) return;
     p.mesh0 = at(rd, &root, [&] { return mesh::read_gmsh_tet_text(file_text, file_name, ""); });
     for (const DeclaredSurface& d : surfaces)
@@ -478,21 +495,22 @@ double read_r3(const Reader& rd, const toml::table& ct, const std::string& w, do
     return r;
 }
 
-/// [[contact]]: a contactor tag (inside a region) against a rigid obstacle; two-body keys are
-/// refused (two-body contact in 3D is not available yet).
+/// [[contact]]: a contactor tag (inside a region) against a rigid obstacle, or against the
+/// faces of a target tag (two bodies: the keys of 2D pairs).
 void read_contacts3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
     double Emin = std::numeric_limits<double>::infinity();
     for (const levels::Body3& b : p.bodies)
         Emin = std::min(Emin, b.material.E);
     for (const toml::table* ct : rd.tables(root, "contact", "the scene")) {
         const std::string w = "[[contact]]";
-        for (const char* k :
-             {"target", "element", "integration", "search_radius", "match_tolerance"})
-            if (const toml::node* n = ct->get(k))
-                rd.fail(n, w + "." + k +
-                               " is 2D-only: two-body contact in 3D is not available yet (a 3D "
-                               "pair presses its contactor on a rigid obstacle)");
-        rd.check_keys(*ct, {"name", "contactor", "region", "mu", "r", "r_over_E", "obstacle"}, w);
+        rd.check_keys(*ct,
+                      {"name", "contactor", "region", "mu", "r", "r_over_E", "obstacle", "target",
+                       "element", "integration", "search_radius", "match_tolerance"},
+                      w);
+        if (ct->get("obstacle") && ct->get("target"))
+            rd.fail(ct, w + " takes an obstacle (rigid) or a target tag (two bodies), not both");
+        if (!ct->get("obstacle") && !ct->get("target"))
+            rd.fail(ct, w + " needs an obstacle (rigid) or a target tag (two bodies)");
         levels::ContactPair3 c;
         c.name = rd.string_or(*ct, "name", "contact" + std::to_string(p.contacts.size() + 1), w);
         c.contactor = rd.string(*ct, "contactor", w);
@@ -517,7 +535,25 @@ void read_contacts3(const Reader& rd, const toml::table& root, ElasticProblem3& 
                 rd.fail(rn, w + ".region: its min exceeds its max in some coordinate");
             c.region = box;
         }
-        c.obstacle = read_obstacle3(rd, *ct, w, p, c.contactor);
+        if (ct->get("target")) {
+            c.target = rd.string(*ct, "target", w);
+            const auto tid = p.mesh0.find_tag(c.target);
+            if (!tid || !p.mesh0.is_boundary_tag(*tid))
+                rd.fail(ct->get("target"), w + ": unknown target tag '" + c.target +
+                                               "': no boundary face carries it (the boundary "
+                                               "face tags are: " +
+                                               known_tags(p.mesh0, false) + ")");
+            if (c.target == c.contactor)
+                rd.fail(ct->get("target"), w + ": the target tag is the contactor tag");
+            read_two_body_keys(rd, *ct, w, c);
+        } else {
+            for (const char* k : {"element", "integration", "search_radius", "match_tolerance"})
+                if (const toml::node* n = ct->get(k))
+                    rd.fail(n, w + "." + k +
+                                   " applies to two-body pairs (with a target), not to an "
+                                   "obstacle");
+            c.obstacle = read_obstacle3(rd, *ct, w, p, c.contactor);
+        }
         p.contacts.push_back(std::move(c));
     }
 }

@@ -135,13 +135,58 @@ TEST(ContactElement3, SupportsPinTheMultipliersAlongHeldDirections) {
     // Both tangential components held: lambda_t pinned; the normal held pins everything.
     EXPECT_EQ(contact::held_components(e, Fixed{{true, true, false}}).pinned, kT);
     EXPECT_EQ(contact::held_components(e, Fixed{{false, false, true}}).pinned, kT | kN);
-    // One tangential direction held and the other free: the multipliers are not unique.
+    // One tangential direction held (x) and n across it: the first tangent, turned onto x,
+    // is pinned alone.
     const auto one = contact::held_components(e, Fixed{{true, false, false}});
-    EXPECT_EQ(one.pinned, 0);
-    EXPECT_TRUE(one.ambiguous);
+    EXPECT_EQ(one.pinned, contact::ContactElement3::kPinnedT1);
+    EXPECT_EQ(one.pinned_axis, 0);
+    EXPECT_FALSE(one.ambiguous);
+    // The normal inclined toward the held x: support and contact would share a force
+    // direction, the multipliers are not unique.
+    const auto tilted = rigid_node<3>(Point<3>(0.6, 0.0, 0.8), 0.0, 0.5, 1.0);
+    const auto amb = contact::held_components(tilted, Fixed{{true, false, false}});
+    EXPECT_EQ(amb.pinned, 0);
+    EXPECT_TRUE(amb.ambiguous);
     // Frictionless: lambda_n alone, whatever holds the tangents.
     const auto f = rigid_node<3>(Point<3>::UnitZ(), 0.0, 0.0, 1.0);
     EXPECT_EQ(contact::held_components(f, Fixed{{true, false, false}}).pinned, 0);
     EXPECT_FALSE(contact::held_components(f, Fixed{{true, false, false}}).ambiguous);
     EXPECT_EQ(contact::held_components(f, Fixed{{false, false, true}}).pinned, kN);
+}
+
+TEST(ContactElement3, APinnedFirstTangentLeavesTheCoulombIntervalOnTheSecond) {
+    // n = z, t1 turned onto y (held by a symmetry plane), t2 = n x t1 = -x; mu = 0.5, r = 1.
+    auto e = rigid_node<3>(Point<3>::UnitZ(), 0.0, 0.5, 1.0);
+    contact::turn_first_tangent_onto_axis(e, 1);
+    e.pinned = contact::ContactElement3::kPinnedT1;
+    EXPECT_LE((e.t.col(0) - Eigen::Vector3d::UnitY()).norm(), 1e-15);
+    EXPECT_LE((e.t.col(1) + Eigen::Vector3d::UnitX()).norm(), 1e-15);
+    // Pressed in by 2 (sigma_n = -1 - 2 = -3, limit mu |sigma_n| = 1.5), slid by (5, 1) along
+    // (t1, t2), lambda_t = (7, 0.2): sigma_t2 = 0.2 + 1 = 1.2 sticks although |sigma_t| would
+    // slip; sigma_t1 counts as 0.
+    const Eigen::Vector3d u = e.t * Eigen::Vector2d(5.0, 1.0) - 2.0 * e.n;
+    Vector x(6);
+    x << u, 7.0, 0.2, -1.0;
+    auto s = contact::evaluate(e, Vector(u), Vector::Zero(3), x, 3);
+    ASSERT_EQ(s.proj.status, contact::Status::stick);
+    EXPECT_EQ(s.proj.phi[0], 0.0);
+    EXPECT_NEAR(s.proj.phi[1], 1.2, 1e-14);
+    EXPECT_NEAR(s.proj.phi[2], -3.0, 1e-14);
+    EXPECT_EQ(s.proj.M.row(0).norm() + s.proj.M.col(0).norm(), 0.0);
+    // Slid by 2 along t2: sigma_t2 = 2.2 > 1.5, slip on the interval: phi_t2 = 1.5, and the
+    // derivative of phi_t2 along sigma_t2 is 0, along sigma_n -mu sign(sigma_t2) = -0.5.
+    const Eigen::Vector3d u2 = e.t * Eigen::Vector2d(5.0, 2.0) - 2.0 * e.n;
+    x.head(3) = u2;
+    s = contact::evaluate(e, Vector(u2), Vector::Zero(3), x, 3);
+    ASSERT_EQ(s.proj.status, contact::Status::slip);
+    EXPECT_EQ(s.proj.phi[0], 0.0);
+    EXPECT_NEAR(s.proj.phi[1], 1.5, 1e-14);
+    EXPECT_NEAR(s.proj.M(1, 1), 0.0, 1e-14);
+    EXPECT_NEAR(s.proj.M(1, 2), -0.5, 1e-14);
+    EXPECT_EQ(s.proj.M.row(0).norm() + s.proj.M.col(0).norm(), 0.0);
+    // The pinned multiplier's residual reads -lambda_t1 / r.
+    const auto dofs = one_vertex<3>(3);
+    Vector R = Vector::Zero(6);
+    contact::add_residual(e, s, dofs, 3, R);
+    EXPECT_NEAR(R[3], -7.0, 1e-14);
 }

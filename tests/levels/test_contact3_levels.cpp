@@ -385,27 +385,56 @@ TEST(Contact3Levels, TheTransfersOfAHierarchyWithMultipliersInterpolateTheDispla
 // ---------------------------------------------------------------------------------------------
 // Held components.
 
-TEST(Contact3Levels, AFrictionalNodeWithOneTangentHeldIsRefusedAsAmbiguous) {
-    // ux = 0 on xmin: the bottom vertices on x = 0 have their tangent along x held and the one
-    // along y free.
+TEST(Contact3Levels, ASymmetryPlaneAcrossFrictionalNodesPinsTheirTangentAlongItsNormal) {
+    // ux = 0 on xmin, uy = 0 on ymin: the bottom vertices on x = 0 (but not y = 0) have u_x held,
+    // those on y = 0 (but not x = 0) u_y; the normal (0, 0, 1) lies across either axis. Their
+    // frame turns its first tangent onto the held axis, and that tangent alone is pinned; the
+    // vertex at the corner (both held) has both tangents pinned.
     const std::string text =
         contact3_box("contactor = \"zmin\"\nmu = 0.5\n" + kPlane,
                      "[[support]]\ntag = \"xmin\"\nux = 0.0\n[[support]]\ntag = \"ymin\"\nuy = "
                      "0.0\n[[support]]\ntag = \"zmax\"\nuz = 0.0\n");
     const levels::ElasticProblem3 p = contact3_parse(text);
+    const levels::Level3 L = levels::build_level(p, p.mesh0);
+    ASSERT_EQ(L.n_contact_nodes(), 9);
+    int one = 0, both = 0;
+    for (const auto& e : L.contacts) {
+        const Vec3 x = L.mesh.vertices[static_cast<size_t>(e.vertex[0])];
+        const bool hx = x.x() == 0.0, hy = x.y() == 0.0;
+        if (hx && hy) {
+            EXPECT_EQ(e.pinned, contact::ContactElement3::kPinnedT);
+            ++both;
+        } else if (hx || hy) {
+            EXPECT_EQ(e.pinned, contact::ContactElement3::kPinnedT1);
+            const Vec3 axis = hx ? Vec3::UnitX() : Vec3::UnitY();
+            EXPECT_LE((e.t.col(0) - axis).norm(), 1e-15);
+            EXPECT_LE((e.t.col(1) - e.n.cross(axis)).norm(), 1e-15);
+            ++one;
+        } else {
+            EXPECT_EQ(e.pinned, 0);
+        }
+    }
+    EXPECT_EQ(both, 1);
+    EXPECT_EQ(one, 4);
+    // A plane inclined across y: the normal has a part along the held u_y, so the support and
+    // the contact would share a force direction: refused.
+    const levels::ElasticProblem3 q = contact3_parse(contact3_box(
+        "contactor = \"zmin\"\nmu = 0.5\nobstacle = { type = \"plane\", point = [0, 0, 0], "
+        "normal = [0, 0.6, 0.8] }\n",
+        "[[support]]\ntag = \"ymin\"\nuy = 0.0\n[[support]]\ntag = \"zmax\"\nuz = 0.0\n"));
     mesh::testing::expect_invalid(
-        [&] { levels::build_level(p, p.mesh0); },
-        {"contact 'floor': contactor vertex 1 at (0.5, 0, 0) has u_y prescribed by a support",
-         "normal (0, 0, 1)", "meets the held directions only in part",
+        [&] { levels::build_level(q, q.mesh0); },
+        {"contact 'floor': contactor vertex 0 at (0, 0, 0) has u_y prescribed by a support",
+         "normal (0, 0.6, 0.8)", "meets the held directions only in part",
          "Prescribe all three components of that vertex", "mu = 0", "region"});
     // Frictionless, the same supports pin nothing and build.
-    const levels::ElasticProblem3 q = contact3_parse(
+    const levels::ElasticProblem3 f = contact3_parse(
         contact3_box("contactor = \"zmin\"\nmu = 0.0\n" + kPlane,
                      "[[support]]\ntag = \"xmin\"\nux = 0.0\n[[support]]\ntag = \"ymin\"\nuy = "
                      "0.0\n"));
-    const levels::Level3 L = levels::build_level(q, q.mesh0);
-    EXPECT_EQ(L.n_contact_nodes(), 9);
-    for (const auto& e : L.contacts)
+    const levels::Level3 F = levels::build_level(f, f.mesh0);
+    EXPECT_EQ(F.n_contact_nodes(), 9);
+    for (const auto& e : F.contacts)
         EXPECT_EQ(e.pinned, 0);
 }
 
@@ -489,7 +518,7 @@ TEST(Contact3Scene, ContactKeysAreReadAndBadValuesRefusedNamingThem) {
         {"contact 'floor' has no contactor node on 'zmin': of its 9 vertices, 9 lie outside the "
          "region, 0 have all three components fixed"});
     contact3_error(contact3_box("contactor = \"zmin\"\nmu = 0.0\n"),
-                   {"missing key 'obstacle' in [[contact]]"});
+                   {"needs an obstacle (rigid) or a target tag (two bodies)"});
     contact3_error(contact3_box("contactor = \"zmin\"\nmu = 0.0\n" + plane, "", "load_steps = 0\n"),
                    {"t.toml:4", "[scene].load_steps must be at least 1, found 0"});
     contact3_error(
@@ -500,15 +529,15 @@ TEST(Contact3Scene, ContactKeysAreReadAndBadValuesRefusedNamingThem) {
         {"unknown key 'tolerance' in [newton]", "rel_tol, max_iter, forcing"});
 }
 
-TEST(Contact3Scene, TwoBodyKeysAndTwoDimensionalObstaclesAreRefusedAsNotYetIn3D) {
-    for (const std::string key :
-         {"target = \"zmax\"", "element = \"node_on_facet\"", "integration = \"segment\"",
-          "search_radius = 2.0", "match_tolerance = 1e-6"}) {
+TEST(Contact3Scene, TwoBodyKeysBesideAnObstacleAndTwoDimensionalObstaclesAreRefused) {
+    for (const std::string key : {"element = \"node_on_facet\"", "integration = \"segment\"",
+                                  "search_radius = 2.0", "match_tolerance = 1e-6"}) {
         const std::string name = key.substr(0, key.find(' '));
         contact3_error(contact3_box("contactor = \"zmin\"\nmu = 0.0\n" + key + "\n" + kPlane),
-                       {"t.toml:15", "[[contact]]." + name + " is 2D-only",
-                        "two-body contact in 3D is not available yet"});
+                       {"t.toml:15", "[[contact]]." + name + " applies to two-body pairs"});
     }
+    contact3_error(contact3_box("contactor = \"zmin\"\nmu = 0.0\ntarget = \"zmax\"\n" + kPlane),
+                   {"takes an obstacle (rigid) or a target tag (two bodies), not both"});
     contact3_error(contact3_box("contactor = \"zmin\"\nmu = 0.0\nobstacle = { type = \"line\", "
                                 "point = [0, 0], normal = [0, 1] }\n"),
                    {"t.toml:15", "obstacle.type \"line\" is 2D-only", "\"plane\""});

@@ -269,9 +269,8 @@ TEST(Scene3, TwoDOnlyKeysAreRefusedNamingTheKey) {
                         {"t.toml:4", "[scene].plane is 2D-only"});
     expect_scene3_error(box_scene("", ", arcs = []", ""), {"mesh.arcs is 2D-only"});
     expect_scene3_error(box_scene("", ", diagonal = \"left\"", ""), {"mesh.diagonal is 2D-only"});
-    expect_scene3_error(box_scene("", "", "[[contact]]\nname = \"c\"\ntarget = \"zmax\"\n"),
-                        {"t.toml:13", "[[contact]].target is 2D-only",
-                         "two-body contact in 3D is not available yet"});
+    expect_scene3_error(box_scene("", ", transform = { rotate_deg = 10.0 }", ""),
+                        {"t.toml:7", "mesh.transform is 2D-only"});
     expect_scene3_error(box_scene("", "",
                                   "[[load]]\ntag = \"zmax\"\npressure = 1.0\nfactors = "
                                   "[1.0]\n"),
