@@ -70,13 +70,7 @@ void Problem::validate() const {
     }
     // Loading path: every per-point list has the same length.
     int K = 0;
-    auto check_len = [&](size_t n, const std::string& what) {
-        if (n == 0) return;
-        MLC_CHECK(K == 0 || static_cast<int>(n) == K,
-                  what << " has " << n << " path values but another list has " << K
-                       << "; every per-step list must have the same length");
-        K = static_cast<int>(n);
-    };
+    auto check_len = [&](size_t n, const std::string& what) { check_path_length(K, n, what); };
     for (const auto& l : loads)
         check_len(l.factors.size(), "load on '" + l.tag + "'");
     for (const auto& s : supports) {
@@ -90,6 +84,14 @@ void Problem::validate() const {
         check_len(s.active.size(), where + " (active)");
     }
     newton.validate();
+}
+
+void check_path_length(int& K, size_t n, const std::string& what) {
+    if (n == 0) return;
+    MLC_CHECK(K == 0 || static_cast<int>(n) == K,
+              what << " has " << n << " path values but another list has " << K
+                   << "; every per-step list must have the same length");
+    K = static_cast<int>(n);
 }
 
 Problem Problem::at_step(int step) const {

@@ -192,6 +192,12 @@ struct Problem {
     static double path_value(const std::vector<double>& path, double full, int k, int K);
 };
 
+/// The loading path's length check, shared by 2D and 3D problems: a per-point list of `n`
+/// entries (0: none) named `what` (e.g. "load on 'top'", "support on 'platen' (ux)") joins a
+/// path whose common length so far is K (0 before any list). Throws InvalidInput when both are
+/// non-zero and differ; otherwise K becomes n (when n > 0).
+void check_path_length(int& K, size_t n, const std::string& what);
+
 /// "hilbert" or "lattice".
 std::string_view to_string(Problem::Numbering n);
 /// The numbering named "hilbert" or "lattice"; anything else throws InvalidInput naming `what`
