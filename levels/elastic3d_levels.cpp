@@ -185,6 +185,21 @@ void ElasticProblem3::validate() const {
         }
     }
     MLC_CHECK(load_steps >= 1, "load_steps must be at least 1, found " << load_steps);
+    // Loading path: every per-point list has the same length (the 2D check and message).
+    int K = 0;
+    for (const FaceLoad3& l : loads)
+        check_path_length(K, l.factors.size(), "load on '" + l.tag + "'");
+    for (const Support3& s : supports) {
+        const std::string where = !s.tag.empty() ? "support on '" + s.tag + "'"
+                                  : s.line       ? std::string("support along a line")
+                                                 : std::string("support at a point");
+        for (size_t c = 0; c < 3; ++c) {
+            const std::string key = std::string("u") + "xyz"[c];
+            check_path_length(K, s.u_path[c].size(), where + " (" + key + ")");
+            MLC_CHECK(s.u_path[c].empty() || (s.u[c] && *s.u[c] == s.u_path[c].back()),
+                      where << ": " << key << " must equal the last entry of its per-point list");
+        }
+    }
     newton.validate();
     for (const ContactPair3& c : contacts) {
         const std::string w = "contact '" + c.name + "'";
@@ -228,6 +243,15 @@ void ElasticProblem3::validate() const {
             throw InvalidInput(w + ": " + e.what());
         }
     }
+}
+
+int ElasticProblem3::n_path_points() const {
+    for (const FaceLoad3& l : loads)
+        if (!l.factors.empty()) return static_cast<int>(l.factors.size());
+    for (const Support3& s : supports)
+        for (const auto& path : s.u_path)
+            if (!path.empty()) return static_cast<int>(path.size());
+    return 1;
 }
 
 // ------------------------------------------------------------------------------------------
@@ -343,6 +367,47 @@ void pin_held_components3(const ElasticProblem3& p, Level3& L) {
     }
 }
 
+/// The loading path of a level whose supports (`vs`, their values those of the last path point),
+/// fixed components, numbering and assembled system at the last path point are set, with
+/// K = p.n_path_points() > 1: Level3::path_u_fixed, path_f and path_f_nodal at every path point
+/// (as the 2D build_level's assemble_loads; the last entries are u_fixed, elastic.f and
+/// elastic.f_nodal_full). `nodal_loads_at(k)` gives the nodal loads of path point k.
+template <class NodalLoads>
+void set_load_path3(const ElasticProblem3& p, Level3& L, std::vector<fem::VertexSupport3> vs,
+                    NodalLoads&& nodal_loads_at) {
+    const int K = p.n_path_points();
+    const int nv = L.mesh.n_vertices();
+    L.path_u_fixed.assign(static_cast<size_t>(K), Vector());
+    L.path_f.assign(static_cast<size_t>(K), Vector());
+    L.path_f_nodal.assign(static_cast<size_t>(K), Vector());
+    for (int k = 1; k < K; ++k) {
+        // The same vertices and components, the values of point k (a later support's value
+        // counts where two hold one component, as at the last point).
+        for (size_t i = 0; i < vs.size(); ++i) {
+            const Support3& s = p.supports[i];
+            for (size_t c = 0; c < 3; ++c)
+                if (s.u[c])
+                    vs[i].value[static_cast<Index>(c)] =
+                        Problem::path_value(s.u_path[c], *s.u[c], k, K);
+        }
+        Vector uk = fem::collect_supports(L.mesh, vs).u_fixed;
+        // f_k = F_k,free - K_(free,fixed) u_k, the lifting from the element-wise K u.
+        const Vector F = nodal_loads_at(k);
+        const Vector Ku = uk.isZero(0.0) ? Vector::Zero(uk.size())
+                                         : fem::internal_forces(L.mesh, L.materials, uk);
+        Vector f = Vector::Zero(L.dofs.n_dofs());
+        for (int v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c)
+                if (const int d = L.dofs.u_dof(v, c); d >= 0) f[d] = F[3 * v + c] - Ku[3 * v + c];
+        L.path_u_fixed[static_cast<size_t>(k - 1)] = std::move(uk);
+        L.path_f[static_cast<size_t>(k - 1)] = std::move(f);
+        L.path_f_nodal[static_cast<size_t>(k - 1)] = F;
+    }
+    L.path_u_fixed.back() = L.u_fixed;
+    L.path_f.back() = L.elastic.f;
+    L.path_f_nodal.back() = L.elastic.f_nodal_full;
+}
+
 } // namespace
 
 Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
@@ -368,9 +433,6 @@ Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
     for (const auto& e : L.contacts)
         L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
     L.u_fixed = std::move(sup.u_fixed);
-    std::vector<fem::Traction3> tr;
-    for (const FaceLoad3& l : p.loads)
-        tr.push_back({L.mesh.tag(l.tag), l.pressure, l.traction});
     std::vector<Vec3> bf;
     bool any_force = false;
     for (const Body3& b : p.bodies) {
@@ -378,8 +440,24 @@ Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
         L.materials.push_back(b.material);
         any_force = any_force || !b.body_force.isZero(0.0);
     }
-    const Vector F = fem::nodal_loads(L.mesh, tr, any_force ? bf : std::vector<Vec3>{});
-    L.elastic = fem::assemble_elastic(L.mesh, L.materials, L.dofs, F, L.u_fixed);
+    if (!any_force) bf.clear();
+    // The nodal loads at path point k of K: each load times its factor there, the body forces
+    // in proportion to s (they take no per-point factors). Point K of K = 1 is the full load.
+    const int K = p.n_path_points();
+    auto nodal_loads_at = [&](int k) {
+        std::vector<fem::Traction3> tr;
+        for (const FaceLoad3& l : p.loads) {
+            const double a = K == 1 ? 1.0 : Problem::path_value(l.factors, 1.0, k, K);
+            tr.push_back({L.mesh.tag(l.tag), a * l.pressure, a * l.traction});
+        }
+        std::vector<Vec3> bk = bf;
+        if (K > 1)
+            for (Vec3& b : bk)
+                b *= static_cast<double>(k) / K;
+        return fem::nodal_loads(L.mesh, tr, bk);
+    };
+    L.elastic = fem::assemble_elastic(L.mesh, L.materials, L.dofs, nodal_loads_at(K), L.u_fixed);
+    if (K > 1) set_load_path3(p, L, std::move(vs), nodal_loads_at);
     return L;
 }
 

@@ -3,7 +3,9 @@
 /// describes (scene/scene3.hpp), its level sizes and memory predicted before anything is built,
 /// the levels (mesh refined 1->8, DofMap3, stiffness on the free unknowns, the P transfers
 /// restricted to the unknowns) and the geometric multigrid on them (solvers::Multigrid with
-/// rediscretized operators and 3 x 3 vertex blocks).
+/// rediscretized operators and 3 x 3 vertex blocks). Loads and supports follow a loading path as
+/// in 2D (levels/problem.hpp): per-point load factors and prescribed values, linear between the
+/// path points, evaluated by Level3::u_fixed_at(s) and f_at(s).
 #pragma once
 
 #include "core/types.hpp"
@@ -35,15 +37,25 @@ struct Body3 {
 };
 
 /// A uniform pressure (positive pushing into the body) and traction (per unit area) on the
-/// boundary faces with a tag.
+/// boundary faces with a tag, at the full load.
+///
+/// Loading path (ElasticProblem3::n_path_points), as a 2D Load: without `factors` the load grows
+/// in proportion to the path parameter s in [0, 1]; with `factors` = (f_1 .. f_K) it is f_k
+/// times (pressure, traction) at path point k (s = k / K), linear in between, and 0 at s = 0.
 struct FaceLoad3 {
     std::string tag;
     double pressure = 0.0;
     Vec3 traction = Vec3::Zero();
+    std::vector<double> factors; ///< per path point, or empty (proportional)
 };
 
 /// Prescribed displacement components on the faces with a tag, along a line, or at a vertex of
 /// level 0 (a point; refinement keeps its index). Unset components are free.
+///
+/// A component is either proportional (u[c] alone: s * u[c] along the path) or given per path
+/// point (u_path[c] = (u_1 .. u_K), linear in between, 0 at s = 0; u[c] then holds u_K), as a
+/// 2D Support's ux/ux_path. A 3D support holds in every load step (the 2D `active` has no 3D
+/// counterpart).
 struct Support3 {
     std::string
         tag; ///< a tag of boundary faces and/or tagged lines; empty for a line or point support
@@ -52,7 +64,9 @@ struct Support3 {
     /// edges of the level-0 mesh; it holds every vertex on the segment, on every level (the
     /// midpoints refinement puts on its edges).
     std::optional<std::array<Vec3, 2>> line;
-    std::array<std::optional<double>, 3> u{}; ///< ux, uy, uz
+    std::array<std::optional<double>, 3> u{}; ///< ux, uy, uz (at s = 1)
+    /// Per component: the values per path point, or empty (proportional).
+    std::array<std::vector<double>, 3> u_path{};
 };
 
 /// The vertices of m on a line support's segment (within 1e-9 of m's diameter), ordered along
@@ -98,7 +112,7 @@ struct ElasticProblem3 {
     std::vector<FaceLoad3> loads;
     std::vector<Support3> supports;
     std::vector<ContactPair3> contacts;
-    /// Load steps: step j solves at the load factor j / load_steps (proportional loading).
+    /// Load steps: step j solves at the path parameter s = j / load_steps (equal increments).
     int load_steps = 1;
     NewtonParams newton;
     int levels = 0;
@@ -112,8 +126,16 @@ struct ElasticProblem3 {
     /// a region with min > max, a bad obstacle (BasicObstacle::validate) of a node-on-rigid
     /// pair; of a two-body pair a target tag on no boundary face, a target equal to the
     /// contactor, search_radius or match_tolerance not > 0, an integration other than nodal for
-    /// node on node.
+    /// node on node; and the loading path: every per-point list of the same length
+    /// (check_path_length, the 2D message), a component's u equal to the last entry of its
+    /// u_path.
     void validate() const;
+
+    /// Number K of points of the loading path: the common length of the per-point lists of the
+    /// loads (`factors`) and supports (`u_path`), or 1 when there is none (proportional loading).
+    /// Path point k (1..K) sits at s = k / K; s = 0 is the unloaded state. Values at the path
+    /// points are Problem::path_value's, as in 2D.
+    int n_path_points() const;
 };
 
 /// The mean length of the level-0 edges of the boundary faces tagged `tag` (each edge once):
@@ -193,7 +215,11 @@ void check_elastic3_fits(const ElasticMemory3& e, const MemoryLimit& limit,
 /// Builds one 3D level on mesh `m` (a refinement of p.mesh0, or p.mesh0): supports
 /// (Level3::fixed, u_fixed), contact elements, numbering (by vertex index: the free components
 /// of a vertex, then its multipliers), materials, loads and the assembled system (K on the
-/// unknowns, its multiplier rows and columns empty; f for the full load).
+/// unknowns, its multiplier rows and columns empty; f for the full load). With a loading path
+/// (K = p.n_path_points() > 1) also the prescribed values and loads at every path point
+/// (Level3::path_u_fixed, path_f, path_f_nodal, as the 2D build_level; body forces grow in
+/// proportion to s), which u_fixed_at(s), f_at(s) and f_nodal_at(s) interpolate; with K = 1
+/// they stay empty and the loading is s times the full load, as before.
 ///
 /// Contactor nodes, pair by pair: the vertices of the boundary faces with the pair's contactor
 /// tag, inside its region (if any), not fully fixed (all three components) and not claimed by
