@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // 3D scenes ([scene] dimension = 3): a box or a Gmsh tetrahedral mesh (its curved surfaces
-// declared), bodies, face loads, supports, contact pairs with rigid obstacles, load steps and
-// Newton settings, read with the Reader of the 2D scenes; keys of 2D scenes are refused as
-// 2D-only.
+// declared), bodies, face loads, supports, contact pairs with rigid obstacles, load steps (along
+// a loading path: per-point load factors and support values, as in 2D) and Newton settings, read
+// with the Reader of the 2D scenes; keys of 2D scenes are refused as 2D-only.
 #include "scene/scene3.hpp"
 
 #include "contact/obstacle.hpp"
@@ -280,13 +280,32 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
     }
 }
 
-/// [[load]]: pressure and/or traction on a boundary tag.
-void read_loads3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
+/// A per-point list of the loading path (a load's factors, a support's ux/uy/uz list) as read:
+/// where it stands, what it belongs to (levels::check_path_length's `what`) and its length.
+struct PathList {
+    const toml::node* node = nullptr;
+    std::string what;
+    size_t n = 0;
+};
+
+/// Refuses the first per-point list whose length differs from the lists before it, at its line,
+/// with the 2D message (levels::check_path_length).
+void check_path_lists3(const Reader& rd, const std::vector<PathList>& lists) {
+    int K = 0;
+    for (const PathList& l : lists)
+        at(rd, l.node, [&] {
+            levels::check_path_length(K, l.n, l.what);
+            return 0;
+        });
+}
+
+/// [[load]]: pressure and/or traction on a boundary tag, with optional factors per path point
+/// (appended to `lists`).
+void read_loads3(const Reader& rd, const toml::table& root, ElasticProblem3& p,
+                 std::vector<PathList>& lists) {
     for (const toml::table* lt : rd.tables(root, "load", "the scene")) {
         const std::string w = "[[load]]";
-        refuse_2d_only(rd, *lt, {"factors"}, w,
-                       "its loads grow in proportion to the load factor j / load_steps");
-        rd.check_keys(*lt, {"tag", "pressure", "traction"}, w);
+        rd.check_keys(*lt, {"tag", "pressure", "traction", "factors"}, w);
         levels::FaceLoad3 ld;
         ld.tag = rd.string(*lt, "tag", w);
         check_tag3(rd, p.mesh0, *lt, ld.tag, w, false);
@@ -294,15 +313,23 @@ void read_loads3(const Reader& rd, const toml::table& root, ElasticProblem3& p) 
         if (lt->get("traction")) ld.traction = vec3(rd, *lt, "traction", w);
         if (!lt->get("pressure") && !lt->get("traction"))
             rd.fail(lt, w + " needs a pressure or a traction");
+        if (const toml::node* fn = lt->get("factors")) {
+            ld.factors = rd.numbers(fn, w + ".factors");
+            lists.push_back({fn, "load on '" + ld.tag + "'", ld.factors.size()});
+        }
         p.loads.push_back(ld);
     }
 }
 
-/// [[support]]: a tag, a line or a point, and ux, uy and/or uz.
-void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& p) {
+/// [[support]]: a tag, a line or a point, and ux, uy and/or uz (numbers, or lists per path point
+/// appended to `lists`).
+void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& p,
+                    std::vector<PathList>& lists) {
     for (const toml::table* st : rd.tables(root, "support", "the scene")) {
         const std::string w = "[[support]]";
-        refuse_2d_only(rd, *st, {"active"}, w, "its supports hold throughout");
+        refuse_2d_only(rd, *st, {"active"}, w,
+                       "a 3D support holds in every load step: releasing it along the loading "
+                       "path, which rebuilds the levels between steps, is 2D-only");
         rd.check_keys(*st, {"tag", "line", "point", "ux", "uy", "uz"}, w);
         levels::Support3 s;
         if (int(st->get("tag") != nullptr) + int(st->get("line") != nullptr) +
@@ -323,14 +350,21 @@ void read_supports3(const Reader& rd, const toml::table& root, ElasticProblem3& 
         } else {
             rd.fail(st, w + " needs a tag, a line or a point");
         }
+        // A number (proportional to the path parameter) or a list of values per path point.
+        const std::string where = !s.tag.empty() ? "support on '" + s.tag + "'"
+                                  : s.line       ? std::string("support along a line")
+                                                 : std::string("support at a point");
         const char* keys[3] = {"ux", "uy", "uz"};
-        for (int c = 0; c < 3; ++c) {
+        for (size_t c = 0; c < 3; ++c) {
             const toml::node* n = st->get(keys[c]);
             if (!n) continue;
-            if (n->is_array())
-                rd.fail(n, w + "." + keys[c] +
-                               " must be a number: a list of values per load step is 2D-only");
-            s.u[static_cast<size_t>(c)] = rd.number(n, w + "." + keys[c]);
+            if (n->is_array()) {
+                s.u_path[c] = rd.numbers(n, w + "." + keys[c]);
+                s.u[c] = s.u_path[c].back();
+                lists.push_back({n, where + " (" + keys[c] + ")", s.u_path[c].size()});
+            } else {
+                s.u[c] = rd.number(n, w + "." + keys[c]);
+            }
         }
         if (!s.u[0] && !s.u[1] && !s.u[2]) rd.fail(st, w + " fixes nothing: give ux, uy and/or uz");
         if (s.point || s.line)
@@ -639,8 +673,10 @@ levels::ElasticProblem3 parse_scene3(const std::string& text, const std::string&
     ElasticProblem3 p;
     read_scene3_table(rd, root, p);
     read_bodies3(rd, root, base_dir, p);
-    read_loads3(rd, root, p);
-    read_supports3(rd, root, p);
+    std::vector<PathList> path_lists;
+    read_loads3(rd, root, p, path_lists);
+    read_supports3(rd, root, p, path_lists);
+    check_path_lists3(rd, path_lists);
     read_contacts3(rd, root, p);
     read_newton3(rd, root, p);
     at(rd, &root, [&] {

@@ -15,6 +15,14 @@
 /// length of the level-0 edges of the contactor's faces (levels::mean_face_edge_length). The
 /// two-body keys of 2D pairs (target, element, integration, search_radius, match_tolerance) and
 /// the 2D obstacles (line, circle) are refused: two-body contact in 3D is not available yet.
+///
+/// The loading path, with the 2D syntax and meaning (docs/guide/scenes.md#scenes-loading-path): a
+/// `[[load]]`'s `factors = [f_1, .., f_K]` and a `[[support]]`'s `ux`, `uy`, `uz` given as lists
+/// of values per path point (`ux = [0.0, 1e-3]`) instead of numbers; path point k sits at
+/// s = k / K, values are linear in between and 0 at s = 0, a number stays proportional to s.
+/// Every list of a scene has the same length K; one that differs is refused at its line
+/// (levels::check_path_length's message). A support's `active` (release along the path) is
+/// 2D-only and refused.
 #pragma once
 
 #include "levels/elastic3d_levels.hpp"

@@ -271,10 +271,9 @@ TEST(Scene3, TwoDOnlyKeysAreRefusedNamingTheKey) {
     expect_scene3_error(box_scene("", ", diagonal = \"left\"", ""), {"mesh.diagonal is 2D-only"});
     expect_scene3_error(box_scene("", ", transform = { rotate_deg = 10.0 }", ""),
                         {"t.toml:7", "mesh.transform is 2D-only"});
-    expect_scene3_error(box_scene("", "",
-                                  "[[load]]\ntag = \"zmax\"\npressure = 1.0\nfactors = "
-                                  "[1.0]\n"),
-                        {"[[load]].factors is 2D-only"});
+    expect_scene3_error(
+        box_scene("", "", "[[support]]\ntag = \"xmin\"\nux = 0.0\nactive = [true]\n"),
+        {"t.toml:14", "[[support]].active is 2D-only"});
     expect_scene3_error(
         "[scene]\nname = \"b\"\ndimension = 3\n[[body]]\nE = 1.0\nnu = 0.3\nmesh = { type = "
         "\"rectangle\", corner = [0, 0], size = [1, 1], divisions = [2, 2] }\n",
@@ -289,8 +288,8 @@ TEST(Scene3, UnknownKeysWrongTypesAndBadTagsAreRefused) {
     expect_scene3_error(box_scene("levels = 13\n", "", ""), {"[scene].levels must lie in"});
     expect_scene3_error(box_scene("", "", "[[support]]\npoint = [0.3, 0, 0]\nux = 0.0\n"),
                         {"no vertex of the level-0 mesh"});
-    expect_scene3_error(box_scene("", "", "[[support]]\ntag = \"xmin\"\nux = [0.0, 1.0]\n"),
-                        {"ux must be a number", "2D-only"});
+    expect_scene3_error(box_scene("", "", "[[support]]\ntag = \"xmin\"\nux = [0.0, true]\n"),
+                        {"t.toml:13", "[[support]].ux[1] must be a number, found a boolean"});
     expect_scene3_error(
         box_scene("", "", "")
             .replace(box_scene("", "", "").find("divisions = [2, 2, 2]"), 21, "divisions = [2, 2]"),
