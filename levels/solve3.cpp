@@ -338,15 +338,6 @@ make_solver3(const Hierarchy3& H, int l, Method3 m, double rel_tol,
                                                     rel_tol);
 }
 
-/// Whether the loading (prescribed values and loads, ElasticProblem3::n_path_points K points)
-/// is linear in s over the load steps k - 2 .. k of n, s = step / n: the three lie on one
-/// segment [(j-1) / K, j / K] of the path. Always so under proportional loading (K = 1).
-bool same_path_segment(int k, int n, int K) {
-    const long a = k - 2, b = k, NK = K, N = n;
-    const long j = (b * NK + N - 1) / N; // the segment ending at or after s_k
-    return (j - 1) * N <= a * NK;
-}
-
 /// What one solved level carries from step to step.
 struct LevelRun {
     std::unique_ptr<ContactNewton3> newton;
@@ -407,16 +398,9 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
         }
     }
     const int K = problem.load_steps;
-    const int path_points = problem.n_path_points();
     out.converged = true;
     for (int k = 1; k <= K && out.converged; ++k) {
         const double s = static_cast<double>(k) / K;
-        // The secant predictor where steps k - 2 .. k share a segment of the loading path; across
-        // a path point the load's direction changes and the level starts from its last state.
-        // (It extrapolates the unknowns only: the prescribed components are those of step k,
-        // u_fixed_at(s), in the Newton residual and every expand below.)
-        const bool extrapolate =
-            options.extrapolate && k >= 2 && same_path_segment(k, K, path_points);
         for (int l = first; l < nl; ++l) {
             const Level3& L = H.levels[static_cast<size_t>(l)];
             auto& run = runs[static_cast<size_t>(l)];
@@ -425,12 +409,12 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
             // The level's own start: its last state, or the secant extrapolation of its last two
             // (steps of equal size: s_k - s_{k-1} = s_{k-1} - s_{k-2}).
             run.start = run.x;
-            if (extrapolate) run.start += run.x - run.x_before;
+            if (options.extrapolate && k >= 2) run.start += run.x - run.x_before;
             Vector x0 = run.start;
             if (options.coarse_to_fine && l > first) {
                 const auto& below = runs[static_cast<size_t>(l - 1)];
                 const Level3& C = H.levels[static_cast<size_t>(l - 1)];
-                const bool correct = extrapolate;
+                const bool correct = options.extrapolate && k >= 2;
                 // Interpolated: the level below's converged state of this step, or (secant
                 // predictor) what it changed from its own start, added to this level's start.
                 Vector uc;
