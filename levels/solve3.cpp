@@ -407,7 +407,9 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
             LevelStep3 ls;
             ls.level = l;
             // The level's own start: its last state, or the secant extrapolation of its last two
-            // (steps of equal size: s_k - s_{k-1} = s_{k-1} - s_{k-2}).
+            // (steps of equal size: s_k - s_{k-1} = s_{k-1} - s_{k-2}). It extrapolates the
+            // unknowns only: the prescribed components are step k's, u_fixed_at(s), in the
+            // Newton residual and in every expand below (also along a loading path).
             run.start = run.x;
             if (options.extrapolate && k >= 2) run.start += run.x - run.x_before;
             Vector x0 = run.start;

@@ -52,8 +52,12 @@ struct SolveOptions3 {
     /// from its extrapolation, interpolated (P on displacements, Q on multipliers). Under
     /// proportional loading with unchanged statuses and slip directions the solution is linear in
     /// the load factor and E is exact; 3D slip makes Newton end only asymptotically, so this is
-    /// where the Newton iterations of steps 2, 3, ... go. Off: each level starts from its previous
-    /// step (cold) or from the level below's state of this step, interpolated (coarse to fine).
+    /// where the Newton iterations of steps 2, 3, ... go. Along a loading path
+    /// (ElasticProblem3::n_path_points K > 1) this holds between path points; a step across one,
+    /// where the loading changes direction, starts from the extrapolation all the same (a start
+    /// like any other). Only the unknowns are extrapolated: the prescribed components are those
+    /// of the new step (Level3::u_fixed_at). Off: each level starts from its previous step (cold)
+    /// or from the level below's state of this step, interpolated (coarse to fine).
     bool extrapolate = true;
     /// The Newton systems of level 0 and of the levels above.
     Method3 level0 = Method3::schur;
