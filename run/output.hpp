@@ -20,6 +20,15 @@
 
 namespace mlc::apps {
 
+/// How the run reports (2D and 3D) name a two-body pair's target: "'tag' (node_on_facet, segment
+/// integration)" or "'tag' (node_on_node)".
+template <class Pair> std::string two_body_target_text(const Pair& c) {
+    std::string s = "'" + c.target + "' (" + std::string(levels::to_string(c.element));
+    if (c.element == levels::ContactElementKind::node_on_facet)
+        s += ", " + std::string(contact::to_string(c.integration)) + " integration";
+    return s + ")";
+}
+
 /// Prints, per two-body contact pair of level L, the contactor nodes the search left out:
 /// "contact 'name': N contactor nodes found no facet: (x,y) ..." (or "no target node" for
 /// node_on_node), listing at most `max_listed` positions (all when negative). Nothing when

@@ -83,11 +83,7 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
         if (c.obstacle)
             os << *c.obstacle;
         else
-            os << "'" << c.target << "' (" << levels::to_string(c.element)
-               << (c.element == levels::ContactElementKind::node_on_facet
-                       ? ", " + std::string(contact::to_string(c.integration)) + " integration"
-                       : std::string())
-               << ")";
+            os << two_body_target_text(c);
         os << ", mu = " << c.mu << ", r = " << c.r << "\n";
     }
     print_not_found(os, p, L);

@@ -174,11 +174,7 @@ void print_header3(std::ostream& os, const ElasticProblem3& p, const RunResult3&
         if (!c.two_body())
             os << c.obstacle;
         else
-            os << "'" << c.target << "' (" << levels::to_string(c.element)
-               << (c.element == levels::ContactElementKind::node_on_facet
-                       ? ", " + std::string(contact::to_string(c.integration)) + " integration"
-                       : std::string())
-               << ")";
+            os << two_body_target_text(c);
         os << ", mu = " << c.mu << ", r = " << c.r << "\n";
         if (k < L.not_found.size() && !L.not_found[k].empty())
             os << "           " << L.not_found[k].size() << " contactor vertices of '"

@@ -146,8 +146,8 @@ Action add_accuracy(CLI::App& ac) {
         a->o.out = a->out;
         if (scene::scene_dimension(a->scene) == 3) {
             if (ac.count("--no-compare") > 0)
-                throw InvalidInput("--no-compare applies to 2D node-on-facet scenes; a 3D scene "
-                                   "has rigid obstacles only");
+                throw InvalidInput("--no-compare applies to 2D node-on-facet scenes; the 3D "
+                                   "accuracy study compares no integration variants");
             return study_accuracy3(scene::load_scene3(a->scene), a->o, at.os);
         }
         return study_accuracy(scene::load_scene(a->scene), a->o, at.os);
