@@ -178,9 +178,8 @@ void read_surfaces(const Reader& rd, const toml::table& mt, const std::string& m
     }
 }
 
-/// The bodies' meshes: boxes (their faces renamed by `tags`, merged in body order: coincident
-/// vertices of two boxes stay distinct), or the physical volumes of one Gmsh file (a body each),
-/// with the curved surfaces their tables declare attached.
+/// The bodies' meshes: boxes (faces renamed by `tags`, merged in body order), or the physical
+/// volumes of one Gmsh file (a body each), with the curved surfaces their tables declare attached.
 void read_bodies3(const Reader& rd, const toml::table& root, const std::filesystem::path& base,
                   ElasticProblem3& p) {
     const auto bodies = rd.tables(root, "body", "the scene");
@@ -221,9 +220,8 @@ void read_bodies3(const Reader& rd, const toml::table& root, const std::filesyst
             boxes = true;
         } else if (type == "gmsh") {
             if (b.get("tags"))
-                rd.fail(b.get("tags"), w + ".tags renames the faces of a box; a Gmsh body's "
-                                           "faces carry the names of the file's physical "
-                                           "surfaces");
+                rd.fail(b.get("tags"), w + ".tags renames a box's faces; a Gmsh body's faces "
+                                           "are named by the file's physical surfaces");
             refuse_2d_only(rd, mt, {"transform", "arcs"}, mw,
                            "a 3D body selects a physical volume with `volume` and declares its "
                            "curved faces with `surface`");
@@ -571,12 +569,10 @@ void read_contacts3(const Reader& rd, const toml::table& root, ElasticProblem3& 
         }
         if (ct->get("target")) {
             c.target = rd.string(*ct, "target", w);
-            const auto tid = p.mesh0.find_tag(c.target);
-            if (!tid || !p.mesh0.is_boundary_tag(*tid))
-                rd.fail(ct->get("target"), w + ": unknown target tag '" + c.target +
-                                               "': no boundary face carries it (the boundary "
-                                               "face tags are: " +
-                                               known_tags(p.mesh0, false) + ")");
+            if (const auto id = p.mesh0.find_tag(c.target); !id || !p.mesh0.is_boundary_tag(*id))
+                rd.fail(ct->get("target"),
+                        w + ": unknown target tag '" + c.target + "' (the " +
+                            "boundary face tags are: " + known_tags(p.mesh0, false) + ")");
             if (c.target == c.contactor)
                 rd.fail(ct->get("target"), w + ": the target tag is the contactor tag");
             read_two_body_keys(rd, *ct, w, c);
