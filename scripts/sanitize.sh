@@ -66,7 +66,9 @@ out=$dir/ctest.log
 # single-precision multigrids against their references, the recovered levels, the held corner and
 # the held Hertz half model, the coarse/fine variants of the Krylov system, mg inside each Krylov
 # method and its exact fallback, the dovetail on levels 0-2, the 3D manufactured solution over
-# levels 0-3, hertz3d on level 2 against Hertz and block3d's multigrid and cold runs on level 2.
+# levels 0-3, hertz3d on level 2 against Hertz, block3d's multigrid and cold runs on level 2 and
+# stack3d's two-body runs on levels 0-2 (their search and weights have their own unit tests, and
+# stack3d's level 0 runs here in TwoBody3.Stack3dNodalWeightsMissThePatchTestOnNonMatchingMeshes).
 # What they run is covered here by the unit tests of the same code (levels, solvers, contact,
 # smoothers, transfer, the hierarchy tests); this keeps .ci/run well under 40 minutes
 # (docs/testing.md#testing-hostile).
@@ -77,7 +79,8 @@ heavy+="|RecoveredLevels\.TheExportedSquareSolvesAsTheRefinedSquareDoes|HeldSupp
 heavy+="|KrylovSystem\.CoarseFineVariantsSolveTheFineSystem|MultilevelPreconditioner\.WorksInsideCgsBicgstabAndGmres|MultilevelPreconditioner\.TheExactFallbackSolvesWhatTheMultigridCannot"
 heavy+="|HeldSupports\.FrictionalHertzHalfModelCarriesTheLoadAndSolvesAlikeByEverySolver|Dovetail\.EquilibriumMirrorSymmetryAndCoulombOnLevels0To2"
 heavy+="|Elastic3dConvergence\.ManufacturedSolutionOrderOneInEnergyTwoInL2"
-heavy+="|Accuracy3\.Hertz3dLevel2AgainstHertz|Contact3\.Block3dMultigridIterationsAndCoarseToFineAgainstCold)$"
+heavy+="|Accuracy3\.Hertz3dLevel2AgainstHertz|Contact3\.Block3dMultigridIterationsAndCoarseToFineAgainstCold"
+heavy+="|TwoBody3\.Stack3dPatchTestExactWithSegmentAndDualWeightsOnLevels0To2|TwoBody3\.Stack3dColdMultigridSolvesTheTwoBodyNewtonSystems)$"
 if ctest --test-dir "$dir" -LE "^(slow|cli)$" -E "$heavy" -j"$jobs" --output-on-failure > "$out" 2>&1; then
   n=$(grep -oE "out of [0-9]+" "$out" | tail -n 1 | grep -oE "[0-9]+")
   echo "sanitize: ${n:-?} tests passed under address+undefined ($cxx, build-asan;" \
