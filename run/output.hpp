@@ -20,6 +20,15 @@
 
 namespace mlc::apps {
 
+/// The start of a run report's loading line (2D and 3D): "loading    N proportional load
+/// step(s)" or "loading    N load step(s) along a K-point loading path".
+template <class Problem> std::string loading_text(const Problem& p) {
+    const int K = p.n_path_points();
+    return "loading    " + std::to_string(p.load_steps) +
+           (K == 1 ? std::string(" proportional load step(s)")
+                   : " load step(s) along a " + std::to_string(K) + "-point loading path");
+}
+
 /// How the run reports (2D and 3D) name a two-body pair's target: "'tag' (node_on_facet, segment
 /// integration)" or "'tag' (node_on_node)".
 template <class Pair> std::string two_body_target_text(const Pair& c) {

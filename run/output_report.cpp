@@ -87,12 +87,7 @@ void print_header(std::ostream& os, const levels::Problem& p, const levels::RunR
         os << ", mu = " << c.mu << ", r = " << c.r << "\n";
     }
     print_not_found(os, p, L);
-    const int K = p.n_path_points();
-    if (K == 1)
-        os << "loading    " << p.load_steps << " proportional load step(s)";
-    else
-        os << "loading    " << p.load_steps << " load step(s) along a " << K
-           << "-point loading path";
+    os << loading_text(p);
     os << "; Newton " << p.newton << "\n";
 }
 

@@ -180,12 +180,7 @@ void print_header3(std::ostream& os, const ElasticProblem3& p, const RunResult3&
             os << "           " << L.not_found[k].size() << " contactor vertices of '"
                << c.contactor << "' found no target on the finest level and are left out\n";
     }
-    const int K = p.n_path_points();
-    if (K == 1)
-        os << "loading    " << p.load_steps << " proportional load step(s)";
-    else
-        os << "loading    " << p.load_steps << " load step(s) along a " << K
-           << "-point loading path";
+    os << loading_text(p);
     os << "; Newton rel_tol = " << p.newton.rel_tol << ", max_iter = " << p.newton.max_iter << "\n";
     os << "solve      " << (so.coarse_to_fine ? "coarse-to-fine" : "cold (finest level alone)")
        << "; Newton systems: level 0 " << levels::to_string(so.level0) << ", levels above "
