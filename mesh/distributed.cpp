@@ -226,59 +226,17 @@ LocalLevel refine_local(const LocalLevel& c, const LevelP& lp, const Partition& 
     return f;
 }
 
-/// Global numbers: owned vertices numbered in rank order, the others asked of their owners by
-/// a key every process computes alike (the level-p index, or the global numbers of the two
-/// parents on the level above).
+/// Global numbers and the global triangle count of a level (detail::number_vertices).
 void number_vertices(LocalLevel& L, const std::vector<Key>& keys, const Communicator& comm) {
-    const int rank = comm.rank(), np = comm.size();
-    const size_t nv = static_cast<size_t>(L.mesh.n_vertices());
-    L.owned_vertices.clear();
-    for (size_t v = 0; v < nv; ++v)
-        if (L.vertex_owner[v] == rank) L.owned_vertices.push_back(static_cast<int>(v));
-    const auto n_owned = static_cast<std::int64_t>(L.owned_vertices.size());
-    L.first_vertex = comm.exclusive_sum(n_owned);
-    L.n_global_vertices = comm.sum(n_owned);
+    detail::VertexNumbers n = detail::number_vertices(L.vertex_owner, keys, comm);
+    L.global_vertex = std::move(n.global_vertex);
+    L.owned_vertices = std::move(n.owned_vertices);
+    L.first_vertex = n.first_vertex;
+    L.n_global_vertices = n.n_global_vertices;
     std::int64_t owned_triangles = 0;
     for (char o : L.triangle_owned)
         owned_triangles += o;
     L.n_global_triangles = comm.sum(owned_triangles);
-    L.global_vertex.assign(nv, -1);
-    std::unordered_map<Key, std::int64_t, KeyHash> owned_key;
-    owned_key.reserve(L.owned_vertices.size());
-    for (size_t i = 0; i < L.owned_vertices.size(); ++i) {
-        const auto v = static_cast<size_t>(L.owned_vertices[i]);
-        L.global_vertex[v] = L.first_vertex + static_cast<std::int64_t>(i);
-        owned_key.emplace(keys[v], L.global_vertex[v]);
-    }
-    std::vector<std::vector<std::int64_t>> ask(static_cast<size_t>(np));
-    std::vector<std::vector<int>> asked(static_cast<size_t>(np));
-    for (size_t v = 0; v < nv; ++v) {
-        const int o = L.vertex_owner[v];
-        if (o == rank) continue;
-        MLC_CHECK(o >= 0 && o < np, "distribute: vertex " << v << " has owner " << o);
-        ask[static_cast<size_t>(o)].push_back(keys[v].first);
-        ask[static_cast<size_t>(o)].push_back(keys[v].second);
-        asked[static_cast<size_t>(o)].push_back(static_cast<int>(v));
-    }
-    const auto requests = comm.exchange(ask);
-    std::vector<std::vector<std::int64_t>> answer(static_cast<size_t>(np));
-    for (size_t q = 0; q < requests.size(); ++q)
-        for (size_t i = 0; i + 1 < requests[q].size(); i += 2) {
-            const auto it = owned_key.find({requests[q][i], requests[q][i + 1]});
-            // The owner holds every vertex it owns (see the header), so a miss is a bug.
-            answer[q].push_back(it == owned_key.end() ? -1 : it->second);
-        }
-    const auto answers = comm.exchange(answer);
-    for (size_t q = 0; q < answers.size(); ++q) {
-        MLC_CHECK(answers[q].size() == asked[q].size(),
-                  "distribute: process " << q << " answered " << answers[q].size() << " of "
-                                         << asked[q].size() << " vertex numbers");
-        for (size_t i = 0; i < answers[q].size(); ++i) {
-            MLC_CHECK(answers[q][i] >= 0, "distribute: process " << q << " does not hold vertex "
-                                                                 << asked[q][i] << " it owns");
-            L.global_vertex[static_cast<size_t>(asked[q][i])] = answers[q][i];
-        }
-    }
 }
 
 } // namespace
@@ -326,11 +284,64 @@ std::filesystem::path piece_path(const std::filesystem::path& file, int rank) {
     return file.parent_path() / (file.stem().string() + "_" + std::to_string(rank) + ".vtu");
 }
 
-namespace {
+namespace detail {
 
-/// Runs write() on every process; if it threw on any, rethrows there and throws elsewhere.
-template <class Write>
-void on_every_process(const Communicator& comm, const char* what, Write&& write) {
+// Global numbers: owned vertices numbered in rank order, the others asked of their owners by
+// a key every process computes alike (the level-p index, or the global numbers of the two
+// parents on the level above).
+VertexNumbers number_vertices(const std::vector<int>& vertex_owner, const std::vector<Key>& keys,
+                              const Communicator& comm) {
+    VertexNumbers L;
+    const int rank = comm.rank(), np = comm.size();
+    const size_t nv = vertex_owner.size();
+    L.owned_vertices.clear();
+    for (size_t v = 0; v < nv; ++v)
+        if (vertex_owner[v] == rank) L.owned_vertices.push_back(static_cast<int>(v));
+    const auto n_owned = static_cast<std::int64_t>(L.owned_vertices.size());
+    L.first_vertex = comm.exclusive_sum(n_owned);
+    L.n_global_vertices = comm.sum(n_owned);
+    L.global_vertex.assign(nv, -1);
+    std::unordered_map<Key, std::int64_t, KeyHash> owned_key;
+    owned_key.reserve(L.owned_vertices.size());
+    for (size_t i = 0; i < L.owned_vertices.size(); ++i) {
+        const auto v = static_cast<size_t>(L.owned_vertices[i]);
+        L.global_vertex[v] = L.first_vertex + static_cast<std::int64_t>(i);
+        owned_key.emplace(keys[v], L.global_vertex[v]);
+    }
+    std::vector<std::vector<std::int64_t>> ask(static_cast<size_t>(np));
+    std::vector<std::vector<int>> asked(static_cast<size_t>(np));
+    for (size_t v = 0; v < nv; ++v) {
+        const int o = vertex_owner[v];
+        if (o == rank) continue;
+        MLC_CHECK(o >= 0 && o < np, "distribute: vertex " << v << " has owner " << o);
+        ask[static_cast<size_t>(o)].push_back(keys[v].first);
+        ask[static_cast<size_t>(o)].push_back(keys[v].second);
+        asked[static_cast<size_t>(o)].push_back(static_cast<int>(v));
+    }
+    const auto requests = comm.exchange(ask);
+    std::vector<std::vector<std::int64_t>> answer(static_cast<size_t>(np));
+    for (size_t q = 0; q < requests.size(); ++q)
+        for (size_t i = 0; i + 1 < requests[q].size(); i += 2) {
+            const auto it = owned_key.find({requests[q][i], requests[q][i + 1]});
+            // The owner holds every vertex it owns (see the header), so a miss is a bug.
+            answer[q].push_back(it == owned_key.end() ? -1 : it->second);
+        }
+    const auto answers = comm.exchange(answer);
+    for (size_t q = 0; q < answers.size(); ++q) {
+        MLC_CHECK(answers[q].size() == asked[q].size(),
+                  "distribute: process " << q << " answered " << answers[q].size() << " of "
+                                         << asked[q].size() << " vertex numbers");
+        for (size_t i = 0; i < answers[q].size(); ++i) {
+            MLC_CHECK(answers[q][i] >= 0, "distribute: process " << q << " does not hold vertex "
+                                                                 << asked[q][i] << " it owns");
+            L.global_vertex[static_cast<size_t>(asked[q][i])] = answers[q][i];
+        }
+    }
+    return L;
+}
+
+void on_every_process(const Communicator& comm, const char* what,
+                      const std::function<void()>& write) {
     std::exception_ptr error;
     try {
         write();
@@ -342,13 +353,27 @@ void on_every_process(const Communicator& comm, const char* what, Write&& write)
     throw std::runtime_error(std::string(what) + ": another process failed (see its message)");
 }
 
-} // namespace
+std::vector<Field> subset(const std::vector<Field>& fields, const std::vector<int>& entities) {
+    std::vector<Field> out;
+    for (const Field& f : fields) {
+        Field g{f.name, f.n_components, {}};
+        const auto nc = static_cast<size_t>(f.n_components);
+        g.values.reserve(entities.size() * nc);
+        for (int e : entities)
+            for (size_t c = 0; c < nc; ++c)
+                g.values.push_back(f.values[static_cast<size_t>(e) * nc + c]);
+        out.push_back(std::move(g));
+    }
+    return out;
+}
+
+} // namespace detail
 
 void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& L,
                            const std::vector<Field>& point_fields,
                            const std::vector<Field>& cell_fields, const Communicator& comm,
                            VtuFormat format) {
-    on_every_process(comm, "write_distributed_vtu (pieces)", [&] {
+    detail::on_every_process(comm, "write_distributed_vtu (pieces)", [&] {
         const int nv = L.mesh.n_vertices(), nt = L.mesh.n_cells();
         for (const Field& f : point_fields)
             MLC_CHECK(f.n_components >= 1 &&
@@ -382,23 +407,10 @@ void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& 
                                    piece_of[static_cast<size_t>(tri[1])],
                                    piece_of[static_cast<size_t>(tri[2])]});
         }
-        auto subset = [](const std::vector<Field>& fields, const std::vector<int>& entities) {
-            std::vector<Field> out;
-            for (const Field& f : fields) {
-                Field g{f.name, f.n_components, {}};
-                const auto nc = static_cast<size_t>(f.n_components);
-                g.values.reserve(entities.size() * nc);
-                for (int e : entities)
-                    for (size_t c = 0; c < nc; ++c)
-                        g.values.push_back(f.values[static_cast<size_t>(e) * nc + c]);
-                out.push_back(std::move(g));
-            }
-            return out;
-        };
-        write_vtu(piece_path(file, comm.rank()), piece, subset(point_fields, vertices),
-                  subset(cell_fields, triangles), format);
+        write_vtu(piece_path(file, comm.rank()), piece, detail::subset(point_fields, vertices),
+                  detail::subset(cell_fields, triangles), format);
     });
-    on_every_process(comm, "write_distributed_vtu (.pvtu)", [&] {
+    detail::on_every_process(comm, "write_distributed_vtu (.pvtu)", [&] {
         if (comm.rank() != 0) return;
         std::vector<std::string> pieces;
         for (int r = 0; r < comm.size(); ++r)

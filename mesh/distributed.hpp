@@ -34,6 +34,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <utility>
 #include <vector>
 
 namespace mlc::mesh {
@@ -125,5 +127,36 @@ void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& 
                            const std::vector<Field>& point_fields,
                            const std::vector<Field>& cell_fields, const Communicator& comm,
                            VtuFormat format = VtuFormat::binary);
+
+/// What the 2D and 3D hierarchies (mesh/distributed3.hpp) share.
+namespace detail {
+
+/// The global numbers of the vertices of one local level.
+struct VertexNumbers {
+    std::vector<std::int64_t> global_vertex; ///< of every local vertex
+    std::vector<int> owned_vertices;         ///< local indices of the owned vertices, in order
+    std::int64_t first_vertex = 0;           ///< global number of owned_vertices[0]
+    std::int64_t n_global_vertices = 0;      ///< over all processes
+};
+
+/// Numbers the vertices of a level: the owned ones (vertex_owner == comm.rank()) in rank order
+/// and local index order, the others asked of their owners by `keys`, which every process
+/// computes alike for a vertex (the level-p index, or the global numbers of the two parents on
+/// the level above) and which are unique within a level. Collective; throws InvalidInput when an
+/// owner does not hold a vertex it owns.
+VertexNumbers number_vertices(const std::vector<int>& vertex_owner,
+                              const std::vector<std::pair<std::int64_t, std::int64_t>>& keys,
+                              const Communicator& comm);
+
+/// Runs write() on every process; if it threw on any, rethrows there and throws a
+/// std::runtime_error "<what>: another process failed" elsewhere. Collective.
+void on_every_process(const Communicator& comm, const char* what,
+                      const std::function<void()>& write);
+
+/// The values of `fields` on the entities `entities` (indices into each field's entities), in
+/// that order: what a piece of a parallel file holds.
+std::vector<Field> subset(const std::vector<Field>& fields, const std::vector<int>& entities);
+
+} // namespace detail
 
 } // namespace mlc::mesh

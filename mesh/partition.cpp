@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// METIS k-way partition of the dual graph of a triangle mesh.
+// METIS k-way partition of the dual graph of a triangle or tetrahedral mesh.
 #include "mesh/partition.hpp"
 
 #include "core/check.hpp"
@@ -7,6 +7,7 @@
 #include <metis.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <numeric>
 
@@ -21,7 +22,7 @@ double Partition::imbalance() const {
 
 namespace {
 
-/// Whether every triangle is reachable from triangle 0 through shared edges.
+/// Whether every cell is reachable from cell 0 through shared facets.
 bool dual_graph_connected(const std::vector<std::vector<idx_t>>& adj) {
     if (adj.empty()) return true;
     std::vector<char> seen(adj.size(), 0);
@@ -41,25 +42,34 @@ bool dual_graph_connected(const std::vector<std::vector<idx_t>>& adj) {
     return reached == adj.size();
 }
 
-} // namespace
+/// The facet of cell `cell` opposite its local vertex k (2D: the edge from vertex k + 1 to
+/// k + 2; 3D: the face without vertex k), sorted.
+template <int dim> std::array<int, dim> facet(const typename SimplexMesh<dim>::Cell& cell, int k) {
+    std::array<int, dim> f{};
+    for (int i = 0; i < dim; ++i)
+        f[static_cast<size_t>(i)] = cell[static_cast<size_t>((k + 1 + i) % (dim + 1))];
+    std::sort(f.begin(), f.end());
+    return f;
+}
 
-Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& weights) {
+/// partition_triangles and partition_tets: `cells` names the cells in messages.
+template <int dim>
+Partition partition_cells(const SimplexMesh<dim>& m, int parts, const std::vector<int>& weights,
+                          const char* cells) {
     const int nt = m.n_cells();
     MLC_CHECK(parts >= 1, "a partition needs at least one part, found " << parts);
-    MLC_CHECK(parts <= nt, "cannot split " << nt << " triangles into " << parts << " parts");
+    MLC_CHECK(parts <= nt, "cannot split " << nt << " " << cells << " into " << parts << " parts");
     MLC_CHECK(weights.empty() || static_cast<int>(weights.size()) == nt,
-              "partition weights: " << weights.size() << " for " << nt << " triangles");
+              "partition weights: " << weights.size() << " for " << nt << " " << cells);
     for (int w : weights)
         MLC_CHECK(w > 0, "partition weights must be positive, found " << w);
-    // Dual graph: triangles sharing an edge (each edge seen from both sides).
-    std::map<std::pair<int, int>, int> first_side;
+    // Dual graph: cells sharing a facet (each facet seen from both sides).
+    std::map<std::array<int, dim>, int> first_side;
     std::vector<std::vector<idx_t>> adj(static_cast<size_t>(nt));
     for (int t = 0; t < nt; ++t) {
-        const auto& tri = m.cells[static_cast<size_t>(t)];
-        for (int k = 0; k < 3; ++k) {
-            const int a = tri[k], b = tri[(k + 1) % 3];
-            const auto key = std::minmax(a, b);
-            auto [it, fresh] = first_side.emplace(std::make_pair(key.first, key.second), t);
+        const auto& cell = m.cells[static_cast<size_t>(t)];
+        for (int k = 0; k <= dim; ++k) {
+            auto [it, fresh] = first_side.emplace(facet<dim>(cell, k), t);
             if (!fresh) {
                 adj[static_cast<size_t>(t)].push_back(it->second);
                 adj[static_cast<size_t>(it->second)].push_back(t);
@@ -102,7 +112,7 @@ Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& 
             if (u > t &&
                 p.triangle_part[static_cast<size_t>(t)] != p.triangle_part[static_cast<size_t>(u)])
                 ++p.cut_edges;
-    // Vertex owners: the part with most triangles around the vertex, ties to the lower part.
+    // Vertex owners: the part with most cells around the vertex, ties to the lower part.
     const int nv = m.n_vertices();
     std::vector<std::map<int, int>> count(static_cast<size_t>(nv));
     for (int t = 0; t < nt; ++t)
@@ -116,10 +126,20 @@ Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& 
                 best = part;
                 best_count = c;
             }
-        MLC_CHECK(best >= 0, "vertex " << v << " belongs to no triangle");
+        MLC_CHECK(best >= 0, "vertex " << v << " belongs to no " << SimplexTraits<dim>::cell_name);
         p.vertex_owner[static_cast<size_t>(v)] = best;
     }
     return p;
+}
+
+} // namespace
+
+Partition partition_triangles(const Mesh& m, int parts, const std::vector<int>& weights) {
+    return partition_cells(m, parts, weights, "triangles");
+}
+
+Partition partition_tets(const TetMesh& m, int parts, const std::vector<int>& weights) {
+    return partition_cells(m, parts, weights, "tetrahedra");
 }
 
 } // namespace mlc::mesh
