@@ -257,20 +257,39 @@ LocalTetLevel local_level_p(const TetMesh& m, const LevelP& lp, const Partition&
     return L;
 }
 
-/// The level-p vertices of the closure of a location's entity.
-std::vector<int> closure(const TetLocation& l, const LevelP& lp, const TetMesh& m) {
+/// Adds the level-p vertices of the closure of a location's entity to the sorted set s[0, n)
+/// (the vertices of the level-p tetrahedron both ends of a new vertex's edge lie in: at most 4).
+void add_closure(const TetLocation& l, const LevelP& lp, const TetMesh& m, std::array<int, 4>& s,
+                 size_t& n) {
+    auto insert = [&](int v) {
+        size_t i = 0;
+        while (i < n && s[i] < v)
+            ++i;
+        if (i < n && s[i] == v) return;
+        MLC_CHECK(n < s.size(), "distribute: a new vertex's edge spans more than a tetrahedron");
+        for (size_t j = n; j > i; --j)
+            s[j] = s[j - 1];
+        s[i] = v;
+        ++n;
+    };
     const auto id = static_cast<size_t>(l.id);
     switch (l.kind) {
     case TetLocation::Kind::vertex:
-        return {l.id};
+        insert(l.id);
+        return;
     case TetLocation::Kind::edge:
-        return {lp.edges[id].begin(), lp.edges[id].end()};
+        for (int v : lp.edges[id])
+            insert(v);
+        return;
     case TetLocation::Kind::face:
-        return {lp.faces[id].begin(), lp.faces[id].end()};
+        for (int v : lp.faces[id])
+            insert(v);
+        return;
     case TetLocation::Kind::tet:
-        break;
+        for (int v : m.cells[id])
+            insert(v);
+        return;
     }
-    return {m.cells[id].begin(), m.cells[id].end()};
 }
 
 /// The next level of a process's part: local refinement, inherited tetrahedron data, and the
@@ -294,25 +313,24 @@ LocalTetLevel refine_local(const LocalTetLevel& c, const LevelP& lp, const TetMe
     for (size_t v = nc; v < static_cast<size_t>(f.mesh.n_vertices()); ++v) {
         const auto& [a, b] = f.mesh.parents[v - nc];
         // The midpoint lies inside the entity spanned by the vertices of its ends' entities.
-        std::vector<int> s = closure(c.vertex_location[static_cast<size_t>(a)], lp, m);
-        const std::vector<int> sb = closure(c.vertex_location[static_cast<size_t>(b)], lp, m);
-        s.insert(s.end(), sb.begin(), sb.end());
-        std::sort(s.begin(), s.end());
-        s.erase(std::unique(s.begin(), s.end()), s.end());
+        std::array<int, 4> s{};
+        size_t n = 0;
+        add_closure(c.vertex_location[static_cast<size_t>(a)], lp, m, s, n);
+        add_closure(c.vertex_location[static_cast<size_t>(b)], lp, m, s, n);
         TetLocation loc;
         int owner = -1, shape = -1;
-        if (s.size() == 2) {
+        if (n == 2) {
             loc = {Kind::edge, lp.edge_of.at({s[0], s[1]})};
             owner = lp.edge_owner[static_cast<size_t>(loc.id)];
             shape = lp.edge_shape[static_cast<size_t>(loc.id)];
-        } else if (s.size() == 3) {
+        } else if (n == 3) {
             loc = {Kind::face, lp.face_of.at({s[0], s[1], s[2]})};
             owner = lp.face_owner[static_cast<size_t>(loc.id)];
             shape = lp.face_shape[static_cast<size_t>(loc.id)];
         } else {
-            MLC_CHECK(s.size() == 4, "distribute: new vertex " << v << " between local vertices "
-                                                               << a << " and " << b
-                                                               << " lies at a level-p vertex");
+            MLC_CHECK(n == 4, "distribute: new vertex " << v << " between local vertices " << a
+                                                        << " and " << b
+                                                        << " lies at a level-p vertex");
             loc = {Kind::tet, lp.tet_of.at({s[0], s[1], s[2], s[3]})};
             owner = part.triangle_part[static_cast<size_t>(loc.id)];
         }
