@@ -472,6 +472,78 @@ TEST(Distributed3, GhostReachHoldsEveryInterfaceFaceWithinReach) {
     } else {
         EXPECT_EQ(added, 0);
     }
+    // Level p against bounds of the face-to-face distance: a tetrahedron with an interface face
+    // having a corner within the reach of a corner of an interface face of the one-layer mesh must
+    // be added; one whose interface faces' bounding boxes are all farther than the reach from
+    // those faces' boxes must not.
+    std::vector<int> face_tet(m0.boundary.size(), -1);
+    {
+        std::map<std::array<int, 3>, int> tet_of_face;
+        for (size_t t = 0; t < m0.cells.size(); ++t)
+            for (size_t k = 0; k < 4; ++k) {
+                std::array<int, 3> f{m0.cells[t][(k + 1) % 4], m0.cells[t][(k + 2) % 4],
+                                     m0.cells[t][(k + 3) % 4]};
+                std::sort(f.begin(), f.end());
+                tet_of_face[f] = static_cast<int>(t);
+            }
+        for (size_t b = 0; b < m0.boundary.size(); ++b) {
+            std::array<int, 3> f = m0.boundary[b].v;
+            std::sort(f.begin(), f.end());
+            face_tet[b] = tet_of_face.at(f);
+        }
+    }
+    auto box_gap = [&](const mesh::BoundaryFace& f, const mesh::BoundaryFace& g) {
+        double gap2 = 0;
+        for (int d = 0; d < 3; ++d) {
+            double flo = 1e300, fhi = -1e300, glo = 1e300, ghi = -1e300;
+            for (int v : f.v) {
+                flo = std::min(flo, m0.vertices[static_cast<size_t>(v)][d]);
+                fhi = std::max(fhi, m0.vertices[static_cast<size_t>(v)][d]);
+            }
+            for (int v : g.v) {
+                glo = std::min(glo, m0.vertices[static_cast<size_t>(v)][d]);
+                ghi = std::max(ghi, m0.vertices[static_cast<size_t>(v)][d]);
+            }
+            const double gap = std::max({0.0, glo - fhi, flo - ghi});
+            gap2 += gap * gap;
+        }
+        return std::sqrt(gap2);
+    };
+    auto corner_gap = [&](const mesh::BoundaryFace& f, const mesh::BoundaryFace& g) {
+        double d = 1e300;
+        for (int v : f.v)
+            for (int w : g.v)
+                d = std::min(
+                    d, (m0.vertices[static_cast<size_t>(v)] - m0.vertices[static_cast<size_t>(w)])
+                           .norm());
+        return d;
+    };
+    std::vector<char> must(m0.cells.size(), 0), may(m0.cells.size(), 0);
+    for (size_t c = 0; c < m0.boundary.size(); ++c) {
+        const auto& fc = m0.boundary[c];
+        if ((fc.tag != tags[0] && fc.tag != tags[1]) || narrow_set.count(face_tet[c])) continue;
+        for (size_t s = 0; s < m0.boundary.size(); ++s) {
+            const auto& fs = m0.boundary[s];
+            if ((fs.tag != tags[0] && fs.tag != tags[1]) || !narrow_set.count(face_tet[s]))
+                continue;
+            if (corner_gap(fc, fs) <= reach) must[static_cast<size_t>(face_tet[c])] = 1;
+            if (box_gap(fc, fs) <= reach) may[static_cast<size_t>(face_tet[c])] = 1;
+        }
+    }
+    int n_must = 0;
+    for (size_t t = 0; t < m0.cells.size(); ++t) {
+        if (narrow_set.count(static_cast<int>(t))) continue;
+        n_must += must[t];
+        if (must[t]) {
+            EXPECT_TRUE(wide_set.count(static_cast<int>(t))) << "tetrahedron " << t;
+        }
+        if (!may[t]) {
+            EXPECT_FALSE(wide_set.count(static_cast<int>(t))) << "tetrahedron " << t;
+        }
+    }
+    if (world3().size() > 1) {
+        EXPECT_GT(world3().sum(n_must), 0);
+    }
     // The numbering does not depend on the ghosts: the same owned vertices, the same numbers.
     EXPECT_EQ(H.levels.back().n_owned_vertices(), H1.levels.back().n_owned_vertices());
     EXPECT_EQ(H.levels.back().first_vertex, H1.levels.back().first_vertex);
