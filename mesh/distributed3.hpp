@@ -70,6 +70,7 @@ struct LocalTetLevel {
     std::int64_t n_global_vertices = 0;      ///< vertices of this level over all processes
     std::int64_t n_global_tets = 0;          ///< tetrahedra of this level over all processes
 
+    /// Local vertices this process owns.
     int n_owned_vertices() const { return static_cast<int>(owned_vertices.size()); }
     /// Local vertices owned by another process (the ghost vertices).
     int n_ghost_vertices() const { return mesh.n_vertices() - n_owned_vertices(); }
