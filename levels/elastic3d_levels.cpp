@@ -336,13 +336,34 @@ void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& 
     }
 }
 
+/// The held components of a 3D element (contact::held_components), with one more case: a
+/// frictional two-body element whose own components leave it unpinned, but whose contactor
+/// vertex alone would pin its first tangent (one component held, the normal across it), pins
+/// it. That is a symmetry plane through two-body contact nodes: the contactor's support holds
+/// it on the plane, and the target facets its weights reach leave the plane (segment and dual
+/// weights spread over them), so not every vertex of the element is held. By symmetry the
+/// traction across the plane vanishes; pinning says so, where the unpinned stick equation
+/// would hold the targets' weighted displacement across the plane at zero (an equation that
+/// couples to the contactor's block only by rounding, which the multigrid's Galerkin coarse
+/// operators cannot smooth).
+contact::HeldComponents held_components3(const contact::ContactElement3& e,
+                                         const std::vector<std::array<bool, 3>>& fixed) {
+    const auto h = contact::held_components<3>(e, fixed);
+    if (h.pinned != 0 || h.ambiguous || !e.frictional() || e.n_nodes() == 1) return h;
+    contact::ContactElement3 contactor = e;
+    contactor.vertex.resize(1);
+    contactor.weight.assign(1, 1.0);
+    const auto own = contact::held_components<3>(contactor, fixed);
+    return own.pinned == contact::ContactElement3::kPinnedT1 ? own : h;
+}
+
 /// Sets ContactElement3::pinned of every element from the fixed components of its vertices
-/// (contact::held_components), turning the frame of an element whose first tangent alone is
-/// pinned onto the held axis (a symmetry plane across frictional contact nodes); throws
-/// InvalidInput for an element whose supports hold a direction its frame meets only in part.
+/// (held_components3), turning the frame of an element whose first tangent alone is pinned onto
+/// the held axis (a symmetry plane across frictional contact nodes); throws InvalidInput for an
+/// element whose supports hold a direction its frame meets only in part.
 void pin_held_components3(const ElasticProblem3& p, Level3& L) {
     for (auto& e : L.contacts) {
-        const auto h = contact::held_components<3>(e, L.fixed);
+        const auto h = held_components3(e, L.fixed);
         const int v = e.vertex[0];
         const std::array<bool, 3>& held = L.fixed[static_cast<size_t>(v)];
         MLC_CHECK(

@@ -2,7 +2,9 @@
 // Two bodies in 3D (levels/solve3 with node-on-facet and node-on-node pairs): the patch test of
 // stack3d (two stacked blocks, non-matching meshes, uniform pressure) exact with the segment and
 // dual weights on levels 0-2 by the exact and the multigrid solvers and not with the nodal
-// weights, the matching interface by node on node, and the refusals of the two-body keys.
+// weights, the matching interface by node on node, shear3d (the loads balanced, the slip zone
+// growing, the multigrid's iterations, the symmetry plane's pinned tangent), and the refusals of
+// the two-body keys.
 #include "core/check.hpp"
 #include "levels/solve3.hpp"
 #include "scene/scene.hpp"
@@ -159,6 +161,85 @@ mu = 0.3
     // Frictional and stuck: no tangential force where nothing slides.
     for (const auto& n : r.nodes)
         EXPECT_LE(n.lambda_t.norm(), 1e-8 * std::abs(n.lambda_n));
+}
+
+// The contact force on the contactor in global axes, summed over its nodes: -(n lambda_n +
+// T lambda_t) at each (the run report's resultant).
+Vec3 contact_resultant(const std::vector<levels::ContactNodeState3>& nodes) {
+    Vec3 F = Vec3::Zero();
+    for (const auto& n : nodes)
+        F -= n.n * n.lambda_n + n.t * n.lambda_t;
+    return F;
+}
+
+TEST(TwoBody3, Shear3dBalancesItsLoadsAndItsSlipZoneGrowsWithThePush) {
+    auto p = scene::load_scene3("shear3d");
+    p.levels = 1;
+    const auto r = levels::solve(p);
+    ASSERT_TRUE(r.converged) << r.failure;
+    ASSERT_EQ(r.step_nodes.size(), 5u);
+    // The upper block is held by the contact alone along x and z: the contact force on it
+    // balances the push (40 MPa x 20 x 20 at the last step, 0 at the first) and the pressure
+    // (50 MPa x 40 x 20) at every step.
+    const double push[] = {0.0, 4000.0, 8000.0, 12000.0, 16000.0}, press = 40000.0;
+    int slipping_before = -1;
+    for (size_t k = 0; k < 5; ++k) {
+        const Vec3 F = contact_resultant(r.step_nodes[k]);
+        EXPECT_NEAR(F.x(), -push[k], 1e-8 * press) << "step " << k + 1;
+        EXPECT_NEAR(F.z(), press, 1e-8 * press) << "step " << k + 1;
+        int slipping = 0;
+        for (const auto& n : r.step_nodes[k])
+            slipping += n.status != contact::Status::stick;
+        EXPECT_GE(slipping, slipping_before) << "step " << k + 1;
+        slipping_before = slipping;
+    }
+    // 153 contact nodes on level 1: most stick under the pressure alone, most no longer do
+    // once the push reaches 0.8 of the friction limit.
+    const auto& first = r.step_nodes.front();
+    ASSERT_EQ(first.size(), 153u);
+    EXPECT_LE(slipping_before, 153);
+    EXPECT_GE(slipping_before, 153 / 3);
+    // The multigrid of level 1 (GMRES + mg on the Galerkin operators of the two-body Jacobian).
+    std::vector<int> its;
+    for (const auto& st : r.level_steps.at(1))
+        its.insert(its.end(), st.report.linear_iterations_per_newton.begin(),
+                   st.report.linear_iterations_per_newton.end());
+    ASSERT_FALSE(its.empty());
+    std::sort(its.begin(), its.end());
+    EXPECT_LE(its[its.size() / 2], 15);
+    EXPECT_LE(its.back(), 25);
+}
+
+TEST(TwoBody3, Shear3dSymmetryPlanePinsTheTangentAcrossItAtItsContactNodes) {
+    // The contact nodes on y = 0 hold uy; their segment patches reach target vertices off the
+    // plane, which leave uy free. The contactor's support decides: t1 along y is pinned and
+    // its multiplier vanishes; the nodes off the plane are not pinned.
+    auto p = scene::load_scene3("shear3d");
+    p.levels = 0;
+    const auto r = levels::solve(p);
+    ASSERT_TRUE(r.converged) << r.failure;
+    const auto& L = r.finest();
+    int on_plane = 0, reaching_off = 0;
+    for (size_t k = 0; k < L.contacts.size(); ++k) {
+        const auto& e = L.contacts[k];
+        const Vec3& x = L.mesh.vertices[static_cast<size_t>(e.vertex[0])];
+        if (x.y() != 0.0) {
+            EXPECT_EQ(e.pinned, 0) << "vertex " << e.vertex[0];
+            continue;
+        }
+        ++on_plane;
+        EXPECT_EQ(e.pinned, contact::ContactElement3::kPinnedT1) << "vertex " << e.vertex[0];
+        EXPECT_NEAR(std::abs(e.t.col(0).y()), 1.0, 1e-14);
+        EXPECT_EQ(r.nodes[k].lambda_t[0], 0.0);
+        for (int j = 1; j < e.n_nodes(); ++j)
+            if (e.weight[static_cast<size_t>(j)] != 0.0 &&
+                L.mesh.vertices[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])].y() > 0.0) {
+                ++reaching_off;
+                break;
+            }
+    }
+    EXPECT_EQ(on_plane, 9); // 8 cells of the upper block along x on level 0
+    EXPECT_EQ(reaching_off, on_plane);
 }
 
 // stack3d's text with `from` replaced by `to` (once).
