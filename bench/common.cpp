@@ -4,9 +4,12 @@
 
 #include "contact/element.hpp"
 #include "core/check.hpp"
+#include "core/csr.hpp"
 #include "core/memory.hpp"
+#include "core/timer.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <set>
 
@@ -60,6 +63,37 @@ long jacobian_nonzeros(const levels::Level& L) {
                 if (!std::binary_search(b, en, col)) extra.emplace(row, col);
             });
     return static_cast<long>(K.nonZeros()) + static_cast<long>(extra.size());
+}
+
+double time_matvec(const SparseMatrix& A, int min_calls, double min_seconds) {
+    const Vector x = Vector::Ones(A.cols());
+    Vector y(A.rows());
+    csr_multiply(A, x, y);
+    std::vector<double> t;
+    const double start = wall_seconds();
+    while (static_cast<int>(t.size()) < min_calls || wall_seconds() - start < min_seconds) {
+        const double t0 = wall_seconds();
+        csr_multiply(A, x, y);
+        t.push_back(wall_seconds() - t0);
+        if (t.size() >= 1000) break;
+    }
+    return median(t);
+}
+
+long long whole(double v) {
+    return static_cast<long long>(std::llround(v));
+}
+
+double gbs(double bytes, double seconds) {
+    return seconds > 0 ? bytes / seconds * 1e-9 : 0.0;
+}
+
+double matrix_bytes(const traffic::Account& a) {
+    return a.b(traffic::Kind::matvec) + a.b(traffic::Kind::smoother) + a.b(traffic::Kind::transfer);
+}
+
+double matrix_seconds(const traffic::Account& a) {
+    return a.s(traffic::Kind::matvec) + a.s(traffic::Kind::smoother) + a.s(traffic::Kind::transfer);
 }
 
 } // namespace mlc::apps

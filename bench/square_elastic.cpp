@@ -57,95 +57,6 @@ struct SquareRow {
     double rss_growth = 0;                      // bytes (first run)
 };
 
-// What the bench records about one level during a run.
-struct LevelTraffic {
-    traffic::Account account;  // counted passes of the level's Newton solves (outermost only)
-    double krylov_seconds = 0; // SolveResult::solve_seconds of those solves
-    int solves = 0;
-    double rss_at_build = 0; // current RSS when the run handed over the level's solver
-    double rss_growth = 0;   // RSS growth: building the solver + its first Newton solve
-    bool first_done = false;
-};
-
-// Forwards to the level's solver and adds the counted passes of each Newton solve to the
-// level's record. `depth` is shared by all levels: a solve reached from inside another level's
-// solve (a coarse solve by the level below's solver) counts for the outermost level only.
-class TrafficRecorder final : public levels::ForwardingSystemSolver {
-public:
-    TrafficRecorder(std::unique_ptr<levels::NewtonSystemSolver> inner, LevelTraffic* slot,
-                    int* depth, double rss_before_build, std::vector<Eigen::Matrix2d>* last_M)
-        : levels::ForwardingSystemSolver(std::move(inner)), slot_(slot), depth_(depth), last_M_(last_M) {
-        slot_->rss_at_build = current_rss_bytes();
-        slot_->rss_growth = slot_->rss_at_build - rss_before_build;
-    }
-    SolveResult solve(const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
-                      double forcing) override {
-        const bool outer = *depth_ == 0;
-        const traffic::Account before = traffic::snapshot();
-        const double rss0 = current_rss_bytes();
-        ++*depth_;
-        SolveResult r;
-        try {
-            r = inner().solve(M, b, dx, forcing);
-        } catch (...) {
-            --*depth_;
-            throw;
-        }
-        --*depth_;
-        if (outer) {
-            slot_->account += traffic::snapshot() - before;
-            slot_->krylov_seconds += r.solve_seconds;
-            ++slot_->solves;
-            if (last_M_ != nullptr) *last_M_ = M;
-        }
-        if (!slot_->first_done) {
-            slot_->rss_growth += current_rss_bytes() - rss0;
-            slot_->first_done = true;
-        }
-        return r;
-    }
-
-private:
-    LevelTraffic* slot_;
-    int* depth_;
-    std::vector<Eigen::Matrix2d>* last_M_;
-};
-
-// Median seconds of one csr_multiply of A (after one untimed call), at least `min_calls` calls
-// and about `min_seconds` in all.
-double time_matvec(const SparseMatrix& A, int min_calls = 10, double min_seconds = 0.5) {
-    const Vector x = Vector::Ones(A.cols());
-    Vector y(A.rows());
-    csr_multiply(A, x, y);
-    std::vector<double> t;
-    const double start = wall_seconds();
-    while (static_cast<int>(t.size()) < min_calls || wall_seconds() - start < min_seconds) {
-        const double t0 = wall_seconds();
-        csr_multiply(A, x, y);
-        t.push_back(wall_seconds() - t0);
-        if (t.size() >= 1000) break;
-    }
-    return median(t);
-}
-
-// A count printed exactly (JSON numbers are written with 6 digits otherwise).
-long long whole(double v) {
-    return static_cast<long long>(std::llround(v));
-}
-
-double gbs(double bytes, double seconds) {
-    return seconds > 0 ? bytes / seconds * 1e-9 : 0.0;
-}
-
-// The kinds whose passes read an assembled matrix (the lattice smoother's structured passes,
-// Kind::structured, are judged by their time instead).
-double matrix_bytes(const traffic::Account& a) {
-    return a.b(traffic::Kind::matvec) + a.b(traffic::Kind::smoother) + a.b(traffic::Kind::transfer);
-}
-double matrix_seconds(const traffic::Account& a) {
-    return a.s(traffic::Kind::matvec) + a.s(traffic::Kind::smoother) + a.s(traffic::Kind::transfer);
-}
-
 /// The JSON file's head and the table's header; `def`: the default solver when one is benched.
 void print_square_header(std::ostream& os, std::ostream& js, const BenchSquareOptions& opt,
                          int load_steps, const std::string& krylov_label,
@@ -430,7 +341,7 @@ int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
                     rss_prev = current_rss_bytes();
                     hierarchy_rss = rss_prev - rss_before_run;
                 }
-                auto w = std::make_unique<TrafficRecorder>(
+                auto w = std::make_unique<TrafficRecorder<2>>(
                     std::move(sys), &lt[static_cast<size_t>(level)], &depth, rss_prev,
                     level == opt.levels ? &last_M : nullptr);
                 rss_prev = lt[static_cast<size_t>(level)].rss_at_build;
