@@ -386,11 +386,12 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
         for (int l = first; l < nl; ++l) {
             const Level3& L = H.levels[static_cast<size_t>(l)];
             auto& run = runs[static_cast<size_t>(l)];
-            run.newton = std::make_unique<ContactNewton3>(
-                L, problem.newton,
-                make_solver3(H, l, l == 0 ? options.level0 : options.upper,
-                             options.krylov_rel_tol, T_full),
-                &out.timings);
+            auto sys = make_solver3(H, l, l == 0 ? options.level0 : options.upper,
+                                    options.krylov_rel_tol, T_full);
+            if (options.wrap_system_solver)
+                sys = options.wrap_system_solver(l, L, std::move(sys));
+            run.newton =
+                std::make_unique<ContactNewton3>(L, problem.newton, std::move(sys), &out.timings);
             if (options.interrupt) run.newton->set_interrupt(options.interrupt);
             run.x = Vector::Zero(L.n_unknowns());
             run.x_before = Vector::Zero(L.n_unknowns());

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -69,6 +70,12 @@ struct SolveOptions3 {
     /// Polled before every Newton iteration; true stops the solve by throwing mlc::Interrupted
     /// (ContactNewton::set_interrupt). Empty: never polled.
     std::function<bool()> interrupt;
+    /// Receives each solved level's index, the level and the Newton-system solver the run built
+    /// for it, and returns the one the run uses (a forwarding solver: `bench square` counts each
+    /// level's passes and memory this way). Empty: the solvers as built.
+    std::function<std::unique_ptr<NewtonSystemSolver3>(int level, const Level3& L,
+                                                       std::unique_ptr<NewtonSystemSolver3>)>
+        wrap_system_solver;
 };
 
 /// A load step of one level and what coarse-to-fine predicted of its statuses.
