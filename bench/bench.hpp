@@ -9,7 +9,8 @@
 ///   level's Newton solves by kind, their time and GB/s, a STREAM copy/triad measured by the same
 ///   binary after the first solver's runs, the time of one CSR mat-vec of the finest Jacobian
 ///   (same threads) and a fine Newton step in those mat-vecs; and per level the RSS growth of
-///   building its solver and running its first Newton solve, per unknown.
+///   building its solver and running its first Newton solve, per unknown. On a 3D scene:
+///   bench_square3 (the 3D run's solvers, and the scaling criterion with --scaling).
 /// - `bench elastic`: the elastic block alone (K on the free displacement unknowns of the finest
 ///   level, right-hand side the full load) solved to the same relative tolerance by hypre
 ///   BoomerAMG-PCG and by our geometric V-cycle (vertex-block Gauss–Seidel, P / P^T, sparse LU
@@ -60,7 +61,22 @@ struct BenchSquareOptions {
     /// STREAM (core/traffic.hpp) array length in doubles, and its repetitions (best taken).
     std::size_t stream_doubles = std::size_t(1) << 25;
     int stream_repeats = 5;
+    /// A 3D scene: take the finest level from its [scene].levels (no --levels given).
+    bool levels_from_scene = false;
+    /// A 3D scene: the scaling criterion (bench_square3): finest levels - 1 and finest levels,
+    /// `repeat` runs each, alternated.
+    bool scaling = false;
+    /// The options given on the command line, by name ("--tol", "--krylov", ...): a 3D scene
+    /// refuses those that have no meaning there, naming them.
+    std::vector<std::string> given;
 };
+
+/// The scaling criterion's bound on the growth of the fine Newton step in fine mat-vecs, from
+/// the level below to the finest (`bench square --scaling`): +10 %.
+inline constexpr double kScalingMatvecGrowth = 0.10;
+/// The scaling criterion's bound on the whole-run wall-time ratio, finest over the level below
+/// (8 times the unknowns in 3D): 10.
+inline constexpr double kScalingTimeRatio = 10.0;
 
 /// The solver `bench square` runs for the entry `pc` of opt.pcs ("default", "schur", "lu" or a
 /// preconditioner spec), planned by levels::plan_solver for `problem` (whose numbering is the
@@ -82,7 +98,29 @@ std::string bench_label(const levels::SolverPlan& plan);
 std::string bench_numbering(const BenchSquareOptions& opt);
 
 /// Runs the benchmark (see the file comment); returns the exit code (0: every run converged).
+/// A 3D scene ([scene] dimension = 3) runs bench_square3.
 int bench_square(const BenchSquareOptions& opt, std::ostream& os);
+
+/// `bench square` on a 3D contact scene (one process): the whole coarse-to-fine run of
+/// levels/solve3.hpp (every level 0..L, every load step, the secant predictor on) with the
+/// Newton-system solvers `mlcontact run` plans (levels::plan_contact3): opt.pcs entries
+/// "default" or "mg" (the run's plan), "schur" or "lu" (that exact solver on every level).
+/// L is opt.levels, or the scene's [scene].levels with opt.levels_from_scene. Per level: unknowns,
+/// contact nodes, Newton steps (per load step), Krylov iterations of every Newton system (median,
+/// max), the Newton systems' seconds per Newton step and per unknown, one CSR mat-vec of the
+/// level's Jacobian (timed after each run at its last statuses) and a Newton step in those
+/// mat-vecs, the bandwidth account (counted bytes by kind per Newton step, per unknown and in
+/// mat-vecs of the level's Jacobian) and the RSS growth of building the level's solver and its
+/// first Newton solve; per run the wall time, peak RSS and the estimate
+/// (levels::estimate_contact3_bytes); a STREAM measurement after every run. opt.repeat runs per
+/// solver, times are medians. With opt.scaling (one solver, L >= 1): finest L - 1 and finest L,
+/// opt.repeat runs each, alternated, and the criterion: the fine Newton step in fine mat-vecs
+/// grows by at most kScalingMatvecGrowth, and the whole-run wall-time ratio is at most
+/// kScalingTimeRatio (medians). Refuses, naming the option, what applies to 2D scenes only
+/// (--krylov, --tol, --max-iter, --numbering, --extrapolate, preconditioner specs). Table and JSON
+/// (default out/bench/<scene name>_L<L>.json). Returns 0, or 2 when a run did not converge (the
+/// criterion's outcome does not change it).
+int bench_square3(const BenchSquareOptions& opt, std::ostream& os);
 
 /// Options of `bench elastic`.
 struct BenchElasticOptions {

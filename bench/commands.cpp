@@ -6,7 +6,9 @@
 #include "bench/comm.hpp"
 #include "bench/distributed.hpp"
 #include "comm/world.hpp"
+#include "core/check.hpp"
 #include "run/preconditioners.hpp"
+#include "scene/scene3.hpp"
 
 #include <memory>
 
@@ -21,14 +23,16 @@ Action add_square(CLI::App& bsq) {
     };
     auto a = std::make_shared<Args>();
     bsq.add_option("scene", a->o.scene, "scene file or built-in name (default square)");
-    bsq.add_option("--levels,-l", a->o.levels, "finest level (default 3)");
+    auto* levels = bsq.add_option("--levels,-l", a->o.levels,
+                                  "finest level (default 3; a 3D scene: its [scene].levels)");
     bsq.add_option(
         "--pc", a->o.pcs,
         pc_option_help(
             "solvers (space-separated list): schur, lu, default (the run's default above the "
             "crossover: BiCGStab + mg:pre=0,post=2, damped with a two-body pair, with "
             "smoother=lattice from level 4 on levels numbered by lattices), or "
-            "preconditioner specs (default: default)"));
+            "preconditioner specs (default: default). A 3D scene: default or mg (the 3D "
+            "run's plan), schur, lu"));
     bsq.add_option("--krylov", a->o.krylov,
                    "Krylov method for the preconditioners (default cgs; for `default` the run's, "
                    "bicgstab)");
@@ -47,9 +51,22 @@ Action add_square(CLI::App& bsq) {
     bsq.add_option("--stream-doubles", a->o.stream_doubles,
                    "STREAM array length in doubles (default 2^25 = 33554432: 256 MiB each)")
         ->check(CLI::PositiveNumber);
-    return [a](const Launch& at) {
+    bsq.add_flag("--scaling", a->o.scaling,
+                 "a 3D scene: finest L-1 and finest L alternated (--repeat runs each) and the "
+                 "scaling criterion: mat-vecs per fine Newton step grow by <= 10 %, whole-run "
+                 "time ratio <= 10");
+    return [a, levels, &bsq](const Launch& at) {
         a->o.out = a->out;
-        if (at.distributed) return bench_square_distributed(a->o, comm::world(), at.os);
+        a->o.levels_from_scene = levels->count() == 0;
+        a->o.given.clear();
+        for (const CLI::Option* o : bsq.get_options())
+            if (o->count() > 0) a->o.given.push_back(o->get_name());
+        if (at.distributed) {
+            MLC_CHECK(scene::scene_dimension(a->o.scene) != 3,
+                      "bench square on a 3D scene runs on one process (3D runs are on one "
+                      "process so far): run it without mpirun");
+            return bench_square_distributed(a->o, comm::world(), at.os);
+        }
         return bench_square(a->o, at.os);
     };
 }

@@ -281,6 +281,9 @@ std::string bench_numbering(const BenchSquareOptions& opt) {
 }
 
 int bench_square(const BenchSquareOptions& opt, std::ostream& os) {
+    if (scene::scene_dimension(opt.scene) == 3) return bench_square3(opt, os);
+    MLC_CHECK(!opt.scaling, "bench square: --scaling is for 3D scenes (the 2D square's levels "
+                            "are compared by two runs of `bench square --levels L`)");
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 8,
               "bench square: --levels must be in 1..8, found " << opt.levels);
     MLC_CHECK(opt.repeat >= 1, "bench square: --repeat must be >= 1, found " << opt.repeat);
