@@ -620,9 +620,9 @@ void refuse_3d_scene(const Reader& rd, const toml::table& root, toml::table& sce
     if (!d) return;
     const int dim = rd.integer(d, "[scene].dimension");
     if (dim == 3)
-        rd.fail(d, "this is a 3D scene ([scene].dimension = 3): 3D scenes run with `mlcontact "
-                   "bench elastic` only (run, the studies, show --msh-level and the Python "
-                   "module solve 2D scenes)");
+        rd.fail(d, "this is a 3D scene ([scene].dimension = 3), which this command does not "
+                   "solve: 3D scenes run with `mlcontact run`, `bench square`, `bench elastic`, "
+                   "`study status-transfer` and `study accuracy`");
     if (dim != 2) rd.fail(d, "[scene].dimension must be 2 or 3, found " + std::to_string(dim));
     (void)root;
     scene_table.erase("dimension");
