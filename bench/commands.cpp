@@ -65,6 +65,7 @@ Action add_square(CLI::App& bsq) {
             MLC_CHECK(scene::scene_dimension(a->o.scene) != 3,
                       "bench square on a 3D scene runs on one process (3D runs are on one "
                       "process so far): run it without mpirun");
+            MLC_CHECK(!a->o.scaling, "bench square: --scaling is for 3D scenes, on one process");
             return bench_square_distributed(a->o, comm::world(), at.os);
         }
         return bench_square(a->o, at.os);

@@ -371,6 +371,7 @@ struct Scaling3 {
     double bytes_below = 0, bytes_fine = 0, bytes_growth = 0;
     double step_below = 0, step_fine = 0;
     double time_ratio = 0;
+    double krylov_below = 0, krylov_fine = 0; ///< median Krylov iterations per fine Newton step
     bool matvecs_met = false, time_met = false;
 };
 
@@ -385,6 +386,8 @@ Scaling3 scaling_of(const Series3& below, const Series3& fine) {
     c.bytes_below = a.bytes_per_newton() / static_cast<double>(a.unknowns);
     c.bytes_fine = b.bytes_per_newton() / static_cast<double>(b.unknowns);
     c.bytes_growth = c.bytes_below > 0 ? c.bytes_fine / c.bytes_below - 1 : 0.0;
+    c.krylov_below = median(as_doubles(a.krylov));
+    c.krylov_fine = median(as_doubles(b.krylov));
     c.step_below = a.seconds_per_newton();
     c.step_fine = b.seconds_per_newton();
     const double wa = median(below.walls), wb = median(fine.walls);
@@ -406,7 +409,8 @@ void json_scaling(std::ostream& js, const Series3& below, const Series3& fine, c
        << ",\n    \"wall_seconds\": [" << median(below.walls) << ", " << median(fine.walls)
        << "], \"time_ratio\": " << c.time_ratio << ", \"time_ratio_bound\": " << kScalingTimeRatio
        << ", \"time_met\": " << (c.time_met ? "true" : "false")
-       << ",\n    \"fine_newton_step_seconds\": [" << c.step_below << ", " << c.step_fine
+       << ",\n    \"fine_krylov_per_newton_median\": [" << c.krylov_below << ", " << c.krylov_fine
+       << "], \"fine_newton_step_seconds\": [" << c.step_below << ", " << c.step_fine
        << "], \"fine_bytes_per_newton_per_unknown\": [" << c.bytes_below << ", " << c.bytes_fine
        << "], \"bytes_growth\": ";
     // No counted passes below (an exact solve there): no growth to give.
@@ -430,9 +434,11 @@ void text_scaling(std::ostream& os, const Series3& below, const Series3& fine, c
        << median(fine.walls) << " s, ratio " << std::setprecision(2) << c.time_ratio << " (bound "
        << std::setprecision(0) << kScalingTimeRatio
        << "x for 8x the unknowns): " << (c.time_met ? "met" : "NOT met") << "\n"
-       << "  beside them: fine Newton step " << std::setprecision(4) << c.step_below << " -> "
-       << c.step_fine << " s; counted bytes per fine Newton step per unknown "
-       << std::setprecision(0) << c.bytes_below << " -> " << c.bytes_fine;
+       << "  beside them: Krylov iterations per fine Newton step (median) " << std::setprecision(1)
+       << c.krylov_below << " -> " << c.krylov_fine << "; fine Newton step " << std::setprecision(4)
+       << c.step_below << " -> " << c.step_fine
+       << " s; counted bytes per fine Newton step per unknown " << std::setprecision(0)
+       << c.bytes_below << " -> " << c.bytes_fine;
     if (c.bytes_below > 0)
         os << " (" << std::showpos << std::setprecision(1) << 100 * c.bytes_growth << std::noshowpos
            << " %)";

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -253,6 +254,16 @@ TEST(BenchSquare3, ScalingComparesTheFinestLevelWithTheLevelBelow) {
     EXPECT_EQ(std::stol(m[1]), below[0].unknowns);
     EXPECT_EQ(std::stol(m[2]), 1368);
     EXPECT_NEAR(std::stod(m[3]), 1368.0 / static_cast<double>(below[0].unknowns), 1e-5);
+    // The Krylov medians of the two finest levels: level 0's exact solve (0) and level 1's GMRES.
+    ASSERT_TRUE(std::regex_search(
+        js, m, std::regex("\"fine_krylov_per_newton_median\": \\[([0-9.]+), ([0-9.]+)\\]")))
+        << js;
+    EXPECT_EQ(std::stod(m[1]), 0.0);
+    std::vector<int> its = fine[1].krylov;
+    std::sort(its.begin(), its.end());
+    ASSERT_FALSE(its.empty());
+    const size_t h = its.size() / 2;
+    EXPECT_DOUBLE_EQ(std::stod(m[2]), its.size() % 2 ? its[h] : 0.5 * (its[h - 1] + its[h]));
     for (const char* key :
          {"\"matvecs_growth_bound\": 0.1", "\"time_ratio_bound\": 10",
           "\"matvecs_met\": ", "\"time_met\": ", "\"fine_newton_step_in_matvecs\": [",
