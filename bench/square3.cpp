@@ -180,16 +180,18 @@ void run_once(levels::ElasticProblem3 problem, Series3& s) {
         row.level_s.push_back(total);
         row.traffic_runs.push_back(lt[l].account);
         row.krylov_s.push_back(lt[l].krylov_seconds);
-        double matvec = 0;
-        if (!last_M[l].empty()) {
-            levels::BasicJacobianAssembler<3> jac(L);
+        // A level that took no Newton step: its Jacobian at unit statuses (same pattern; the
+        // values do not change a mat-vec's time).
+        levels::BasicJacobianAssembler<3> jac(L);
+        if (last_M[l].empty())
+            jac.assemble(std::vector<levels::StatusMatrix<3>>(L.contacts.size(),
+                                                              levels::StatusMatrix<3>::Identity()));
+        else
             jac.assemble(last_M[l]);
-            const SparseMatrix& J = jac.matrix();
-            matvec = time_matvec(J, 10, l + 1 == nl ? 0.5 : 0.1);
-            row.nonzeros = static_cast<long>(J.nonZeros());
-            row.matvec_bytes = traffic::csr_bytes(J.rows(), J.cols(), J.nonZeros(), false);
-        }
-        row.matvec_s.push_back(matvec);
+        const SparseMatrix& J = jac.matrix();
+        row.matvec_s.push_back(time_matvec(J, 10, l + 1 == nl ? 0.5 : 0.1));
+        row.nonzeros = static_cast<long>(J.nonZeros());
+        row.matvec_bytes = traffic::csr_bytes(J.rows(), J.cols(), J.nonZeros(), false);
         if (first) {
             row.level = static_cast<int>(l);
             row.unknowns = L.n_unknowns();
