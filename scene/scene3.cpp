@@ -569,7 +569,7 @@ void read_contacts3(const Reader& rd, const toml::table& root, ElasticProblem3& 
         }
         if (ct->get("target")) {
             c.target = rd.string(*ct, "target", w);
-            if (const auto id = p.mesh0.find_tag(c.target); !id || !p.mesh0.is_boundary_tag(*id))
+            if (const auto tid = p.mesh0.find_tag(c.target); !tid || !p.mesh0.is_boundary_tag(*tid))
                 rd.fail(ct->get("target"),
                         w + ": unknown target tag '" + c.target + "' (the " +
                             "boundary face tags are: " + known_tags(p.mesh0, false) + ")");
