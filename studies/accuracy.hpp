@@ -117,7 +117,13 @@ int study_accuracy(const levels::Problem& problem, const AccuracyOptions& opt, s
 /// The closed-form quantities of a converged 3D run: hertz3d and sphere_punch (P, the contact
 /// radius a against (3 P R / (4 E*))^(1/3) with 1/E* = (1 - nu^2) / E, the pressure of the node
 /// nearest the axis against p0 = 3 P / (2 pi a^2), the rms of p - p0 sqrt(1 - r^2 / a^2) over
-/// r < 0.9 a relative to p0; pressures -lambda_n / int N_i dA), punch3d (the largest relative
+/// r < 0.9 a relative to p0; pressures -lambda_n / int N_i dA), sphere_on_block (Hertz between
+/// two equal bodies, 1/E* = 2 (1 - nu^2) / E, P and Q twice the half model's normal force and x
+/// force; the same radius, peak pressure and rms, then, after the shift of the last step, c / a
+/// against Cattaneo-Mindlin's (1 - Q / (mu P))^(1/3) with c and a the half-widths of the stick
+/// and the closed nodes on the x axis (y = 0), each end midway to the next node, as in 2D; the
+/// rms of the traction along x against the closed form over r < 0.9 a relative to mu p0; the
+/// largest |lambda_t| / (mu |lambda_n|) after the first step), punch3d (the largest relative
 /// error of the pressure against the load's, and of the resultant). Throws InvalidInput for
 /// another scene.
 std::vector<AccuracyValue> accuracy_values3(const levels::ElasticProblem3& p,
