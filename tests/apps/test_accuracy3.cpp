@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The 3D Hertz scenes against the closed form (studies/accuracy3.cpp) on level 2: the contact
 // radius within 2 %, the peak pressure within 5 %, the pressure profile's rms within 3 % of p0,
-// and level 2's errors below level 0's.
+// and level 2's errors below level 0's; sphere_on_block against Hertz and Cattaneo-Mindlin.
 #include "scene/scene3.hpp"
 #include "core/check.hpp"
 #include "studies/accuracy.hpp"
@@ -10,18 +10,24 @@
 
 #include <cmath>
 #include <map>
+#include <string>
 
 namespace mlc {
 namespace {
 
-std::map<std::string, double> hertz3_errors(const std::string& scene, int level) {
+/// The errors of the accuracy study's quantities on `level`, and their values into `values`
+/// when given.
+std::map<std::string, double> hertz3_errors(const std::string& scene, int level,
+                                            std::map<std::string, double>* values = nullptr) {
     auto p = scene::load_scene3(scene);
     p.levels = level;
     const auto r = levels::solve(p);
     EXPECT_TRUE(r.converged) << r.failure;
     std::map<std::string, double> e;
-    for (const auto& v : apps::accuracy_values3(p, r))
+    for (const auto& v : apps::accuracy_values3(p, r)) {
         e[v.name] = v.error;
+        if (values) (*values)[v.name] = v.value;
+    }
     return e;
 }
 
@@ -43,6 +49,22 @@ TEST(Accuracy3, Hertz3dLevel2AgainstHertz) { expect_hertz3("hertz3d", true); }
 // The rigid sphere's block is 40 a wide and 40 a deep, graded toward the contact: close enough
 // to the half-space that the peak pressure improves with the radius and the profile.
 TEST(Accuracy3, SpherePunchLevel2AgainstHertz_Slow) { expect_hertz3("sphere_punch", true); }
+
+// Two equal elastic bodies (sphere_on_block, half model): after the press, a and p0 within 3 %
+// of Hertz; after the shift (Q / (mu P) near 0.5), c / a on the x axis within 5 % of
+// Cattaneo-Mindlin's (1 - Q / (mu P))^(1/3); each error on level 2 below level 0's.
+TEST(Accuracy3, SphereOnBlockLevel2AgainstHertzAndCattaneoMindlin_Slow) {
+    std::map<std::string, double> v0, v2;
+    const auto e0 = hertz3_errors("sphere_on_block", 0, &v0);
+    const auto e2 = hertz3_errors("sphere_on_block", 2, &v2);
+    EXPECT_GT(v2.at("Q_over_muP"), 0.4);
+    EXPECT_LT(v2.at("Q_over_muP"), 0.6);
+    for (const char* q : {"radius", "peak_pressure", "c_over_a"})
+        EXPECT_LT(std::abs(e2.at(q)), std::abs(e0.at(q))) << q;
+    EXPECT_LE(std::abs(e2.at("radius")), 0.03);
+    EXPECT_LE(std::abs(e2.at("peak_pressure")), 0.03);
+    EXPECT_LE(std::abs(e2.at("c_over_a")), 0.05);
+}
 
 TEST(Accuracy3, Punch3dIsExact) {
     auto p = scene::load_scene3("punch3d");
