@@ -51,7 +51,8 @@ Action add_extremes(CLI::App& ex) {
         std::string out;
     };
     auto a = std::make_shared<Args>();
-    ex.add_option("--levels,-l", a->o.levels, "finest level of every case (default 2)");
+    ex.add_option("--levels,-l", a->o.levels,
+                  "finest level of every case (default 2; 1 with --dimension 3)");
     ex.add_option("--seconds", a->o.seconds_per_case, "time bound per case (default 120)");
     ex.add_option("--only", a->o.only, "run only cases whose name contains this text");
     ex.add_option("--out,-o", a->out, "output folder (default out/studies/extremes)");
@@ -63,8 +64,16 @@ Action add_extremes(CLI::App& ex) {
     ex.add_option("--pc", a->o.pc, pc_option_help("preconditioner (implies a Krylov solve)"));
     ex.add_option("--linear-tol", a->o.linear_rel_tol,
                   "relative tolerance of each Krylov solve (implies a Krylov solve)");
-    return [a](const Launch& at) {
+    ex.add_option("--dimension", a->o.dimension,
+                  "2: the square-based cases (default); 3: the block3d- and stack3d-based ones "
+                  "(default --levels 1; --linear schur|lu only)")
+        ->check(CLI::IsMember({2, 3}));
+    return [a, &ex](const Launch& at) {
         a->o.out = a->out;
+        if (a->o.dimension == 3) {
+            if (ex.count("--levels") == 0) a->o.levels = 1;
+            return study_extremes3(a->o, at.os);
+        }
         return study_extremes(a->o, at.os);
     };
 }
@@ -76,15 +85,24 @@ Action add_error_vs_time(CLI::App& ev) {
     };
     auto a = std::make_shared<Args>();
     ev.add_option("scene", a->scene, "scene file or built-in name (default square)");
-    ev.add_option("--levels,-l", a->o.max_level, "configurations on levels 0..L (default 3)");
+    ev.add_option("--levels,-l", a->o.max_level,
+                  "configurations on levels 0..L (default 3; 1 on a 3D scene)");
     ev.add_option("--ilu-levels", a->o.ilu_max_level,
                   "the ILU(0) configurations only up to this level (default 3)");
     ev.add_option("--only", a->o.only,
                   "run only the configurations whose name contains this text (e.g. mg)");
     ev.add_option("--out,-o", a->out, "output folder (default out/studies/<scene>_error_vs_time)");
     ev.add_flag("!--no-plot", a->o.plot, "do not draw the PNG");
-    return [a](const Launch& at) {
+    return [a, &ev](const Launch& at) {
         a->o.out = a->out;
+        if (scene::scene_dimension(a->scene) == 3) {
+            if (ev.count("--ilu-levels") > 0)
+                throw InvalidInput("--ilu-levels applies to 2D scenes: the 3D grid has no ILU(0) "
+                                   "configurations (gmres+mg, schur and lu, coarse-to-fine and "
+                                   "cold)");
+            if (ev.count("--levels") == 0) a->o.max_level = 1;
+            return study_error_vs_time3(scene::load_scene3(a->scene), a->o, at.os);
+        }
         return study_error_vs_time(scene::load_scene(a->scene), a->o, at.os);
     };
 }

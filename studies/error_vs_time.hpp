@@ -4,6 +4,7 @@
 #pragma once
 
 #include "levels/problem.hpp"
+#include "levels/solve3.hpp"
 
 #include <filesystem>
 #include <ostream>
@@ -15,7 +16,8 @@ namespace mlc::apps {
 struct ErrorVsTimeOptions {
     int max_level = 3; ///< configurations run on levels 0..max_level
     /// The reference solution is computed on level max_level + reference_offset (exact solver,
-    /// coarse-to-fine).
+    /// coarse-to-fine): 1 or 2 in 2D; 0, 1 or 2 in 3D (0: the reference level is the finest
+    /// of the grid, whose reference row then measures the reference against itself).
     int reference_offset = 1;
     /// The ILU(0) configurations run on levels 0..min(max_level, ilu_max_level): their Krylov
     /// iterations grow with the level (the 5000-iteration cap near 30 000 unknowns), so above
@@ -45,5 +47,23 @@ std::string error_vs_time_pc(const levels::Problem& problem, const std::string& 
 /// error_vs_time.csv/json, marks the Pareto front, and draws error_vs_time.png.
 int study_error_vs_time(const levels::Problem& problem, const ErrorVsTimeOptions& opt,
                         std::ostream& os);
+
+/// The study of a 3D scene (levels 0..max_level, max_level <= 3; ilu_max_level unused).
+/// Configurations: coarse-to-fine and cold, each with the run's plan (`gmres+mg`: schur or lu on
+/// level 0 by levels::plan_contact3, GMRES + the Galerkin multigrid above; levels 1..max_level),
+/// `schur` and `lu` on every level (levels 0..max_level). The reference is `c2f lu` on level
+/// max_level + reference_offset. Errors of a run on level l: its nodal displacements and its
+/// contact tractions (each node's multiplier in global components over its lumped area
+/// levels::contact_areas, a vertex field zero off the contact nodes) are interpolated to the
+/// reference level by the hierarchy's P_vertex (per component, through each refinement); the
+/// displacement error is relative in the energy norm of the reference level's K on its
+/// unknowns, the traction error the relative L2 norm (lumped areas) over the reference's
+/// contact nodes. The energy error is the primary one (Pareto front, plot). A run that throws
+/// (a refused memory plan) is a row that did not converge. Writes error_vs_time.csv (the 2D
+/// columns, closed_form_error -1), error_vs_time.json and error_vs_time.png. Returns 0, or 2
+/// when the reference did not converge; throws InvalidInput for max_level outside 0..3, a
+/// reference offset outside 0..2 and a scene without contact.
+int study_error_vs_time3(const levels::ElasticProblem3& problem, const ErrorVsTimeOptions& opt,
+                         std::ostream& os);
 
 } // namespace mlc::apps

@@ -28,7 +28,7 @@ namespace mlc::apps {
 namespace {
 
 /// What a case reports back to the parent (key = value lines through a pipe).
-using Fields = std::map<std::string, std::string>;
+using Fields = ExtremesFields;
 
 struct Case {
     std::string name;
@@ -315,9 +315,9 @@ std::vector<Case> make_cases() {
     return cs;
 }
 
-/// Runs one case in a child process with a wall-clock bound.
-Fields run_isolated(const Case& c, int levels, const levels::LinearSolverSpec& solver,
-                    double seconds) {
+} // namespace
+
+ExtremesFields run_isolated(const std::function<ExtremesFields()>& run, double seconds) {
     std::fflush(nullptr); // nothing buffered may be written twice by the child
     int fd[2];
     if (pipe(fd) != 0) return {{"status", "error"}, {"diagnosis", "pipe failed"}};
@@ -326,7 +326,7 @@ Fields run_isolated(const Case& c, int levels, const levels::LinearSolverSpec& s
         close(fd[0]);
         Fields f;
         try {
-            f = c.run(levels, solver);
+            f = run();
         } catch (const std::exception& e) {
             f["status"] = "error";
             f["diagnosis"] = e.what();
@@ -393,8 +393,6 @@ Fields run_isolated(const Case& c, int levels, const levels::LinearSolverSpec& s
     return f;
 }
 
-} // namespace
-
 int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
     MLC_CHECK(opt.levels >= 0 && opt.levels <= 6, "--levels must lie in [0, 6]");
     MLC_CHECK(opt.seconds_per_case > 0, "--seconds must be positive");
@@ -443,7 +441,8 @@ int study_extremes(const ExtremesOptions& opt, std::ostream& os) {
            << std::right << std::flush;
         for (const auto& c : make_cases()) {
             if (!opt.only.empty() && c.name.find(opt.only) == std::string::npos) continue;
-            Fields f = run_isolated(c, opt.levels, solver.spec, opt.seconds_per_case);
+            Fields f =
+                run_isolated([&] { return c.run(opt.levels, solver.spec); }, opt.seconds_per_case);
             auto get = [&](const std::string& k) { return f.count(k) ? f[k] : std::string("-"); };
             std::string notes = get("diagnosis") == "-" ? "" : get("diagnosis");
             if (f.count("statuses"))
