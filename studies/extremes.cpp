@@ -22,6 +22,9 @@
 #include <toml++/toml.h>
 #include <unistd.h>
 #include <vector>
+#if defined(_OPENMP)
+#include <omp.h>
+#endif
 
 namespace mlc::apps {
 
@@ -319,6 +322,12 @@ std::vector<Case> make_cases() {
 
 ExtremesFields run_isolated(const std::function<ExtremesFields()>& run, double seconds) {
     std::fflush(nullptr); // nothing buffered may be written twice by the child
+#if defined(_OPENMP)
+    // OpenMP's idle threads (CHOLMOD's, when the process factorized before) are not copied into
+    // the child, whose first parallel region would wait for them forever: end them first (the
+    // next region of this process starts new ones).
+    omp_pause_resource_all(omp_pause_hard);
+#endif
     int fd[2];
     if (pipe(fd) != 0) return {{"status", "error"}, {"diagnosis", "pipe failed"}};
     const pid_t pid = fork();

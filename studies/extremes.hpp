@@ -35,7 +35,8 @@ using ExtremesFields = std::map<std::string, std::string>;
 /// fields, read back through a pipe (a newline in a value becomes a space), with "exit" the
 /// child's exit code (0 when its status is "converged", else 2). An exception in the child gives
 /// status "error" with its message; a child killed by a signal status "crash" ("signal ..."); one
-/// past the bound is killed and reported as status "timeout".
+/// past the bound is killed and reported as status "timeout". OpenMP's idle threads are ended
+/// before the fork (omp_pause_resource_all), since a child cannot use the parent's.
 ExtremesFields run_isolated(const std::function<ExtremesFields()>& run, double seconds);
 
 /// Runs every case with every solver; prints one table per solver (Krylov iterations per Newton
