@@ -1,0 +1,324 @@
+// SPDX-License-Identifier: MIT
+// A process's part of a distributed 3D level (elastic block): ghost data from the owners,
+// numbering, the owned rows of K and of the transfers as ParCSR matrices.
+#include "levels/distributed3.hpp"
+
+#include "core/check.hpp"
+#include "fem/assembly.hpp"
+#include "levels/distributed.hpp"
+#include "mesh/tet_refine.hpp"
+#include "transfer/prolongation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace mlc::levels {
+
+// ---------------------------------------------------------------------------------------------
+GhostExchange3::GhostExchange3(const mesh::LocalTetLevel& part, const Communicator& comm)
+    : comm_(&comm) {
+    const int np = comm.size();
+    const int me = comm.rank();
+    recv_.assign(static_cast<size_t>(np), {});
+    std::vector<std::vector<std::int64_t>> ask(static_cast<size_t>(np));
+    for (int v = 0; v < part.mesh.n_vertices(); ++v) {
+        const int o = part.vertex_owner[static_cast<size_t>(v)];
+        if (o == me) continue;
+        recv_[static_cast<size_t>(o)].push_back(v);
+        ask[static_cast<size_t>(o)].push_back(part.global_vertex[static_cast<size_t>(v)]);
+    }
+    const auto asked = comm.exchange(ask);
+    send_.assign(static_cast<size_t>(np), {});
+    for (int q = 0; q < np; ++q)
+        for (const std::int64_t g : asked[static_cast<size_t>(q)]) {
+            const std::int64_t i = g - part.first_vertex;
+            MLC_CHECK(i >= 0 && i < part.n_owned_vertices(),
+                      "GhostExchange3: process " << q << " asks for vertex " << g
+                                                 << ", which process " << me << " does not own");
+            send_[static_cast<size_t>(q)].push_back(part.owned_vertices[static_cast<size_t>(i)]);
+        }
+}
+
+void GhostExchange3::vertex_records(std::vector<double>& rec, int width) const {
+    const auto w = static_cast<size_t>(width);
+    std::vector<std::vector<double>> out(send_.size());
+    for (size_t q = 0; q < send_.size(); ++q)
+        for (const int v : send_[q])
+            out[q].insert(out[q].end(), rec.begin() + static_cast<std::ptrdiff_t>(v * w),
+                          rec.begin() + static_cast<std::ptrdiff_t>((v + 1) * w));
+    const auto in = comm_->exchange(out);
+    for (size_t q = 0; q < recv_.size(); ++q) {
+        MLC_CHECK(in[q].size() == recv_[q].size() * w,
+                  "GhostExchange3: process " << q << " sent " << in[q].size() << " values for "
+                                             << recv_[q].size() << " vertices");
+        for (size_t i = 0; i < recv_[q].size(); ++i)
+            std::copy_n(in[q].begin() + static_cast<std::ptrdiff_t>(i * w), w,
+                        rec.begin() + static_cast<std::ptrdiff_t>(recv_[q][i] * w));
+    }
+}
+
+namespace {
+/// The unknowns of vertex v in a fixed order: its free components, then its extra unknowns.
+template <class F> void for_vertex_dofs3(const fem::DofMap3& dofs, int v, F&& f) {
+    for (int c = 0; c < 3; ++c)
+        if (const int d = dofs.u_dof(v, c); d >= 0) f(d);
+    if (const int e = dofs.extra_dof(v); e >= 0)
+        for (int k = e; k < dofs.n_dofs() && dofs.vertex_of(k) == v && !dofs.is_displacement(k);
+             ++k)
+            f(k);
+}
+
+/// Relative distance (to the level-0 diameter) under which a support point is a vertex, or a
+/// vertex lies on a support line (elastic3d_levels.cpp's kPointTol).
+constexpr double kPointTol = 1e-9;
+
+/// line_vertices with the tolerance of the whole level-0 mesh (a part's diameter is smaller).
+std::vector<int> line_vertices_within(const mesh::TetMesh& m, const std::array<Vec3, 2>& line,
+                                      double tol) {
+    const Vec3 d = line[1] - line[0];
+    const double len2 = d.squaredNorm();
+    std::vector<int> out;
+    for (int v = 0; v < m.n_vertices(); ++v) {
+        const Vec3 x = m.vertices[static_cast<size_t>(v)] - line[0];
+        const double s = len2 > 0 ? x.dot(d) / len2 : 0.0;
+        if (s < -tol || s > 1 + tol) continue;
+        if ((x - s * d).norm() <= tol) out.push_back(v);
+    }
+    return out;
+}
+
+/// The numbering view of a part (first_dof, n_owned, global_dof) as a DistributedLevel, whose
+/// row_blocks and owned_rows read nothing else: the 2D code cuts the rows.
+struct NumberingView {
+    DistributedLevel d;
+    explicit NumberingView(const DistributedLevel3& l) {
+        d.first_dof = l.first_dof;
+        d.n_owned = l.n_owned;
+        d.global_dof = l.global_dof;
+    }
+};
+} // namespace
+
+void GhostExchange3::update(const fem::DofMap3& dofs, Vector& x) const {
+    std::vector<std::vector<double>> out(send_.size());
+    for (size_t q = 0; q < send_.size(); ++q)
+        for (const int v : send_[q])
+            for_vertex_dofs3(dofs, v, [&](int d) { out[q].push_back(x[d]); });
+    const auto in = comm_->exchange(out);
+    for (size_t q = 0; q < recv_.size(); ++q) {
+        size_t i = 0;
+        for (const int v : recv_[q])
+            for_vertex_dofs3(dofs, v, [&](int d) {
+                MLC_CHECK(i < in[q].size(),
+                          "GhostExchange3: process " << q << " sent too few values");
+                x[d] = in[q][i++];
+            });
+        MLC_CHECK(i == in[q].size(), "GhostExchange3: process " << q << " sent too many values");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+solvers::DistributedRows DistributedLevel3::owned_rows(const SparseMatrix& A) const {
+    return NumberingView(*this).d.owned_rows(A);
+}
+
+solvers::RowBlocks DistributedLevel3::row_blocks(const SparseMatrix& A) const {
+    return NumberingView(*this).d.row_blocks(A);
+}
+
+solvers::DistributedRows DistributedLevel3::K_rows() const {
+    const solvers::RowBlocks& kb = *K_blocks;
+    solvers::DistributedRows rows;
+    rows.first_row = kb.first_row;
+    rows.row_ptr.assign(1, 0);
+    rows.cols.reserve(static_cast<size_t>(kb.diag.nonZeros() + kb.offd.nonZeros()));
+    rows.values.reserve(rows.cols.capacity());
+    for (Index i = 0; i < kb.diag.rows(); ++i) {
+        for (SparseMatrix::InnerIterator it(kb.diag, i); it; ++it) {
+            rows.cols.push_back(kb.first_col + it.col());
+            rows.values.push_back(it.value());
+        }
+        for (SparseMatrix::InnerIterator it(kb.offd, i); it; ++it) {
+            rows.cols.push_back(kb.col_map[static_cast<size_t>(it.col())]);
+            rows.values.push_back(it.value());
+        }
+        rows.row_ptr.push_back(static_cast<int>(rows.cols.size()));
+    }
+    return rows;
+}
+
+std::vector<int> DistributedLevel3::dof_function() const {
+    std::vector<int> f(static_cast<size_t>(n_owned), -1);
+    for (int v = 0; v < local.mesh.n_vertices(); ++v)
+        for (int c = 0; c < 3; ++c)
+            if (const int d = local.dofs.u_dof(v, c); d >= 0 && d < n_owned)
+                f[static_cast<size_t>(d)] = c;
+    return f;
+}
+
+DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::LocalTetLevel part,
+                                           const Communicator& comm) {
+    MLC_CHECK(p.n_path_points() == 1,
+              "a distributed 3D level takes proportional loading only; the scene has a loading "
+              "path of "
+                  << p.n_path_points() << " points (per-point factors or u lists)");
+    DistributedLevel3 d;
+    const int me = comm.rank();
+    const int nv = part.mesh.n_vertices();
+    d.ghosts = GhostExchange3(part, comm);
+    const double tol = kPointTol * p.mesh0.diameter();
+    Level3& L = d.local;
+    L.mesh = std::move(part.mesh);
+    const mesh::TetMesh& m = L.mesh;
+
+    // Supports on the local mesh; a point support is held where its vertex is local.
+    std::vector<fem::VertexSupport3> vs;
+    std::vector<int> point_owned;
+    for (const Support3& s : p.supports) {
+        fem::VertexSupport3 v;
+        if (!s.tag.empty()) {
+            if (const auto id = m.find_tag(s.tag)) v.vertices = m.vertices_on_tag(*id);
+        } else if (s.line) {
+            v.vertices = line_vertices_within(m, *s.line, tol);
+        } else {
+            const int w = m.nearest_vertex(*s.point);
+            const bool here = (m.vertices[static_cast<size_t>(w)] - *s.point).norm() <= tol;
+            if (here) v.vertices = {w};
+            point_owned.push_back(here && part.vertex_owner[static_cast<size_t>(w)] == me);
+        }
+        for (int c = 0; c < 3; ++c) {
+            v.components[static_cast<size_t>(c)] = s.u[static_cast<size_t>(c)].has_value();
+            v.value[c] = s.u[static_cast<size_t>(c)].value_or(0.0);
+        }
+        vs.push_back(std::move(v));
+    }
+    comm.allreduce(std::span<int>(point_owned), ReduceOp::sum);
+    for (const int n : point_owned)
+        MLC_CHECK(n == 1, "a support point is a vertex of " << n
+                                                           << " processes' owned vertices (one "
+                                                              "expected)");
+    fem::Supports3 sup = fem::collect_supports(m, vs);
+    // Ghost vertices: their owners' fixed components and values.
+    {
+        std::vector<double> rec(static_cast<size_t>(nv) * 6);
+        for (int v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c) {
+                rec[6 * static_cast<size_t>(v) + static_cast<size_t>(c)] =
+                    sup.fixed[static_cast<size_t>(v)][static_cast<size_t>(c)];
+                rec[6 * static_cast<size_t>(v) + 3 + static_cast<size_t>(c)] =
+                    sup.u_fixed[3 * v + c];
+            }
+        d.ghosts.vertex_records(rec, 6);
+        for (int v = 0; v < nv; ++v)
+            for (int c = 0; c < 3; ++c) {
+                sup.fixed[static_cast<size_t>(v)][static_cast<size_t>(c)] =
+                    rec[6 * static_cast<size_t>(v) + static_cast<size_t>(c)] != 0.0;
+                sup.u_fixed[3 * v + c] = rec[6 * static_cast<size_t>(v) + 3 + static_cast<size_t>(c)];
+            }
+    }
+    L.fixed = std::move(sup.fixed);
+    L.u_fixed = std::move(sup.u_fixed);
+    L.contact_of_vertex.assign(static_cast<size_t>(nv), -1);
+    L.not_found.assign(p.contacts.size(), {});
+
+    // Owned vertices first (in their global order), then the ghosts.
+    std::vector<int> order = part.owned_vertices;
+    {
+        std::vector<char> owned(static_cast<size_t>(nv), 0);
+        for (const int v : order)
+            owned[static_cast<size_t>(v)] = 1;
+        for (int v = 0; v < nv; ++v)
+            if (!owned[static_cast<size_t>(v)]) order.push_back(v);
+    }
+    L.dofs = fem::DofMap3(L.fixed, std::vector<int>(static_cast<size_t>(nv), 0), order);
+
+    // Materials and the full load.
+    std::vector<Vec3> bf;
+    bool any_force = false;
+    for (const Body3& b : p.bodies) {
+        bf.push_back(b.body_force);
+        L.materials.push_back(b.material);
+        any_force = any_force || !b.body_force.isZero(0.0);
+    }
+    if (!any_force) bf.clear();
+    std::vector<fem::Traction3> tr;
+    for (const FaceLoad3& l : p.loads)
+        if (const auto id = m.find_tag(l.tag)) tr.push_back({*id, l.pressure, l.traction});
+    L.elastic = fem::assemble_elastic(m, L.materials, L.dofs, fem::nodal_loads(m, tr, bf),
+                                      L.u_fixed);
+
+    // Owned unknowns first.
+    d.n_owned = 0;
+    for (const int v : part.owned_vertices)
+        for_vertex_dofs3(L.dofs, v, [&]([[maybe_unused]] int dof) {
+            MLC_ASSERT(dof == d.n_owned, "an owned unknown is numbered after a ghost one");
+            ++d.n_owned;
+        });
+    d.first_dof = comm.exclusive_sum(static_cast<std::int64_t>(d.n_owned));
+    d.n_global_dofs = comm.sum(static_cast<std::int64_t>(d.n_owned));
+    Vector g = Vector::Constant(L.dofs.n_dofs(), -1.0);
+    for (Index i = 0; i < d.n_owned; ++i)
+        g[i] = static_cast<double>(d.first_dof + i);
+    d.ghosts.update(L.dofs, g);
+    d.global_dof.resize(static_cast<size_t>(L.dofs.n_dofs()));
+    for (Index i = 0; i < L.dofs.n_dofs(); ++i) {
+        MLC_CHECK(g[i] >= 0, "internal error: unknown " << i << " has no global number");
+        d.global_dof[static_cast<size_t>(i)] = std::llround(g[i]);
+    }
+    d.K_blocks = std::make_unique<solvers::RowBlocks>(d.row_blocks(L.elastic.K));
+    L.elastic.K = SparseMatrix(); // its owned rows are in K_blocks
+    d.K = std::make_unique<solvers::ParMatrix>(comm, *d.K_blocks);
+    part.mesh = mesh::TetMesh{};
+    d.part = std::move(part);
+    return d;
+}
+
+DistributedTransfer3 build_distributed_transfer3(const DistributedLevel3& coarse,
+                                                 const DistributedLevel3& fine,
+                                                 const Communicator& comm) {
+    const SparseMatrix P_vertex = transfer::vertex_prolongation(fine.local.mesh);
+    MLC_CHECK(P_vertex.cols() == coarse.local.mesh.n_vertices(),
+              "build_distributed_transfer3: the fine part's mesh refines a mesh of "
+                  << P_vertex.cols() << " vertices, the coarse part has "
+                  << coarse.local.mesh.n_vertices());
+    const SparseMatrix T = transfer::restrict_to_unknowns(
+        P_vertex, 3, transfer::vertex_unknowns(coarse.local.dofs, 3),
+        static_cast<int>(coarse.local.dofs.n_dofs()), transfer::vertex_unknowns(fine.local.dofs, 3),
+        static_cast<int>(fine.local.dofs.n_dofs()));
+    solvers::DistributedRows r;
+    r.first_row = fine.first_dof;
+    const int n = static_cast<int>(fine.n_owned);
+    const int nnz = T.outerIndexPtr()[n];
+    r.row_ptr.assign(T.outerIndexPtr(), T.outerIndexPtr() + n + 1);
+    r.cols.resize(static_cast<size_t>(nnz));
+    for (int k = 0; k < nnz; ++k)
+        r.cols[static_cast<size_t>(k)] =
+            coarse.global_dof[static_cast<size_t>(T.innerIndexPtr()[k])];
+    r.values.assign(T.valuePtr(), T.valuePtr() + nnz);
+    DistributedTransfer3 t;
+    t.T = std::make_unique<solvers::ParMatrix>(comm, r, coarse.first_dof,
+                                               static_cast<int>(coarse.n_owned));
+    return t;
+}
+
+DistributedHierarchy3 build_distributed_hierarchy3(const ElasticProblem3& p, int p_level,
+                                                   int n_refinements, const Communicator& comm) {
+    MLC_CHECK(p_level >= 0, "the partition level must be >= 0, found " << p_level);
+    MLC_CHECK(n_refinements >= 0,
+              "the refinements above the partition level must be >= 0, found " << n_refinements);
+    mesh::TetMesh level_p = p.mesh0;
+    for (int l = 0; l < p_level; ++l)
+        level_p = mesh::refine(level_p);
+    mesh::DistributedTetHierarchy dh = mesh::distribute(level_p, n_refinements, comm);
+    DistributedHierarchy3 h;
+    for (auto& part : dh.levels) {
+        h.levels.push_back(build_distributed_level3(p, std::move(part), comm));
+        if (h.levels.size() >= 2)
+            h.transfers.push_back(build_distributed_transfer3(h.levels[h.levels.size() - 2],
+                                                              h.levels.back(), comm));
+    }
+    return h;
+}
+
+} // namespace mlc::levels

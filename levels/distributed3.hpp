@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: MIT
+/// @file The elastic part of the levels of a distributed 3D run: the counterpart of
+/// levels/distributed.hpp (read its file comment first) on mesh::distribute's tetrahedral parts
+/// (mesh/distributed3.hpp, docs/parallel.md#parallel-3d-mesh).
+///
+/// Numbering. A process's part of a level is a Level3 on its local mesh (owned and ghost
+/// tetrahedra) numbered by the vertex order owned vertices first (LocalTetLevel::owned_vertices,
+/// in their global order), then the ghosts (in local index order): the free components of a
+/// vertex, interleaved. The owned unknowns are the first `n_owned` of the part and the global
+/// unknowns [first_dof, first_dof + n_owned) (contiguous per process, in rank order: hypre's row
+/// partition). The fixed components and prescribed values of ghost vertices are their owners'
+/// (a part's mesh may lack a ghost vertex's boundary faces). On one process the part is the
+/// serial level with the serial numbering (levels::build_level on the same mesh, contact
+/// nodes aside).
+///
+/// What is exact. The owned rows of the part's stiffness K, load f and transfers are those of
+/// the whole level: every tetrahedron around an owned vertex is local (the ghost layer), with the
+/// boundary faces of its owned faces, and every parent of an owned vertex is a local vertex of
+/// the level below. Rows of ghost unknowns are incomplete and never used.
+///
+/// What is not yet here (each refused with InvalidInput, never ignored silently, unless said):
+/// - contact: the problem's contact pairs are left out; a part has no contact elements and no
+///   multipliers (the elastic block of the level: its stiffness on the displacements alone,
+///   what `bench elastic` solves for a contact scene). Level3::contacts stays empty.
+/// - a loading path (ElasticProblem3::n_path_points() > 1): refused; the loading is the full
+///   load (K, f at load factor 1, u_fixed) as with proportional loading.
+/// - the distributed multigrid (levels/distributed_multigrid.hpp is 2D: its statuses, coarse
+///   solve and smoother rows) and the distributed solves on these levels; the elastic block can
+///   be solved by hypre's BoomerAMG-PCG on K_rows().
+#pragma once
+
+#include "core/communicator.hpp"
+#include "levels/elastic3d_levels.hpp"
+#include "levels/level.hpp"
+#include "mesh/distributed3.hpp"
+#include "solvers/hypre/par_matrix.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace mlc::levels {
+
+/// Fetches values held per vertex from the vertices' owners into the ghost vertices of a
+/// process's part of a tetrahedral level (one personalised exchange over the Communicator), as
+/// GhostExchange does for a triangular part.
+class GhostExchange3 {
+public:
+    GhostExchange3() = default;
+    /// Collective: every process tells the owners which of their vertices it holds as ghosts.
+    GhostExchange3(const mesh::LocalTetLevel& part, const Communicator& comm);
+    /// Collective: `records` holds `width` values per local vertex; the records of the ghost
+    /// vertices are overwritten with their owners'.
+    void vertex_records(std::vector<double>& records, int width) const;
+    /// Collective: the entries of x (a part's unknowns, `dofs` numbering) at ghost vertices are
+    /// overwritten with their owners' values: per vertex its free components, then its extra
+    /// unknowns. Every process must agree on which components of a vertex are unknowns and on its
+    /// extra unknowns (build_distributed_level3 makes the fixed flags agree).
+    void update(const fem::DofMap3& dofs, Vector& x) const;
+    /// Vertices held as ghosts from each process (rank order).
+    const std::vector<std::vector<int>>& ghosts_by_owner() const { return recv_; }
+
+private:
+    const Communicator* comm_ = nullptr;
+    std::vector<std::vector<int>> recv_; ///< per owner: this part's ghost vertices it sends
+    std::vector<std::vector<int>> send_; ///< per process: owned vertices it holds as ghosts
+};
+
+/// One process's part of one 3D level of a distributed run (its elastic block).
+struct DistributedLevel3 {
+    mesh::LocalTetLevel part; ///< the local mesh moved into `local`: part.mesh is empty
+    Level3 local;             ///< the part as a Level3 (owned unknowns first; no contacts)
+    GhostExchange3 ghosts;
+    Index n_owned = 0;                    ///< owned unknowns: local unknowns [0, n_owned)
+    std::int64_t first_dof = 0;           ///< global number of local unknown 0
+    std::int64_t n_global_dofs = 0;       ///< unknowns of the level over all processes
+    std::vector<std::int64_t> global_dof; ///< global number of every local unknown
+    /// The stiffness's owned rows, the one copy of it (local.elastic.K is freed once they are
+    /// cut from it), and K, the ParCSR matrix on their arrays (for hypre's own solvers, which
+    /// want the diagonal entry first in its row, build one from owned_rows instead).
+    std::unique_ptr<solvers::RowBlocks> K_blocks; ///< (held by pointer: K points into its arrays)
+    std::unique_ptr<solvers::ParMatrix> K;
+
+    /// The owned rows of a matrix on the part's unknowns (rows and columns in local numbering,
+    /// owned rows first) with global column numbers.
+    solvers::DistributedRows owned_rows(const SparseMatrix& A) const;
+    /// The owned rows of A split as hypre stores them (DistributedLevel::row_blocks).
+    solvers::RowBlocks row_blocks(const SparseMatrix& A) const;
+    /// The owned entries of local.elastic.f (the load at factor 1 on the owned unknowns).
+    Vector owned_load() const { return local.elastic.f.head(n_owned); }
+    /// The owned rows of K (K_blocks) with global columns, for a ParMatrix built through IJ
+    /// (what solvers::boomeramg_pcg_par needs).
+    solvers::DistributedRows K_rows() const;
+    /// The component (0, 1 or 2) of every owned unknown: BoomerAMG's dof_func.
+    std::vector<int> dof_function() const;
+};
+
+/// Collective: builds this process's part of a 3D level from its local mesh (`part`, a level of
+/// mesh::distribute of a refinement of p.mesh0; its mesh is moved out): supports (a point
+/// support is the local vertex at its position, held by the processes that have it), body
+/// materials, face loads and body forces at the full load, the numbering above, K and f
+/// assembled on the local tetrahedra, and the owned rows of K as a ParMatrix. Throws InvalidInput
+/// on every process alike for a loading path (n_path_points() > 1) and for a support point that
+/// is a vertex of no process's part; p must have passed validate().
+DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::LocalTetLevel part,
+                                           const Communicator& comm);
+
+/// The transfer between consecutive distributed 3D levels (fine refined from coarse): the
+/// local T (transfer::vertex_prolongation of the fine part restricted to the free
+/// displacements, transfer::restrict_to_unknowns, as build_hierarchy's), whose owned fine rows
+/// are exact, as a ParMatrix (owned fine rows, coarse unknowns as columns).
+struct DistributedTransfer3 {
+    std::unique_ptr<solvers::ParMatrix> T;
+};
+
+/// Collective. `fine`'s part must be the refinement of `coarse`'s (levels k + 1 and k of one
+/// mesh::distribute).
+DistributedTransfer3 build_distributed_transfer3(const DistributedLevel3& coarse,
+                                                 const DistributedLevel3& fine,
+                                                 const Communicator& comm);
+
+/// The distributed levels p .. p + n_refinements of a 3D problem and the transfers between
+/// them: levels[k] is level p + k, transfers[k] from levels[k] to levels[k + 1].
+struct DistributedHierarchy3 {
+    std::vector<DistributedLevel3> levels;
+    std::vector<DistributedTransfer3> transfers;
+};
+
+/// Collective: refines p.mesh0 `p_level` times serially (mesh::refine, every process alike),
+/// distributes that level (mesh::distribute with `n_refinements`) and builds every part and
+/// transfer. Throws InvalidInput for p_level < 0 or n_refinements < 0.
+DistributedHierarchy3 build_distributed_hierarchy3(const ElasticProblem3& p, int p_level,
+                                                   int n_refinements, const Communicator& comm);
+
+} // namespace mlc::levels
