@@ -71,7 +71,7 @@ template <class F> void for_vertex_dofs3(const fem::DofMap3& dofs, int v, F&& f)
 
 /// Relative distance (to the level-0 diameter) under which a support point is a vertex, or a
 /// vertex lies on a support line (elastic3d_levels.cpp's kPointTol).
-constexpr double kPointTol = 1e-9;
+constexpr double kSupportTol3 = 1e-9;
 
 /// line_vertices with the tolerance of the whole level-0 mesh (a part's diameter is smaller).
 std::vector<int> line_vertices_within(const mesh::TetMesh& m, const std::array<Vec3, 2>& line,
@@ -167,7 +167,7 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
     const int me = comm.rank();
     const int nv = part.mesh.n_vertices();
     d.ghosts = GhostExchange3(part, comm);
-    const double tol = kPointTol * p.mesh0.diameter();
+    const double tol = kSupportTol3 * p.mesh0.diameter();
     Level3& L = d.local;
     L.mesh = std::move(part.mesh);
     const mesh::TetMesh& m = L.mesh;
