@@ -80,7 +80,9 @@ heavy+="|KrylovSystem\.CoarseFineVariantsSolveTheFineSystem|MultilevelPreconditi
 heavy+="|HeldSupports\.FrictionalHertzHalfModelCarriesTheLoadAndSolvesAlikeByEverySolver|Dovetail\.EquilibriumMirrorSymmetryAndCoulombOnLevels0To2"
 heavy+="|Elastic3dConvergence\.ManufacturedSolutionOrderOneInEnergyTwoInL2"
 heavy+="|Accuracy3\.Hertz3dLevel2AgainstHertz|Contact3\.Block3dMultigridIterationsAndCoarseToFineAgainstCold"
-heavy+="|TwoBody3\.Stack3dPatchTestExactWithSegmentAndDualWeightsOnLevels0To2|TwoBody3\.Stack3dColdMultigridSolvesTheTwoBodyNewtonSystems)$"
+heavy+="|TwoBody3\.Stack3dPatchTestExactWithSegmentAndDualWeightsOnLevels0To2|TwoBody3\.Stack3dColdMultigridSolvesTheTwoBodyNewtonSystems"
+heavy+="|TwoBody3\.Shear3dBalancesItsLoadsAndItsSlipZoneGrowsWithThePush|ErrorVsTime3\.ReferenceRowIsExactAgainstItselfAndErrorsFallWithTheLevel"
+heavy+="|ErrorVsTime3\.ErrorsAgainstAFinerReferenceFallWithTheLevel)$"
 if ctest --test-dir "$dir" -LE "^(slow|cli)$" -E "$heavy" -j"$jobs" --output-on-failure > "$out" 2>&1; then
   n=$(grep -oE "out of [0-9]+" "$out" | tail -n 1 | grep -oE "[0-9]+")
   echo "sanitize: ${n:-?} tests passed under address+undefined ($cxx, build-asan;" \

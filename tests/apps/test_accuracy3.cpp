@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The 3D Hertz scenes against the closed form (studies/accuracy3.cpp) on level 2: the contact
 // radius within 2 %, the peak pressure within 5 %, the pressure profile's rms within 3 % of p0,
-// and level 2's errors below level 0's; sphere_on_block against Hertz and Cattaneo-Mindlin.
+// and level 2's errors below level 0's; sphere_on_block against Hertz and Cattaneo-Mindlin
+// (level 1).
 #include "scene/scene3.hpp"
 #include "core/check.hpp"
 #include "studies/accuracy.hpp"
@@ -52,18 +53,21 @@ TEST(Accuracy3, SpherePunchLevel2AgainstHertz_Slow) { expect_hertz3("sphere_punc
 
 // Two equal elastic bodies (sphere_on_block, half model): after the press, a and p0 within 3 %
 // of Hertz; after the shift (Q / (mu P) near 0.5), c / a on the x axis within 5 % of
-// Cattaneo-Mindlin's (1 - Q / (mu P))^(1/3); each error on level 2 below level 0's.
-TEST(Accuracy3, SphereOnBlockLevel2AgainstHertzAndCattaneoMindlin_Slow) {
-    std::map<std::string, double> v0, v2;
+// Cattaneo-Mindlin's (1 - Q / (mu P))^(1/3); each error on level 1 below level 0's.
+TEST(Accuracy3, SphereOnBlockLevel1AgainstHertzAndCattaneoMindlin_Slow) {
+    // Level 1 (about a minute): level 2, 500 445 unknowns, takes five more minutes of the
+    // suite; its figures (a, p0, c/a within 0.15 % on level 2) are measured by `study accuracy
+    // sphere_on_block --levels 2` in docs/results/contact3d.md. The bounds are the same.
+    std::map<std::string, double> v0, v1;
     const auto e0 = hertz3_errors("sphere_on_block", 0, &v0);
-    const auto e2 = hertz3_errors("sphere_on_block", 2, &v2);
-    EXPECT_GT(v2.at("Q_over_muP"), 0.4);
-    EXPECT_LT(v2.at("Q_over_muP"), 0.6);
+    const auto e1 = hertz3_errors("sphere_on_block", 1, &v1);
+    EXPECT_GT(v1.at("Q_over_muP"), 0.4);
+    EXPECT_LT(v1.at("Q_over_muP"), 0.6);
     for (const char* q : {"radius", "peak_pressure", "c_over_a"})
-        EXPECT_LT(std::abs(e2.at(q)), std::abs(e0.at(q))) << q;
-    EXPECT_LE(std::abs(e2.at("radius")), 0.03);
-    EXPECT_LE(std::abs(e2.at("peak_pressure")), 0.03);
-    EXPECT_LE(std::abs(e2.at("c_over_a")), 0.05);
+        EXPECT_LT(std::abs(e1.at(q)), std::abs(e0.at(q))) << q;
+    EXPECT_LE(std::abs(e1.at("radius")), 0.03);
+    EXPECT_LE(std::abs(e1.at("peak_pressure")), 0.03);
+    EXPECT_LE(std::abs(e1.at("c_over_a")), 0.05);
 }
 
 TEST(Accuracy3, Punch3dIsExact) {
