@@ -2,6 +2,7 @@
 // One process's part of a hierarchy refined from a partitioned level: local triangles with one
 // ghost layer, local refinement, owners from the level-p location, global numbers by exchange.
 #include "mesh/distributed.hpp"
+#include "mesh/distributed_piece.hpp"
 
 #include "core/check.hpp"
 
@@ -374,48 +375,15 @@ void write_distributed_vtu(const std::filesystem::path& file, const LocalLevel& 
                            const std::vector<Field>& cell_fields, const Communicator& comm,
                            VtuFormat format) {
     detail::on_every_process(comm, "write_distributed_vtu (pieces)", [&] {
-        const int nv = L.mesh.n_vertices(), nt = L.mesh.n_cells();
-        for (const Field& f : point_fields)
-            MLC_CHECK(f.n_components >= 1 &&
-                          f.values.size() == static_cast<size_t>(nv * f.n_components),
-                      "write_distributed_vtu: point field '"
-                          << f.name << "' has " << f.values.size() << " values for " << nv
-                          << " local vertices");
-        for (const Field& f : cell_fields)
-            MLC_CHECK(f.n_components >= 1 &&
-                          f.values.size() == static_cast<size_t>(nt * f.n_components),
-                      "write_distributed_vtu: cell field '" << f.name << "' has " << f.values.size()
-                                                            << " values for " << nt
-                                                            << " local triangles");
-        Mesh piece;
-        std::vector<int> piece_of(static_cast<size_t>(nv), -1), vertices, triangles;
-        for (int t = 0; t < nt; ++t)
-            if (L.triangle_owned[static_cast<size_t>(t)]) {
-                triangles.push_back(t);
-                for (int v : L.mesh.cells[static_cast<size_t>(t)])
-                    piece_of[static_cast<size_t>(v)] = 0;
-            }
-        for (int v = 0; v < nv; ++v)
-            if (piece_of[static_cast<size_t>(v)] == 0) {
-                piece_of[static_cast<size_t>(v)] = static_cast<int>(vertices.size());
-                vertices.push_back(v);
-                piece.vertices.push_back(L.mesh.vertices[static_cast<size_t>(v)]);
-            }
-        for (int t : triangles) {
-            const auto& tri = L.mesh.cells[static_cast<size_t>(t)];
-            piece.cells.push_back({piece_of[static_cast<size_t>(tri[0])],
-                                   piece_of[static_cast<size_t>(tri[1])],
-                                   piece_of[static_cast<size_t>(tri[2])]});
-        }
-        write_vtu(piece_path(file, comm.rank()), piece, detail::subset(point_fields, vertices),
-                  detail::subset(cell_fields, triangles), format);
+        const auto piece =
+            detail::owned_piece(L.mesh, L.triangle_owned, point_fields, cell_fields, "triangles");
+        write_vtu(piece_path(file, comm.rank()), piece.mesh,
+                  detail::subset(point_fields, piece.vertices),
+                  detail::subset(cell_fields, piece.cells), format);
     });
     detail::on_every_process(comm, "write_distributed_vtu (.pvtu)", [&] {
-        if (comm.rank() != 0) return;
-        std::vector<std::string> pieces;
-        for (int r = 0; r < comm.size(); ++r)
-            pieces.push_back(piece_path(file, r).filename().string());
-        write_pvtu(file, pieces, point_fields, cell_fields);
+        if (comm.rank() == 0)
+            write_pvtu(file, detail::piece_names(file, comm), point_fields, cell_fields);
     });
 }
 

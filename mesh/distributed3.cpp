@@ -3,6 +3,7 @@
 // tetrahedra with one ghost layer, local refinement with the serial geometry, owners from the
 // level-p location, global numbers by exchange (detail::number_vertices, shared with 2D).
 #include "mesh/distributed3.hpp"
+#include "mesh/distributed_piece.hpp"
 
 #include "core/check.hpp"
 #include "mesh/io/vtu_tet.hpp"
@@ -414,53 +415,21 @@ void write_distributed_vtu(const std::filesystem::path& file, const LocalTetLeve
                            const std::vector<Field>& point_fields,
                            const std::vector<Field>& cell_fields, const Communicator& comm) {
     detail::on_every_process(comm, "write_distributed_vtu (pieces)", [&] {
-        const int nv = L.mesh.n_vertices(), nt = L.mesh.n_cells();
-        for (const Field& f : point_fields)
-            MLC_CHECK(f.n_components >= 1 &&
-                          f.values.size() == static_cast<size_t>(nv * f.n_components),
-                      "write_distributed_vtu: point field '"
-                          << f.name << "' has " << f.values.size() << " values for " << nv
-                          << " local vertices");
-        for (const Field& f : cell_fields)
-            MLC_CHECK(f.n_components >= 1 &&
-                          f.values.size() == static_cast<size_t>(nt * f.n_components),
-                      "write_distributed_vtu: cell field '" << f.name << "' has " << f.values.size()
-                                                            << " values for " << nt
-                                                            << " local tetrahedra");
-        TetMesh piece;
-        std::vector<int> piece_of(static_cast<size_t>(nv), -1), vertices, owned;
-        for (int t = 0; t < nt; ++t)
-            if (L.tet_owned[static_cast<size_t>(t)]) {
-                owned.push_back(t);
-                for (int v : L.mesh.cells[static_cast<size_t>(t)])
-                    piece_of[static_cast<size_t>(v)] = 0;
-            }
-        for (int v = 0; v < nv; ++v)
-            if (piece_of[static_cast<size_t>(v)] == 0) {
-                piece_of[static_cast<size_t>(v)] = static_cast<int>(vertices.size());
-                vertices.push_back(v);
-                piece.vertices.push_back(L.mesh.vertices[static_cast<size_t>(v)]);
-            }
-        for (int t : owned) {
-            const auto& c = L.mesh.cells[static_cast<size_t>(t)];
-            piece.cells.push_back(
-                {piece_of[static_cast<size_t>(c[0])], piece_of[static_cast<size_t>(c[1])],
-                 piece_of[static_cast<size_t>(c[2])], piece_of[static_cast<size_t>(c[3])]});
-            if (!L.mesh.attribute.empty())
-                piece.attribute.push_back(L.mesh.attribute[static_cast<size_t>(t)]);
-        }
-        write_vtu(piece_path(file, comm.rank()), piece, detail::subset(point_fields, vertices),
-                  detail::subset(cell_fields, owned));
+        auto piece =
+            detail::owned_piece(L.mesh, L.tet_owned, point_fields, cell_fields, "tetrahedra");
+        if (!L.mesh.attribute.empty())
+            for (int t : piece.cells)
+                piece.mesh.attribute.push_back(L.mesh.attribute[static_cast<size_t>(t)]);
+        write_vtu(piece_path(file, comm.rank()), piece.mesh,
+                  detail::subset(point_fields, piece.vertices),
+                  detail::subset(cell_fields, piece.cells));
     });
     detail::on_every_process(comm, "write_distributed_vtu (.pvtu)", [&] {
         if (comm.rank() != 0) return;
-        std::vector<std::string> pieces;
-        for (int r = 0; r < comm.size(); ++r)
-            pieces.push_back(piece_path(file, r).filename().string());
         // The pieces hold the cell field "body" first (write_vtu for a TetMesh).
         std::vector<Field> cells{Field{"body", 1, {}}};
         cells.insert(cells.end(), cell_fields.begin(), cell_fields.end());
-        write_pvtu(file, pieces, point_fields, cells);
+        write_pvtu(file, detail::piece_names(file, comm), point_fields, cells);
     });
 }
 
