@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // A process's part of a distributed level: ghost data from the owners, numbering, ParCSR rows.
 #include "levels/distributed.hpp"
+#include "levels/ghost_lists.hpp"
 
 #include "core/check.hpp"
 #include "levels/hierarchy.hpp"
@@ -17,44 +18,11 @@ namespace mlc::levels {
 // ---------------------------------------------------------------------------------------------
 GhostExchange::GhostExchange(const mesh::LocalLevel& part, const Communicator& comm)
     : comm_(&comm) {
-    const int np = comm.size();
-    const int me = comm.rank();
-    recv_.assign(static_cast<size_t>(np), {});
-    std::vector<std::vector<std::int64_t>> ask(static_cast<size_t>(np));
-    for (int v = 0; v < part.mesh.n_vertices(); ++v) {
-        const int o = part.vertex_owner[static_cast<size_t>(v)];
-        if (o == me) continue;
-        recv_[static_cast<size_t>(o)].push_back(v);
-        ask[static_cast<size_t>(o)].push_back(part.global_vertex[static_cast<size_t>(v)]);
-    }
-    const auto asked = comm.exchange(ask);
-    send_.assign(static_cast<size_t>(np), {});
-    for (int q = 0; q < np; ++q)
-        for (const std::int64_t g : asked[static_cast<size_t>(q)]) {
-            const std::int64_t i = g - part.first_vertex;
-            MLC_CHECK(i >= 0 && i < part.n_owned_vertices(),
-                      "GhostExchange: process " << q << " asks for vertex " << g
-                                                << ", which process " << me << " does not own");
-            send_[static_cast<size_t>(q)].push_back(part.owned_vertices[static_cast<size_t>(i)]);
-        }
+    detail::ghost_lists(part, comm, "GhostExchange", recv_, send_);
 }
 
 void GhostExchange::vertex_records(std::vector<double>& rec, int width) const {
-    const auto w = static_cast<size_t>(width);
-    std::vector<std::vector<double>> out(send_.size());
-    for (size_t q = 0; q < send_.size(); ++q)
-        for (const int v : send_[q])
-            out[q].insert(out[q].end(), rec.begin() + static_cast<std::ptrdiff_t>(v * w),
-                          rec.begin() + static_cast<std::ptrdiff_t>((v + 1) * w));
-    const auto in = comm_->exchange(out);
-    for (size_t q = 0; q < recv_.size(); ++q) {
-        MLC_CHECK(in[q].size() == recv_[q].size() * w,
-                  "GhostExchange: process " << q << " sent " << in[q].size() << " values for "
-                                            << recv_[q].size() << " vertices");
-        for (size_t i = 0; i < recv_[q].size(); ++i)
-            std::copy_n(in[q].begin() + static_cast<std::ptrdiff_t>(i * w), w,
-                        rec.begin() + static_cast<std::ptrdiff_t>(recv_[q][i] * w));
-    }
+    detail::exchange_vertex_records(*comm_, "GhostExchange", recv_, send_, rec, width);
 }
 
 namespace {
