@@ -68,7 +68,9 @@ out=$dir/ctest.log
 # method and its exact fallback, the dovetail on levels 0-2, the 3D manufactured solution over
 # levels 0-3, hertz3d on level 2 against Hertz, block3d's multigrid and cold runs on level 2 and
 # stack3d's two-body runs on levels 0-2 (their search and weights have their own unit tests, and
-# stack3d's level 0 runs here in TwoBody3.Stack3dNodalWeightsMissThePatchTestOnNonMatchingMeshes).
+# stack3d's level 0 runs here in TwoBody3.Stack3dNodalWeightsMissThePatchTestOnNonMatchingMeshes),
+# shear3d, the 3D error-vs-time rows, the 3D extremes, the 3D elastic multigrid over box3d's and
+# the two-volume mesh's levels, and Mindlin's first-step traction over three contact widths.
 # What they run is covered here by the unit tests of the same code (levels, solvers, contact,
 # smoothers, transfer, the hierarchy tests); this keeps .ci/run well under 40 minutes
 # (docs/testing.md#testing-hostile).
@@ -82,7 +84,9 @@ heavy+="|Elastic3dConvergence\.ManufacturedSolutionOrderOneInEnergyTwoInL2"
 heavy+="|Accuracy3\.Hertz3dLevel2AgainstHertz|Contact3\.Block3dMultigridIterationsAndCoarseToFineAgainstCold"
 heavy+="|TwoBody3\.Stack3dPatchTestExactWithSegmentAndDualWeightsOnLevels0To2|TwoBody3\.Stack3dColdMultigridSolvesTheTwoBodyNewtonSystems"
 heavy+="|TwoBody3\.Shear3dBalancesItsLoadsAndItsSlipZoneGrowsWithThePush|ErrorVsTime3\.ReferenceRowIsExactAgainstItselfAndErrorsFallWithTheLevel"
-heavy+="|ErrorVsTime3\.ErrorsAgainstAFinerReferenceFallWithTheLevel)$"
+heavy+="|ErrorVsTime3\.ErrorsAgainstAFinerReferenceFallWithTheLevel|Extremes3\.EveryCaseConvergesOrIsDiagnosedWithFiniteNumbers"
+heavy+="|Elastic3dMg\.BoxScene_IterationsBoundedOverLevelsAndSolutionIsTheDirectOne|Elastic3dMg\.GmshTwoVolumes_BodiesMaterialsAndIterationsBoundedOverLevels"
+heavy+="|Mindlin\.StepOneTractionIsAFiniteGeometryEffectThatShrinksWithTheContactWidth)$"
 if ctest --test-dir "$dir" -LE "^(slow|cli)$" -E "$heavy" -j"$jobs" --output-on-failure > "$out" 2>&1; then
   n=$(grep -oE "out of [0-9]+" "$out" | tail -n 1 | grep -oE "[0-9]+")
   echo "sanitize: ${n:-?} tests passed under address+undefined ($cxx, build-asan;" \
