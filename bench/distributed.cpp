@@ -237,21 +237,7 @@ ElasticRow boomeramg_pcg_row(const levels::DistributedLevel& fine, const Vector&
         const int v = fine.local.dofs.vertex_of(i);
         dof_func[static_cast<size_t>(i)] = fine.local.dofs.u_dof(v, 0) == i ? 0 : 1;
     }
-    const solvers::RowBlocks& kb = *fine.K_blocks;
-    solvers::DistributedRows rows;
-    rows.first_row = kb.first_row;
-    rows.row_ptr.assign(1, 0);
-    for (Index i = 0; i < kb.diag.rows(); ++i) {
-        for (SparseMatrix::InnerIterator it(kb.diag, i); it; ++it) {
-            rows.cols.push_back(kb.first_col + it.col());
-            rows.values.push_back(it.value());
-        }
-        for (SparseMatrix::InnerIterator it(kb.offd, i); it; ++it) {
-            rows.cols.push_back(kb.col_map[static_cast<size_t>(it.col())]);
-            rows.values.push_back(it.value());
-        }
-        rows.row_ptr.push_back(static_cast<int>(rows.cols.size()));
-    }
+    const solvers::DistributedRows rows = solvers::distributed_rows(*fine.K_blocks);
     ElasticRow r;
     r.name = "boomeramg-pcg";
     for (int rep = 0; rep < opt.repeat; ++rep) {

@@ -96,24 +96,7 @@ solvers::RowBlocks DistributedLevel3::row_blocks(const SparseMatrix& A) const {
 }
 
 solvers::DistributedRows DistributedLevel3::K_rows() const {
-    const solvers::RowBlocks& kb = *K_blocks;
-    solvers::DistributedRows rows;
-    rows.first_row = kb.first_row;
-    rows.row_ptr.assign(1, 0);
-    rows.cols.reserve(static_cast<size_t>(kb.diag.nonZeros() + kb.offd.nonZeros()));
-    rows.values.reserve(rows.cols.capacity());
-    for (Index i = 0; i < kb.diag.rows(); ++i) {
-        for (SparseMatrix::InnerIterator it(kb.diag, i); it; ++it) {
-            rows.cols.push_back(kb.first_col + it.col());
-            rows.values.push_back(it.value());
-        }
-        for (SparseMatrix::InnerIterator it(kb.offd, i); it; ++it) {
-            rows.cols.push_back(kb.col_map[static_cast<size_t>(it.col())]);
-            rows.values.push_back(it.value());
-        }
-        rows.row_ptr.push_back(static_cast<int>(rows.cols.size()));
-    }
-    return rows;
+    return solvers::distributed_rows(*K_blocks);
 }
 
 std::vector<int> DistributedLevel3::dof_function() const {

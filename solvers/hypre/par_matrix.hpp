@@ -38,6 +38,11 @@ struct RowBlocks {
     std::vector<std::int64_t> col_map; ///< global column of every offd column, increasing
 };
 
+/// The rows of `b` in compressed sparse row form with global columns: per row its owned columns
+/// (diag, in their stored order) then the others (offd). For a ParMatrix built through IJ (what
+/// hypre's own solvers want: IJ puts the diagonal entry first in its row).
+DistributedRows distributed_rows(const RowBlocks& b);
+
 /// A square ParCSR matrix whose rows are spread over the processes of `comm`.
 ///
 /// Every process owns the rows (and the entries of vectors) [first_row, first_row + n_rows) of
