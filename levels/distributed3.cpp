@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
-// A process's part of a distributed 3D level (elastic block): ghost data from the owners,
+// A process's part of a distributed 3D level: ghost data from the owners, contact elements,
 // numbering, the owned rows of K and of the transfers as ParCSR matrices.
 #include "levels/distributed3.hpp"
+#include "levels/elastic3d_detail.hpp"
 #include "levels/ghost_lists.hpp"
 
 #include "core/check.hpp"
@@ -12,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <string>
 
 namespace mlc::levels {
@@ -54,6 +56,110 @@ std::vector<int> line_vertices_within(const mesh::TetMesh& m, const std::array<V
         if ((x - s * d).norm() <= tol) out.push_back(v);
     }
     return out;
+}
+
+/// Runs `local` (work on this process's part alone) and agrees on its errors: when it throws
+/// InvalidInput on some process, every process throws the message of the lowest such process
+/// (followed by its rank when there are several), so that none waits alone in a later exchange.
+template <class F> void agree_on_errors3(const Communicator& comm, F&& local) {
+    std::string error;
+    bool failed = false;
+    try {
+        local();
+    } catch (const InvalidInput& e) {
+        error = e.what();
+        failed = true;
+    }
+    const int first = comm.min(failed ? comm.rank() : comm.size());
+    if (first == comm.size()) return;
+    std::int64_t n = comm.rank() == first ? static_cast<std::int64_t>(error.size()) : 0;
+    comm.broadcast(std::span<std::int64_t>(&n, 1), first);
+    std::vector<std::int64_t> chars(static_cast<size_t>(n));
+    if (comm.rank() == first) std::copy(error.begin(), error.end(), chars.begin());
+    comm.broadcast(std::span<std::int64_t>(chars), first);
+    std::string message(chars.begin(), chars.end());
+    if (comm.size() > 1) message += " (process " + std::to_string(first) + ")";
+    throw InvalidInput(message);
+}
+
+/// The contact elements of a part (`owned`: its owned vertices): those of its owned contact nodes
+/// (detail::find_contact_nodes3), each pair checked over all parts, the multiplier counts and
+/// contact pairs of the ghost vertices from their owners, Level3::ghost_contacts (the two-body
+/// elements of other processes' contact nodes that reach an owned vertex, searched again here as
+/// their owners search them), the pinned components (detail::pin_held_components3) and `pinned`
+/// per vertex (ghosts: their owners'). Sets n_extra per vertex.
+void build_part_contacts3(const ElasticProblem3& p, Level3& L, const std::vector<char>& owned,
+                          const GhostExchange3& ghosts, const Communicator& comm,
+                          std::vector<int>& n_extra, std::vector<unsigned char>& pinned) {
+    const int nv = L.mesh.n_vertices();
+    const size_t np = p.contacts.size();
+    agree_on_errors3(comm, [&] { detail::find_contact_nodes3(p, L, n_extra, &owned); });
+    // Per pair over all parts: its elements, then its contactor nodes (found or not).
+    std::vector<int> count(2 * np, 0);
+    for (const auto& e : L.contacts)
+        ++count[static_cast<size_t>(e.pair)];
+    for (size_t k = 0; k < np; ++k)
+        count[np + k] = count[k] + static_cast<int>(L.not_found[k].size());
+    comm.allreduce(std::span<int>(count), ReduceOp::sum);
+    for (size_t k = 0; k < np; ++k) {
+        const ContactPair3& pair = p.contacts[k];
+        MLC_CHECK(count[np + k] > 0, "contact '" << pair.name << "' has no contactor node on '"
+                                                 << pair.contactor << "' on any process");
+        MLC_CHECK(count[k] > 0, "contact '" << pair.name << "': none of the " << count[np + k]
+                                            << " contactor vertices on '" << pair.contactor
+                                            << "' found a target on '" << pair.target << "' ("
+                                            << (pair.element == ContactElementKind::node_on_node
+                                                    ? "no target vertex within match_tolerance"
+                                                    : "no target face within search_radius")
+                                            << " of any of them)");
+    }
+    // The ghosts' multipliers and contact pairs from their owners.
+    std::vector<int> contact_pair(static_cast<size_t>(nv), -1);
+    {
+        std::vector<double> rec(2 * static_cast<size_t>(nv), 0.0);
+        for (int v = 0; v < nv; ++v)
+            rec[2 * static_cast<size_t>(v)] = n_extra[static_cast<size_t>(v)];
+        for (const auto& e : L.contacts)
+            rec[2 * static_cast<size_t>(e.vertex[0]) + 1] = e.pair + 1;
+        ghosts.vertex_records(rec, 2);
+        for (int v = 0; v < nv; ++v) {
+            n_extra[static_cast<size_t>(v)] =
+                static_cast<int>(std::lround(rec[2 * static_cast<size_t>(v)]));
+            contact_pair[static_cast<size_t>(v)] =
+                static_cast<int>(std::lround(rec[2 * static_cast<size_t>(v) + 1])) - 1;
+        }
+    }
+    agree_on_errors3(comm, [&] {
+        for (size_t k = 0; k < np; ++k) {
+            const ContactPair3& pair = p.contacts[k];
+            if (!pair.two_body()) continue;
+            // Other processes' nodes of the pair on a local contactor face (a node whose element
+            // reaches an owned vertex has all its faces here: contact_ghost_reach3).
+            std::vector<int> nodes;
+            for (const int v : L.mesh.vertices_with_tag(L.mesh.tag(pair.contactor)))
+                if (!owned[static_cast<size_t>(v)] &&
+                    contact_pair[static_cast<size_t>(v)] == static_cast<int>(k))
+                    nodes.push_back(v);
+            if (nodes.empty()) continue;
+            for (auto& e : detail::two_body_search3(p, L.mesh, k, nodes, true).elements) {
+                bool reaches = false;
+                for (int j = 1; j < e.n_nodes(); ++j)
+                    reaches =
+                        reaches || owned[static_cast<size_t>(e.vertex[static_cast<size_t>(j)])];
+                if (reaches) L.ghost_contacts.push_back(std::move(e));
+            }
+        }
+        detail::pin_held_components3(p, L);
+    });
+    // The pinned components per vertex, ghosts from their owners.
+    std::vector<double> rec(static_cast<size_t>(nv), 0.0);
+    for (const auto& e : L.contacts)
+        rec[static_cast<size_t>(e.vertex[0])] = e.pinned;
+    ghosts.vertex_records(rec, 1);
+    pinned.resize(static_cast<size_t>(nv));
+    for (int v = 0; v < nv; ++v)
+        pinned[static_cast<size_t>(v)] =
+            static_cast<unsigned char>(std::lround(rec[static_cast<size_t>(v)]));
 }
 
 /// The numbering view of a part (first_dof, n_owned, global_dof) as a DistributedLevel, whose
@@ -170,19 +276,23 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
     }
     L.fixed = std::move(sup.fixed);
     L.u_fixed = std::move(sup.u_fixed);
-    L.contact_of_vertex.assign(static_cast<size_t>(nv), -1);
-    L.not_found.assign(p.contacts.size(), {});
+    std::vector<char> owned(static_cast<size_t>(nv), 0);
+    for (const int v : part.owned_vertices)
+        owned[static_cast<size_t>(v)] = 1;
+    build_part_contacts3(p, L, owned, d.ghosts, comm, d.n_extra, d.pinned);
+    d.n_global_contacts = comm.sum(L.n_contact_nodes());
 
     // Owned vertices first (in their global order), then the ghosts.
     std::vector<int> order = part.owned_vertices;
-    {
-        std::vector<char> owned(static_cast<size_t>(nv), 0);
-        for (const int v : order)
-            owned[static_cast<size_t>(v)] = 1;
-        for (int v = 0; v < nv; ++v)
-            if (!owned[static_cast<size_t>(v)]) order.push_back(v);
-    }
-    L.dofs = fem::DofMap3(L.fixed, std::vector<int>(static_cast<size_t>(nv), 0), order);
+    for (int v = 0; v < nv; ++v)
+        if (!owned[static_cast<size_t>(v)]) order.push_back(v);
+    L.dofs = fem::DofMap3(L.fixed, d.n_extra, order);
+    L.lambda_dof.clear();
+    for (const auto& e : L.contacts)
+        L.lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
+    L.ghost_lambda_dof.clear();
+    for (const auto& e : L.ghost_contacts)
+        L.ghost_lambda_dof.push_back(L.dofs.extra_dof(e.vertex[0]));
 
     // Materials and the full load.
     std::vector<Vec3> bf;
@@ -225,6 +335,37 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
     return d;
 }
 
+std::vector<mesh::GhostReach> contact_ghost_reach3(const ElasticProblem3& p,
+                                                   const mesh::TetMesh& level_p) {
+    std::vector<mesh::GhostReach> out;
+    const mesh::TetMesh& m0 = p.mesh0;
+    // The longest edge of the faces of `m` tagged one of `tags`.
+    auto longest_edge = [](const mesh::TetMesh& m, const std::vector<int>& tags) {
+        double h = 0.0;
+        for (const mesh::BoundaryFace& f : m.boundary) {
+            if (std::find(tags.begin(), tags.end(), f.tag) == tags.end()) continue;
+            for (size_t i = 0; i < 3; ++i)
+                h = std::max(h, (m.vertices[static_cast<size_t>(f.v[i])] -
+                                 m.vertices[static_cast<size_t>(f.v[(i + 1) % 3])])
+                                    .norm());
+        }
+        return h;
+    };
+    for (const ContactPair3& pair : p.contacts) {
+        if (!pair.two_body()) continue;
+        mesh::GhostReach r;
+        r.tags = {level_p.tag(pair.contactor), level_p.tag(pair.target)};
+        const double h0 = longest_edge(m0, {m0.tag(pair.target)});
+        const double hp = longest_edge(level_p, r.tags);
+        const double factor = pair.element == ContactElementKind::node_on_facet
+                                  ? pair.search_radius
+                                  : pair.match_tolerance;
+        r.distance = 2.0 * ((factor + 2.0) * h0 + 2.0 * hp);
+        out.push_back(std::move(r));
+    }
+    return out;
+}
+
 DistributedTransfer3 build_distributed_transfer3(const DistributedLevel3& coarse,
                                                  const DistributedLevel3& fine,
                                                  const Communicator& comm) {
@@ -261,7 +402,8 @@ DistributedHierarchy3 build_distributed_hierarchy3(const ElasticProblem3& p, int
     mesh::TetMesh level_p = p.mesh0;
     for (int l = 0; l < p_level; ++l)
         level_p = mesh::refine(level_p);
-    mesh::DistributedTetHierarchy dh = mesh::distribute(level_p, n_refinements, comm);
+    mesh::DistributedTetHierarchy dh =
+        mesh::distribute(level_p, n_refinements, comm, {}, contact_ghost_reach3(p, level_p));
     DistributedHierarchy3 h;
     for (auto& part : dh.levels) {
         h.levels.push_back(build_distributed_level3(p, std::move(part), comm));

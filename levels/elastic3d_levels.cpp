@@ -256,15 +256,22 @@ int ElasticProblem3::n_path_points() const {
 
 // ------------------------------------------------------------------------------------------
 
-namespace {
-
-/// The two-body elements of pair k for the contactor vertices `nodes` of level mesh m. Whether a
-/// vertex is a contact node is decided on the level-0 target faces (node on facet), the same on
-/// every level, so that the contact nodes nest (transfer/ requires it).
-contact::SearchResult3 two_body_search3(const ElasticProblem3& p, const mesh::TetMesh& m,
-                                        size_t k, const std::vector<int>& nodes) {
+// The two-body elements of pair k for the contactor vertices `nodes` of level mesh m. Whether a
+// vertex is a contact node is decided on the level-0 target faces (node on facet), the same on
+// every level, so that the contact nodes nest (transfer/ requires it).
+contact::SearchResult3 detail::two_body_search3(const ElasticProblem3& p, const mesh::TetMesh& m,
+                                                size_t k, const std::vector<int>& nodes,
+                                                bool is_part) {
     const ContactPair3& pair = p.contacts[k];
     const int ip = static_cast<int>(k);
+    if (is_part) {
+        // A part without target faces: its nodes lie beyond the search's reach of the target
+        // (the ghost layer holds every target face within it: contact_ghost_reach3).
+        const int target = m.tag(pair.target);
+        if (std::none_of(m.boundary.begin(), m.boundary.end(),
+                         [&](const mesh::BoundaryFace& f) { return f.tag == target; }))
+            return {{}, nodes};
+    }
     if (pair.element == ContactElementKind::node_on_node)
         return contact::node_on_node_search3(m, nodes, m.tag(pair.target), pair.match_tolerance,
                                              pair.mu, pair.r, ip);
@@ -276,9 +283,10 @@ contact::SearchResult3 two_body_search3(const ElasticProblem3& p, const mesh::Te
                                           pair.integration, m.tag(pair.contactor));
 }
 
-/// The contact elements of every pair (Level3::contacts, contact_of_vertex, not_found) and the
-/// multipliers of each vertex (n_extra, sized to the vertices); L.fixed is set.
-void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& n_extra) {
+// The contact elements of every pair (Level3::contacts, contact_of_vertex, not_found) and the
+// multipliers of each vertex (n_extra, sized to the vertices); L.fixed is set.
+void detail::find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& n_extra,
+                                 const std::vector<char>* owned) {
     const mesh::TetMesh& m = L.mesh;
     const auto nv = static_cast<size_t>(m.n_vertices());
     L.contact_of_vertex.assign(nv, -1);
@@ -297,11 +305,14 @@ void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& 
                 ++fixed;
             } else if (L.contact_of_vertex[vi] >= 0) {
                 ++claimed;
+            } else if (owned && !(*owned)[vi]) {
+                continue; // a part's contact nodes are those of the vertices it owns
             } else {
                 nodes.push_back(v);
                 L.contact_of_vertex[vi] = -2; // claimed; the element index is set below
             }
         }
+        if (owned && nodes.empty()) continue; // the caller checks the pair over all parts
         MLC_CHECK(!nodes.empty(), "contact '" << pair.name << "' has no contactor node on '"
                                               << pair.contactor << "': of its " << on_tag.size()
                                               << " vertices, " << outside
@@ -310,10 +321,10 @@ void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& 
                                               << claimed << " belong to an earlier contact pair");
         std::vector<contact::ContactElement3> elements;
         if (pair.two_body()) {
-            auto found = two_body_search3(p, m, k, nodes);
+            auto found = two_body_search3(p, m, k, nodes, owned != nullptr);
             for (int v : found.not_found)
                 L.contact_of_vertex[static_cast<size_t>(v)] = -1;
-            MLC_CHECK(!found.elements.empty(),
+            MLC_CHECK(owned || !found.elements.empty(),
                       "contact '" << pair.name << "': none of the " << nodes.size()
                                   << " contactor vertices on '" << pair.contactor
                                   << "' found a target on '" << pair.target << "' ("
@@ -336,6 +347,8 @@ void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& 
     }
 }
 
+namespace {
+
 /// The held components of a 3D element (contact::held_components), with one more case: a
 /// frictional two-body element whose own components leave it unpinned, but whose contactor
 /// vertex alone would pin its first tangent (one component held, the normal across it), pins
@@ -357,11 +370,21 @@ contact::HeldComponents held_components3(const contact::ContactElement3& e,
     return own.pinned == contact::ContactElement3::kPinnedT1 ? own : h;
 }
 
-/// Sets ContactElement3::pinned of every element from the fixed components of its vertices
-/// (held_components3), turning the frame of an element whose first tangent alone is pinned onto
-/// the held axis (a symmetry plane across frictional contact nodes); throws InvalidInput for an
-/// element whose supports hold a direction its frame meets only in part.
-void pin_held_components3(const ElasticProblem3& p, Level3& L) {
+} // namespace
+
+// Sets ContactElement3::pinned of every element (Level3::contacts and ghost_contacts) from the
+// fixed components of its vertices (held_components3), turning the frame of an element whose
+// first tangent alone is pinned onto the held axis (a symmetry plane across frictional contact
+// nodes); throws InvalidInput for an element of L.contacts whose supports hold a direction its
+// frame meets only in part (a ghost element is its owner's to refuse).
+void detail::pin_held_components3(const ElasticProblem3& p, Level3& L) {
+    for (auto& e : L.ghost_contacts) {
+        const auto h = held_components3(e, L.fixed);
+        if (h.ambiguous) continue;
+        if (h.pinned & contact::ContactElement3::kPinnedT1)
+            contact::turn_first_tangent_onto_axis(e, h.pinned_axis);
+        e.pinned = h.pinned;
+    }
     for (auto& e : L.contacts) {
         const auto h = held_components3(e, L.fixed);
         const int v = e.vertex[0];
@@ -387,6 +410,8 @@ void pin_held_components3(const ElasticProblem3& p, Level3& L) {
         e.pinned = h.pinned;
     }
 }
+
+namespace {
 
 /// The loading path of a level whose supports (`vs`, their values those of the last path point),
 /// fixed components, numbering and assembled system at the last path point are set, with
@@ -447,8 +472,8 @@ Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
     L.fixed = std::move(sup.fixed);
     L.mesh = std::move(m);
     std::vector<int> n_extra;
-    find_contact_nodes3(p, L, n_extra);
-    pin_held_components3(p, L);
+    detail::find_contact_nodes3(p, L, n_extra);
+    detail::pin_held_components3(p, L);
     L.dofs = fem::DofMap3(L.fixed, n_extra);
     L.lambda_dof.reserve(L.contacts.size());
     for (const auto& e : L.contacts)

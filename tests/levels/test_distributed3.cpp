@@ -1,16 +1,22 @@
 // SPDX-License-Identifier: MIT
-// The distributed 3D levels (levels/distributed3.hpp: elastic block) against the one-process
-// levels (levels::build_hierarchy), on any number of processes: ctest runs these tests alone (one
+// The distributed 3D levels (levels/distributed3.hpp) against the one-process levels
+// (levels::build_hierarchy), on any number of processes: ctest runs these tests alone (one
 // process) and under mpirun -np 1, 2 and 3 (label mpi). Every process compares the unknowns it
-// owns with the one-process level's, matched by their vertices' exact coordinates (midpoints are
-// computed by the same arithmetic on every process).
+// owns with the one-process level's, matched by their vertices' exact coordinates and bodies
+// (midpoints are computed by the same arithmetic on every process): the numbering, K, f and T
+// (block3d, its rigid contact), BoomerAMG-PCG on the elastic block (block3d without contact), the
+// contact elements of the owned and ghost contact nodes (block3d; stack3d, two bodies, with its
+// segment weights, and with friction and segment or nodal weights) and the owned rows of the
+// contact residual and Jacobian at a global state.
 #include "core/check.hpp"
 
 #include <gtest/gtest.h>
 
 #if MLC_HAVE_HYPRE
 #include "comm/world.hpp"
+#include "contact/element.hpp"
 #include "levels/distributed3.hpp"
+#include "levels/newton.hpp"
 #include "scene/scene3.hpp"
 #include "solvers/hypre/boomeramg.hpp"
 #include "solvers/hypre/par_matrix.hpp"
@@ -20,6 +26,8 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
+#include <string>
 
 using namespace mlc;
 
@@ -37,25 +45,62 @@ double pseudo_random(Index i) {
            std::floor(std::sin(12.9898 * static_cast<double>(i) + 0.7) * 43758.5453) - 0.5;
 }
 
-/// The serial unknown of every local unknown of a part (-1: none), matched by coordinates;
-/// expects every local vertex in the serial mesh with the same fixed components.
-std::vector<Index> serial_dofs(const levels::DistributedLevel3& d, const levels::Level3& s) {
-    std::map<P3, int> serial_vertex;
+/// The body (cell attribute) of every vertex of m: two bodies' vertices may coincide.
+std::vector<int> vertex_bodies(const mesh::TetMesh& m) {
+    std::vector<int> body(static_cast<size_t>(m.n_vertices()), 0);
+    for (int t = 0; t < m.n_cells(); ++t)
+        for (const int v : m.cells[static_cast<size_t>(t)])
+            body[static_cast<size_t>(v)] =
+                m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
+    return body;
+}
+
+/// The serial vertex of every local vertex of a part (-1: none), matched by coordinates and
+/// body.
+std::vector<int> serial_vertices(const levels::DistributedLevel3& d, const levels::Level3& s) {
+    std::map<std::pair<P3, int>, int> serial_vertex;
+    const std::vector<int> serial_body = vertex_bodies(s.mesh);
     for (int v = 0; v < s.mesh.n_vertices(); ++v)
-        serial_vertex[p3(s.mesh.vertices[static_cast<size_t>(v)])] = v;
+        serial_vertex[{p3(s.mesh.vertices[static_cast<size_t>(v)]),
+                       serial_body[static_cast<size_t>(v)]}] = v;
+    const std::vector<int> body = vertex_bodies(d.local.mesh);
+    std::vector<int> out(static_cast<size_t>(d.local.mesh.n_vertices()), -1);
+    for (int v = 0; v < d.local.mesh.n_vertices(); ++v) {
+        const auto it = serial_vertex.find(
+            {p3(d.local.mesh.vertices[static_cast<size_t>(v)]), body[static_cast<size_t>(v)]});
+        EXPECT_NE(it, serial_vertex.end()) << "local vertex " << v << " is no serial vertex";
+        if (it != serial_vertex.end()) out[static_cast<size_t>(v)] = it->second;
+    }
+    return out;
+}
+
+/// The multipliers of serial vertex v (0 when it is no contact node).
+int serial_n_extra(const levels::Level3& s, int v) {
+    const int e = s.contact_of_vertex[static_cast<size_t>(v)];
+    return e < 0 ? 0 : s.contacts[static_cast<size_t>(e)].n_multipliers();
+}
+
+/// The serial unknown of every local unknown of a part (-1: none), matched by coordinates;
+/// expects every local vertex in the serial mesh with the same fixed components and multipliers.
+std::vector<Index> serial_dofs(const levels::DistributedLevel3& d, const levels::Level3& s) {
+    const std::vector<int> sv = serial_vertices(d, s);
     const auto& dofs = d.local.dofs;
     std::vector<Index> out(static_cast<size_t>(dofs.n_dofs()), -1);
     for (int v = 0; v < d.local.mesh.n_vertices(); ++v) {
-        const auto it = serial_vertex.find(p3(d.local.mesh.vertices[static_cast<size_t>(v)]));
-        EXPECT_NE(it, serial_vertex.end()) << "local vertex " << v << " is no serial vertex";
-        if (it == serial_vertex.end()) continue;
+        const int w = sv[static_cast<size_t>(v)];
+        if (w < 0) continue;
         for (int c = 0; c < 3; ++c) {
             EXPECT_EQ(d.local.fixed[static_cast<size_t>(v)][static_cast<size_t>(c)],
-                      s.fixed[static_cast<size_t>(it->second)][static_cast<size_t>(c)])
+                      s.fixed[static_cast<size_t>(w)][static_cast<size_t>(c)])
                 << "vertex " << v << " component " << c;
             if (const int i = dofs.u_dof(v, c); i >= 0)
-                out[static_cast<size_t>(i)] = s.dofs.u_dof(it->second, c);
+                out[static_cast<size_t>(i)] = s.dofs.u_dof(w, c);
         }
+        const int n = d.n_extra[static_cast<size_t>(v)];
+        EXPECT_EQ(n, serial_n_extra(s, w)) << "vertex " << v;
+        if (n > 0 && n == serial_n_extra(s, w) && dofs.extra_dof(v) >= 0)
+            for (int k = 0; k < n; ++k)
+                out[static_cast<size_t>(dofs.extra_dof(v) + k)] = s.dofs.extra_dof(w) + k;
     }
     return out;
 }
@@ -82,51 +127,96 @@ struct Block3dLevels {
     levels::DistributedHierarchy3 dist;
 };
 
-/// block3d, levels 0-1, partitioned on level 0.
+/// Levels 0-1 of p, serial and partitioned on level 0.
+Block3dLevels levels01(levels::ElasticProblem3 p) {
+    Block3dLevels r;
+    r.p = std::move(p);
+    r.serial = levels::build_hierarchy(r.p, 1);
+    r.dist = levels::build_distributed_hierarchy3(r.p, 0, 1, comm::world());
+    return r;
+}
+
+/// block3d (a block on a rigid plane, friction, a symmetry plane), levels 0-1.
 const Block3dLevels& block3d() {
+    static const Block3dLevels b = levels01(scene::load_scene3("block3d"));
+    return b;
+}
+
+/// block3d without its contact pair (the elastic block alone), levels 0-1.
+const Block3dLevels& block3d_elastic() {
     static const Block3dLevels b = [] {
-        Block3dLevels r;
-        r.p = scene::load_scene3("block3d");
-        r.serial = levels::build_hierarchy(r.p, 1);
-        r.dist = levels::build_distributed_hierarchy3(r.p, 0, 1, comm::world());
-        return r;
+        auto p = scene::load_scene3("block3d");
+        p.contacts.clear();
+        return levels01(std::move(p));
     }();
     return b;
+}
+
+/// stack3d (two blocks, non-matching meshes, frictionless, segment weights), levels 0-1.
+const Block3dLevels& stack3d() {
+    static const Block3dLevels b = levels01(scene::load_scene3("stack3d"));
+    return b;
+}
+
+/// stack3d with friction (mu = 0.3: three multipliers, the symmetry planes pinning the first
+/// tangent) and segment or nodal weights, levels 0-1.
+const Block3dLevels& stack3d_friction(contact::FacetIntegration integration) {
+    auto make = [](contact::FacetIntegration i) {
+        auto p = scene::load_scene3("stack3d");
+        p.contacts.at(0).mu = 0.3;
+        p.contacts.at(0).integration = i;
+        return levels01(std::move(p));
+    };
+    static const Block3dLevels segment = make(contact::FacetIntegration::segment);
+    static const Block3dLevels nodal = make(contact::FacetIntegration::nodal);
+    return integration == contact::FacetIntegration::nodal ? nodal : segment;
+}
+
+/// The contact scenes of the tests, with their names.
+std::vector<std::pair<std::string, const Block3dLevels*>> contact_scenes() {
+    return {{"block3d", &block3d()},
+            {"stack3d", &stack3d()},
+            {"stack3d mu 0.3 segment", &stack3d_friction(contact::FacetIntegration::segment)},
+            {"stack3d mu 0.3 nodal", &stack3d_friction(contact::FacetIntegration::nodal)}};
 }
 
 } // namespace
 
 TEST(Distributed3Levels, NumberingCoversTheSerialUnknownsOnce) {
-    const auto& b = block3d();
     const Communicator& comm = comm::world();
-    ASSERT_EQ(b.dist.levels.size(), 2U);
-    for (size_t l = 0; l < 2; ++l) {
-        const auto& d = b.dist.levels[l];
-        const auto& s = b.serial.levels[l];
-        EXPECT_EQ(d.n_global_dofs, s.dofs.n_displacement_dofs()) << "level " << l;
-        EXPECT_EQ(d.first_dof, comm.exclusive_sum(static_cast<std::int64_t>(d.n_owned)));
-        const auto to_serial = serial_dofs(d, s);
-        // Every serial displacement unknown is owned by exactly one process.
-        std::vector<int> count(static_cast<size_t>(s.dofs.n_dofs()), 0);
-        for (Index i = 0; i < d.n_owned; ++i) {
-            ASSERT_GE(to_serial[static_cast<size_t>(i)], 0);
-            ++count[static_cast<size_t>(to_serial[static_cast<size_t>(i)])];
+    for (const auto& [name, bp] : contact_scenes())
+        for (size_t l = 0; l < 2; ++l) {
+            SCOPED_TRACE(name);
+            const auto& b = *bp;
+            ASSERT_EQ(b.dist.levels.size(), 2U);
+            const auto& d = b.dist.levels[l];
+            const auto& s = b.serial.levels[l];
+            ASSERT_GT(s.n_contact_nodes(), 0);
+            EXPECT_EQ(d.n_global_dofs, s.dofs.n_dofs()) << "level " << l;
+            EXPECT_EQ(d.first_dof, comm.exclusive_sum(static_cast<std::int64_t>(d.n_owned)));
+            const auto to_serial = serial_dofs(d, s);
+            // Every serial unknown (displacement or multiplier) is owned by exactly one process.
+            std::vector<int> count(static_cast<size_t>(s.dofs.n_dofs()), 0);
+            for (Index i = 0; i < d.n_owned; ++i) {
+                ASSERT_GE(to_serial[static_cast<size_t>(i)], 0);
+                ++count[static_cast<size_t>(to_serial[static_cast<size_t>(i)])];
+            }
+            comm.allreduce(std::span<int>(count), ReduceOp::sum);
+            for (Index i = 0; i < s.dofs.n_dofs(); ++i)
+                EXPECT_EQ(count[static_cast<size_t>(i)], 1)
+                    << "level " << l << " serial unknown " << i;
+            // Ghost unknowns carry their owners' global numbers: the same serial unknown.
+            std::vector<std::int64_t> serial_of_global(static_cast<size_t>(d.n_global_dofs), 0);
+            for (Index i = 0; i < d.n_owned; ++i)
+                serial_of_global[static_cast<size_t>(d.first_dof + i)] =
+                    to_serial[static_cast<size_t>(i)];
+            comm.allreduce(std::span<std::int64_t>(serial_of_global), ReduceOp::sum);
+            for (Index i = d.n_owned; i < d.local.dofs.n_dofs(); ++i)
+                EXPECT_EQ(
+                    serial_of_global[static_cast<size_t>(d.global_dof[static_cast<size_t>(i)])],
+                    to_serial[static_cast<size_t>(i)])
+                    << "level " << l << " ghost unknown " << i;
         }
-        comm.allreduce(std::span<int>(count), ReduceOp::sum);
-        for (Index i = 0; i < s.dofs.n_dofs(); ++i)
-            EXPECT_EQ(count[static_cast<size_t>(i)], s.dofs.is_displacement(i) ? 1 : 0)
-                << "level " << l << " serial unknown " << i;
-        // Ghost unknowns carry their owners' global numbers: the same serial unknown.
-        std::vector<std::int64_t> serial_of_global(static_cast<size_t>(d.n_global_dofs), 0);
-        for (Index i = 0; i < d.n_owned; ++i)
-            serial_of_global[static_cast<size_t>(d.first_dof + i)] =
-                to_serial[static_cast<size_t>(i)];
-        comm.allreduce(std::span<std::int64_t>(serial_of_global), ReduceOp::sum);
-        for (Index i = d.n_owned; i < d.local.dofs.n_dofs(); ++i)
-            EXPECT_EQ(serial_of_global[static_cast<size_t>(d.global_dof[static_cast<size_t>(i)])],
-                      to_serial[static_cast<size_t>(i)])
-                << "level " << l << " ghost unknown " << i;
-    }
 }
 
 TEST(Distributed3Levels, StiffnessTimesARandomVectorAndLoadAreTheSerialOnes) {
@@ -184,7 +274,7 @@ TEST(Distributed3Levels, TransferTimesACoarseVectorIsTheSerialOne) {
 }
 
 TEST(Distributed3Levels, BoomerAmgPcgSolutionIsTheSerialDirectOne) {
-    const auto& b = block3d();
+    const auto& b = block3d_elastic();
     const Communicator& comm = comm::world();
     const auto& d = b.dist.levels[1];
     const auto& s = b.serial.levels[1];
@@ -218,6 +308,300 @@ TEST(Distributed3Levels, LoadingPathIsRefusedOnEveryProcess) {
     p.loads[0].factors = {0.5, 1.0};
     p.loads[1].factors = {0.5, 1.0};
     EXPECT_THROW(levels::build_distributed_hierarchy3(p, 0, 0, comm::world()), InvalidInput);
+}
+
+namespace {
+
+/// Expects the part's element a (vertices local) to be the serial element b: its contactor the
+/// serial one, the same nonzero weights at the same serial vertices, frame, gap, pair, mu, r,
+/// pinned components and multipliers, to 1e-14 (the search of a part sees its target faces in
+/// another order, so a target vertex of weight 0 may differ).
+void expect_same_element(const contact::ContactElement3& a, const std::vector<int>& serial_of,
+                         const contact::ContactElement3& b, const std::string& where) {
+    SCOPED_TRACE(where);
+    EXPECT_EQ(serial_of[static_cast<size_t>(a.vertex[0])], b.vertex[0]);
+    std::map<int, double> wa, wb;
+    for (int j = 0; j < a.n_nodes(); ++j)
+        wa[serial_of[static_cast<size_t>(a.vertex[static_cast<size_t>(j)])]] +=
+            a.weight[static_cast<size_t>(j)];
+    for (int j = 0; j < b.n_nodes(); ++j)
+        wb[b.vertex[static_cast<size_t>(j)]] += b.weight[static_cast<size_t>(j)];
+    for (const auto& [v, w] : wa)
+        EXPECT_NEAR(w, wb.count(v) ? wb.at(v) : 0.0, 1e-14) << "serial vertex " << v;
+    for (const auto& [v, w] : wb)
+        EXPECT_NEAR(w, wa.count(v) ? wa.at(v) : 0.0, 1e-14) << "serial vertex " << v;
+    EXPECT_LE((a.n - b.n).cwiseAbs().maxCoeff(), 1e-14);
+    EXPECT_LE((a.t - b.t).cwiseAbs().maxCoeff(), 1e-14);
+    EXPECT_NEAR(a.g0, b.g0, 1e-14);
+    EXPECT_EQ(a.pair, b.pair);
+    EXPECT_EQ(a.mu, b.mu);
+    EXPECT_EQ(a.r, b.r);
+    EXPECT_EQ(a.pinned, b.pinned);
+    EXPECT_EQ(a.n_multipliers(), b.n_multipliers());
+}
+
+/// Whether some target vertex of serial element e with a nonzero weight is one of `vertices`.
+bool reaches(const contact::ContactElement3& e, const std::set<int>& vertices) {
+    for (int j = 1; j < e.n_nodes(); ++j)
+        if (e.weight[static_cast<size_t>(j)] != 0.0 &&
+            vertices.count(e.vertex[static_cast<size_t>(j)]))
+            return true;
+    return false;
+}
+
+/// A smooth displacement of amplitude a at x (mesh of diameter h), component c, with a jump
+/// between the bodies (`body`), so that two-body gaps open and close.
+double smooth_u(const mesh::Vec3& x, int c, int body, double h, double a) {
+    const mesh::Vec3 y = x / h;
+    return a * (std::sin(2.1 * y.x() + 0.7 * c) * std::cos(1.3 * y.y() - 0.4 * c) +
+                0.5 * std::sin(1.7 * y.z() + c) + 0.3 * body * (c - 1.0));
+}
+
+/// The serial state of the residual test: displacement unknowns from smooth_u, multipliers
+/// pseudo-random of the size of r times the displacements (the tangents' a quarter of it); and
+/// u_prev_full, the state's displacements less a smaller smooth field (a slip increment), so
+/// that the nodes fall in every status.
+struct State3 {
+    Vector x, u_prev_full;
+};
+State3 serial_state(const levels::Level3& s, double a) {
+    const auto& m = s.mesh;
+    const std::vector<int> body = vertex_bodies(m);
+    const double h = m.diameter();
+    State3 st;
+    st.x = Vector::Zero(s.dofs.n_dofs());
+    for (int v = 0; v < m.n_vertices(); ++v)
+        for (int c = 0; c < 3; ++c)
+            if (const int d = s.dofs.u_dof(v, c); d >= 0)
+                st.x[d] = smooth_u(m.vertices[static_cast<size_t>(v)], c,
+                                   body[static_cast<size_t>(v)], h, a);
+    for (size_t e = 0; e < s.contacts.size(); ++e) {
+        const int nm = s.contacts[e].n_multipliers();
+        for (int q = 0; q < nm; ++q) {
+            const int d = s.lambda_dof[e] + q;
+            st.x[d] = (q + 1 < nm ? 1.0 : 4.0) * a * s.contacts[e].r * pseudo_random(d);
+        }
+    }
+    s.dofs.expand(st.x, s.u_fixed, st.u_prev_full);
+    for (int v = 0; v < m.n_vertices(); ++v)
+        for (int c = 0; c < 3; ++c)
+            st.u_prev_full[3 * v + c] -=
+                smooth_u(m.vertices[static_cast<size_t>(v)], 2 - c, 0, h, 0.2 * a);
+    return st;
+}
+
+/// The contact residual and Jacobian entries of a level's elements `els` (lambda dofs `ld`) at
+/// x, as the 3D Newton assembles them (contact::evaluate, add_residual, for_each_tangent_entry
+/// with each element's status matrix); `J` keyed by (row, col) of the level's unknowns.
+void contact_rows(const levels::Level3& L, const std::vector<contact::ContactElement3>& els,
+                  const std::vector<int>& ld, const Vector& x, const Vector& u_prev_full, Vector& R,
+                  std::map<std::pair<Index, Index>, double>& J, levels::StatusCounts* counts) {
+    Vector u_full;
+    L.dofs.expand(x, L.u_fixed, u_full);
+    for (size_t e = 0; e < els.size(); ++e) {
+        const auto es = contact::evaluate(els[e], u_full, u_prev_full, x, ld[e]);
+        contact::add_residual(els[e], es, L.dofs, ld[e], R);
+        contact::for_each_tangent_entry(els[e], es.proj.M, L.dofs, ld[e],
+                                        [&](Index i, Index j, double v) {
+                                            J[{i, j}] += v;
+                                        });
+        if (counts) counts->add(es.proj.status);
+    }
+}
+
+} // namespace
+
+TEST(Distributed3Levels, OwnedContactNodesAreTheSerialOnes) {
+    const Communicator& comm = comm::world();
+    for (const auto& [name, bp] : contact_scenes())
+        for (size_t l = 0; l < 2; ++l) {
+            SCOPED_TRACE(name + " level " + std::to_string(l));
+            const auto& d = bp->dist.levels[l];
+            const auto& s = bp->serial.levels[l];
+            const auto& L = d.local;
+            const std::vector<int> sv = serial_vertices(d, s);
+            std::set<int> owned_serial;
+            std::vector<char> owned(static_cast<size_t>(L.mesh.n_vertices()), 0);
+            for (const int v : d.part.owned_vertices) {
+                owned[static_cast<size_t>(v)] = 1;
+                owned_serial.insert(sv[static_cast<size_t>(v)]);
+            }
+            // Owned nodes: each serial node once over all processes, the same element.
+            std::vector<int> count(s.contacts.size(), 0);
+            EXPECT_EQ(L.lambda_dof.size(), L.contacts.size());
+            for (size_t e = 0; e < L.contacts.size(); ++e) {
+                const int v = L.contacts[e].vertex[0];
+                EXPECT_TRUE(owned[static_cast<size_t>(v)]) << "element " << e;
+                const int se = s.contact_of_vertex[static_cast<size_t>(sv[static_cast<size_t>(v)])];
+                EXPECT_GE(se, 0) << "element " << e << " is at no serial contact node";
+                if (se < 0) continue; // (no ASSERT before the collective sum below)
+                ++count[static_cast<size_t>(se)];
+                expect_same_element(L.contacts[e], sv, s.contacts[static_cast<size_t>(se)],
+                                    "element " + std::to_string(e));
+                EXPECT_EQ(L.lambda_dof[e], L.dofs.extra_dof(v));
+                EXPECT_EQ(L.contact_of_vertex[static_cast<size_t>(v)], static_cast<int>(e));
+            }
+            comm.allreduce(std::span<int>(count), ReduceOp::sum);
+            for (size_t e = 0; e < count.size(); ++e)
+                EXPECT_EQ(count[e], 1) << "serial element " << e;
+            EXPECT_EQ(d.n_global_contacts, s.n_contact_nodes());
+            // Two-body pairs cut by the partition: some process holds ghost elements.
+            const int n_ghost = comm.sum(static_cast<int>(L.ghost_contacts.size()));
+            if (comm.size() > 1 && s.contacts.front().n_nodes() > 1) {
+                EXPECT_GT(n_ghost, 0);
+            }
+            // Multipliers and pinned components of every local vertex, ghosts included.
+            for (int v = 0; v < L.mesh.n_vertices(); ++v) {
+                const int w = sv[static_cast<size_t>(v)];
+                const int se = s.contact_of_vertex[static_cast<size_t>(w)];
+                EXPECT_EQ(d.n_extra[static_cast<size_t>(v)], serial_n_extra(s, w))
+                    << "vertex " << v;
+                EXPECT_EQ(d.pinned[static_cast<size_t>(v)],
+                          se < 0 ? 0 : s.contacts[static_cast<size_t>(se)].pinned)
+                    << "vertex " << v;
+            }
+            // Ghost elements: the serial elements of other processes' nodes that reach an owned
+            // vertex (a target vertex of weight 0 may differ with the order of the faces).
+            std::set<int> ghost_serial;
+            EXPECT_EQ(L.ghost_lambda_dof.size(), L.ghost_contacts.size());
+            for (size_t e = 0; e < L.ghost_contacts.size(); ++e) {
+                const auto& el = L.ghost_contacts[e];
+                const int v = el.vertex[0];
+                EXPECT_FALSE(owned[static_cast<size_t>(v)]) << "ghost element " << e;
+                bool reaches_owned = false;
+                for (int j = 1; j < el.n_nodes(); ++j)
+                    reaches_owned = reaches_owned ||
+                                    owned[static_cast<size_t>(el.vertex[static_cast<size_t>(j)])];
+                EXPECT_TRUE(reaches_owned) << "ghost element " << e;
+                const int se = s.contact_of_vertex[static_cast<size_t>(sv[static_cast<size_t>(v)])];
+                EXPECT_GE(se, 0) << "ghost element " << e << " is at no serial contact node";
+                if (se < 0) continue;
+                EXPECT_TRUE(ghost_serial.insert(se).second) << "ghost element " << e << " twice";
+                expect_same_element(el, sv, s.contacts[static_cast<size_t>(se)],
+                                    "ghost element " + std::to_string(e));
+                EXPECT_EQ(L.ghost_lambda_dof[e], L.dofs.extra_dof(v));
+            }
+            for (size_t e = 0; e < s.contacts.size(); ++e) {
+                const auto& el = s.contacts[e];
+                if (!owned_serial.count(el.vertex[0]) && reaches(el, owned_serial)) {
+                    EXPECT_EQ(ghost_serial.count(static_cast<int>(e)), 1U)
+                        << "serial element " << e;
+                }
+                if (owned_serial.count(el.vertex[0]) || el.n_nodes() == 1) {
+                    EXPECT_EQ(ghost_serial.count(static_cast<int>(e)), 0U)
+                        << "serial element " << e;
+                }
+            }
+        }
+}
+
+TEST(Distributed3Levels, OnOneProcessThePartsContactsAreBuildLevels) {
+    if (comm::world().size() != 1) GTEST_SKIP() << "one process only";
+    for (const auto& [name, bp] : contact_scenes())
+        for (size_t l = 0; l < 2; ++l) {
+            SCOPED_TRACE(name + " level " + std::to_string(l));
+            const auto& L = bp->dist.levels[l].local;
+            const auto& s = bp->serial.levels[l];
+            ASSERT_EQ(L.mesh.n_vertices(), s.mesh.n_vertices());
+            ASSERT_EQ(L.contacts.size(), s.contacts.size());
+            EXPECT_TRUE(L.ghost_contacts.empty());
+            EXPECT_EQ(L.lambda_dof, s.lambda_dof);
+            EXPECT_EQ(L.contact_of_vertex, s.contact_of_vertex);
+            EXPECT_EQ(L.not_found, s.not_found);
+            ASSERT_EQ(L.dofs.n_dofs(), s.dofs.n_dofs());
+            for (int v = 0; v < s.mesh.n_vertices(); ++v) {
+                EXPECT_EQ(L.dofs.extra_dof(v), s.dofs.extra_dof(v)) << "vertex " << v;
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_EQ(L.dofs.u_dof(v, c), s.dofs.u_dof(v, c)) << "vertex " << v;
+            }
+            for (size_t e = 0; e < s.contacts.size(); ++e) {
+                const auto& a = L.contacts[e];
+                const auto& b = s.contacts[e];
+                EXPECT_EQ(a.vertex, b.vertex) << "element " << e;
+                EXPECT_EQ(a.weight, b.weight) << "element " << e;
+                EXPECT_EQ(a.n, b.n) << "element " << e;
+                EXPECT_EQ(a.t, b.t) << "element " << e;
+                EXPECT_EQ(a.g0, b.g0) << "element " << e;
+                EXPECT_EQ(a.pinned, b.pinned) << "element " << e;
+                EXPECT_EQ(a.mu, b.mu) << "element " << e;
+                EXPECT_EQ(a.r, b.r) << "element " << e;
+            }
+        }
+}
+
+TEST(Distributed3Levels, OwnedContactResidualAndJacobianRowsAreTheSerialOnes) {
+    const Communicator& comm = comm::world();
+    for (const auto& [name, bp] : contact_scenes())
+        for (size_t l = 0; l < 2; ++l) {
+            SCOPED_TRACE(name + " level " + std::to_string(l));
+            const auto& d = bp->dist.levels[l];
+            const auto& s = bp->serial.levels[l];
+            const auto& L = d.local;
+            const double a = 1e-3 * s.mesh.diameter();
+            const State3 st = serial_state(s, a);
+            // Serial rows; the state puts nodes in every status.
+            Vector Rs = Vector::Zero(s.dofs.n_dofs());
+            std::map<std::pair<Index, Index>, double> Js;
+            levels::StatusCounts counts;
+            contact_rows(s, s.contacts, s.lambda_dof, st.x, st.u_prev_full, Rs, Js, &counts);
+            EXPECT_GT(counts.gap, 0);
+            EXPECT_GT(counts.stick + counts.slip, 0);
+            if (s.contacts.front().frictional()) {
+                EXPECT_GT(counts.stick, 0);
+                EXPECT_GT(counts.slip, 0);
+            }
+            // The part's: owned unknowns from the serial state, ghosts from their owners.
+            const std::vector<Index> to_serial = serial_dofs(d, s);
+            const std::vector<int> sv = serial_vertices(d, s);
+            Vector x = Vector::Constant(L.dofs.n_dofs(), std::nan(""));
+            for (Index i = 0; i < d.n_owned; ++i)
+                x[i] = st.x[to_serial[static_cast<size_t>(i)]];
+            d.ghosts.update(L.dofs, x);
+            EXPECT_TRUE(x.allFinite()) << "a ghost unknown got no value";
+            Vector u_prev(3 * L.mesh.n_vertices());
+            for (int v = 0; v < L.mesh.n_vertices(); ++v)
+                u_prev.segment<3>(3 * v) =
+                    st.u_prev_full.segment<3>(3 * sv[static_cast<size_t>(v)]);
+            Vector R = Vector::Zero(L.dofs.n_dofs());
+            std::map<std::pair<Index, Index>, double> J;
+            contact_rows(L, L.contacts, L.lambda_dof, x, u_prev, R, J, nullptr);
+            contact_rows(L, L.ghost_contacts, L.ghost_lambda_dof, x, u_prev, R, J, nullptr);
+            // Residual: the owned rows.
+            const double r_scale = Rs.cwiseAbs().maxCoeff();
+            ASSERT_GT(r_scale, 0.0);
+            std::set<Index> owned_rows;
+            for (Index i = 0; i < d.n_owned; ++i) {
+                const Index si = to_serial[static_cast<size_t>(i)];
+                owned_rows.insert(si);
+                EXPECT_NEAR(R[i], Rs[si], 1e-12 * r_scale) << "owned row " << i;
+            }
+            // Jacobian: the entries of the owned rows, in serial numbering.
+            std::map<std::pair<Index, Index>, double> Jp;
+            for (const auto& [ij, v] : J)
+                if (ij.first < d.n_owned)
+                    Jp[{to_serial[static_cast<size_t>(ij.first)],
+                        to_serial[static_cast<size_t>(ij.second)]}] += v;
+            double j_scale = 0.0;
+            for (const auto& [ij, v] : Js)
+                j_scale = std::max(j_scale, std::abs(v));
+            ASSERT_GT(j_scale, 0.0);
+            int compared = 0;
+            for (const auto& [ij, v] : Js) {
+                if (!owned_rows.count(ij.first)) continue;
+                const auto it = Jp.find(ij);
+                EXPECT_NEAR(it == Jp.end() ? 0.0 : it->second, v, 1e-12 * j_scale)
+                    << "serial entry (" << ij.first << ", " << ij.second << ")";
+                ++compared;
+            }
+            for (const auto& [ij, v] : Jp) {
+                if (!Js.count(ij)) {
+                    EXPECT_NEAR(v, 0.0, 1e-12 * j_scale)
+                        << "serial entry (" << ij.first << ", " << ij.second << ") not in serial";
+                }
+            }
+            // Every serial entry of a contact row is compared on some process.
+            EXPECT_EQ(comm.sum(compared), static_cast<int>(Js.size()));
+        }
 }
 
 #endif
