@@ -604,4 +604,29 @@ TEST(Distributed3Levels, OwnedContactResidualAndJacobianRowsAreTheSerialOnes) {
         }
 }
 
+TEST(Distributed3Levels, PairWithoutContactNodeIsRefusedOnEveryProcess) {
+    levels::ElasticProblem3 p = scene::load_scene3("block3d");
+    levels::Box3 away;
+    away.lo = mesh::Vec3(100.0, 100.0, 100.0);
+    away.hi = mesh::Vec3(101.0, 101.0, 101.0);
+    p.contacts.at(0).region = away;
+    EXPECT_THROW(levels::build_distributed_hierarchy3(p, 0, 0, comm::world()), InvalidInput);
+}
+
+TEST(Distributed3Levels, GhostReachOfStack3dIsTwiceTheSearchReach) {
+    const levels::ElasticProblem3 p = scene::load_scene3("stack3d");
+    const auto reach = levels::contact_ghost_reach3(p, p.mesh0);
+    ASSERT_EQ(reach.size(), 1U);
+    EXPECT_EQ(reach[0].tags,
+              (std::vector<int>{p.mesh0.tag("upper_bottom"), p.mesh0.tag("lower_top")}));
+    // h0 = hp = the diagonal of the lower block's 0.25 x 0.25 face squares (the longest edge of
+    // both faces on level 0); search_radius 2: 2 ((2 + 2) h0 + 2 hp) = 12 h0.
+    ASSERT_EQ(p.contacts[0].search_radius, 2.0);
+    EXPECT_NEAR(reach[0].distance, 12.0 * 0.25 * std::sqrt(2.0), 1e-12);
+    // Without a two-body pair, no reach.
+    EXPECT_TRUE(levels::contact_ghost_reach3(scene::load_scene3("block3d"),
+                                             scene::load_scene3("block3d").mesh0)
+                    .empty());
+}
+
 #endif
