@@ -407,10 +407,7 @@ std::vector<mesh::GhostReach> contact_ghost_reach(const Problem& problem,
                 hp = std::max(hp, (level_p.vertices[static_cast<size_t>(e.v1)] -
                                    level_p.vertices[static_cast<size_t>(e.v0)])
                                       .norm());
-        const double factor = pair.element == ContactElementKind::node_on_facet
-                                  ? pair.search_radius
-                                  : pair.match_tolerance;
-        r.distance = 2.0 * ((factor + 2.0) * h0 + 2.0 * hp);
+        r.distance = contact_reach_distance(pair, h0, hp);
         out.push_back(std::move(r));
     }
     return out;

@@ -112,6 +112,15 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
 std::vector<mesh::GhostReach> contact_ghost_reach(const Problem& problem,
                                                   const mesh::Mesh& level_p);
 
+/// The ghost reach of one two-body pair (2D ContactPair or 3D ContactPair3): 2 R with
+/// R = (search_radius + 2) h0 + 2 hp for node on facet, match_tolerance in place of
+/// search_radius for node on node (contact_ghost_reach's rule; h0 and hp as there).
+template <class Pair> double contact_reach_distance(const Pair& pair, double h0, double hp) {
+    const double factor = pair.element == ContactElementKind::node_on_facet ? pair.search_radius
+                                                                            : pair.match_tolerance;
+    return 2.0 * ((factor + 2.0) * h0 + 2.0 * hp);
+}
+
 /// The transfer between consecutive distributed levels (fine refined from coarse): the local
 /// LevelTransfer of the two parts (whose owned fine rows are exact) and its T as a ParMatrix
 /// (owned fine rows, coarse unknowns as columns).

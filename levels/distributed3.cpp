@@ -105,13 +105,8 @@ void build_part_contacts3(const ElasticProblem3& p, Level3& L, const std::vector
         const ContactPair3& pair = p.contacts[k];
         MLC_CHECK(count[np + k] > 0, "contact '" << pair.name << "' has no contactor node on '"
                                                  << pair.contactor << "' on any process");
-        MLC_CHECK(count[k] > 0, "contact '" << pair.name << "': none of the " << count[np + k]
-                                            << " contactor vertices on '" << pair.contactor
-                                            << "' found a target on '" << pair.target << "' ("
-                                            << (pair.element == ContactElementKind::node_on_node
-                                                    ? "no target vertex within match_tolerance"
-                                                    : "no target face within search_radius")
-                                            << " of any of them)");
+        MLC_CHECK(count[k] > 0,
+                  detail::no_target_message(pair, static_cast<std::size_t>(count[np + k])));
     }
     // The ghosts' multipliers and contact pairs from their owners.
     std::vector<int> contact_pair(static_cast<size_t>(nv), -1);
@@ -357,10 +352,7 @@ std::vector<mesh::GhostReach> contact_ghost_reach3(const ElasticProblem3& p,
         r.tags = {level_p.tag(pair.contactor), level_p.tag(pair.target)};
         const double h0 = longest_edge(m0, {m0.tag(pair.target)});
         const double hp = longest_edge(level_p, r.tags);
-        const double factor = pair.element == ContactElementKind::node_on_facet
-                                  ? pair.search_radius
-                                  : pair.match_tolerance;
-        r.distance = 2.0 * ((factor + 2.0) * h0 + 2.0 * hp);
+        r.distance = contact_reach_distance(pair, h0, hp);
         out.push_back(std::move(r));
     }
     return out;

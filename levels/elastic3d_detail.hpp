@@ -8,6 +8,8 @@
 #include "levels/elastic3d_levels.hpp"
 
 #include <array>
+#include <cstddef>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -51,5 +53,8 @@ void find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& 
 /// an element of L.contacts whose supports hold a direction its frame meets only in part; such a
 /// ghost element is left unpinned (its owner refuses it).
 void pin_held_components3(const ElasticProblem3& p, Level3& L);
+
+/// The message of a two-body pair none of whose `n_nodes` contactor vertices found a target.
+std::string no_target_message(const ContactPair3& pair, std::size_t n_nodes);
 
 } // namespace mlc::levels::detail

@@ -283,6 +283,17 @@ contact::SearchResult3 detail::two_body_search3(const ElasticProblem3& p, const 
                                           pair.integration, m.tag(pair.contactor));
 }
 
+std::string detail::no_target_message(const ContactPair3& pair, std::size_t n_nodes) {
+    std::ostringstream os;
+    os << "contact '" << pair.name << "': none of the " << n_nodes << " contactor vertices on '"
+       << pair.contactor << "' found a target on '" << pair.target << "' ("
+       << (pair.element == ContactElementKind::node_on_node
+               ? "no target vertex within match_tolerance"
+               : "no target face within search_radius")
+       << " of any of them)";
+    return os.str();
+}
+
 // The contact elements of every pair (Level3::contacts, contact_of_vertex, not_found) and the
 // multipliers of each vertex (n_extra, sized to the vertices); L.fixed is set.
 void detail::find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vector<int>& n_extra,
@@ -324,14 +335,7 @@ void detail::find_contact_nodes3(const ElasticProblem3& p, Level3& L, std::vecto
             auto found = two_body_search3(p, m, k, nodes, owned != nullptr);
             for (int v : found.not_found)
                 L.contact_of_vertex[static_cast<size_t>(v)] = -1;
-            MLC_CHECK(owned || !found.elements.empty(),
-                      "contact '" << pair.name << "': none of the " << nodes.size()
-                                  << " contactor vertices on '" << pair.contactor
-                                  << "' found a target on '" << pair.target << "' ("
-                                  << (pair.element == ContactElementKind::node_on_node
-                                          ? "no target vertex within match_tolerance"
-                                          : "no target face within search_radius")
-                                  << " of any of them)");
+            MLC_CHECK(owned || !found.elements.empty(), no_target_message(pair, nodes.size()));
             L.not_found[k] = std::move(found.not_found);
             elements = std::move(found.elements);
         } else {
