@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // A process's part of a distributed level: ghost data from the owners, numbering, ParCSR rows.
 #include "levels/distributed.hpp"
+#include "levels/agree_errors.hpp"
 #include "levels/ghost_lists.hpp"
 
 #include "core/check.hpp"
@@ -293,19 +294,7 @@ DistributedLevel build_distributed_level(const Problem& problem, mesh::LocalLeve
         error = e.what();
         if (!reached_complete) comm.max(1); // the agreement at the start of `complete`
     }
-    if (comm.max(error.empty() ? 0 : 1) > 0) {
-        // Every process reports the error of the lowest process that had one of its own.
-        const int first =
-            comm.min(error.empty() || error.rfind(kAnother, 0) == 0 ? comm.size() : comm.rank());
-        if (first == comm.size()) throw InvalidInput(error.empty() ? kAnother : error);
-        std::int64_t n = comm.rank() == first ? static_cast<std::int64_t>(error.size()) : 0;
-        comm.broadcast(std::span<std::int64_t>(&n, 1), first);
-        std::vector<std::int64_t> chars(static_cast<size_t>(n));
-        if (comm.rank() == first) std::copy(error.begin(), error.end(), chars.begin());
-        comm.broadcast(std::span<std::int64_t>(chars), first);
-        throw InvalidInput(std::string(chars.begin(), chars.end()) + " (process " +
-                           std::to_string(first) + ")");
-    }
+    detail::throw_first_error(comm, error, kAnother);
     part.mesh = mesh::Mesh{};
     d.part = std::move(part);
     // Pairs with no contact node anywhere; support points held by no process.

@@ -3,6 +3,7 @@
 // numbering, the owned rows of K and of the transfers as ParCSR matrices.
 #include "levels/distributed3.hpp"
 #include "levels/elastic3d_detail.hpp"
+#include "levels/agree_errors.hpp"
 #include "levels/ghost_lists.hpp"
 
 #include "core/check.hpp"
@@ -58,30 +59,6 @@ std::vector<int> line_vertices_within(const mesh::TetMesh& m, const std::array<V
     return out;
 }
 
-/// Runs `local` (work on this process's part alone) and agrees on its errors: when it throws
-/// InvalidInput on some process, every process throws the message of the lowest such process
-/// (followed by its rank when there are several), so that none waits alone in a later exchange.
-template <class F> void agree_on_errors3(const Communicator& comm, F&& local) {
-    std::string error;
-    bool failed = false;
-    try {
-        local();
-    } catch (const InvalidInput& e) {
-        error = e.what();
-        failed = true;
-    }
-    const int first = comm.min(failed ? comm.rank() : comm.size());
-    if (first == comm.size()) return;
-    std::int64_t n = comm.rank() == first ? static_cast<std::int64_t>(error.size()) : 0;
-    comm.broadcast(std::span<std::int64_t>(&n, 1), first);
-    std::vector<std::int64_t> chars(static_cast<size_t>(n));
-    if (comm.rank() == first) std::copy(error.begin(), error.end(), chars.begin());
-    comm.broadcast(std::span<std::int64_t>(chars), first);
-    std::string message(chars.begin(), chars.end());
-    if (comm.size() > 1) message += " (process " + std::to_string(first) + ")";
-    throw InvalidInput(message);
-}
-
 /// The contact elements of a part (`owned`: its owned vertices): those of its owned contact nodes
 /// (detail::find_contact_nodes3), each pair checked over all parts, the multiplier counts and
 /// contact pairs of the ghost vertices from their owners, Level3::ghost_contacts (the two-body
@@ -93,7 +70,7 @@ void build_part_contacts3(const ElasticProblem3& p, Level3& L, const std::vector
                           std::vector<int>& n_extra, std::vector<unsigned char>& pinned) {
     const int nv = L.mesh.n_vertices();
     const size_t np = p.contacts.size();
-    agree_on_errors3(comm, [&] { detail::find_contact_nodes3(p, L, n_extra, &owned); });
+    detail::agree_on_errors(comm, [&] { detail::find_contact_nodes3(p, L, n_extra, &owned); });
     // Per pair over all parts: its elements, then its contactor nodes (found or not).
     std::vector<int> count(2 * np, 0);
     for (const auto& e : L.contacts)
@@ -124,7 +101,7 @@ void build_part_contacts3(const ElasticProblem3& p, Level3& L, const std::vector
                 static_cast<int>(std::lround(rec[2 * static_cast<size_t>(v) + 1])) - 1;
         }
     }
-    agree_on_errors3(comm, [&] {
+    detail::agree_on_errors(comm, [&] {
         for (size_t k = 0; k < np; ++k) {
             const ContactPair3& pair = p.contacts[k];
             if (!pair.two_body()) continue;
