@@ -25,7 +25,8 @@ inline void throw_first_error(const Communicator& comm, const std::string& error
     if (comm.max(error.empty() ? 0 : 1) == 0) return;
     const bool own = !error.empty() && !(placeholder && error.rfind(placeholder, 0) == 0);
     const int first = comm.min(own ? comm.rank() : comm.size());
-    if (first == comm.size()) throw InvalidInput(error.empty() && placeholder ? placeholder : error);
+    if (first == comm.size())
+        throw InvalidInput(error.empty() && placeholder ? placeholder : error);
     std::int64_t n = comm.rank() == first ? static_cast<std::int64_t>(error.size()) : 0;
     comm.broadcast(std::span<std::int64_t>(&n, 1), first);
     std::vector<std::int64_t> chars(static_cast<size_t>(n));

@@ -2,8 +2,8 @@
 // A process's part of a distributed 3D level: ghost data from the owners, contact elements,
 // numbering, the owned rows of K and of the transfers as ParCSR matrices.
 #include "levels/distributed3.hpp"
-#include "levels/elastic3d_detail.hpp"
 #include "levels/agree_errors.hpp"
+#include "levels/elastic3d_detail.hpp"
 #include "levels/ghost_lists.hpp"
 
 #include "core/check.hpp"
@@ -225,8 +225,8 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
     comm.allreduce(std::span<int>(point_owned), ReduceOp::sum);
     for (const int n : point_owned)
         MLC_CHECK(n == 1, "a support point is a vertex of " << n
-                                                           << " processes' owned vertices (one "
-                                                              "expected)");
+                                                            << " processes' owned vertices (one "
+                                                               "expected)");
     fem::Supports3 sup = fem::collect_supports(m, vs);
     // Ghost vertices: their owners' fixed components and values.
     {
@@ -243,7 +243,8 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
             for (int c = 0; c < 3; ++c) {
                 sup.fixed[static_cast<size_t>(v)][static_cast<size_t>(c)] =
                     rec[6 * static_cast<size_t>(v) + static_cast<size_t>(c)] != 0.0;
-                sup.u_fixed[3 * v + c] = rec[6 * static_cast<size_t>(v) + 3 + static_cast<size_t>(c)];
+                sup.u_fixed[3 * v + c] =
+                    rec[6 * static_cast<size_t>(v) + 3 + static_cast<size_t>(c)];
             }
     }
     L.fixed = std::move(sup.fixed);
@@ -278,8 +279,8 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
     std::vector<fem::Traction3> tr;
     for (const FaceLoad3& l : p.loads)
         if (const auto id = m.find_tag(l.tag)) tr.push_back({*id, l.pressure, l.traction});
-    L.elastic = fem::assemble_elastic(m, L.materials, L.dofs, fem::nodal_loads(m, tr, bf),
-                                      L.u_fixed);
+    L.elastic =
+        fem::assemble_elastic(m, L.materials, L.dofs, fem::nodal_loads(m, tr, bf), L.u_fixed);
 
     // Owned unknowns first.
     d.n_owned = 0;
@@ -377,8 +378,8 @@ DistributedHierarchy3 build_distributed_hierarchy3(const ElasticProblem3& p, int
     for (auto& part : dh.levels) {
         h.levels.push_back(build_distributed_level3(p, std::move(part), comm));
         if (h.levels.size() >= 2)
-            h.transfers.push_back(build_distributed_transfer3(h.levels[h.levels.size() - 2],
-                                                              h.levels.back(), comm));
+            h.transfers.push_back(
+                build_distributed_transfer3(h.levels[h.levels.size() - 2], h.levels.back(), comm));
     }
     return h;
 }
