@@ -4,6 +4,7 @@
 #include "core/check.hpp"
 #include "levels/elastic3d_detail.hpp"
 #include "levels/elastic3d_levels.hpp"
+#include "mesh/tet_refine.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -56,8 +56,15 @@ double estimate_contact3_bytes(const std::vector<ElasticLevelSize3>& sizes, Meth
     auto schur = [](const ElasticLevelSize3& s) {
         return 48.0 * s.multipliers * s.multipliers + estimate_direct3_bytes(s);
     };
-    // Sparse LU of the whole Jacobian: about twice a Cholesky factor of K (L and U).
-    auto lu = [](const ElasticLevelSize3& s) { return 2.0 * estimate_direct3_bytes(s); };
+    // Sparse LU of the whole Jacobian (Eigen's SparseLU, COLAMD ordering): its fill grows about
+    // as the square of the unknowns on the 3D levels, far faster than a Cholesky factor of K
+    // (calibrated on block3d's levels 2 and 3: docs/results/contact3d.md#results-contact3d-lu-memory).
+    auto lu = [](const ElasticLevelSize3& s) {
+        constexpr double kBytes3 = 3.64e9, kUnknowns3 = 58080, kExponent = 2.06;
+        const double n = std::max(s.unknowns + s.multipliers, 1.0);
+        return std::max(2.0 * estimate_direct3_bytes(s),
+                        kBytes3 * std::pow(n / kUnknowns3, kExponent));
+    };
     if (level0 == Method3::schur) bytes += schur(sizes.front());
     if (level0 == Method3::lu) bytes += lu(sizes.front());
     if (upper == Method3::schur && sizes.size() > 1) bytes += schur(top);

@@ -114,7 +114,9 @@ struct RunResult3 {
 /// per level the Jacobian and its Galerkin operator (24 bytes per nonzero of K), GMRES(50)'s
 /// 51 vectors on the finest level, and for each level solved by `schur` its dense systems on the
 /// contact components m (48 m^2 bytes: S, the reduced system and, in 3D slip, the doubled one)
-/// and the Cholesky factor of its regularized stiffness (estimate_direct3_bytes).
+/// and the Cholesky factor of its regularized stiffness (estimate_direct3_bytes); for each level
+/// solved by `lu`, the sparse LU of its Jacobian, whose fill grows about as the square of the
+/// level's unknowns (calibrated on block3d, docs/results/contact3d.md#results-contact3d-lu-memory).
 double estimate_contact3_bytes(const std::vector<ElasticLevelSize3>& sizes, Method3 level0,
                                Method3 upper);
 
