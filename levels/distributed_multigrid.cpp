@@ -72,15 +72,50 @@ std::vector<int> merge_diagonal_pattern(const SparseMatrix& Kd,
 }
 } // namespace
 
-struct DistributedMultigrid::Impl final : solvers::VCycle {
-    Impl(const std::vector<DistributedLevel>& levels,
-         const std::vector<DistributedTransfer>& transfers, const Communicator& comm,
-         LinearSolverSpec spec, solvers::MultigridParams mg)
-        : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), mg_(mg),
-          use_mg_(spec_.pc.name() == "mg"), use_ebe_(spec_.pc.entry->element_matrices),
+namespace detail {
+
+/// The level and transfer types of the distributed levels in `dim` dimensions.
+template <int dim> struct DistributedTypes;
+template <> struct DistributedTypes<2> {
+    using DLevel = DistributedLevel;
+    using DTransfer = DistributedTransfer;
+};
+template <> struct DistributedTypes<3> {
+    using DLevel = DistributedLevel3;
+    using DTransfer = DistributedTransfer3;
+};
+
+/// The distributed multigrid in `dim` dimensions (DistributedMultigrid in 2D,
+/// DistributedMultigrid3 in 3D). 2D: spec's Krylov method and preconditioner (mg, or a
+/// preconditioner of each process's diagonal block), the lattice sweep, mg's precision, V-cycles.
+/// 3D: mg only, vertex-block Gauss-Seidel in double precision, V- or W-cycles.
+template <int dim> struct DistributedMultigridCore : solvers::VCycle {
+    using DLevel = typename DistributedTypes<dim>::DLevel;
+    using DTransfer = typename DistributedTypes<dim>::DTransfer;
+    using LevelD = BasicLevel<dim>;
+    using Status = StatusMatrix<dim>;
+
+    /// `kp`: the Krylov parameters but the tolerance's forcing and comm (set by solve).
+    DistributedMultigridCore(const std::vector<DLevel>& levels,
+                             const std::vector<DTransfer>& transfers, const Communicator& comm,
+                             LinearSolverSpec spec, solvers::KrylovParams kp,
+                             solvers::MultigridParams mg)
+        : levels_(levels), transfers_(transfers), comm_(comm), spec_(std::move(spec)), kp_(kp),
+          mg_(mg), use_mg_(spec_.pc.name() == "mg"), use_ebe_(spec_.pc.entry->element_matrices),
           op_(levels.size()) {
-        MLC_CHECK(mg.cycles == 1,
-                  "the distributed multigrid runs V-cycles only, found cycles = " << mg.cycles);
+        if constexpr (dim == 2) {
+            MLC_CHECK(mg.cycles == 1,
+                      "the distributed multigrid runs V-cycles only, found cycles = " << mg.cycles);
+        } else {
+            mg.validate();
+            MLC_CHECK(use_mg_, "internal error: the 3D distributed multigrid is mg only");
+            MLC_CHECK(mg.smoother == solvers::MultigridParams::Smoother::block,
+                      "the 3D distributed multigrid smooths by vertex blocks only "
+                      "(mg:smoother=lattice is 2D)");
+            MLC_CHECK(mg.precision == Precision::float64,
+                      "the 3D distributed multigrid runs in double precision only "
+                      "(mg:precision=single is 2D)");
+        }
         for (size_t k = 1; k < levels.size(); ++k) {
             build_jacobian(k);
             transfer_.emplace_back(*transfers[k - 1].T);
@@ -88,11 +123,11 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
     }
 
     /// Level p at its converged statuses: the gathered coarse solve (map built on first use).
-    void set_coarse(const Level& Lp, const std::vector<Eigen::Matrix2d>& M) {
+    void set_coarse(const LevelD& Lp, const std::vector<Status>& M) {
         if (!use_mg_) return; // no coarse level without mg
         if (coarse_level_ != &Lp) {
             coarse_level_ = &Lp;
-            coarse_asm_ = std::make_unique<JacobianAssembler>(Lp);
+            coarse_asm_ = std::make_unique<BasicJacobianAssembler<dim>>(Lp);
             build_coarse_map(Lp);
             analyzed_ = false;
         }
@@ -108,7 +143,7 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
     }
 
     /// J_k(M) assembled, its ParCSR values refreshed, the smoother set up on the diagonal block.
-    void prepare(size_t k, const std::vector<Eigen::Matrix2d>& M) {
+    void prepare(size_t k, const std::vector<Status>& M) {
         Op& o = op_[k];
         // Unchanged on every process (the refresh below is collective).
         const bool same = o.prepared && M.size() == o.last_M.size() &&
@@ -118,7 +153,7 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         // The owned rows of J: the tangents of this process's elements and of the ghost elements
         // (other processes' contact nodes reaching owned vertices), whose columns may be other
         // processes' unknowns (the off-diagonal block).
-        const DistributedLevel& L = levels_[k];
+        const DLevel& L = levels_[k];
         const size_t n_el = L.local.contacts.size() + L.local.ghost_contacts.size();
         MLC_CHECK(M.size() == n_el, "internal error: " << M.size() << " status matrices for "
                                                        << n_el << " contact elements");
@@ -153,19 +188,25 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
             contact::for_each_tangent_entry(L.local.ghost_contacts[e],
                                             M[L.local.contacts.size() + e], L.local.dofs,
                                             L.local.ghost_lambda_dof[e], add);
-        if (!use_mg_) {
-            if (use_ebe_) refresh_block_elements(k, M);
-            if (!o.block_pc) {
-                // EBE: built from the process's elements restricted to its owned unknowns.
-                solvers::LevelData d;
-                d.has_multipliers = !L.local.contacts.empty();
-                d.elements = [&o]() { return &o.elements; };
-                o.block_pc = solvers::make_preconditioner(spec_.pc, use_ebe_ ? &d : nullptr);
-                o.block_pc->setup(o.blocks->diag);
-            } else {
-                o.block_pc->update_values(o.blocks->diag);
+        if constexpr (dim == 2) {
+            if (!use_mg_) {
+                if (use_ebe_) refresh_block_elements(k, M);
+                if (!o.block_pc) {
+                    // EBE: built from the process's elements restricted to its owned unknowns.
+                    solvers::LevelData d;
+                    d.has_multipliers = !L.local.contacts.empty();
+                    d.elements = [&o]() { return &o.elements; };
+                    o.block_pc = solvers::make_preconditioner(spec_.pc, use_ebe_ ? &d : nullptr);
+                    o.block_pc->setup(o.blocks->diag);
+                } else {
+                    o.block_pc->update_values(o.blocks->diag);
+                }
+                o.last_M = M;
+                o.prepared = true;
+                return;
             }
-        } else if (!o.smoother && !o.lattice) {
+        }
+        if (!o.smoother && !o.lattice) {
             make_smoother(k);
         } else if (o.lattice) {
             o.lattice->update_values(o.blocks->diag);
@@ -182,23 +223,25 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
     /// process sweeps its block in one piece.
     void make_smoother(size_t k) {
         Op& o = op_[k];
-        const DistributedLevel& L = levels_[k];
+        const DLevel& L = levels_[k];
         std::vector<int> vertex_of(static_cast<size_t>(L.n_owned));
         for (Index i = 0; i < L.n_owned; ++i)
             vertex_of[static_cast<size_t>(i)] = L.local.dofs.vertex_of(i);
         std::vector<Index> starts = solvers::vertex_block_starts(vertex_of);
-        const auto& rows = L.local.lattice;
-        if (mg_.smoother == solvers::MultigridParams::Smoother::lattice && rows &&
-            rows->n >= solvers::kMinLatticeSubdivisions) {
-            o.lattice = std::make_unique<smoothers::LatticeGS>(
-                std::move(starts), *rows,
-                smoothers::LatticeGSParams{.omega = mg_.omega, .parts = 1});
-            o.lattice->setup(o.blocks->diag);
-            return;
+        if constexpr (dim == 2) {
+            const auto& rows = L.local.lattice;
+            if (mg_.smoother == solvers::MultigridParams::Smoother::lattice && rows &&
+                rows->n >= solvers::kMinLatticeSubdivisions) {
+                o.lattice = std::make_unique<smoothers::LatticeGS>(
+                    std::move(starts), *rows,
+                    smoothers::LatticeGSParams{.omega = mg_.omega, .parts = 1});
+                o.lattice->setup(o.blocks->diag);
+                return;
+            }
         }
         o.smoother = std::make_unique<smoothers::BlockSOR>(
             smoothers::BlockSORParams{.omega = mg_.omega,
-                                      .block_size = 2,
+                                      .block_size = dim,
                                       .block_starts = std::move(starts),
                                       .parts = 1,
                                       .kernel = smoothers::Kernel::unrolled,
@@ -206,16 +249,13 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         o.smoother->setup(o.blocks->diag);
     }
 
-    SolveResult solve(size_t k, const std::vector<Eigen::Matrix2d>& M, const Vector& b, Vector& dx,
+    SolveResult solve(size_t k, const std::vector<Status>& M, const Vector& b, Vector& dx,
                       double forcing) {
         const double t0 = wall_seconds();
         prepare(k, M);
         const double t1 = wall_seconds();
-        solvers::KrylovParams kp;
-        kp.rel_tol = std::max(forcing, spec_.rel_tol);
-        kp.max_iter = spec_.max_iter;
-        kp.restart = spec_.restart;
-        kp.give_up_budget = spec_.give_up_budget;
+        solvers::KrylovParams kp = kp_;
+        kp.rel_tol = std::max(forcing, kp_.rel_tol);
         kp.comm = &comm_;
         const Cycle cycle(*this, k);
         const BlockPc block(*this, k);
@@ -236,9 +276,9 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
     /// restricted to the owned unknowns (so that they sum to the diagonal block of K; the
     /// triangles cut by the partition contribute their owned rows and columns), then the contact
     /// elements (all at owned vertices) at the statuses M. EBE colours them within the process.
-    void refresh_block_elements(size_t k, const std::vector<Eigen::Matrix2d>& M) {
+    void refresh_block_elements(size_t k, const std::vector<Status>& M) requires(dim == 2) {
         Op& o = op_[k];
-        const DistributedLevel& D = levels_[k];
+        const DLevel& D = levels_[k];
         if (o.elements.empty()) {
             o.elements = elastic_element_matrices(D.local);
             restrict_elements(o.elements, D.n_owned);
@@ -262,6 +302,7 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
            << ",post=" << mg_.post_sweeps << ",omega=" << mg_.omega;
         if (mg_.precision == Precision::float32) os << ",precision=single";
         if (mg_.smoother == solvers::MultigridParams::Smoother::lattice) os << ",smoother=lattice";
+        if (mg_.cycles == 2) os << ",cycles=2";
         os << ")";
         return os.str();
     }
@@ -294,9 +335,10 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         /// block_pc borrows.
         std::vector<smoothers::ElementMatrix> elements;
         size_t n_elastic = 0;
-        std::vector<Eigen::Matrix2d> last_M;
+        std::vector<Status> last_M;
         bool prepared = false;
         mutable Vector res, t, rc, ec, d, ghost;
+        mutable Vector rw, ew; ///< the W-cycle's work vectors of the level below
 
         /// y -= A_offd z (the halo exchange of z).
         void minus_offdiagonal(const Vector& z, Vector& y) const {
@@ -359,20 +401,20 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
     /// Without mg: the preconditioner of each process's diagonal block (Jacobi across the cuts).
     class BlockPc final : public Preconditioner {
     public:
-        BlockPc(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
+        BlockPc(const DistributedMultigridCore& s, size_t k) : s_(s), k_(k) {}
         void setup(const SparseMatrix&) override {}
         void apply(const Vector& r, Vector& z) const override { s_.op_[k_].block_pc->apply(r, z); }
         std::string name() const override { return s_.name(); }
 
     private:
-        const DistributedMultigrid::Impl& s_;
+        const DistributedMultigridCore& s_;
         size_t k_;
     };
 
     /// One V-cycle from level k as a Preconditioner.
     class Cycle final : public Preconditioner {
     public:
-        Cycle(const DistributedMultigrid::Impl& s, size_t k) : s_(s), k_(k) {}
+        Cycle(const DistributedMultigridCore& s, size_t k) : s_(s), k_(k) {}
         void setup(const SparseMatrix&) override {}
         void apply(const Vector& r, Vector& z) const override {
             s_.cycle(static_cast<int>(k_), r, z);
@@ -380,14 +422,14 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         std::string name() const override { return s_.name(); }
 
     private:
-        const DistributedMultigrid::Impl& s_;
+        const DistributedMultigridCore& s_;
         size_t k_;
     };
 
     void build_jacobian(size_t k) {
-        const DistributedLevel& D = levels_[k];
+        const DLevel& D = levels_[k];
         const solvers::RowBlocks& Kb = *D.K_blocks;
-        const Level& L = D.local;
+        const LevelD& L = D.local;
         const int n = static_cast<int>(D.n_owned);
         Op& o = op_[k];
         o.blocks = std::make_unique<solvers::RowBlocks>();
@@ -397,7 +439,7 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         // The contact entries of the owned rows: (row, local column) in visiting order, -1 rows
         // for those owned elsewhere.
         std::vector<std::pair<int, int>> centries;
-        const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+        const Status I = Status::Identity();
         auto visit = [&](int row, int col, double) {
             centries.emplace_back(row < n ? row : -1, col);
         };
@@ -462,15 +504,16 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         o.J = std::make_unique<solvers::ParMatrix>(comm_, B);
     }
 
-    void build_coarse_map(const Level& Lp) {
-        const DistributedLevel& D = levels_[0];
+    void build_coarse_map(const LevelD& Lp) {
+        const DLevel& D = levels_[0];
         std::vector<std::int64_t> mine(static_cast<size_t>(D.n_owned), -1);
         const auto& dofs = D.local.dofs;
         for (int v = 0; v < D.local.mesh.n_vertices(); ++v) {
             const auto& loc = D.part.vertex_location[static_cast<size_t>(v)];
-            MLC_CHECK(loc.kind == mesh::Location::Kind::vertex,
+            using Kind = typename std::remove_cvref_t<decltype(loc)>::Kind;
+            MLC_CHECK(loc.kind == Kind::vertex,
                       "internal error: a vertex of level p's part is not a level-p vertex");
-            for (int c = 0; c < 2; ++c) {
+            for (int c = 0; c < dim; ++c) {
                 const int d = dofs.u_dof(v, c);
                 if (d >= 0 && d < D.n_owned)
                     mine[static_cast<size_t>(d)] = Lp.dofs.u_dof(loc.id, c);
@@ -502,7 +545,10 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
                 mg_.post_sweeps,
                 o.res,
                 o.rc,
-                o.ec};
+                o.ec,
+                mg_.cycles,
+                &o.rw,
+                &o.ew};
     }
 
     /// The gathered coarse solve: the residual gathered on every process, solved by the LU of
@@ -512,34 +558,68 @@ struct DistributedMultigrid::Impl final : solvers::VCycle {
         for (size_t g = 0; g < full.size(); ++g)
             coarse_rhs_[coarse_map_[g]] = full[g];
         const Vector zs = lu_.solve(coarse_rhs_);
-        const DistributedLevel& D = levels_[0];
+        const DLevel& D = levels_[0];
         z.resize(D.n_owned);
         for (Index i = 0; i < D.n_owned; ++i)
             z[i] = zs[coarse_map_[static_cast<size_t>(D.first_dof + i)]];
     }
 
-    const std::vector<DistributedLevel>& levels_;
-    const std::vector<DistributedTransfer>& transfers_;
+    const std::vector<DLevel>& levels_;
+    const std::vector<DTransfer>& transfers_;
     const Communicator& comm_;
-    LinearSolverSpec spec_;
+    LinearSolverSpec spec_; ///< 2D: the Krylov method and preconditioner; 3D: gmres + mg
+    solvers::KrylovParams kp_;
     solvers::MultigridParams mg_;
     bool use_mg_ = true;   ///< else spec_.pc on each process's diagonal block
     bool use_ebe_ = false; ///< spec_.pc is ebe (on each process's diagonal block)
     std::vector<Op> op_;
     std::vector<Transfer> transfer_; ///< transfer_[k - 1]: level k - 1 -> k
-    const Level* coarse_level_ = nullptr;
-    std::unique_ptr<JacobianAssembler> coarse_asm_;
+    const LevelD* coarse_level_ = nullptr;
+    std::unique_ptr<BasicJacobianAssembler<dim>> coarse_asm_;
     Eigen::SparseLU<SparseMatrixCol> lu_;
     bool analyzed_ = false;
     std::vector<std::int64_t> coarse_map_;
     mutable Vector coarse_rhs_;
 };
 
+} // namespace detail
+
+/// The 2D multigrid.
+struct DistributedMultigrid::Impl final : detail::DistributedMultigridCore<2> {
+    using DistributedMultigridCore::DistributedMultigridCore;
+};
+
+/// The 3D multigrid.
+struct DistributedMultigrid3::Impl final : detail::DistributedMultigridCore<3> {
+    using DistributedMultigridCore::DistributedMultigridCore;
+};
+
+namespace {
+/// The Krylov parameters of a 2D spec (its tolerance the floor of solve's forcing).
+solvers::KrylovParams krylov_params(const LinearSolverSpec& spec) {
+    solvers::KrylovParams kp;
+    kp.rel_tol = spec.rel_tol;
+    kp.max_iter = spec.max_iter;
+    kp.restart = spec.restart;
+    kp.give_up_budget = spec.give_up_budget;
+    return kp;
+}
+
+/// The 3D multigrid's spec: GMRES preconditioned by mg.
+LinearSolverSpec gmres_mg_spec() {
+    LinearSolverSpec s;
+    s.method = solvers::Method::krylov;
+    s.krylov = solvers::Krylov::gmres;
+    s.pc = solvers::parse_pc("mg");
+    return s;
+}
+} // namespace
+
 DistributedMultigrid::DistributedMultigrid(const std::vector<DistributedLevel>& levels,
                                            const std::vector<DistributedTransfer>& transfers,
                                            const Communicator& comm, LinearSolverSpec spec,
                                            solvers::MultigridParams mg)
-    : impl_(std::make_unique<Impl>(levels, transfers, comm, std::move(spec), mg)) {}
+    : impl_(std::make_unique<Impl>(levels, transfers, comm, spec, krylov_params(spec), mg)) {}
 DistributedMultigrid::~DistributedMultigrid() = default;
 void DistributedMultigrid::set_coarse(const Level& level_p, const std::vector<Eigen::Matrix2d>& M) {
     impl_->set_coarse(level_p, M);
@@ -565,42 +645,35 @@ std::string DistributedMultigrid::name() const {
     return impl_->name();
 }
 
-solvers::MultigridParams distributed_mg_params(const LinearSolverSpec& spec) {
-    MLC_CHECK(spec.method == solvers::Method::krylov,
-              "on several processes the Newton systems are solved by a Krylov method with mg "
-              "(--linear krylov --pc mg); '"
-                  << spec.method
-                  << "' has no distributed form (schur, lu, cf and sorcf need the "
-                     "whole level on one process)");
-    const solvers::PcSpec& pc = spec.pc;
-    const std::string why = pc.distributed();
-    MLC_CHECK(why.empty(), why);
-    if (pc.name() != "mg") {
-        // A preconditioner of the matrix alone (or ebe) runs on each process's diagonal block;
-        // its options checked here, on every process (ebe: on no elements, not set up).
-        static const std::vector<smoothers::ElementMatrix> none;
-        solvers::LevelData d;
-        d.elements = [] { return &none; };
-        solvers::make_preconditioner(pc, pc.entry->level_aware ? &d : nullptr);
-        return {};
-    }
-    // Per process on its diagonal block, as one process smooths its level (block or lattice
-    // sweeps, double or single precision).
-    const solvers::MultigridParams p = pc.get<solvers::MgOptions>().cycle();
-    p.validate();
-    return p;
+DistributedMultigrid3::DistributedMultigrid3(const std::vector<DistributedLevel3>& levels,
+                                             const std::vector<DistributedTransfer3>& transfers,
+                                             const Communicator& comm, solvers::KrylovParams krylov,
+                                             solvers::MultigridParams mg)
+    : impl_(std::make_unique<Impl>(levels, transfers, comm, gmres_mg_spec(), krylov, mg)) {}
+DistributedMultigrid3::~DistributedMultigrid3() = default;
+void DistributedMultigrid3::set_coarse(const Level3& level_p,
+                                       const std::vector<Eigen::Matrix3d>& M) {
+    impl_->set_coarse(level_p, M);
 }
-
-LinearSolverSpec serial_levels_spec(const LinearSolverSpec& spec, int partition_level) {
-    LinearSolverSpec s = spec;
-    if (spec.method != solvers::Method::krylov || partition_level >= kMgDefaultLatticeLevel ||
-        spec.pc.name() != "mg")
-        return s;
-    solvers::MgOptions m = spec.pc.get<solvers::MgOptions>();
-    if (m.smoother != solvers::MultigridParams::Smoother::lattice) return s;
-    m.smoother = solvers::MultigridParams::Smoother::block;
-    s.pc.options = m;
-    return s;
+void DistributedMultigrid3::prepare(size_t k, const std::vector<Eigen::Matrix3d>& M) {
+    impl_->prepare(k, M);
+}
+SolveResult DistributedMultigrid3::solve(size_t k, const std::vector<Eigen::Matrix3d>& M,
+                                         const Vector& b, Vector& dx, double forcing) {
+    return impl_->solve(k, M, b, dx, forcing);
+}
+const solvers::ParMatrix& DistributedMultigrid3::matrix(size_t k) const {
+    MLC_CHECK(k >= 1 && k < impl_->op_.size() && impl_->op_[k].prepared,
+              "DistributedMultigrid3::matrix: level " << k << " is not prepared");
+    return *impl_->op_[k].J;
+}
+std::unique_ptr<Preconditioner> DistributedMultigrid3::preconditioner(size_t k) const {
+    MLC_CHECK(k >= 1 && k < impl_->op_.size(),
+              "DistributedMultigrid3::preconditioner: no level " << k);
+    return std::make_unique<Impl::Cycle>(*impl_, k);
+}
+std::string DistributedMultigrid3::name() const {
+    return impl_->name();
 }
 
 } // namespace mlc::levels
