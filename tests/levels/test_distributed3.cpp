@@ -20,6 +20,7 @@
 #include "scene/scene3.hpp"
 #include "solvers/hypre/boomeramg.hpp"
 #include "solvers/hypre/par_matrix.hpp"
+#include "tests/levels/distributed3_fixtures.hpp"
 
 #include <Eigen/SparseCholesky>
 
@@ -30,88 +31,9 @@
 #include <string>
 
 using namespace mlc;
+using namespace mlc::distributed3_fixtures;
 
 namespace {
-
-using P3 = std::array<double, 3>;
-
-P3 p3(const mesh::Vec3& x) {
-    return {x.x(), x.y(), x.z()};
-}
-
-/// A reproducible "random" value of serial unknown i (the same on every process).
-double pseudo_random(Index i) {
-    return std::sin(12.9898 * static_cast<double>(i) + 0.7) * 43758.5453 -
-           std::floor(std::sin(12.9898 * static_cast<double>(i) + 0.7) * 43758.5453) - 0.5;
-}
-
-/// The body (cell attribute) of every vertex of m: two bodies' vertices may coincide.
-std::vector<int> vertex_bodies(const mesh::TetMesh& m) {
-    std::vector<int> body(static_cast<size_t>(m.n_vertices()), 0);
-    for (int t = 0; t < m.n_cells(); ++t)
-        for (const int v : m.cells[static_cast<size_t>(t)])
-            body[static_cast<size_t>(v)] =
-                m.attribute.empty() ? 0 : m.attribute[static_cast<size_t>(t)];
-    return body;
-}
-
-/// The serial vertex of every local vertex of a part (-1: none), matched by coordinates and
-/// body.
-std::vector<int> serial_vertices(const levels::DistributedLevel3& d, const levels::Level3& s) {
-    std::map<std::pair<P3, int>, int> serial_vertex;
-    const std::vector<int> serial_body = vertex_bodies(s.mesh);
-    for (int v = 0; v < s.mesh.n_vertices(); ++v)
-        serial_vertex[{p3(s.mesh.vertices[static_cast<size_t>(v)]),
-                       serial_body[static_cast<size_t>(v)]}] = v;
-    const std::vector<int> body = vertex_bodies(d.local.mesh);
-    std::vector<int> out(static_cast<size_t>(d.local.mesh.n_vertices()), -1);
-    for (int v = 0; v < d.local.mesh.n_vertices(); ++v) {
-        const auto it = serial_vertex.find(
-            {p3(d.local.mesh.vertices[static_cast<size_t>(v)]), body[static_cast<size_t>(v)]});
-        EXPECT_NE(it, serial_vertex.end()) << "local vertex " << v << " is no serial vertex";
-        if (it != serial_vertex.end()) out[static_cast<size_t>(v)] = it->second;
-    }
-    return out;
-}
-
-/// The multipliers of serial vertex v (0 when it is no contact node).
-int serial_n_extra(const levels::Level3& s, int v) {
-    const int e = s.contact_of_vertex[static_cast<size_t>(v)];
-    return e < 0 ? 0 : s.contacts[static_cast<size_t>(e)].n_multipliers();
-}
-
-/// The serial unknown of every local unknown of a part (-1: none), matched by coordinates;
-/// expects every local vertex in the serial mesh with the same fixed components and multipliers.
-std::vector<Index> serial_dofs(const levels::DistributedLevel3& d, const levels::Level3& s) {
-    const std::vector<int> sv = serial_vertices(d, s);
-    const auto& dofs = d.local.dofs;
-    std::vector<Index> out(static_cast<size_t>(dofs.n_dofs()), -1);
-    for (int v = 0; v < d.local.mesh.n_vertices(); ++v) {
-        const int w = sv[static_cast<size_t>(v)];
-        if (w < 0) continue;
-        for (int c = 0; c < 3; ++c) {
-            EXPECT_EQ(d.local.fixed[static_cast<size_t>(v)][static_cast<size_t>(c)],
-                      s.fixed[static_cast<size_t>(w)][static_cast<size_t>(c)])
-                << "vertex " << v << " component " << c;
-            if (const int i = dofs.u_dof(v, c); i >= 0)
-                out[static_cast<size_t>(i)] = s.dofs.u_dof(w, c);
-        }
-        const int n = d.n_extra[static_cast<size_t>(v)];
-        EXPECT_EQ(n, serial_n_extra(s, w)) << "vertex " << v;
-        if (n > 0 && n == serial_n_extra(s, w) && dofs.extra_dof(v) >= 0)
-            for (int k = 0; k < n; ++k)
-                out[static_cast<size_t>(dofs.extra_dof(v) + k)] = s.dofs.extra_dof(w) + k;
-    }
-    return out;
-}
-
-/// The serial vector x (of level s) at the owned unknowns of a part.
-Vector owned_part(const std::vector<Index>& to_serial, Index n_owned, const Vector& x) {
-    Vector y(n_owned);
-    for (Index i = 0; i < n_owned; ++i)
-        y[i] = x[to_serial[static_cast<size_t>(i)]];
-    return y;
-}
 
 /// x with a reproducible value at every serial displacement unknown (0 at multipliers).
 Vector serial_random(const levels::Level3& s) {
@@ -121,19 +43,9 @@ Vector serial_random(const levels::Level3& s) {
     return x;
 }
 
-struct Block3dLevels {
-    levels::ElasticProblem3 p;
-    levels::Hierarchy3 serial;
-    levels::DistributedHierarchy3 dist;
-};
-
 /// Levels 0-1 of p, serial and partitioned on level 0.
 Block3dLevels levels01(levels::ElasticProblem3 p) {
-    Block3dLevels r;
-    r.p = std::move(p);
-    r.serial = levels::build_hierarchy(r.p, 1);
-    r.dist = levels::build_distributed_hierarchy3(r.p, 0, 1, comm::world());
-    return r;
+    return levels_up_to(std::move(p), 1, comm::world());
 }
 
 /// block3d (a block on a rigid plane, friction, a symmetry plane), levels 0-1.
@@ -347,47 +259,6 @@ bool reaches(const contact::ContactElement3& e, const std::set<int>& vertices) {
             vertices.count(e.vertex[static_cast<size_t>(j)]))
             return true;
     return false;
-}
-
-/// A smooth displacement of amplitude a at x (mesh of diameter h), component c, with a jump
-/// between the bodies (`body`), so that two-body gaps open and close.
-double smooth_u(const mesh::Vec3& x, int c, int body, double h, double a) {
-    const mesh::Vec3 y = x / h;
-    return a * (std::sin(2.1 * y.x() + 0.7 * c) * std::cos(1.3 * y.y() - 0.4 * c) +
-                0.5 * std::sin(1.7 * y.z() + c) + 0.3 * body * (c - 1.0));
-}
-
-/// The serial state of the residual test: displacement unknowns from smooth_u, multipliers
-/// pseudo-random of the size of r times the displacements (the tangents' a quarter of it); and
-/// u_prev_full, the state's displacements less a smaller smooth field (a slip increment), so
-/// that the nodes fall in every status.
-struct State3 {
-    Vector x, u_prev_full;
-};
-State3 serial_state(const levels::Level3& s, double a) {
-    const auto& m = s.mesh;
-    const std::vector<int> body = vertex_bodies(m);
-    const double h = m.diameter();
-    State3 st;
-    st.x = Vector::Zero(s.dofs.n_dofs());
-    for (int v = 0; v < m.n_vertices(); ++v)
-        for (int c = 0; c < 3; ++c)
-            if (const int d = s.dofs.u_dof(v, c); d >= 0)
-                st.x[d] = smooth_u(m.vertices[static_cast<size_t>(v)], c,
-                                   body[static_cast<size_t>(v)], h, a);
-    for (size_t e = 0; e < s.contacts.size(); ++e) {
-        const int nm = s.contacts[e].n_multipliers();
-        for (int q = 0; q < nm; ++q) {
-            const int d = s.lambda_dof[e] + q;
-            st.x[d] = (q + 1 < nm ? 1.0 : 4.0) * a * s.contacts[e].r * pseudo_random(d);
-        }
-    }
-    s.dofs.expand(st.x, s.u_fixed, st.u_prev_full);
-    for (int v = 0; v < m.n_vertices(); ++v)
-        for (int c = 0; c < 3; ++c)
-            st.u_prev_full[3 * v + c] -=
-                smooth_u(m.vertices[static_cast<size_t>(v)], 2 - c, 0, h, 0.2 * a);
-    return st;
 }
 
 /// The contact residual and Jacobian entries of a level's elements `els` (lambda dofs `ld`) at
