@@ -244,4 +244,23 @@ TEST(Distributed3Mg, Stack3dWithFrictionSolutionIsTheSerialLuOne) {
                            comm::world().size() == 1 ? 30 : 60);
 }
 
+TEST(Distributed3Mg, RefusesTheTwoDimensionalOptionsOnEveryProcess) {
+    const Block3dLevels b3 = levels_up_to(block3d_scene(), 1, comm::world());
+    solvers::MultigridParams single = levels::elastic3_mg_params();
+    single.precision = Precision::float32;
+    EXPECT_THROW(
+        levels::DistributedMultigrid3(b3.dist.levels, b3.dist.transfers, comm::world(), {}, single),
+        InvalidInput);
+    solvers::MultigridParams lattice = levels::elastic3_mg_params();
+    lattice.smoother = solvers::MultigridParams::Smoother::lattice;
+    EXPECT_THROW(levels::DistributedMultigrid3(b3.dist.levels, b3.dist.transfers, comm::world(), {},
+                                               lattice),
+                 InvalidInput);
+    solvers::MultigridParams three = levels::elastic3_mg_params();
+    three.cycles = 3;
+    EXPECT_THROW(
+        levels::DistributedMultigrid3(b3.dist.levels, b3.dist.transfers, comm::world(), {}, three),
+        InvalidInput);
+}
+
 #endif
