@@ -29,13 +29,11 @@
 /// the level below. Rows of ghost unknowns are incomplete and never used. K's multiplier rows
 /// and columns are empty, as build_level's; T's too (3D transfers act on the displacements).
 ///
-/// What is not yet here (each refused with InvalidInput, never ignored silently, unless said):
-/// - a loading path (ElasticProblem3::n_path_points() > 1): refused; the loading is the full
-///   load (K, f at load factor 1, u_fixed) as with proportional loading.
-/// - the distributed multigrid (levels/distributed_multigrid.hpp is 2D: its statuses, coarse
-///   solve and smoother rows) and the distributed Newton and solve on these levels
-///   (ContactNewton3 takes no NewtonDistribution yet); the elastic block can be solved by
-///   hypre's BoomerAMG-PCG on K_rows() for a scene without contact.
+/// These levels are solved by levels/distributed_solve3.hpp (Newton with a NewtonDistribution,
+/// GMRES with DistributedMultigrid3); the elastic block alone can be solved by hypre's
+/// BoomerAMG-PCG on K_rows(). What is not yet here: a loading path
+/// (ElasticProblem3::n_path_points() > 1) is refused with InvalidInput; the loading is the full
+/// load (K, f at load factor 1, u_fixed) as with proportional loading.
 #pragma once
 
 #include "core/communicator.hpp"

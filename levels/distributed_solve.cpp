@@ -57,12 +57,6 @@ void reduce_confusion(const Communicator& comm, Confusion& c) {
             c[i][j] = flat[4 * i + j];
 }
 
-StatusCounts reduce_counts(const Communicator& comm, StatusCounts c) {
-    std::array<int, 4> v{c.gap, c.stick, c.slip_forward, c.slip_backward};
-    comm.allreduce(std::span<int>(v), ReduceOp::sum);
-    return {v[0], v[1], v[2], v[3]};
-}
-
 /// The checks before anything is built, alike on every process: the partition level, the
 /// coarse-to-fine mode, supports that stay, the distributed multigrid's options (returned), and
 /// the memory of a process (about 1/N of the one-process run, the processes on one machine
@@ -410,6 +404,12 @@ private:
 };
 
 } // namespace
+
+StatusCounts reduce_counts(const Communicator& comm, StatusCounts c) {
+    std::array<int, 5> v{c.gap, c.stick, c.slip_forward, c.slip_backward, c.slip};
+    comm.allreduce(std::span<int>(v), ReduceOp::sum);
+    return {v[0], v[1], v[2], v[3], v[4]};
+}
 
 DistributedRunResult solve_distributed(const Problem& problem, const SolveOptions& options,
                                        const Communicator& comm, int p, SolveObserver* observer) {

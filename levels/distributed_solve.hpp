@@ -60,6 +60,9 @@ struct DistributedRunResult {
     const DistributedLevel& finest() const { return levels.back(); }
 };
 
+/// Collective: the status counts summed over the processes of `comm` (2D and 3D statuses).
+StatusCounts reduce_counts(const Communicator& comm, StatusCounts c);
+
 /// Collective: solves `problem` on the processes of `comm` (at least one level above level p,
 /// rigid or two-body pairs, supports that stay the same along the path) with the partition level
 /// `partition_level` (< problem.levels). options.linear must be "krylov" with pc "mg" (its

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `mlcontact run` on a 3D scene: options, report and files.
 #include "run/run3.hpp"
+#include "run/run3_detail.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/check.hpp"
@@ -18,40 +19,12 @@
 
 namespace mlc::apps {
 
-namespace {
+namespace detail3 {
 
 using levels::ContactNodeState3;
 using levels::ElasticProblem3;
-using levels::Level3;
-using levels::RunResult3;
 using mesh::Vec3;
 
-/// The options of `run` that have no effect on a 3D scene (yet): refused, naming why.
-void refuse_2d_options(const RunOptions& opt) {
-    auto refuse = [](bool given, const std::string& option, const std::string& why) {
-        if (given)
-            throw InvalidInput(option + " does not apply to a 3D scene: " + why);
-    };
-    const std::string krylov = "3D contact levels are solved by schur on level 0 and GMRES with "
-                               "the Galerkin vertex-block multigrid above, or exactly on every "
-                               "level with --linear schur|lu";
-    refuse(opt.krylov.has_value(), "--krylov", krylov);
-    refuse(opt.pc.has_value(), "--pc", krylov);
-    refuse(opt.linear_rel_tol.has_value(), "--linear-tol", krylov);
-    refuse(opt.linear && *opt.linear == "krylov", "--linear krylov", krylov);
-    refuse(opt.no_fallback, "--no-fallback", "there is no Krylov solve to fall back from");
-    refuse(opt.numbering.has_value(), "--numbering",
-           "3D levels number their vertices along a Hilbert curve only");
-    refuse(opt.no_continuation, "--no-continuation",
-           "3D runs have no r continuation to turn off");
-    refuse(opt.every_step || opt.every_level, opt.every_step ? "--every-step" : "--every-level",
-           "3D runs write the final state's solution.vtu and every step's contact_steps.csv");
-    refuse(opt.plot, "--plot", "the contact plot draws 2D contact lines");
-    refuse(opt.partition_level.has_value(), "--partition-level",
-           "3D runs are on one process so far");
-}
-
-/// --levels, --steps, --mu and --r, checked as in 2D.
 void apply_overrides3(ElasticProblem3& p, const RunOptions& opt) {
     if (opt.levels) {
         MLC_CHECK(*opt.levels >= 0 && *opt.levels <= levels::kMaxLevels3,
@@ -69,6 +42,10 @@ void apply_overrides3(ElasticProblem3& p, const RunOptions& opt) {
         for (auto& c : p.contacts)
             c.mu = *opt.mu;
     }
+    if (opt.linear_rel_tol)
+        MLC_CHECK(std::isfinite(*opt.linear_rel_tol) && *opt.linear_rel_tol > 0 &&
+                      *opt.linear_rel_tol < 1,
+                  "--linear-tol must lie in (0, 1), found " << *opt.linear_rel_tol);
     if (opt.r) {
         MLC_CHECK(std::isfinite(*opt.r) && *opt.r > 0, "--r must be > 0, found " << *opt.r);
         for (auto& c : p.contacts)
@@ -91,34 +68,39 @@ void require_finite3(double v, const char* what) {
                               "): the solve produced NaN/Inf");
 }
 
-/// The multiplier of a node in global components: lambda_t1 t1 + lambda_t2 t2 + lambda_n n.
 Vec3 global_lambda(const ContactNodeState3& n) {
     return n.t.col(0) * n.lambda_t[0] + n.t.col(1) * n.lambda_t[1] + n.n * n.lambda_n;
 }
 
-/// The contact.csv columns of one node (after the leading ones).
-void write_node(std::ostream& f, const ElasticProblem3& p, const Level3& L, size_t e,
-                const ContactNodeState3& n, double area) {
+void write_node(std::ostream& f, const std::string& pair, const ContactNodeState3& n, double area) {
     const Vec3 lg = global_lambda(n);
     const Vec3 slip = n.t.col(0) * n.slip_direction[0] + n.t.col(1) * n.slip_direction[1];
     auto per_area = [&](double v) { return area > 0 ? -v / area + 0.0 : 0.0; };
-    f << csv_name(p.contacts[static_cast<size_t>(L.contacts[e].pair)].name) << "," << n.vertex
-      << "," << n.x.x() << "," << n.x.y() << "," << n.x.z() << "," << n.u.x() << "," << n.u.y()
-      << "," << n.u.z() << "," << levels::kStatusNames3[static_cast<size_t>(
-                                      levels::status_code3(n.status))]
-      << "," << levels::status_code3(n.status) << "," << n.d_n << "," << area << ","
-      << n.lambda_n << "," << n.lambda_t[0] << "," << n.lambda_t[1] << "," << lg.x() << ","
-      << lg.y() << "," << lg.z() << "," << per_area(n.lambda_n) << "," << per_area(lg.x()) << ","
-      << per_area(lg.y()) << "," << per_area(lg.z()) << "," << slip.x() << "," << slip.y() << ","
-      << slip.z() << "," << n.n.x() << "," << n.n.y() << "," << n.n.z() << "," << n.t(0, 0)
-      << "," << n.t(1, 0) << "," << n.t(2, 0) << "," << n.t(0, 1) << "," << n.t(1, 1) << ","
-      << n.t(2, 1) << "\n";
+    f << csv_name(pair) << "," << n.vertex << "," << n.x.x() << "," << n.x.y() << "," << n.x.z()
+      << "," << n.u.x() << "," << n.u.y() << "," << n.u.z() << ","
+      << levels::kStatusNames3[static_cast<size_t>(levels::status_code3(n.status))] << ","
+      << levels::status_code3(n.status) << "," << n.d_n << "," << area << "," << n.lambda_n << ","
+      << n.lambda_t[0] << "," << n.lambda_t[1] << "," << lg.x() << "," << lg.y() << "," << lg.z()
+      << "," << per_area(n.lambda_n) << "," << per_area(lg.x()) << "," << per_area(lg.y()) << ","
+      << per_area(lg.z()) << "," << slip.x() << "," << slip.y() << "," << slip.z() << "," << n.n.x()
+      << "," << n.n.y() << "," << n.n.z() << "," << n.t(0, 0) << "," << n.t(1, 0) << ","
+      << n.t(2, 0) << "," << n.t(0, 1) << "," << n.t(1, 1) << "," << n.t(2, 1) << "\n";
 }
 
-constexpr const char* kNodeColumns =
+const char* const kNodeColumns =
     "pair,vertex,x,y,z,ux,uy,uz,status,status_code,gap,area,lambda_n,lambda_t1,lambda_t2,"
     "lambda_x,lambda_y,lambda_z,pressure,traction_x,traction_y,traction_z,slip_x,slip_y,slip_z,"
     "n_x,n_y,n_z,t1_x,t1_y,t1_z,t2_x,t2_y,t2_z";
+
+std::function<void(int, int, const levels::StepReport&)> progress_lines(std::ostream& os) {
+    return [&os](int l, int k, const levels::StepReport& s) {
+        os << "level " << l << " step " << k << ": " << s.iterations << " Newton iterations, "
+           << (s.converged ? "converged" : "not converged") << " (" << std::fixed
+           << std::setprecision(3) << s.seconds << " s)\n";
+        os.unsetf(std::ios::floatfield);
+        os << std::setprecision(6);
+    };
+}
 
 void check_nodes(const std::vector<ContactNodeState3>& nodes) {
     for (const auto& n : nodes) {
@@ -126,6 +108,39 @@ void check_nodes(const std::vector<ContactNodeState3>& nodes) {
         require_finite3(n.lambda_t.norm(), "lambda_t");
         require_finite3(n.u.norm(), "displacement");
     }
+}
+
+void refuse_2d_options(const RunOptions& opt, bool distributed) {
+    auto refuse = [](bool given, const std::string& option, const std::string& why) {
+        if (given) throw InvalidInput(option + " does not apply to a 3D scene: " + why);
+    };
+    const std::string krylov = "3D contact levels are solved by schur on level 0 and GMRES with "
+                               "the Galerkin vertex-block multigrid above, or exactly on every "
+                               "level with --linear schur|lu";
+    refuse(opt.krylov.has_value(), "--krylov", krylov);
+    refuse(opt.pc.has_value(), "--pc", krylov);
+    refuse(opt.linear && *opt.linear == "krylov", "--linear krylov", krylov);
+    refuse(opt.no_fallback, "--no-fallback", "there is no Krylov solve to fall back from");
+    refuse(opt.numbering.has_value(), "--numbering",
+           "3D levels number their vertices along a Hilbert curve only");
+    refuse(opt.no_continuation, "--no-continuation", "3D runs have no r continuation to turn off");
+    refuse(opt.every_step || opt.every_level, opt.every_step ? "--every-step" : "--every-level",
+           "3D runs write the final state's solution.vtu and every step's contact_steps.csv");
+    refuse(opt.plot, "--plot", "the contact plot draws 2D contact lines");
+    refuse(opt.partition_level.has_value() && !distributed, "--partition-level",
+           "it applies to runs on several processes (mpirun -np N, N > 1)");
+}
+
+} // namespace detail3
+
+namespace {
+
+using namespace detail3;
+using levels::Level3;
+using levels::RunResult3;
+
+const std::string& pair_name(const ElasticProblem3& p, const Level3& L, size_t e) {
+    return p.contacts[static_cast<size_t>(L.contacts[e].pair)].name;
 }
 
 void write_solution_vtu3(const std::filesystem::path& file, const Level3& L, const Vector& u_full,
@@ -211,15 +226,14 @@ void write_iterations3(const std::filesystem::path& file, const RunResult3& r) {
         for (size_t l = 0; l < r.level_steps.size(); ++l)
             for (const auto& st : r.level_steps[l])
                 for (size_t i = 0; i < st.report.linear_iterations_per_newton.size(); ++i)
-                    f << l << "," << r.hierarchy.levels[l].n_unknowns() << ",0,"
-                      << st.report.step << "," << i + 1 << ","
-                      << st.report.linear_iterations_per_newton[i] << "\n";
+                    f << l << "," << r.hierarchy.levels[l].n_unknowns() << ",0," << st.report.step
+                      << "," << i + 1 << "," << st.report.linear_iterations_per_newton[i] << "\n";
     });
 }
 
-void write_summary3(const std::filesystem::path& dir, const ElasticProblem3& p,
-                    const RunResult3& r, const std::vector<std::string>& files,
-                    const levels::SolveOptions3& so, const levels::Plan3& plan) {
+void write_summary3(const std::filesystem::path& dir, const ElasticProblem3& p, const RunResult3& r,
+                    const std::vector<std::string>& files, const levels::SolveOptions3& so,
+                    const levels::Plan3& plan) {
     toml::table root;
     root.insert("complete", true);
     root.insert("scene", p.name);
@@ -291,7 +305,7 @@ void write_summary3(const std::filesystem::path& dir, const ElasticProblem3& p,
 } // namespace
 
 int run_scene3(const RunOptions& opt, std::ostream& os) {
-    refuse_2d_options(opt);
+    refuse_2d_options(opt, false);
     ElasticProblem3 p = scene::load_scene3(opt.scene);
     apply_overrides3(p, opt);
     MLC_CHECK(!p.contacts.empty(),
@@ -309,17 +323,16 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
                                                      forced, levels::process_memory_limit());
     so.level0 = plan.level0;
     so.upper = plan.upper;
+    if (opt.linear_rel_tol) {
+        MLC_CHECK(plan.upper == levels::Method3::mg && p.levels >= 1,
+                  "--linear-tol sets the tolerance of the GMRES solves of the levels above level "
+                  "0, and this run has none (--levels 0 or --linear schur|lu)");
+        so.krylov_rel_tol = *opt.linear_rel_tol;
+    }
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
     OutputFolder folder(dir);
     if (opt.stop) so.interrupt = [&] { return opt.stop->load(); };
-    if (!opt.quiet)
-        so.progress = [&](int l, int k, const levels::StepReport& s) {
-            os << "level " << l << " step " << k << ": " << s.iterations << " Newton iterations, "
-               << (s.converged ? "converged" : "not converged") << " (" << std::fixed
-               << std::setprecision(3) << s.seconds << " s)\n";
-            os.unsetf(std::ios::floatfield);
-            os << std::setprecision(6);
-        };
+    if (!opt.quiet) so.progress = progress_lines(os);
     os << "mlcontact: solving '" << p.name << "' (3D)\n";
     RunResult3 r;
     try {
@@ -355,7 +368,7 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
     write_file_atomically(dir / "contact.csv", [&](std::ostream& f) {
         f << kNodeColumns << "\n" << std::setprecision(17);
         for (size_t e = 0; e < r.nodes.size(); ++e)
-            write_node(f, p, L, e, r.nodes[e], areas[e]);
+            write_node(f, pair_name(p, L, e), r.nodes[e], areas[e]);
     });
     files.push_back("contact.csv");
     write_file_atomically(dir / "contact_steps.csv", [&](std::ostream& f) {
@@ -363,7 +376,7 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
         for (size_t k = 0; k < r.step_nodes.size(); ++k)
             for (size_t e = 0; e < r.step_nodes[k].size(); ++e) {
                 f << k + 1 << "," << static_cast<double>(k + 1) / p.load_steps << ",";
-                write_node(f, p, L, e, r.step_nodes[k][e], areas[e]);
+                write_node(f, pair_name(p, L, e), r.step_nodes[k][e], areas[e]);
             }
     });
     files.push_back("contact_steps.csv");

@@ -15,6 +15,7 @@
 #include "run/output.hpp"
 #include "run/summary_json.hpp"
 #include "scene/scene.hpp"
+#include "scene/scene3.hpp"
 #include "solvers/factory.hpp"
 
 #include <toml++/toml.h>
@@ -457,10 +458,51 @@ std::vector<PairResultant> pair_resultants(const levels::Problem& p,
 
 } // namespace
 
+void write_summary_last(const std::filesystem::path& dir, const toml::table& summary,
+                        std::vector<std::string>& files) {
+    write_file_atomically(dir / "summary.json",
+                          [&](std::ostream& f) { f << toml::json_formatter{summary} << "\n"; });
+    files.push_back("summary.json");
+    set_stop_summary({}, {}, {});
+}
+
+void print_written(std::ostream& os, const Communicator& comm, const std::filesystem::path& dir,
+                   const std::vector<std::string>& files) {
+    comm.barrier();
+    os << "\nwrote";
+    for (size_t i = 0; i < files.size(); ++i)
+        os << (i ? ", " : " ") << (dir / files[i]).string();
+    os << "\n";
+}
+
+void open_output_folder(std::optional<OutputFolder>& folder, const std::filesystem::path& dir,
+                        const std::string& scene, const Communicator& comm, std::ostream& os) {
+    // Process 0 checks and locks the output folder before the solve (OutputFolder) and alone
+    // writes in it but for the .vtu pieces; every process learns whether it may go on.
+    const bool root = comm.rank() == 0;
+    int refused = 0;
+    std::string why;
+    if (root) try {
+            folder.emplace(dir);
+            set_stop_summary(dir / "summary.json", killed_summary(scene, SIGINT, comm.size()),
+                             killed_summary(scene, SIGTERM, comm.size()));
+        } catch (const InvalidInput& e) {
+            refused = 1;
+            why = e.what();
+        }
+    comm.broadcast(std::span<int>(&refused, 1), 0);
+    if (refused)
+        throw InvalidInput(root ? why : "the output folder was refused (process 0 says why)");
+    if (folder && folder->took_over_from() > 0)
+        os << "note: the output folder's lock was left by process " << folder->took_over_from()
+           << ", which has ended; taken over\n";
+}
+
 int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::ostream& out) {
     std::ostream null_stream(nullptr);
     const bool root = comm.rank() == 0;
     std::ostream& os = root ? out : null_stream;
+    if (scene::scene_dimension(opt.scene) == 3) return run_scene3_distributed(opt, comm, out);
     levels::Problem p = scene::load_scene(opt.scene);
     apply_overrides(p, opt);
     MLC_CHECK(opt.vtu == "binary" || opt.vtu == "ascii",
@@ -488,27 +530,8 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
     const mesh::VtuFormat vtu =
         opt.vtu == "ascii" ? mesh::VtuFormat::ascii : mesh::VtuFormat::binary;
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
-    // Process 0 checks and locks the output folder before the solve (OutputFolder) and alone
-    // writes in it but for the .vtu pieces; every process learns whether it may go on.
     std::optional<OutputFolder> folder;
-    {
-        int refused = 0;
-        std::string why;
-        if (root) try {
-                folder.emplace(dir);
-                set_stop_summary(dir / "summary.json", killed_summary(p.name, SIGINT, comm.size()),
-                                 killed_summary(p.name, SIGTERM, comm.size()));
-            } catch (const InvalidInput& e) {
-                refused = 1;
-                why = e.what();
-            }
-        comm.broadcast(std::span<int>(&refused, 1), 0);
-        if (refused)
-            throw InvalidInput(root ? why : "the output folder was refused (process 0 says why)");
-        if (folder && folder->took_over_from() > 0)
-            os << "note: the output folder's lock was left by process " << folder->took_over_from()
-               << ", which has ended; taken over\n";
-    }
+    open_output_folder(folder, dir, p.name, comm, os);
 
     levels::SolveOptions so;
     so.predicted_sizes = levels::predict_level_sizes([&] {
@@ -585,16 +608,9 @@ int run_scene_distributed(const RunOptions& opt, const Communicator& comm, std::
         sv.insert("rel_tol", spec.rel_tol);
         sv.insert("distributed", true);
         root_t.insert("solver", sv);
-        write_file_atomically(dir / "summary.json",
-                              [&](std::ostream& f) { f << toml::json_formatter{root_t} << "\n"; });
-        files.push_back("summary.json");
-        set_stop_summary({}, {}, {});
+        write_summary_last(dir, root_t, files);
     }
-    comm.barrier();
-    os << "\nwrote";
-    for (size_t i = 0; i < files.size(); ++i)
-        os << (i ? ", " : " ") << (dir / files[i]).string();
-    os << "\n";
+    print_written(os, comm, dir, files);
     return 0;
 }
 

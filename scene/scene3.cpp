@@ -621,8 +621,8 @@ void refuse_3d_scene(const Reader& rd, const toml::table& root, toml::table& sce
     const int dim = rd.integer(d, "[scene].dimension");
     if (dim == 3)
         rd.fail(d, "this is a 3D scene ([scene].dimension = 3), which this command does not "
-                   "solve: 3D scenes run on one process with `mlcontact run`, `bench square`, "
-                   "`bench elastic` and every study but `preconditioners`");
+                   "solve: 3D scenes run with `mlcontact run` (on one or several processes), "
+                   "`bench square`, `bench elastic` and every study but `preconditioners`");
     if (dim != 2) rd.fail(d, "[scene].dimension must be 2 or 3, found " + std::to_string(dim));
     (void)root;
     scene_table.erase("dimension");

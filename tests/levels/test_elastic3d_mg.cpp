@@ -454,11 +454,11 @@ TEST(Scene3, AMissingPhysicalVolumeIsRefusedListingThoseThereAre) {
 TEST(Scene3, The2DLoaderRefusesA3DSceneNamingWhatRunsIt) {
     EXPECT_EQ(scene::scene_dimension("box3d"), 3);
     EXPECT_EQ(scene::scene_dimension("square"), 2);
-    mesh::testing::expect_invalid([] { scene::load_scene("box3d"); },
-                                  {"builtin:box3d:", "3D scene",
-                                   "which this command does not solve", "on one process",
-                                   "`mlcontact run`", "`bench square`", "bench elastic",
-                                   "every study but `preconditioners`"});
+    mesh::testing::expect_invalid(
+        [] { scene::load_scene("box3d"); },
+        {"builtin:box3d:", "3D scene", "which this command does not solve",
+         "on one or several processes", "`mlcontact run`", "`bench square`", "bench elastic",
+         "every study but `preconditioners`"});
     // dimension = 2 is a 2D scene's right; 4 is refused.
     std::string sq = scene::builtin_scene_text("square");
     sq.insert(sq.find("[scene]\n") + 8, "dimension = 2\n");
