@@ -9,8 +9,10 @@
 #include "core/check.hpp"
 #include "fem/assembly.hpp"
 #include "levels/distributed.hpp"
+#include "levels/solve3.hpp"
 #include "mesh/tet_refine.hpp"
 #include "transfer/prolongation.hpp"
+#include "transfer/surface_q.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -336,7 +338,76 @@ std::vector<mesh::GhostReach> contact_ghost_reach3(const ElasticProblem3& p,
     return out;
 }
 
-DistributedTransfer3 build_distributed_transfer3(const DistributedLevel3& coarse,
+namespace {
+
+/// The multiplier rows of the owned fine contact nodes (the multiplier block of
+/// full_prolongation3 on these parts): per fine node, F_f^T Q_fc F_c over the coarse contact
+/// nodes of its surface row, with Q = diag(m_h) P diag(1 / m_H) and m_H = P^T m_h. The coarse
+/// masses and frames are the coarse vertices' owners' (a ghost coarse vertex's fine surface is
+/// not all local); entries (local fine row, global coarse column, value) into `rows`.
+void multiplier_rows3(const ElasticProblem3& p, const DistributedLevel3& coarse,
+                      const DistributedLevel3& fine, const Communicator& comm,
+                      std::vector<std::vector<std::pair<std::int64_t, double>>>& rows) {
+    const Level3& C = coarse.local;
+    const Level3& F = fine.local;
+    if (p.contacts.empty()) return; // the same on every process
+    transfer::SurfaceQ q;
+    detail::agree_on_errors(comm, [&] {
+        q = transfer::build_surface_q<3>(
+            transfer::SurfacePoints(C.mesh.vertices.begin(), C.mesh.vertices.end()),
+            contactor_faces(p, C),
+            transfer::SurfacePoints(F.mesh.vertices.begin(), F.mesh.vertices.end()),
+            contactor_faces(p, F), F.mesh.parents);
+    });
+    // Per coarse vertex: m_H, contact node?, frictional?, t1, t2, n (owners' values).
+    constexpr int w = 12;
+    const auto nc = static_cast<size_t>(C.mesh.n_vertices());
+    std::vector<double> rec(w * nc, 0.0);
+    for (int i = 0; i < q.coarse.size(); ++i)
+        rec[w * static_cast<size_t>(q.coarse.vertex[static_cast<size_t>(i)])] =
+            q.coarse_mass_on_fine[i];
+    for (const auto& el : C.contacts) {
+        double* r = rec.data() + w * static_cast<size_t>(el.vertex[0]);
+        r[1] = 1.0;
+        r[2] = el.frictional() ? 1.0 : 0.0;
+        for (int c = 0; c < 3; ++c) {
+            r[3 + c] = el.t(c, 0);
+            r[6 + c] = el.t(c, 1);
+            r[9 + c] = el.n[c];
+        }
+    }
+    coarse.ghosts.vertex_records(rec, w);
+    for (size_t e = 0; e < F.contacts.size(); ++e) {
+        const auto& el = F.contacts[e];
+        const int i = q.fine.index[static_cast<size_t>(el.vertex[0])];
+        if (i < 0) continue;
+        Eigen::Matrix3d Bf;
+        Bf << el.t.col(0), el.t.col(1), el.n;
+        const int a0 = el.frictional() ? 0 : 2;
+        const int df = F.lambda_dof[e];
+        for (MovableSparseMatrix::InnerIterator it(q.P, i); it; ++it) {
+            const int vc = q.coarse.vertex[static_cast<size_t>(it.col())];
+            const double* r = rec.data() + w * static_cast<size_t>(vc);
+            if (r[1] == 0.0 || r[0] <= 0.0) continue;
+            Eigen::Matrix3d Bc;
+            Bc << Eigen::Vector3d(r[3], r[4], r[5]), Eigen::Vector3d(r[6], r[7], r[8]),
+                Eigen::Vector3d(r[9], r[10], r[11]);
+            const Eigen::Matrix3d B = q.fine_mass[i] * it.value() / r[0] * Bf.transpose() * Bc;
+            const int b0 = r[2] != 0.0 ? 0 : 2;
+            const int dc = C.dofs.extra_dof(vc);
+            for (int a = a0; a < 3; ++a)
+                for (int b = b0; b < 3; ++b)
+                    if (B(a, b) != 0.0)
+                        rows[static_cast<size_t>(df + a - a0)].emplace_back(
+                            coarse.global_dof[static_cast<size_t>(dc + b - b0)], B(a, b));
+        }
+    }
+}
+
+} // namespace
+
+DistributedTransfer3 build_distributed_transfer3(const ElasticProblem3& p,
+                                                 const DistributedLevel3& coarse,
                                                  const DistributedLevel3& fine,
                                                  const Communicator& comm) {
     const SparseMatrix P_vertex = transfer::vertex_prolongation(fine.local.mesh);
@@ -348,16 +419,23 @@ DistributedTransfer3 build_distributed_transfer3(const DistributedLevel3& coarse
         P_vertex, 3, transfer::vertex_unknowns(coarse.local.dofs, 3),
         static_cast<int>(coarse.local.dofs.n_dofs()), transfer::vertex_unknowns(fine.local.dofs, 3),
         static_cast<int>(fine.local.dofs.n_dofs()));
+    const int n = static_cast<int>(fine.n_owned);
+    std::vector<std::vector<std::pair<std::int64_t, double>>> extra(static_cast<size_t>(n));
+    multiplier_rows3(p, coarse, fine, comm, extra);
     solvers::DistributedRows r;
     r.first_row = fine.first_dof;
-    const int n = static_cast<int>(fine.n_owned);
-    const int nnz = T.outerIndexPtr()[n];
-    r.row_ptr.assign(T.outerIndexPtr(), T.outerIndexPtr() + n + 1);
-    r.cols.resize(static_cast<size_t>(nnz));
-    for (int k = 0; k < nnz; ++k)
-        r.cols[static_cast<size_t>(k)] =
-            coarse.global_dof[static_cast<size_t>(T.innerIndexPtr()[k])];
-    r.values.assign(T.valuePtr(), T.valuePtr() + nnz);
+    r.row_ptr.assign(1, 0);
+    for (int i = 0; i < n; ++i) {
+        for (SparseMatrix::InnerIterator it(T, i); it; ++it) {
+            r.cols.push_back(coarse.global_dof[static_cast<size_t>(it.col())]);
+            r.values.push_back(it.value());
+        }
+        for (const auto& [col, v] : extra[static_cast<size_t>(i)]) {
+            r.cols.push_back(col);
+            r.values.push_back(v);
+        }
+        r.row_ptr.push_back(static_cast<int>(r.cols.size()));
+    }
     DistributedTransfer3 t;
     t.T = std::make_unique<solvers::ParMatrix>(comm, r, coarse.first_dof,
                                                static_cast<int>(coarse.n_owned));
@@ -378,8 +456,8 @@ DistributedHierarchy3 build_distributed_hierarchy3(const ElasticProblem3& p, int
     for (auto& part : dh.levels) {
         h.levels.push_back(build_distributed_level3(p, std::move(part), comm));
         if (h.levels.size() >= 2)
-            h.transfers.push_back(
-                build_distributed_transfer3(h.levels[h.levels.size() - 2], h.levels.back(), comm));
+            h.transfers.push_back(build_distributed_transfer3(p, h.levels[h.levels.size() - 2],
+                                                              h.levels.back(), comm));
     }
     return h;
 }

@@ -143,17 +143,22 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
 std::vector<mesh::GhostReach> contact_ghost_reach3(const ElasticProblem3& p,
                                                    const mesh::TetMesh& level_p);
 
-/// The transfer between consecutive distributed 3D levels (fine refined from coarse): the
-/// local T (transfer::vertex_prolongation of the fine part restricted to the free
-/// displacements, transfer::restrict_to_unknowns, as build_hierarchy's), whose owned fine rows
-/// are exact, as a ParMatrix (owned fine rows, coarse unknowns as columns).
+/// The transfer between consecutive distributed 3D levels (fine refined from coarse), the
+/// full_prolongation3 of the serial levels on the owned fine rows, as a ParMatrix (owned fine
+/// rows, coarse unknowns as columns): the displacements by the local T
+/// (transfer::vertex_prolongation of the fine part restricted to the free displacements,
+/// transfer::restrict_to_unknowns, as build_hierarchy's), the multipliers of the owned fine
+/// contact nodes by the surface transfer Q of the contactor faces (transfer/surface_q.hpp, its
+/// coarse masses P^T m_h and the coarse nodes' frames taken from their owners), in each node's
+/// frame.
 struct DistributedTransfer3 {
     std::unique_ptr<solvers::ParMatrix> T;
 };
 
 /// Collective. `fine`'s part must be the refinement of `coarse`'s (levels k + 1 and k of one
-/// mesh::distribute).
-DistributedTransfer3 build_distributed_transfer3(const DistributedLevel3& coarse,
+/// mesh::distribute of p).
+DistributedTransfer3 build_distributed_transfer3(const ElasticProblem3& p,
+                                                 const DistributedLevel3& coarse,
                                                  const DistributedLevel3& fine,
                                                  const Communicator& comm);
 
