@@ -158,4 +158,24 @@ inline State3 serial_state(const levels::Level3& s, double a) {
     return st;
 }
 
+/// The serial state st on a part: x with the owned unknowns from st and the ghosts from their
+/// owners, u_prev_full from the serial vertices.
+inline State3 part_state(const levels::DistributedLevel3& d, const levels::Level3& s,
+                         const State3& st) {
+    const auto& L = d.local;
+    const std::vector<Index> to_serial = serial_dofs(d, s);
+    const std::vector<int> sv = serial_vertices(d, s);
+    State3 out;
+    out.x = Vector::Constant(L.dofs.n_dofs(), std::nan(""));
+    for (Index i = 0; i < d.n_owned; ++i)
+        out.x[i] = st.x[to_serial[static_cast<size_t>(i)]];
+    d.ghosts.update(L.dofs, out.x);
+    EXPECT_TRUE(out.x.allFinite()) << "a ghost unknown got no value";
+    out.u_prev_full.resize(3 * L.mesh.n_vertices());
+    for (int v = 0; v < L.mesh.n_vertices(); ++v)
+        out.u_prev_full.segment<3>(3 * v) =
+            st.u_prev_full.segment<3>(3 * sv[static_cast<size_t>(v)]);
+    return out;
+}
+
 } // namespace mlc::distributed3_fixtures

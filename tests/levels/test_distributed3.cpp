@@ -423,16 +423,9 @@ TEST(Distributed3Levels, OwnedContactResidualAndJacobianRowsAreTheSerialOnes) {
             }
             // The part's: owned unknowns from the serial state, ghosts from their owners.
             const std::vector<Index> to_serial = serial_dofs(d, s);
-            const std::vector<int> sv = serial_vertices(d, s);
-            Vector x = Vector::Constant(L.dofs.n_dofs(), std::nan(""));
-            for (Index i = 0; i < d.n_owned; ++i)
-                x[i] = st.x[to_serial[static_cast<size_t>(i)]];
-            d.ghosts.update(L.dofs, x);
-            EXPECT_TRUE(x.allFinite()) << "a ghost unknown got no value";
-            Vector u_prev(3 * L.mesh.n_vertices());
-            for (int v = 0; v < L.mesh.n_vertices(); ++v)
-                u_prev.segment<3>(3 * v) =
-                    st.u_prev_full.segment<3>(3 * sv[static_cast<size_t>(v)]);
+            const State3 ps = part_state(d, s, st);
+            const Vector& x = ps.x;
+            const Vector& u_prev = ps.u_prev_full;
             Vector R = Vector::Zero(L.dofs.n_dofs());
             std::map<std::pair<Index, Index>, double> J;
             contact_rows(L, L.contacts, L.lambda_dof, x, u_prev, R, J, nullptr);

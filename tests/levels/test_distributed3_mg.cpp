@@ -56,16 +56,9 @@ std::vector<Eigen::Matrix3d> status_matrices(const levels::Level3& L,
 std::vector<Eigen::Matrix3d> part_status_matrices(const levels::DistributedLevel3& d,
                                                   const levels::Level3& s, const State3& st) {
     const auto& L = d.local;
-    const std::vector<Index> to_serial = serial_dofs(d, s);
-    const std::vector<int> sv = serial_vertices(d, s);
-    Vector x = Vector::Constant(L.dofs.n_dofs(), std::nan(""));
-    for (Index i = 0; i < d.n_owned; ++i)
-        x[i] = st.x[to_serial[static_cast<size_t>(i)]];
-    d.ghosts.update(L.dofs, x);
-    EXPECT_TRUE(x.allFinite()) << "a ghost unknown got no value";
-    Vector u_prev(3 * L.mesh.n_vertices());
-    for (int v = 0; v < L.mesh.n_vertices(); ++v)
-        u_prev.segment<3>(3 * v) = st.u_prev_full.segment<3>(3 * sv[static_cast<size_t>(v)]);
+    const State3 ps = part_state(d, s, st);
+    const Vector& x = ps.x;
+    const Vector& u_prev = ps.u_prev_full;
     std::vector<Eigen::Matrix3d> M =
         status_matrices(L, L.contacts, L.lambda_dof, x, u_prev, nullptr);
     const auto Mg = status_matrices(L, L.ghost_contacts, L.ghost_lambda_dof, x, u_prev, nullptr);

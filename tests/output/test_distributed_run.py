@@ -17,36 +17,17 @@ import subprocess
 
 import numpy as np
 import pytest
-import vtk
+from mpi_runs import ENV, MLCONTACT, MPIEXEC, run_processes
+from mpi_runs import read_grid as read
+from mpi_runs import tight_scene as scene_file
 from vtk.util.numpy_support import vtk_to_numpy
-
-MLCONTACT = os.environ["MLCONTACT"]
-MPIEXEC = os.environ.get("MPIEXEC", "mpiexec")
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-
-
-def scene_file(tmp_path, name):
-    """The built-in scene with the Newton tolerance at 1e-12."""
-    text = subprocess.run([MLCONTACT, "show", name], capture_output=True, text=True,
-                          env=dict(ENV, OMPI_MCA_ess_singleton_isolated="1"), check=True).stdout
-    assert "[newton]" not in text
-    f = tmp_path / f"{name}.toml"
-    f.write_text(text + "\n[newton]\nrel_tol = 1e-12\n")
-    return f
 
 
 def run(tmp_path, scene, levels, np_, *extra, expect=0):
     out = tmp_path / f"out_np{np_}"
     pc = [] if "--pc" in extra else ["--pc", "mg"]
-    cmd = [MLCONTACT, "run", str(scene), "--levels", str(levels), *pc,
-           "--linear-tol", "1e-12", "--quiet", "--out", str(out), *extra]
-    env = dict(ENV)
-    if np_ > 1:
-        cmd = [MPIEXEC, "-n", str(np_), "--oversubscribe", *cmd]
-    else:
-        env["OMPI_MCA_ess_singleton_isolated"] = "1"
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
-    assert p.returncode == expect, p.stdout + p.stderr
+    p = run_processes(["run", str(scene), "--levels", str(levels), *pc, "--linear-tol", "1e-12",
+                       "--quiet", "--out", str(out), *extra], np_, expect)
     return out, p
 
 
@@ -64,14 +45,6 @@ def points_and_displacements(grid):
     for (x, y), d in zip(pts, u):
         out.setdefault((round(x, 12), round(y, 12)), []).append(d)
     return out
-
-
-def read(path, parallel):
-    r = vtk.vtkXMLPUnstructuredGridReader() if parallel else vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(str(path))
-    r.Update()
-    assert r.GetErrorCode() == 0, f"VTK could not read {path}"
-    return r.GetOutput()
 
 
 def compare(serial, dist):

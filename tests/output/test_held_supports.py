@@ -15,11 +15,9 @@ import os
 import subprocess
 
 import pytest
+from mpi_runs import ENV, MLCONTACT, run_processes
 
-MLCONTACT = os.environ["MLCONTACT"]
-MPIEXEC = os.environ.get("MPIEXEC", "mpiexec")
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data", "redundant")
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
 
 # scene file (or built-in name), extra flags, the held contact node
 SCENES = {
@@ -46,15 +44,8 @@ def scene_file(tmp_path, name):
 
 def run(tmp_path, scene, levels, np_, extra):
     out = tmp_path / f"out_np{np_}"
-    cmd = [MLCONTACT, "run", str(scene), "--levels", str(levels), "--pc", "mg", "--no-fallback",
-           "--linear-tol", "1e-12", "--quiet", "--out", str(out), *extra]
-    env = dict(ENV)
-    if np_ > 1:
-        cmd = [MPIEXEC, "-n", str(np_), "--oversubscribe", *cmd]
-    else:
-        env["OMPI_MCA_ess_singleton_isolated"] = "1"
-    p = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600)
-    assert p.returncode == 0, p.stdout + p.stderr
+    run_processes(["run", str(scene), "--levels", str(levels), "--pc", "mg", "--no-fallback",
+                   "--linear-tol", "1e-12", "--quiet", "--out", str(out), *extra], np_)
     return out
 
 
