@@ -41,7 +41,9 @@ def test_two_processes_lock_and_complete_the_folder(tmp_path):
 
 
 def test_sigterm_under_mpirun(tmp_path):
-    a = subprocess.Popen(mpirun("square", "--levels", "4", "--quiet", "--out", str(tmp_path)),
+    # Level 6, so that the run is still solving when the signal comes after the second run's
+    # refusal; a smaller scene can finish first on a fast machine.
+    a = subprocess.Popen(mpirun("square", "--levels", "6", "--quiet", "--out", str(tmp_path)),
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=ENV)
     t0 = time.time()
     while lock_pid(tmp_path) == 0:
