@@ -88,7 +88,8 @@ template <> struct DistributedTypes<3> {
 /// The distributed multigrid in `dim` dimensions (DistributedMultigrid in 2D,
 /// DistributedMultigrid3 in 3D). 2D: spec's Krylov method and preconditioner (mg, or a
 /// preconditioner of each process's diagonal block), the lattice sweep, mg's precision, V-cycles.
-/// 3D: mg only, vertex-block Gauss-Seidel in double precision, V- or W-cycles.
+/// 3D: mg with vertex-block Gauss-Seidel in double precision, V- or W-cycles, or a
+/// preconditioner of the matrix alone on each process's diagonal block.
 template <int dim> struct DistributedMultigridCore : solvers::VCycle {
     using DLevel = typename DistributedTypes<dim>::DLevel;
     using DTransfer = typename DistributedTypes<dim>::DTransfer;
@@ -106,9 +107,17 @@ template <int dim> struct DistributedMultigridCore : solvers::VCycle {
         if constexpr (dim == 2) {
             MLC_CHECK(mg.cycles == 1,
                       "the distributed multigrid runs V-cycles only, found cycles = " << mg.cycles);
+        } else if (!use_mg_) {
+            // A preconditioner of each process's diagonal block (the matrix alone).
+            const std::string why = spec_.pc.dimension_reason(3);
+            MLC_CHECK(why.empty(), why);
+            const std::string not_distributed = spec_.pc.distributed();
+            MLC_CHECK(not_distributed.empty() && !spec_.pc.entry->level_aware,
+                      spec_.pc.text()
+                          << " has no form on each process's diagonal block of a 3D level"
+                          << (not_distributed.empty() ? "" : ": " + not_distributed));
         } else {
             mg.validate();
-            MLC_CHECK(use_mg_, "internal error: the 3D distributed multigrid is mg only");
             MLC_CHECK(mg.smoother == solvers::MultigridParams::Smoother::block,
                       "the 3D distributed multigrid smooths by vertex blocks only "
                       "(mg:smoother=lattice is 2D)");
@@ -188,23 +197,22 @@ template <int dim> struct DistributedMultigridCore : solvers::VCycle {
             contact::for_each_tangent_entry(L.local.ghost_contacts[e],
                                             M[L.local.contacts.size() + e], L.local.dofs,
                                             L.local.ghost_lambda_dof[e], add);
-        if constexpr (dim == 2) {
-            if (!use_mg_) {
+        if (!use_mg_) {
+            if constexpr (dim == 2)
                 if (use_ebe_) refresh_block_elements(k, M);
-                if (!o.block_pc) {
-                    // EBE: built from the process's elements restricted to its owned unknowns.
-                    solvers::LevelData d;
-                    d.has_multipliers = !L.local.contacts.empty();
-                    d.elements = [&o]() { return &o.elements; };
-                    o.block_pc = solvers::make_preconditioner(spec_.pc, use_ebe_ ? &d : nullptr);
-                    o.block_pc->setup(o.blocks->diag);
-                } else {
-                    o.block_pc->update_values(o.blocks->diag);
-                }
-                o.last_M = M;
-                o.prepared = true;
-                return;
+            if (!o.block_pc) {
+                // EBE (2D): built from the process's elements restricted to its owned unknowns.
+                solvers::LevelData d;
+                d.has_multipliers = !L.local.contacts.empty();
+                d.elements = [&o]() { return &o.elements; };
+                o.block_pc = solvers::make_preconditioner(spec_.pc, use_ebe_ ? &d : nullptr);
+                o.block_pc->setup(o.blocks->diag);
+            } else {
+                o.block_pc->update_values(o.blocks->diag);
             }
+            o.last_M = M;
+            o.prepared = true;
+            return;
         }
         if (!o.smoother && !o.lattice) {
             make_smoother(k);
@@ -650,6 +658,12 @@ DistributedMultigrid3::DistributedMultigrid3(const std::vector<DistributedLevel3
                                              const Communicator& comm, solvers::KrylovParams krylov,
                                              solvers::MultigridParams mg)
     : impl_(std::make_unique<Impl>(levels, transfers, comm, gmres_mg_spec(), krylov, mg)) {}
+DistributedMultigrid3::DistributedMultigrid3(const std::vector<DistributedLevel3>& levels,
+                                             const std::vector<DistributedTransfer3>& transfers,
+                                             const Communicator& comm, const LinearSolverSpec& spec,
+                                             solvers::KrylovParams krylov,
+                                             solvers::MultigridParams mg)
+    : impl_(std::make_unique<Impl>(levels, transfers, comm, spec, krylov, mg)) {}
 DistributedMultigrid3::~DistributedMultigrid3() = default;
 void DistributedMultigrid3::set_coarse(const Level3& level_p,
                                        const std::vector<Eigen::Matrix3d>& M) {

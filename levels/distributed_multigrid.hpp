@@ -80,6 +80,13 @@ public:
                           const std::vector<DistributedTransfer3>& transfers,
                           const Communicator& comm, solvers::KrylovParams krylov,
                           solvers::MultigridParams mg);
+    /// spec's Krylov method with spec.pc: mg (the cycle above), or a preconditioner of the
+    /// matrix alone (diag, ilu, sor, ssor, lu) on each process's diagonal block, Jacobi across
+    /// the cuts; what has no distributed or no 3D form throws InvalidInput.
+    DistributedMultigrid3(const std::vector<DistributedLevel3>& levels,
+                          const std::vector<DistributedTransfer3>& transfers,
+                          const Communicator& comm, const LinearSolverSpec& spec,
+                          solvers::KrylovParams krylov, solvers::MultigridParams mg);
     ~DistributedMultigrid3();
     /// The coarse solve: level p (the whole level, on every process) at the status matrices M
     /// (one per contact element of level_p), its Jacobian (BasicJacobianAssembler<3>) factored

@@ -54,7 +54,7 @@ void check_distributable3(const ElasticProblem3& problem, const SolveOptions3& o
     MLC_CHECK(options.coarse_to_fine,
               "on several processes the levels are solved coarse to fine (--cold is one process "
               "only)");
-    MLC_CHECK(options.upper == Method3::mg,
+    MLC_CHECK(options.upper == Method3::mg || options.upper == Method3::krylov,
               "on several processes the levels above the partition level are solved by GMRES "
               "with the distributed multigrid; '"
                   << to_string(options.upper)
@@ -127,7 +127,7 @@ public:
 
 private:
     void take_level_p(int step);
-    void start_from_below(size_t k, Vector& xo);
+    void start_from_below(size_t k, int step, Vector& xo);
     void accept(size_t k, double s, const Vector& xo);
 
     const ElasticProblem3& problem_;
@@ -142,6 +142,9 @@ private:
     // Per level: the state of the last converged step (local unknowns with ghosts, nodal
     // displacements of the part's vertices) and the nodal displacements of the step before.
     std::vector<Vector> x_, u_prev_, u_now_;
+    // Per level (local unknowns with ghosts): the converged state of the step before x_'s, and
+    // this step's own start (x_, or its secant extrapolation: SolveOptions3::extrapolate).
+    std::vector<Vector> x_before_, start_;
 };
 
 DistributedSteps3::DistributedSteps3(const ElasticProblem3& problem, const SolveOptions3& options,
@@ -153,8 +156,17 @@ DistributedSteps3::DistributedSteps3(const ElasticProblem3& problem, const Solve
     kp.rel_tol = options.krylov_rel_tol;
     kp.max_iter = 500;
     kp.restart = 50;
-    mg_ = std::make_unique<DistributedMultigrid3>(levels, res.parts.transfers, comm, kp,
-                                                  elastic3_mg_params());
+    if (options.upper == Method3::krylov) {
+        LinearSolverSpec spec = options.krylov;
+        spec.rel_tol = options.krylov_rel_tol;
+        kp.max_iter = spec.max_iter;
+        kp.restart = spec.restart;
+        mg_ = std::make_unique<DistributedMultigrid3>(levels, res.parts.transfers, comm, spec, kp,
+                                                      elastic3_mg_params());
+    } else {
+        mg_ = std::make_unique<DistributedMultigrid3>(levels, res.parts.transfers, comm, kp,
+                                                      elastic3_mg_params());
+    }
     res.solver = mg_->name();
     const bool two_body = std::any_of(problem.contacts.begin(), problem.contacts.end(),
                                       [](const ContactPair3& c) { return c.two_body(); });
@@ -179,8 +191,10 @@ DistributedSteps3::DistributedSteps3(const ElasticProblem3& problem, const Solve
     x_.resize(m_ + 1);
     u_prev_.resize(m_ + 1);
     u_now_.resize(m_ + 1);
+    x_before_.resize(m_ + 1);
+    start_.resize(m_ + 1);
     for (size_t k = 0; k <= m_; ++k) {
-        x_[k] = Vector::Zero(levels[k].local.n_unknowns());
+        x_[k] = x_before_[k] = start_[k] = Vector::Zero(levels[k].local.n_unknowns());
         u_prev_[k] = u_now_[k] = Vector::Zero(3 * levels[k].local.mesh.n_vertices());
     }
 }
@@ -199,6 +213,11 @@ void DistributedSteps3::take_level_p(int step) {
         ScopedTimer t(&res_.timings, "distributed/coarse_setup");
         mg_->set_coarse(Lp, Mp);
     }
+    // Level p's own start of this step, as the one-process solve of levels 0..p took it (the
+    // level above corrects its start by what level p changed from it).
+    start_[0] = x_[0];
+    if (options_.extrapolate && step >= 2) start_[0] += x_[0] - x_before_[0];
+    x_before_[0] = x_[0];
     // Level p's part: its local unknowns and nodal values, from the serial state.
     const DistributedLevel3& D = res_.parts.levels[0];
     const auto& dofs = D.local.dofs;
@@ -217,18 +236,28 @@ void DistributedSteps3::take_level_p(int step) {
     }
 }
 
-void DistributedSteps3::start_from_below(size_t k, Vector& xo) {
+void DistributedSteps3::start_from_below(size_t k, int step, Vector& xo) {
     ScopedTimer t(&res_.timings, "newton/interpolate");
     const DistributedLevel3& D = res_.parts.levels[k];
     const Level3& L = D.local;
-    const Vector uf = interpolate_nodal3(P_vertex_[k], u_now_[k - 1]);
+    // Secant predictor (as levels::solve): this level's own extrapolation, corrected by what the
+    // level below changed from its own, interpolated. Else the level below's state.
+    const bool secant = options_.extrapolate && step >= 2;
+    start_[k] = x_[k];
+    if (secant) start_[k] += x_[k] - x_before_[k];
+    Vector uc;
+    const Vector xc = secant ? Vector(x_[k - 1] - start_[k - 1]) : x_[k - 1];
+    if (secant)
+        res_.parts.levels[k - 1].local.dofs.expand(xc, Vector::Zero(u_now_[k - 1].size()), uc);
+    const Vector uf = interpolate_nodal3(P_vertex_[k], secant ? uc : u_now_[k - 1]);
     Vector xi = Vector::Zero(L.n_unknowns());
     for (int v = 0; v < L.mesh.n_vertices(); ++v)
         for (int c = 0; c < 3; ++c)
             if (const int d = L.dofs.u_dof(v, c); d >= 0) xi[d] = uf[3 * v + c];
     // The multipliers of the coarse part's own contact nodes (a fine node near a cut may miss
     // the contribution of a coarse node owned elsewhere: a start, Newton corrects it).
-    q_[k]->apply(x_[k - 1], xi);
+    q_[k]->apply(xc, xi);
+    if (secant) xi += start_[k];
     xo = xi.head(D.n_owned);
 }
 
@@ -237,6 +266,7 @@ void DistributedSteps3::accept(size_t k, double s, const Vector& xo) {
     // output; this level's operator at its converged statuses for the multigrid.
     const DistributedLevel3& D = res_.parts.levels[k];
     const Level3& L = D.local;
+    x_before_[k] = x_[k];
     x_[k].setZero();
     x_[k].head(D.n_owned) = xo;
     D.ghosts.update(L.dofs, x_[k]);
@@ -260,7 +290,7 @@ bool DistributedSteps3::step(int step) {
         LevelStep3 ls;
         ls.level = level;
         Vector xo;
-        start_from_below(k, xo);
+        start_from_below(k, step, xo);
         ls.predicted = true;
         ls.predicted_statuses = newton_[k]->statuses(s, u_prev_[k], xo);
         ls.report = newton_[k]->solve(s, u_prev_[k], xo);

@@ -8,6 +8,7 @@
 #include "fem/elasticity.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/factory.hpp"
+#include "solvers/hypre/mgr.hpp"
 #include "solvers/krylov.hpp"
 #include "solvers/mg.hpp"
 #include "solvers/sorcf.hpp"
@@ -157,8 +158,9 @@ private:
             }
             return &ebe_elements_;
         };
-        d.unknown_functions = [this]() { // 0 / 1: u_x / u_y; 2 (kMultiplierFunction): lambda
-            std::vector<int> f(static_cast<size_t>(level_.n_unknowns()), 2);
+        d.unknown_functions = [this]() { // 0 / 1: u_x / u_y; kMultiplierFunction: lambda
+            std::vector<int> f(static_cast<size_t>(level_.n_unknowns()),
+                               solvers::kMultiplierFunction);
             for (int v = 0; v < level_.dofs.n_vertices(); ++v)
                 for (int c = 0; c < 2; ++c)
                     if (const int i = level_.dofs.u_dof(v, c); i >= 0)

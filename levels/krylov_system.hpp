@@ -101,4 +101,37 @@ solvers::CoarseFineSplit
 coarse_fine_split(const Level& fine, const Level& coarse, const transfer::LevelTransfer& transfer,
                   solvers::MultiplierScale scale = solvers::MultiplierScale::q);
 
+/// The level below of a 3D level, for CF and SORCF. Its pointees must outlive the solvers built
+/// with it; the coarse statuses reach the solver by NewtonSystemSolver3::set_coarse_statuses.
+struct LevelBelow3 {
+    const Level3* coarse = nullptr;         ///< the level below
+    const SparseMatrix* P_vertex = nullptr; ///< its vertex prolongation to this level
+    const SparseMatrix* T_full = nullptr; ///< all its unknowns to this level's (full_prolongation3)
+    NewtonSystemSolver3* solver = nullptr; ///< its own exact solver (coarse=solver, fallback)
+};
+
+/// A 3D level's Newton systems by `spec.krylov` preconditioned by `spec.pc`, on the assembled
+/// Jacobian (its pattern fixed per level): the preconditioners of the matrix alone (diag, ilu,
+/// sor, ssor, lu), "cf" and "sorcf" with the split of coarse_fine_split3 and the level below's
+/// Jacobian at its converged statuses (coarse=lu, by sparse LU; singular: the level below's own
+/// exact solver) or its solver (coarse=solver), and hypre's "mgr" (systems BoomerAMG on the
+/// three displacement components). What has no 3D form (PcSpec::dimension_reason: ebe, mg's
+/// lattice sweep) throws InvalidInput; mg on a 3D level is the Galerkin multigrid of
+/// levels::solve (Method3::mg). "cf" and "sorcf" need `below` (level >= 1). A Krylov solve that
+/// does not converge is reported (converged false), not thrown.
+std::unique_ptr<NewtonSystemSolver3> make_krylov_system_solver(const Level3& level,
+                                                               const LinearSolverSpec& spec,
+                                                               const LevelBelow3* below);
+
+/// The coarse/fine split of a 3D level for CF/SORCF: the coarse set is every displacement of a
+/// vertex of the level below (a row of P_vertex with the single entry 1), mapped to that
+/// vertex's component, and every multiplier of such a vertex, mapped to the coarse multiplier of
+/// that vertex its row of T_full weighs most (q, the weight: the mass ratio of the surface Q, the
+/// frames of one vertex on two levels being nearly equal); the multiplier factors follow `scale`
+/// as in 2D. The fine set is the rest, in one diagonal block per vertex.
+solvers::CoarseFineSplit coarse_fine_split3(const Level3& fine, const Level3& coarse,
+                                            const SparseMatrix& P_vertex,
+                                            const SparseMatrix& T_full,
+                                            solvers::MultiplierScale scale);
+
 } // namespace mlc::levels

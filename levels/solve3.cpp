@@ -3,6 +3,7 @@
 #include "levels/solve3.hpp"
 
 #include "core/check.hpp"
+#include "levels/krylov_system.hpp"
 #include "solvers/krylov.hpp"
 #include "solvers/mg.hpp"
 
@@ -32,6 +33,8 @@ const char* to_string(Method3 m) {
         return "lu";
     case Method3::mg:
         return "gmres + mg";
+    case Method3::krylov:
+        return "krylov";
     }
     return "?";
 }
@@ -330,11 +333,18 @@ Vector interpolate_nodal(const SparseMatrix& P_vertex, const Vector& u_coarse) {
 }
 
 std::unique_ptr<NewtonSystemSolver3>
-make_solver3(const Hierarchy3& H, int l, Method3 m, double rel_tol,
-             const std::vector<std::shared_ptr<const SparseMatrix>>& T_full) {
+make_solver3(const Hierarchy3& H, int l, Method3 m, const SolveOptions3& options,
+             const std::vector<std::shared_ptr<const SparseMatrix>>& T_full,
+             const LevelBelow3* below3) {
+    const double rel_tol = options.krylov_rel_tol;
     const Level3& L = H.levels[static_cast<size_t>(l)];
     if (m == Method3::schur) return make_schur_system_solver(L);
     if (m == Method3::lu || l == 0) return make_assembled_system_solver(L, make_sparse_lu_solver());
+    if (m == Method3::krylov) {
+        LinearSolverSpec spec = options.krylov;
+        spec.rel_tol = rel_tol;
+        return make_krylov_system_solver(L, spec, below3);
+    }
     std::vector<const Level3*> below;
     std::vector<std::shared_ptr<const SparseMatrix>> transfers;
     for (int k = 0; k < l; ++k) {
@@ -348,6 +358,9 @@ make_solver3(const Hierarchy3& H, int l, Method3 m, double rel_tol,
 /// What one solved level carries from step to step.
 struct LevelRun {
     std::unique_ptr<ContactNewton3> newton;
+    NewtonSystemSolver3* sys = nullptr; ///< newton's solver
+    /// Its preconditioner (CF, SORCF) needs the level below's converged statuses.
+    bool needs_coarse_statuses = false;
     Vector x;            ///< unknowns at the last converged step
     Vector x_before;     ///< unknowns at the converged step before it (zero before step 2)
     Vector start;        ///< this step's own start: x, or its secant extrapolation
@@ -372,13 +385,21 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
     out.level_steps.assign(static_cast<size_t>(nl), {});
     std::vector<LevelRun> runs(static_cast<size_t>(nl));
     std::vector<std::unique_ptr<MultiplierTransfer3>> qs(static_cast<size_t>(nl));
+    std::vector<LevelBelow3> below3(static_cast<size_t>(nl)); // CF/SORCF's level below
     {
         ScopedTimer t(&out.timings, "setup/linear_solver");
         std::vector<transfer::SurfaceFacets<3>> faces(static_cast<size_t>(nl));
         for (int l = 0; l < nl; ++l)
             faces[static_cast<size_t>(l)] = contactor_faces(problem, H.levels[static_cast<size_t>(l)]);
         // The multiplier transfers: coarse-to-fine guesses and the multigrid's T.
-        const bool mg = options.upper == Method3::mg && finest > 0;
+        const bool level_below = options.upper == Method3::krylov &&
+                                 options.krylov.pc.entry != nullptr &&
+                                 options.krylov.pc.entry->needs_level_below;
+        MLC_CHECK(!level_below || options.coarse_to_fine || finest == 0,
+                  options.krylov.pc.name()
+                      << " needs the level below's converged statuses: it runs coarse to fine "
+                         "(not with --cold)");
+        const bool mg = (options.upper == Method3::mg || level_below) && finest > 0;
         for (int l = 1; l < nl; ++l)
             if (mg || (options.coarse_to_fine && l > first))
                 qs[static_cast<size_t>(l)] = std::make_unique<MultiplierTransfer3>(
@@ -393,10 +414,18 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
         for (int l = first; l < nl; ++l) {
             const Level3& L = H.levels[static_cast<size_t>(l)];
             auto& run = runs[static_cast<size_t>(l)];
-            auto sys = make_solver3(H, l, l == 0 ? options.level0 : options.upper,
-                                    options.krylov_rel_tol, T_full);
+            if (l > 0 && level_below)
+                below3[static_cast<size_t>(l)] = LevelBelow3{
+                    &H.levels[static_cast<size_t>(l - 1)],
+                    &H.transfers[static_cast<size_t>(l - 1)].P_vertex,
+                    T_full[static_cast<size_t>(l - 1)].get(), runs[static_cast<size_t>(l - 1)].sys};
+            auto sys = make_solver3(H, l, l == 0 ? options.level0 : options.upper, options, T_full,
+                                    l > 0 && level_below ? &below3[static_cast<size_t>(l)]
+                                                         : nullptr);
             if (options.wrap_system_solver)
                 sys = options.wrap_system_solver(l, L, std::move(sys));
+            run.sys = sys.get();
+            run.needs_coarse_statuses = l > 0 && level_below;
             run.newton =
                 std::make_unique<ContactNewton3>(L, problem.newton, std::move(sys), &out.timings);
             if (options.interrupt) run.newton->set_interrupt(options.interrupt);
@@ -451,6 +480,12 @@ RunResult3 solve(const ElasticProblem3& problem, const SolveOptions3& options) {
                                   [static_cast<size_t>(status_code3(ls.final_statuses[i]))];
             if (options.progress) options.progress(l, k, ls.report);
             const bool ok = ls.report.converged;
+            if (ok && l < finest && runs[static_cast<size_t>(l + 1)].needs_coarse_statuses) {
+                Vector R(x0.size());
+                std::vector<StatusMatrix<3>> M;
+                run.newton->residual(s, run.u_prev_full, x0, R, nullptr, &M, nullptr);
+                runs[static_cast<size_t>(l + 1)].sys->set_coarse_statuses(M);
+            }
             if (ok) {
                 if (l == finest) {
                     out.step_nodes.push_back(run.newton->node_states(s, run.u_prev_full, x0));

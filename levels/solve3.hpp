@@ -8,6 +8,7 @@
 #include "core/timer.hpp"
 #include "levels/elastic3d_levels.hpp"
 #include "levels/newton.hpp"
+#include "levels/newton_system.hpp"
 #include "transfer/surface_q.hpp"
 
 #include <array>
@@ -31,10 +32,13 @@ enum class Method3 {
     /// GMRES preconditioned by the multigrid on the levels at and below (Galerkin operators
     /// R J T of the assembled Jacobian, T the displacements' P and the multipliers' surface Q,
     /// vertex blocks of three displacements and the vertex's multipliers; elastic3_mg_params).
-    mg
+    mg,
+    /// SolveOptions3::krylov: a Krylov method with a preconditioner of the registry
+    /// (make_krylov_system_solver for Level3: diag, ilu, sor, ssor, cf, sorcf, mgr, ...).
+    krylov
 };
 
-/// "schur", "lu", "mg".
+/// "schur", "lu", "gmres + mg", "krylov".
 const char* to_string(Method3 m);
 
 /// Options of a 3D run that are not part of the problem.
@@ -65,6 +69,14 @@ struct SolveOptions3 {
     Method3 upper = Method3::mg;
     /// Relative tolerance of each GMRES solve (Method3::mg); the Newton forcing may loosen it.
     double krylov_rel_tol = 1e-10;
+    /// Method3::krylov: the Krylov method, its preconditioner, iteration limit and restart
+    /// (method krylov; its rel_tol is krylov_rel_tol's).
+    LinearSolverSpec krylov = [] {
+        LinearSolverSpec k;
+        k.method = solvers::Method::krylov;
+        k.krylov = solvers::Krylov::gmres;
+        return k;
+    }();
     /// Called after each load step of each solved level (converged or not); may be empty.
     std::function<void(int level, int step, const StepReport&)> progress;
     /// Polled before every Newton iteration; true stops the solve by throwing mlc::Interrupted

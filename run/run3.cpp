@@ -10,6 +10,8 @@
 #include "run/interrupt.hpp"
 #include "run/output.hpp"
 #include "scene/scene3.hpp"
+#include "solvers/krylov.hpp"
+#include "solvers/pc_spec.hpp"
 
 #include <toml++/toml.h>
 
@@ -114,12 +116,6 @@ void refuse_2d_options(const RunOptions& opt, bool distributed) {
     auto refuse = [](bool given, const std::string& option, const std::string& why) {
         if (given) throw InvalidInput(option + " does not apply to a 3D scene: " + why);
     };
-    const std::string krylov = "3D contact levels are solved by schur on level 0 and GMRES with "
-                               "the Galerkin vertex-block multigrid above, or exactly on every "
-                               "level with --linear schur|lu";
-    refuse(opt.krylov.has_value(), "--krylov", krylov);
-    refuse(opt.pc.has_value(), "--pc", krylov);
-    refuse(opt.linear && *opt.linear == "krylov", "--linear krylov", krylov);
     refuse(opt.no_fallback, "--no-fallback", "there is no Krylov solve to fall back from");
     refuse(opt.numbering.has_value(), "--numbering",
            "3D levels number their vertices along a Hilbert curve only");
@@ -129,6 +125,45 @@ void refuse_2d_options(const RunOptions& opt, bool distributed) {
     refuse(opt.plot, "--plot", "the contact plot draws 2D contact lines");
     refuse(opt.partition_level.has_value() && !distributed, "--partition-level",
            "it applies to runs on several processes (mpirun -np N, N > 1)");
+}
+
+std::optional<levels::LinearSolverSpec> krylov_spec3(const RunOptions& opt, bool distributed) {
+    if (!opt.pc && !opt.krylov) return std::nullopt;
+    MLC_CHECK(!opt.linear || *opt.linear == "krylov",
+              (opt.pc ? "--pc" : "--krylov")
+                  << " sets the Krylov solve of the levels above level 0, and --linear "
+                  << *opt.linear << " solves every level exactly: give one or the other");
+    levels::SolveOptions3 defaults;
+    levels::LinearSolverSpec spec = defaults.krylov;
+    if (opt.krylov) spec.krylov = solvers::parse_krylov(*opt.krylov);
+    if (opt.pc) spec.pc = solvers::parse_pc(*opt.pc);
+    if (!opt.pc || spec.pc.name() == "mg") {
+        MLC_CHECK(!opt.pc || spec.pc.text() == "mg",
+                  "--pc " << *opt.pc
+                          << ": the 3D multigrid's cycle is fixed (W(2,2), vertex-block "
+                             "Gauss-Seidel); give --pc mg without options");
+        MLC_CHECK(spec.krylov == solvers::Krylov::gmres,
+                  "--krylov " << *opt.krylov
+                              << ": the 3D multigrid runs with GMRES; give --pc with another "
+                                 "preconditioner (diag, ilu, sorcf, ...) for another method");
+        return std::nullopt;
+    }
+    if (const std::string why = spec.pc.dimension_reason(3); !why.empty())
+        throw InvalidInput("--pc " + *opt.pc + ": " + why);
+    if (distributed)
+        if (const std::string why = spec.pc.distributed(); !why.empty())
+            throw InvalidInput("--pc " + *opt.pc + " on several processes: " + why);
+    if (distributed && spec.pc.entry->needs_level_below)
+        throw InvalidInput("--pc " + *opt.pc +
+                           " needs the whole level below on one process; on several processes "
+                           "use mg or a preconditioner of each process's diagonal block (diag, "
+                           "ilu, sor, ssor)");
+    return spec;
+}
+
+std::string upper_solver_text(const levels::SolveOptions3& so) {
+    if (so.upper != levels::Method3::krylov) return levels::to_string(so.upper);
+    return std::string(solvers::to_string(so.krylov.krylov)) + " + " + so.krylov.pc.text();
 }
 
 } // namespace detail3
@@ -199,7 +234,7 @@ void print_header3(std::ostream& os, const ElasticProblem3& p, const RunResult3&
     os << "; Newton rel_tol = " << p.newton.rel_tol << ", max_iter = " << p.newton.max_iter << "\n";
     os << "solve      " << (so.coarse_to_fine ? "coarse-to-fine" : "cold (finest level alone)")
        << "; Newton systems: level 0 " << levels::to_string(so.level0) << ", levels above "
-       << levels::to_string(so.upper) << "\n";
+       << upper_solver_text(so) << "\n";
     os << "plan       " << plan.why << "\n";
 }
 
@@ -245,7 +280,7 @@ void write_summary3(const std::filesystem::path& dir, const ElasticProblem3& p, 
     root.insert("completed_steps", static_cast<int64_t>(r.completed_steps));
     root.insert("coarse_to_fine", so.coarse_to_fine);
     root.insert("solver_level0", std::string(levels::to_string(so.level0)));
-    root.insert("solver_upper", std::string(levels::to_string(so.upper)));
+    root.insert("solver_upper", upper_solver_text(so));
     root.insert("plan", plan.why);
     root.insert("unknowns", static_cast<int64_t>(r.finest().n_unknowns()));
     root.insert("contact_nodes", static_cast<int64_t>(r.finest().n_contact_nodes()));
@@ -316,15 +351,26 @@ int run_scene3(const RunOptions& opt, std::ostream& os) {
     so.coarse_to_fine = !opt.cold;
     so.extrapolate = !opt.no_extrapolation;
     std::optional<levels::Method3> forced;
-    if (opt.linear) forced = *opt.linear == "lu" ? levels::Method3::lu : levels::Method3::schur;
+    if (opt.linear && *opt.linear != "krylov")
+        forced = *opt.linear == "lu" ? levels::Method3::lu : levels::Method3::schur;
     // The solvers by the levels' predicted sizes; a run that cannot fit is refused before
     // anything is built.
-    const levels::Plan3 plan = levels::plan_contact3(levels::predict_elastic3_sizes(p, p.levels),
-                                                     forced, levels::process_memory_limit());
+    levels::Plan3 plan = levels::plan_contact3(levels::predict_elastic3_sizes(p, p.levels), forced,
+                                               levels::process_memory_limit());
     so.level0 = plan.level0;
     so.upper = plan.upper;
+    if (const auto spec = krylov_spec3(opt, false)) {
+        MLC_CHECK(p.levels >= 1, "--pc " << spec->pc.text()
+                                         << " sets the solver of the levels above level 0, and "
+                                            "this run has none (--levels 0)");
+        so.upper = levels::Method3::krylov;
+        so.krylov = *spec;
+        if (const auto at = plan.why.find(", gmres + mg above"); at != std::string::npos)
+            plan.why = plan.why.substr(0, at) + ", " + upper_solver_text(so) + " above (--pc)";
+    }
     if (opt.linear_rel_tol) {
-        MLC_CHECK(plan.upper == levels::Method3::mg && p.levels >= 1,
+        MLC_CHECK(so.upper != levels::Method3::schur && so.upper != levels::Method3::lu &&
+                      p.levels >= 1,
                   "--linear-tol sets the tolerance of the GMRES solves of the levels above level "
                   "0, and this run has none (--levels 0 or --linear schur|lu)");
         so.krylov_rel_tol = *opt.linear_rel_tol;

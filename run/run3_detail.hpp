@@ -9,6 +9,7 @@
 #include "run/run.hpp"
 
 #include <functional>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -18,6 +19,15 @@ namespace mlc::apps::detail3 {
 /// The options of `run` that have no effect on a 3D scene (yet): refused, naming why
 /// (--partition-level only on one process).
 void refuse_2d_options(const RunOptions& opt, bool distributed);
+/// The levels above level 0 by a Krylov method with a preconditioner of the registry
+/// (Method3::krylov), from --pc and --krylov; empty: the Galerkin multigrid with GMRES (no
+/// --pc, --pc mg). Refused: --pc or --krylov with --linear schur|lu, mg with options (the 3D
+/// multigrid's cycle is fixed) or with another Krylov method than GMRES, a preconditioner
+/// with no 3D form (ebe, ...), and on several processes (`distributed`) one with no
+/// distributed form (cf, sorcf, mgr, ...).
+std::optional<levels::LinearSolverSpec> krylov_spec3(const RunOptions& opt, bool distributed);
+/// The solver of the levels above level 0: "gmres + ilu:0", "gmres + mg", "schur", ...
+std::string upper_solver_text(const levels::SolveOptions3& so);
 /// --levels, --steps, --mu and --r, checked as in 2D.
 void apply_overrides3(levels::ElasticProblem3& p, const RunOptions& opt);
 /// s quoted for a CSV field when it holds a comma, a quote or a newline.

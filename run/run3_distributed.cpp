@@ -196,6 +196,25 @@ void print_steps(std::ostream& os, const DistributedRunResult3& r) {
     }
 }
 
+/// The solve's options: the secant predictor, the Krylov solve of the distributed levels (mg, or
+/// --pc on each process's block), its tolerance, and level 0's exact solver by the plan of levels
+/// 0..p (they run whole on every process).
+levels::SolveOptions3 distributed_solve_options3(const RunOptions& opt, const ElasticProblem3& p,
+                                                 int plevel) {
+    levels::SolveOptions3 so;
+    so.extrapolate = !opt.no_extrapolation;
+    so.upper = levels::Method3::mg;
+    if (const auto spec = krylov_spec3(opt, true)) {
+        so.upper = levels::Method3::krylov;
+        so.krylov = *spec;
+    }
+    if (opt.linear_rel_tol) so.krylov_rel_tol = *opt.linear_rel_tol;
+    so.level0 = levels::plan_contact3(levels::predict_elastic3_sizes(p, plevel), std::nullopt,
+                                      levels::process_memory_limit())
+                    .level0;
+    return so;
+}
+
 } // namespace
 
 int run_scene3_distributed(const RunOptions& opt, const Communicator& comm, std::ostream& out) {
@@ -211,10 +230,11 @@ int run_scene3_distributed(const RunOptions& opt, const Communicator& comm, std:
     MLC_CHECK(opt.vtu == "binary", "--vtu ascii is 2D-only: 3D runs write binary VTU");
     MLC_CHECK(!opt.cold, "--cold is one process only: on several processes the levels are solved "
                          "coarse to fine");
-    MLC_CHECK(!opt.linear, "--linear " << *opt.linear
-                                       << " needs a whole level on one process: on several "
-                                          "processes the levels above the partition level are "
-                                          "solved by GMRES with the distributed multigrid");
+    MLC_CHECK(!opt.linear || *opt.linear == "krylov",
+              "--linear " << *opt.linear
+                          << " needs a whole level on one process: on several "
+                             "processes the levels above the partition level are "
+                             "solved by GMRES with the distributed multigrid");
     MLC_CHECK(p.levels >= 1, "a run on several processes needs --levels >= 1 (level 0 is solved "
                              "on every process; the levels above it are distributed)");
     const int finest = p.levels;
@@ -226,14 +246,7 @@ int run_scene3_distributed(const RunOptions& opt, const Communicator& comm, std:
                                                   << ", found " << plevel);
     // One thread per process: the processes are the parallelism.
     parallel::set_num_threads(1);
-    levels::SolveOptions3 so;
-    so.extrapolate = !opt.no_extrapolation;
-    so.upper = levels::Method3::mg;
-    if (opt.linear_rel_tol) so.krylov_rel_tol = *opt.linear_rel_tol;
-    // Level 0's exact solver by the plan of levels 0..p (they run whole on every process).
-    so.level0 = levels::plan_contact3(levels::predict_elastic3_sizes(p, plevel), std::nullopt,
-                                      levels::process_memory_limit())
-                    .level0;
+    levels::SolveOptions3 so = distributed_solve_options3(opt, p, plevel);
     const std::filesystem::path dir = opt.out.empty() ? "out/" + p.name : opt.out;
     std::optional<OutputFolder> folder;
     open_output_folder(folder, dir, p.name, comm, os);

@@ -30,8 +30,8 @@ struct LevelData {
     /// EBE: the element matrices of the level (elastic, then one per contact element); asking
     /// builds them, and the caller refreshes the contact ones before each setup/update_values.
     std::function<const std::vector<smoothers::ElementMatrix>*()> elements;
-    /// mgr: the function of every unknown of the level, 0 / 1 the x / y displacement component,
-    /// 2 (kMultiplierFunction) a contact multiplier; asking computes it.
+    /// mgr: the function of every unknown of the level, 0 / 1 / 2 the x / y / z displacement
+    /// component, kMultiplierFunction a contact multiplier; asking computes it.
     std::function<std::vector<int>()> unknown_functions;
     /// mg without the level below (or with coarse=aggregation): the level's elastic operator
     /// and the owner and kind of each unknown, for the algebraic hierarchy

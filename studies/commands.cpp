@@ -3,6 +3,7 @@
 #include "studies/commands.hpp"
 
 #include "run/preconditioners.hpp"
+#include "run/run3_detail.hpp"
 #include "scene/scene.hpp"
 #include "scene/scene3.hpp"
 #include "studies/accuracy.hpp"
@@ -11,6 +12,7 @@
 #include "studies/preconditioners.hpp"
 #include "studies/status_transfer.hpp"
 
+#include <algorithm>
 #include <memory>
 
 namespace mlc::apps {
@@ -107,11 +109,41 @@ Action add_error_vs_time(CLI::App& ev) {
     };
 }
 
-Action add_preconditioners(CLI::App& ps) {
-    struct Args {
-        PreconditionerStudyOptions o;
-        std::string scene = "square", out;
+struct PreconditionerArgs {
+    PreconditionerStudyOptions o;
+    std::string scene = "square", out;
+};
+
+// The preconditioner study on a 3D scene: every cell an `mlcontact run` (one process without
+// --np-list), GMRES by default, the papers' family that has a 3D form beside mg and hypre's MGR
+// (BoomerAMG on the displacements); over processes the ones with a distributed form.
+int preconditioners3(PreconditionerArgs& a, const CLI::App& ps, const Launch& at) {
+    const levels::ElasticProblem3 p = scene::load_scene3(a.scene);
+    NpStudyScene sc;
+    sc.name = p.name;
+    sc.dimension = 3;
+    sc.young_modulus = p.bodies.front().material.E;
+    for (const auto& b : p.bodies)
+        sc.young_modulus = std::min(sc.young_modulus, b.material.E);
+    sc.check = [](const std::string& kr, const std::string& pc, int np) {
+        RunOptions ro;
+        ro.krylov = kr;
+        ro.pc = pc;
+        (void)detail3::krylov_spec3(ro, np > 1);
     };
+    PreconditionerStudyOptions& o = a.o;
+    if (o.np_list.empty()) o.np_list = {1};
+    const bool several = *std::max_element(o.np_list.begin(), o.np_list.end()) > 1;
+    if (ps.count("--pc") == 0)
+        o.pcs = several ? std::vector<std::string>{"diag", "ilu:0", "mg"}
+                        : std::vector<std::string>{"diag", "ilu:0", "cf", "sorcf", "mgr", "mg"};
+    if (ps.count("--krylov") == 0) o.krylovs = {"gmres"};
+    o.scene_arg = a.scene;
+    return study_preconditioners_np(sc, o, at.os);
+}
+
+Action add_preconditioners(CLI::App& ps) {
+    using Args = PreconditionerArgs;
     auto a = std::make_shared<Args>();
     ps.add_option("scene", a->scene, "scene file or built-in name (default square)");
     ps.add_option("--levels,-l", a->o.levels, "finest level (default 2)");
@@ -139,6 +171,7 @@ Action add_preconditioners(CLI::App& ps) {
         ->needs(np);
     return [a, &ps](const Launch& at) {
         a->o.out = a->out;
+        if (scene::scene_dimension(a->scene) == 3) return preconditioners3(*a, ps, at);
         if (!a->o.np_list.empty()) {
             a->o.scene_arg = a->scene;
             if (ps.count("--pc") == 0) a->o.pcs = {"diag", "ilu:0", "ebe", "mg"};

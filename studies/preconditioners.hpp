@@ -7,6 +7,7 @@
 #include "levels/problem.hpp"
 
 #include <filesystem>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -56,6 +57,23 @@ int study_preconditioners(const levels::Problem& problem, const PreconditionerSt
 /// summary.json) and preconditioners_np.png. Throws InvalidInput for bad options, a
 /// preconditioner with no distributed form when some N > 1, or no launcher for N > 1.
 int study_preconditioners_np(const levels::Problem& problem, const PreconditionerStudyOptions& opt,
+                             std::ostream& os);
+
+/// What the processes' study needs of its scene, in 2D or 3D.
+struct NpStudyScene {
+    std::string name;
+    double young_modulus = 1.0; ///< r = (r/E) times this
+    /// 2: the runs also get --no-fallback and --no-continuation (the Krylov solve alone); 3D
+    /// runs have neither.
+    int dimension = 2;
+    /// Throws InvalidInput when (Krylov method, preconditioner) cannot run on np processes,
+    /// with the run's own message.
+    std::function<void(const std::string& krylov, const std::string& pc, int np)> check;
+};
+
+/// study_preconditioners_np for a scene of any dimension (a 3D scene's runs: the levels above
+/// level 0 by the Krylov method and preconditioner, on one process or distributed).
+int study_preconditioners_np(const NpStudyScene& scene, const PreconditionerStudyOptions& opt,
                              std::ostream& os);
 
 } // namespace mlc::apps

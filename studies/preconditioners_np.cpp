@@ -221,7 +221,7 @@ std::string run_name(const Cell& c) {
 
 /// Runs one cell as `mlcontact run` (under the launcher `mpiexec` when c.np > 1) in its folder
 /// under dir/runs, reads its iterations and prints its row.
-void run_cell(Cell& c, const levels::Problem& problem, const PreconditionerStudyOptions& opt,
+void run_cell(Cell& c, const NpStudyScene& problem, const PreconditionerStudyOptions& opt,
               const std::filesystem::path& dir, const std::filesystem::path& self,
               const std::vector<std::string>& mpiexec, std::ostream& os) {
     const std::string& kr = c.krylov;
@@ -237,30 +237,16 @@ void run_cell(Cell& c, const levels::Problem& problem, const PreconditionerStudy
         argv.insert(argv.end(), {"-n", std::to_string(np)});
     }
     std::ostringstream r, m, t;
-    r << std::setprecision(17) << rf * problem.min_young_modulus();
+    r << std::setprecision(17) << rf * problem.young_modulus;
     m << std::setprecision(17) << mu;
     t << std::setprecision(17) << opt.rel_tol;
-    argv.insert(argv.end(), {self.string(),
-                             "run",
-                             opt.scene_arg,
-                             "--levels",
-                             std::to_string(l),
-                             "--krylov",
-                             c.krylov,
-                             "--pc",
-                             c.pc,
-                             "--linear-tol",
-                             t.str(),
-                             "--mu",
-                             m.str(),
-                             "--r",
-                             r.str(),
-                             "--no-fallback",
-                             "--no-continuation",
-                             "--quiet",
-                             "--out",
-                             rd.string()});
+    argv.insert(argv.end(), {self.string(), "run", opt.scene_arg, "--levels", std::to_string(l),
+                             "--krylov", c.krylov, "--pc", c.pc, "--linear-tol", t.str(), "--mu",
+                             m.str(), "--r", r.str(), "--quiet", "--out", rd.string()});
     if (opt.load_steps > 0) argv.insert(argv.end(), {"--steps", std::to_string(opt.load_steps)});
+    // 2D runs fall back to an exact solve and continue in r by default: the study measures the
+    // Krylov solve alone (3D runs have neither).
+    if (problem.dimension == 2) argv.insert(argv.end(), {"--no-fallback", "--no-continuation"});
     {
         std::ofstream cmd(rd / "command.txt");
         for (size_t i = 0; i < argv.size(); ++i)
@@ -392,6 +378,19 @@ void print_by_processes(std::ostream& os, const std::vector<int>& nps,
 
 int study_preconditioners_np(const levels::Problem& problem, const PreconditionerStudyOptions& opt,
                              std::ostream& os) {
+    NpStudyScene scene;
+    scene.name = problem.name;
+    scene.young_modulus = problem.min_young_modulus();
+    scene.check = [&problem](const std::string& kr, const std::string& pc, int np) {
+        const levels::SolverRequest req{.krylov = solvers::parse_krylov(kr),
+                                        .pc = solvers::parse_pc(pc)};
+        (void)levels::plan_solver(problem, req, np);
+    };
+    return study_preconditioners_np(scene, opt, os);
+}
+
+int study_preconditioners_np(const NpStudyScene& problem, const PreconditionerStudyOptions& opt,
+                             std::ostream& os) {
     MLC_CHECK(opt.levels >= 1 && opt.levels <= 6, "--levels must lie in [1, 6]");
     MLC_CHECK(!opt.np_list.empty(), "--np-list is empty");
     MLC_CHECK(!opt.pcs.empty() && !opt.krylovs.empty() && !opt.mu.empty() && !opt.r_over_E.empty(),
@@ -412,15 +411,13 @@ int study_preconditioners_np(const levels::Problem& problem, const Preconditione
     std::sort(nps.begin(), nps.end());
     nps.erase(std::unique(nps.begin(), nps.end()), nps.end());
     std::vector<std::string> mpiexec;
-    if (nps.back() > 1) {
-        // What has no distributed form is refused before anything runs (the run's own message).
+    if (nps.back() > 1 || problem.dimension == 3) {
+        // What has no distributed form (or no 3D form) is refused before anything runs (the
+        // run's own message).
         for (const auto& kr : opt.krylovs)
-            for (const auto& pc : opt.pcs) {
-                const levels::SolverRequest req{.krylov = solvers::parse_krylov(kr),
-                                                .pc = solvers::parse_pc(pc)};
-                (void)levels::plan_solver(problem, req, nps.back());
-            }
-        mpiexec = launcher(opt.mpiexec);
+            for (const auto& pc : opt.pcs)
+                problem.check(kr, pc, nps.back());
+        if (nps.back() > 1) mpiexec = launcher(opt.mpiexec);
     }
     const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
     const auto dir = opt.out.empty() ? std::filesystem::path("out/studies") /

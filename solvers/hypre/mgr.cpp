@@ -7,6 +7,7 @@
 #include "smoothers/matrix_checks.hpp"
 #include "solvers/hypre/ij_system.h"
 
+#include <algorithm>
 #include <mpi.h>
 
 #include <cmath>
@@ -69,9 +70,9 @@ MGRPreconditioner::MGRPreconditioner(std::vector<int> unknown_function, MGRParam
     ensure_hypre_initialized();
     size_t n_c = 0;
     for (size_t i = 0; i < function_.size(); ++i) {
-        MLC_CHECK(function_[i] == 0 || function_[i] == 1 || function_[i] == kMultiplierFunction,
+        MLC_CHECK((function_[i] >= 0 && function_[i] <= 2) || function_[i] == kMultiplierFunction,
                   "MGR: unknown " << i << " has function " << function_[i]
-                                  << "; valid 0, 1 (displacement components), "
+                                  << "; valid 0, 1, 2 (displacement components), "
                                   << kMultiplierFunction << " (multiplier)");
         n_c += function_[i] == kMultiplierFunction;
     }
@@ -110,8 +111,11 @@ void MGRPreconditioner::setup(const SparseMatrix& A) {
     HYPRE_MGRSetLevelFRelaxType(h->mgr, &h->level_frelax);
     if (p.f_relax == 2) {
         // Our BoomerAMG on A_FF: systems AMG with each F row's displacement component.
-        h->f_amg = hypre_detail::create_boomeramg(p.f_amg, true, f_func,
-                                                  static_cast<HYPRE_Int>(f_func.size()));
+        // Systems AMG over the displacement components present: x, y (2D) or x, y, z (3D).
+        BoomerAMGParams fp = p.f_amg;
+        fp.num_functions = 1 + *std::max_element(f_func.begin(), f_func.end());
+        h->f_amg =
+            hypre_detail::create_boomeramg(fp, true, f_func, static_cast<HYPRE_Int>(f_func.size()));
         HYPRE_MGRSetFSolver(h->mgr, reinterpret_cast<HYPRE_PtrToParSolverFcn>(HYPRE_BoomerAMGSolve),
                             reinterpret_cast<HYPRE_PtrToParSolverFcn>(HYPRE_BoomerAMGSetup),
                             h->f_amg);

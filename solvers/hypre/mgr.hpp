@@ -49,16 +49,16 @@ struct MGRParams {
 
 std::ostream& operator<<(std::ostream& os, const MGRParams& p);
 
-/// Function of every unknown for MGR: 0 / 1 the x / y displacement component, 2 a contact
-/// multiplier.
-inline constexpr int kMultiplierFunction = 2;
+/// Function of every unknown for MGR: 0 / 1 / 2 the x / y / z displacement component (z on a
+/// 3D level), 3 a contact multiplier.
+inline constexpr int kMultiplierFunction = 3;
 
 /// One MGR cycle (max_iter 1, tolerance 0) as a preconditioner: z = MGR(r) from z = 0.
 /// `setup` copies A into hypre and builds the reduction (A_FF's AMG, the reduced system and its
 /// AMG); `update_values` does the same (the statuses changed the values). Not thread-safe.
 class MGRPreconditioner final : public Preconditioner {
 public:
-    /// `unknown_function[i]` in {0, 1, kMultiplierFunction}: the C/F marker (C = multipliers)
+    /// `unknown_function[i]` in {0, 1, 2, kMultiplierFunction}: the C/F marker (C = multipliers)
     /// and the function of each F row for the AMG of A_FF. Throws mlc::InvalidInput when there is
     /// no multiplier or no displacement, or when built without hypre.
     MGRPreconditioner(std::vector<int> unknown_function, MGRParams params = {});

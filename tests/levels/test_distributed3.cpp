@@ -215,11 +215,39 @@ TEST(Distributed3Levels, BoomerAmgPcgSolutionIsTheSerialDirectOne) {
         EXPECT_NEAR(x[i], ref[i], 1e-8 * scale) << "row " << i;
 }
 
-TEST(Distributed3Levels, LoadingPathIsRefusedOnEveryProcess) {
+// A loading path on the parts: block3d pressed at the first of two path points and pushed at the
+// second, its held bottom edge moved along x and back. At path parameters on both sides of the
+// first point, every part's prescribed values (ghost vertices' too) and loads on its owned
+// unknowns are the serial level's.
+TEST(Distributed3Levels, LoadingPathOfEachPartIsTheSerialOne) {
     levels::ElasticProblem3 p = scene::load_scene3("block3d");
-    p.loads[0].factors = {0.5, 1.0};
-    p.loads[1].factors = {0.5, 1.0};
-    EXPECT_THROW(levels::build_distributed_hierarchy3(p, 0, 0, comm::world()), InvalidInput);
+    p.loads[0].factors = {1.0, 1.0};
+    p.loads[1].factors = {0.0, 1.0};
+    ASSERT_TRUE(p.supports[1].line.has_value());
+    p.supports[1].u_path[0] = {0.5, 0.0};
+    ASSERT_EQ(p.n_path_points(), 2);
+    const Block3dLevels b = levels01(p);
+    for (size_t l = 0; l < 2; ++l) {
+        const auto& d = b.dist.levels[l];
+        const auto& s = b.serial.levels[l];
+        const auto to_serial = serial_dofs(d, s);
+        const auto sv = serial_vertices(d, s);
+        for (const double t : {0.3, 0.5, 0.8, 1.0}) {
+            const Vector f_ref = owned_part(to_serial, d.n_owned, s.f_at(t));
+            const Vector f = d.local.f_at(t).head(d.n_owned);
+            const double f_scale = s.f_at(t).cwiseAbs().maxCoeff();
+            ASSERT_GT(f_scale, 0.0);
+            for (Index i = 0; i < d.n_owned; ++i)
+                EXPECT_NEAR(f[i], f_ref[i], 1e-12 * f_scale) << "level " << l << " s " << t;
+            const Vector u = d.local.u_fixed_at(t), u_ref = s.u_fixed_at(t);
+            for (int v = 0; v < d.local.mesh.n_vertices(); ++v)
+                for (int c = 0; c < 3; ++c)
+                    EXPECT_EQ(u[3 * v + c], u_ref[3 * sv[static_cast<size_t>(v)] + c])
+                        << "level " << l << " s " << t << " vertex " << v;
+        }
+        // Half way to the first point the edge is at 0.25 along x: the path is not proportional.
+        EXPECT_NEAR(s.u_fixed_at(0.25).maxCoeff(), 0.25, 1e-15);
+    }
 }
 
 namespace {

@@ -92,3 +92,44 @@ def test_what_has_no_distributed_form_is_refused(tmp_path):
                                    (0, [], "needs --levels >= 1")):
         _, p = run(tmp_path, "block3d", 2, *extra, expect=1, tag=str(len(message)), levels=levels)
         assert p.stderr.count("mlcontact: error:") == 1 and message in p.stderr, p.stderr
+
+
+def test_a_preconditioner_of_the_matrix_alone_runs_on_each_process_block(tmp_path):
+    """--pc ilu:0 on block3d: GMRES with ILU(0) on each process's diagonal block (Jacobi across
+    the cuts) gives the one-process ILU(0) answer, which the one-process run names."""
+    f = tight_scene(tmp_path, "block3d")
+    serial, _ = run(tmp_path, f, 1, "--pc", "ilu:0", "--linear-tol", "1e-12")
+    assert json.load(open(serial / "summary.json"))["solver_upper"] == "gmres + ilu"
+    dist, _ = run(tmp_path, f, 2, "--pc", "ilu:0", "--linear-tol", "1e-12", "--partition-level",
+                  "0")
+    compare(serial, dist)
+    summary = json.load(open(dist / "summary.json"))
+    assert summary["solver_upper"] == "gmres + ilu on each process's diagonal block", summary
+
+
+def test_what_needs_a_whole_level_or_has_no_3d_form_is_refused(tmp_path):
+    for np_, pc, message in ((2, "sorcf", "has no distributed form"),
+                             (2, "mgr", "has no distributed form"),
+                             (1, "ebe", "2D-only"),
+                             (2, "mg:pre=3", "the 3D multigrid's cycle is fixed")):
+        _, p = run(tmp_path, "block3d", np_, "--pc", pc, expect=1, tag=pc.replace(":", "_"))
+        assert p.stderr.count("mlcontact: error:") == 1 and message in p.stderr, p.stderr
+
+
+def newton_per_level(out):
+    with open(out / "iterations.csv") as g:
+        rows = list(csv.DictReader(g))
+    return {l: sum(1 for r in rows if r["level"] == l) for l in {r["level"] for r in rows}}
+
+
+@pytest.mark.parametrize("scene", ["block3d", "shear3d"])
+def test_the_secant_predictor_and_a_loading_path_on_distributed_levels(tmp_path, scene):
+    """block3d (proportional loading) and shear3d (pressed, then pushed: a loading path) on two
+    processes with level 1 distributed give the one-process answer, and the distributed level
+    starts every step from the secant predictor as one process does: the same Newton iterations
+    per level (block3d's steps 2 to 5 take none)."""
+    f = tight_scene(tmp_path, scene)
+    serial, _ = run(tmp_path, f, 1, "--linear-tol", "1e-12")
+    dist, _ = run(tmp_path, f, 2, "--linear-tol", "1e-12", "--partition-level", "0")
+    compare(serial, dist)
+    assert newton_per_level(dist) == newton_per_level(serial)

@@ -102,3 +102,51 @@ def test_a_preconditioner_with_no_distributed_form_is_refused(tmp_path):
     assert p.returncode == 1, p.stdout + p.stderr
     assert "'sorcf' has no distributed form" in p.stderr, p.stderr
     assert not (tmp_path / "o" / "runs").exists()
+
+
+def iterations_by_level(out, level):
+    with open(out / "iterations.csv") as f:
+        return [int(r["krylov"]) for r in csv.DictReader(f) if int(r["level"]) == level]
+
+
+def test_a_3d_scene_over_processes_and_its_one_process_family(tmp_path):
+    """block3d, level 1: GMRES (the 3D default) with ilu:0 and mg on 1 and 2 processes, and the
+    one-process family (cf, sorcf, mgr) without --np-list; every cell converged and each N = 1
+    cell is a plain one-process `mlcontact run` with that preconditioner."""
+    cells = {}
+    for args, tag in ((["--np-list", "1,2", "--pc", "ilu:0", "mg"], "np"),
+                      (["--pc", "cf", "sorcf", "mgr"], "one")):
+        out = tmp_path / tag
+        p = subprocess.run([MLCONTACT, "study", "preconditioners", "block3d", "--levels", "1",
+                            *args, "--no-plot", "--out", str(out)],
+                           capture_output=True, text=True, env=ENV, timeout=900)
+        assert p.returncode == 0, p.stdout + p.stderr
+        with open(out / "preconditioners_np.csv") as f:
+            for r in csv.DictReader(f):
+                cells[(r["pc"], int(r["processes"]))] = r
+    assert sorted(cells) == sorted([("ilu:0", 1), ("ilu:0", 2), ("mg", 1), ("mg", 2), ("cf", 1),
+                                    ("sorcf", 1), ("mgr", 1)])
+    for (pc, n), r in cells.items():
+        assert r["result"] == "converged" and r["krylov"] == "gmres", r
+        assert r["level_distributed"] == ("1" if n > 1 else "0"), r
+        if n > 1:
+            continue
+        # The study's friction and penalty (mu 1, r = E / 10 by default) given to a plain run.
+        words = (tmp_path / ("np" if pc in ("ilu:0", "mg") else "one") / "runs" /
+                 f"gmres_{pc.replace(':', '-')}_mu1_r0.1_L1_np1" / "command.txt").read_text().split()
+        mu, r_ = words[words.index("--mu") + 1], words[words.index("--r") + 1]
+        out = tmp_path / f"plain_{pc}"
+        p = subprocess.run([MLCONTACT, "run", "block3d", "--levels", "1", "--pc", pc,
+                            "--linear-tol", "1e-8", "--mu", mu, "--r", r_, "--quiet", "--out",
+                            str(out)],
+                           capture_output=True, text=True, timeout=600,
+                           env=dict(ENV, OMPI_MCA_ess_singleton_isolated="1", OMP_NUM_THREADS="1"))
+        assert p.returncode == 0, p.stdout + p.stderr
+        its = iterations_by_level(out, 1)
+        assert int(r["newton"]) == len(its) > 0, (r, its)
+        assert float(r["krylov_per_newton_mean"]) == pytest.approx(sum(its) / len(its), rel=1e-7)
+        assert float(r["krylov_per_newton_max"]) == max(its)
+    # The multigrid needs fewer iterations than ILU(0) on every process count.
+    for n in (1, 2):
+        assert (float(cells[("mg", n)]["krylov_per_newton_mean"])
+                < float(cells[("ilu:0", n)]["krylov_per_newton_mean"]))

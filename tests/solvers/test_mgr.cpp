@@ -99,7 +99,7 @@ TEST(MGR, RefusesASystemWithoutMultipliersAndBadOptions) {
     EXPECT_THROW(solvers::MGRPreconditioner({0, 1, 5}), InvalidInput);
     solvers::LevelData data;
     data.has_multipliers = true;
-    data.unknown_functions = []() { return std::vector<int>{0, 1, 2}; };
+    data.unknown_functions = []() { return std::vector<int>{0, 1, solvers::kMultiplierFunction}; };
     EXPECT_THROW(solvers::make_preconditioner("mgr:frelax=ilu", &data), InvalidInput);
     EXPECT_THROW(solvers::make_preconditioner("mgr:interp=99", &data), InvalidInput);
     EXPECT_THROW(solvers::make_preconditioner("mgr:theta=2", &data), InvalidInput);
@@ -109,11 +109,13 @@ TEST(MGR, RefusesASystemWithoutMultipliersAndBadOptions) {
 TEST(MGR, AvailableExactlyWhenBuiltWithHypre) {
     // With hypre the preconditioner is built; without it, the message says why not.
     if (solvers::have_hypre()) {
-        EXPECT_NO_THROW(solvers::MGRPreconditioner pc({0, 1, 2}));
+        EXPECT_NO_THROW(solvers::MGRPreconditioner pc({0, 1, solvers::kMultiplierFunction}));
+        // A 3D vertex: x, y and z, then a multiplier.
+        EXPECT_NO_THROW(solvers::MGRPreconditioner pc({0, 1, 2, solvers::kMultiplierFunction}));
         return;
     }
     try {
-        solvers::MGRPreconditioner pc({0, 1, 2});
+        solvers::MGRPreconditioner pc({0, 1, solvers::kMultiplierFunction});
         ADD_FAILURE() << "built without hypre";
     } catch (const InvalidInput& e) {
         EXPECT_NE(std::string(e.what()).find("mgr (hypre MGR) is not available"), std::string::npos)
