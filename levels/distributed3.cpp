@@ -188,53 +188,6 @@ std::vector<int> DistributedLevel3::dof_function() const {
     return f;
 }
 
-namespace {
-
-/// The loading path of a process's part of a level (K = p.n_path_points() > 1), as build_level's:
-/// at every path point k < K the prescribed values of the supports `vs` (held on the part's
-/// vertices, ghost vertices' from their owners) and the loads f_k = F_k - K u_k on the unknowns
-/// (complete on the owned ones: every tetrahedron around an owned vertex is local); the last
-/// point's are u_fixed, elastic.f and elastic.f_nodal_full.
-template <class NodalLoads>
-void set_part_load_path3(const ElasticProblem3& p, Level3& L, std::vector<fem::VertexSupport3> vs,
-                         const GhostExchange3& ghosts, NodalLoads&& nodal_loads_at) {
-    const int K = p.n_path_points();
-    const int nv = L.mesh.n_vertices();
-    L.path_u_fixed.assign(static_cast<size_t>(K), Vector());
-    L.path_f.assign(static_cast<size_t>(K), Vector());
-    L.path_f_nodal.assign(static_cast<size_t>(K), Vector());
-    for (int k = 1; k < K; ++k) {
-        for (size_t i = 0; i < vs.size(); ++i) {
-            const Support3& s = p.supports[i];
-            for (size_t c = 0; c < 3; ++c)
-                if (s.u[c])
-                    vs[i].value[static_cast<Index>(c)] =
-                        Problem::path_value(s.u_path[c], *s.u[c], k, K);
-        }
-        Vector uk = fem::collect_supports(L.mesh, vs).u_fixed;
-        std::vector<double> rec(uk.data(), uk.data() + uk.size());
-        ghosts.vertex_records(rec, 3);
-        for (Index i = 0; i < uk.size(); ++i)
-            uk[i] = rec[static_cast<size_t>(i)];
-        const Vector F = nodal_loads_at(k);
-        const Vector Ku = uk.isZero(0.0) ? Vector::Zero(uk.size())
-                                         : fem::internal_forces(L.mesh, L.materials, uk);
-        Vector f = Vector::Zero(L.dofs.n_dofs());
-        for (int v = 0; v < nv; ++v)
-            for (int c = 0; c < 3; ++c)
-                if (const int dof = L.dofs.u_dof(v, c); dof >= 0)
-                    f[dof] = F[3 * v + c] - Ku[3 * v + c];
-        L.path_u_fixed[static_cast<size_t>(k - 1)] = std::move(uk);
-        L.path_f[static_cast<size_t>(k - 1)] = std::move(f);
-        L.path_f_nodal[static_cast<size_t>(k - 1)] = F;
-    }
-    L.path_u_fixed.back() = L.u_fixed;
-    L.path_f.back() = L.elastic.f;
-    L.path_f_nodal.back() = L.elastic.f_nodal_full;
-}
-
-} // namespace
-
 DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::LocalTetLevel part,
                                            const Communicator& comm) {
     DistributedLevel3 d;
@@ -337,7 +290,14 @@ DistributedLevel3 build_distributed_level3(const ElasticProblem3& p, mesh::Local
         return fem::nodal_loads(m, tr, bk);
     };
     L.elastic = fem::assemble_elastic(m, L.materials, L.dofs, nodal_loads_at(K), L.u_fixed);
-    if (K > 1) set_part_load_path3(p, L, vs, d.ghosts, nodal_loads_at);
+    // Along a loading path, the prescribed values of every path point, ghost vertices' from their
+    // owners (as the last point's above).
+    if (K > 1)
+        detail::set_load_path3(p, L, vs, nodal_loads_at, [&d](Vector& u) {
+            std::vector<double> rec(u.data(), u.data() + u.size());
+            d.ghosts.vertex_records(rec, 3);
+            u = Eigen::Map<const Vector>(rec.data(), u.size());
+        });
 
     // Owned unknowns first.
     d.n_owned = 0;

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 /// @file What levels/elastic3d_levels.cpp shares with levels/elastic3d_sizes.cpp (the level-0
 /// edges and the edges of line supports) and with levels/distributed3.cpp (the contact nodes of a
-/// level or of a process's part of it, and their pinned components). Internal to mlc_levels.
+/// level or of a process's part of it, their pinned components, and the loading path). Internal
+/// to mlc_levels.
 #pragma once
 
 #include "contact/search3.hpp"
@@ -9,6 +10,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,5 +58,15 @@ void pin_held_components3(const ElasticProblem3& p, Level3& L);
 
 /// The message of a two-body pair none of whose `n_nodes` contactor vertices found a target.
 std::string no_target_message(const ContactPair3& pair, std::size_t n_nodes);
+
+/// The loading path of a level whose supports (`vs`, their values those of the last path point),
+/// fixed components, numbering and assembled system at the last path point are set, with
+/// K = p.n_path_points() > 1: Level3::path_u_fixed, path_f and path_f_nodal at every path point
+/// (the last entries are u_fixed, elastic.f and elastic.f_nodal_full). `nodal_loads_at(k)` gives
+/// the nodal loads of path point k; `share(u)` (may be empty) completes the prescribed values of
+/// a point where `vs` does not reach (a process's ghost vertices: their owners' values).
+void set_load_path3(const ElasticProblem3& p, Level3& L, std::vector<fem::VertexSupport3> vs,
+                    const std::function<Vector(int)>& nodal_loads_at,
+                    const std::function<void(Vector&)>& share = {});
 
 } // namespace mlc::levels::detail

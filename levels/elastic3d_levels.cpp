@@ -415,16 +415,10 @@ void detail::pin_held_components3(const ElasticProblem3& p, Level3& L) {
     }
 }
 
-namespace {
-
-/// The loading path of a level whose supports (`vs`, their values those of the last path point),
-/// fixed components, numbering and assembled system at the last path point are set, with
-/// K = p.n_path_points() > 1: Level3::path_u_fixed, path_f and path_f_nodal at every path point
-/// (as the 2D build_level's assemble_loads; the last entries are u_fixed, elastic.f and
-/// elastic.f_nodal_full). `nodal_loads_at(k)` gives the nodal loads of path point k.
-template <class NodalLoads>
-void set_load_path3(const ElasticProblem3& p, Level3& L, std::vector<fem::VertexSupport3> vs,
-                    NodalLoads&& nodal_loads_at) {
+void detail::set_load_path3(const ElasticProblem3& p, Level3& L,
+                            std::vector<fem::VertexSupport3> vs,
+                            const std::function<Vector(int)>& nodal_loads_at,
+                            const std::function<void(Vector&)>& share) {
     const int K = p.n_path_points();
     const int nv = L.mesh.n_vertices();
     L.path_u_fixed.assign(static_cast<size_t>(K), Vector());
@@ -441,6 +435,7 @@ void set_load_path3(const ElasticProblem3& p, Level3& L, std::vector<fem::Vertex
                         Problem::path_value(s.u_path[c], *s.u[c], k, K);
         }
         Vector uk = fem::collect_supports(L.mesh, vs).u_fixed;
+        if (share) share(uk);
         // f_k = F_k,free - K_(free,fixed) u_k, the lifting from the element-wise K u.
         const Vector F = nodal_loads_at(k);
         const Vector Ku = uk.isZero(0.0) ? Vector::Zero(uk.size())
@@ -457,8 +452,6 @@ void set_load_path3(const ElasticProblem3& p, Level3& L, std::vector<fem::Vertex
     L.path_f.back() = L.elastic.f;
     L.path_f_nodal.back() = L.elastic.f_nodal_full;
 }
-
-} // namespace
 
 Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
     Level3 L;
@@ -507,7 +500,7 @@ Level3 build_level(const ElasticProblem3& p, mesh::TetMesh m) {
         return fem::nodal_loads(L.mesh, tr, bk);
     };
     L.elastic = fem::assemble_elastic(L.mesh, L.materials, L.dofs, nodal_loads_at(K), L.u_fixed);
-    if (K > 1) set_load_path3(p, L, std::move(vs), nodal_loads_at);
+    if (K > 1) detail::set_load_path3(p, L, std::move(vs), nodal_loads_at);
     return L;
 }
 

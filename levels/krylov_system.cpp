@@ -2,6 +2,7 @@
 // Krylov + preconditioner on the assembled contact Jacobian, with the level-aware CF, SORCF and
 // EBE preconditioners built from the level (and the level below).
 #include "levels/krylov_system.hpp"
+#include "levels/krylov_system_detail.hpp"
 
 #include "core/check.hpp"
 #include "core/timer.hpp"
@@ -31,26 +32,7 @@ std::vector<Index> level_vertex_blocks(const Level& L) {
     return solvers::vertex_block_starts(owner);
 }
 
-// A Newton-system solver (at fixed statuses) used as a preconditioner: the exact coarse solve
-// when the coarse Jacobian cannot be factored by sparse LU.
-class CoarseSolverAsPreconditioner final : public Preconditioner {
-public:
-    CoarseSolverAsPreconditioner(NewtonSystemSolver& solver, const std::vector<Eigen::Matrix2d>& M)
-        : solver_(&solver), M_(M) {}
-    void setup(const SparseMatrix&) override {}
-    void apply(const Vector& r, Vector& z) const override {
-        z.setZero(r.size());
-        const SolveResult res = solver_->solve(M_, r, z);
-        if (!res.converged)
-            throw SolverBreakdown("the coarse solve (" + solver_->name() +
-                                  ") did not converge: " + res.message);
-    }
-    std::string name() const override { return solver_->name(); }
-
-private:
-    NewtonSystemSolver* solver_;
-    const std::vector<Eigen::Matrix2d>& M_; // the context's coarse statuses, read at each apply
-};
+using CoarseSolverAsPreconditioner = detail::CoarseSolverAsPreconditioner<2>;
 
 class KrylovSystemSolver final : public NewtonSystemSolver {
 public:
@@ -185,13 +167,7 @@ private:
                     coarse_lu_->apply(r, z);
             };
         };
-        d.coarse_solver = [this](const Vector& r, Vector& z) {
-            z.setZero(r.size());
-            const SolveResult res = below_->solver->solve(coarse_M_, r, z);
-            if (!res.converged)
-                throw SolverBreakdown("CF: the coarse solve (" + below_->solver->name() +
-                                      ") did not converge: " + res.message);
-        };
+        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_M_);
         d.top.T = &below_->transfer->T;
         d.top.R = &below_->transfer->R;
         d.top.block_starts = level_vertex_blocks(level_);

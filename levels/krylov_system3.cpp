@@ -3,6 +3,7 @@
 // preconditioners of the matrix alone, CF and SORCF on the split of the level below, and hypre's
 // MGR.
 #include "levels/krylov_system.hpp"
+#include "levels/krylov_system_detail.hpp"
 
 #include "core/check.hpp"
 #include "core/timer.hpp"
@@ -92,26 +93,7 @@ namespace {
 
 using Matrix3 = StatusMatrix<3>;
 
-/// The level below's exact solver at fixed statuses as a preconditioner (the coarse solve when
-/// the coarse Jacobian cannot be factored by sparse LU).
-class CoarseSolver3 final : public Preconditioner {
-public:
-    CoarseSolver3(NewtonSystemSolver3& solver, const std::vector<Matrix3>& M)
-        : solver_(&solver), M_(M) {}
-    void setup(const SparseMatrix&) override {}
-    void apply(const Vector& r, Vector& z) const override {
-        z.setZero(r.size());
-        const SolveResult res = solver_->solve(M_, r, z);
-        if (!res.converged)
-            throw SolverBreakdown("the coarse solve (" + solver_->name() +
-                                  ") did not converge: " + res.message);
-    }
-    std::string name() const override { return solver_->name(); }
-
-private:
-    NewtonSystemSolver3* solver_;
-    const std::vector<Matrix3>& M_; // the coarse statuses, read at each apply
-};
+using CoarseSolver3 = detail::CoarseSolverAsPreconditioner<3>;
 
 class KrylovSystemSolver3 final : public NewtonSystemSolver3 {
 public:
@@ -225,13 +207,7 @@ private:
                     coarse_lu_->apply(r, z);
             };
         };
-        d.coarse_solver = [this](const Vector& r, Vector& z) {
-            z.setZero(r.size());
-            const SolveResult res = below_->solver->solve(coarse_M_, r, z);
-            if (!res.converged)
-                throw SolverBreakdown("CF: the coarse solve (" + below_->solver->name() +
-                                      ") did not converge: " + res.message);
-        };
+        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_M_);
         return d;
     }
 

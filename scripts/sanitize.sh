@@ -74,7 +74,7 @@ out=$dir/ctest.log
 # that take 10 to 22 s under ASan: three aggregation-mg checks on the square (smoothed prolongation,
 # Galerkin product and its refresh), the 3D size predictions, the released axis, the attached
 # Hertz sphere, every preconditioner on the fine system, the 3D secant predictor and the inexact
-# Newton forcing terms.
+# Newton forcing terms; and ILU(0), SORCF and MGR on block3d's level 1 (CF's solve of it runs here).
 # What they run is covered here by the unit tests of the same code (levels, solvers, contact,
 # smoothers, transfer, the hierarchy tests); this keeps .ci/run well under 40 minutes
 # (docs/testing.md#testing-hostile).
@@ -95,7 +95,8 @@ heavy+="|Aggregation\.SmoothedProlongationReproducesRigidModesAwayFromTheSupport
 heavy+="|Aggregation\.GalerkinRefreshOfChangedRowsIsTheFullProduct|Elastic3dLevels\.PredictedSizesAgainstTheBuiltLevels"
 heavy+="|AxisRelease\.AxisHeldThenReleasedWithBalanceAndCoulomb|Contact3Scenes\.Hertz3dSphereIsAttachedAndRefinementPutsItsVerticesOnIt"
 heavy+="|KrylovSystem\.EveryPreconditionerSolvesTheFineSystem|Contact3\.SecantPredictorExactUnderProportionalLoading"
-heavy+="|InexactNewton\.ForcingTermsSaveKrylovIterationsAndGiveTheSameSolution)$"
+heavy+="|InexactNewton\.ForcingTermsSaveKrylovIterationsAndGiveTheSameSolution"
+heavy+="|KrylovSystem3\.EveryOtherPreconditionerOfThe3dFamilyGivesTheMultigridSolution)$"
 if ctest --test-dir "$dir" -LE "^(slow|cli)$" -E "$heavy" -j"$jobs" --output-on-failure > "$out" 2>&1; then
   n=$(grep -oE "out of [0-9]+" "$out" | tail -n 1 | grep -oE "[0-9]+")
   echo "sanitize: ${n:-?} tests passed under address+undefined ($cxx, build-asan;" \

@@ -51,8 +51,10 @@ int study_error_vs_time(const levels::Problem& problem, const ErrorVsTimeOptions
 /// The study of a 3D scene (levels 0..max_level, max_level <= 3; ilu_max_level unused).
 /// Configurations: coarse-to-fine and cold, each with the run's plan (`gmres+mg`: schur or lu on
 /// level 0 by levels::plan_contact3, GMRES + the Galerkin multigrid above; levels 1..max_level),
-/// `schur` and `lu` on every level (levels 0..max_level). The reference is `c2f lu` on level
-/// max_level + reference_offset. Errors of a run on level l: its nodal displacements and its
+/// `schur` and `lu` on every level (levels 0..max_level). The reference is on level
+/// max_level + reference_offset: `c2f lu` where it fits in the process's memory
+/// (lu_reference_fits3), else the run's plan with the Newton and GMRES tolerances at 1e-12.
+/// Errors of a run on level l: its nodal displacements and its
 /// contact tractions (each node's multiplier in global components over its lumped area
 /// levels::contact_areas, a vertex field zero off the contact nodes) are interpolated to the
 /// reference level by the hierarchy's P_vertex (per component, through each refinement); the
@@ -65,5 +67,10 @@ int study_error_vs_time(const levels::Problem& problem, const ErrorVsTimeOptions
 /// reference offset outside 0..2 and a scene without contact.
 int study_error_vs_time3(const levels::ElasticProblem3& problem, const ErrorVsTimeOptions& opt,
                          std::ostream& os);
+
+/// Whether coarse-to-fine sparse LU on every level of `problem` up to `level` fits in `limit`
+/// (levels::plan_contact3 with lu forced), as the 3D study's reference.
+bool lu_reference_fits3(const levels::ElasticProblem3& problem, int level,
+                        const levels::MemoryLimit& limit);
 
 } // namespace mlc::apps

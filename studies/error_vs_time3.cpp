@@ -29,9 +29,12 @@ struct Config3 {
     std::optional<Method3> forced;
 };
 
-/// The reference: coarse-to-fine, sparse LU on every level (exact, and no dense Schur systems,
-/// so it fits at the finest level the others reach).
+/// The reference: coarse-to-fine, sparse LU on every level (exact, and no dense Schur systems)
+/// where it fits in memory; else the multigrid with the Newton and GMRES tolerances at 1e-12
+/// (kReferenceMg3), whose memory grows as the unknowns (the LU's fill grows as their square).
 const char* const kReference3 = "c2f lu";
+const char* const kReferenceMg3 = "c2f gmres+mg, tolerances 1e-12";
+
 
 std::vector<Config3> configurations3() {
     return {{"c2f gmres+mg", true, std::nullopt}, {"cold gmres+mg", false, std::nullopt},
@@ -40,8 +43,9 @@ std::vector<Config3> configurations3() {
 }
 
 /// Solves `problem` on levels 0..level with a configuration (its plan checked against the
-/// process's memory first: a refusal is thrown as InvalidInput).
-levels::RunResult3 solve_config3(levels::ElasticProblem3 problem, const Config3& c, int level) {
+/// process's memory first: a refusal is thrown as InvalidInput), GMRES to krylov_rel_tol.
+levels::RunResult3 solve_config3(levels::ElasticProblem3 problem, const Config3& c, int level,
+                                 double krylov_rel_tol = levels::SolveOptions3{}.krylov_rel_tol) {
     problem.levels = level;
     const levels::Plan3 plan = levels::plan_contact3(levels::predict_elastic3_sizes(problem, level),
                                                      c.forced, levels::process_memory_limit());
@@ -49,6 +53,7 @@ levels::RunResult3 solve_config3(levels::ElasticProblem3 problem, const Config3&
     so.coarse_to_fine = c.coarse_to_fine;
     so.level0 = plan.level0;
     so.upper = plan.upper;
+    so.krylov_rel_tol = krylov_rel_tol;
     return levels::solve(problem, so);
 }
 
@@ -159,7 +164,8 @@ void mark_pareto3(std::vector<Row3>& rows) {
     }
 }
 
-void write_files3(const std::string& scene, int Lref, const std::vector<Row3>& rows,
+void write_files3(const std::string& scene, int Lref, const std::string& reference,
+                  const std::vector<Row3>& rows,
                   const std::filesystem::path& dir) {
     // The 2D study's columns (scripts/plot_error_vs_time.py reads them); no closed form: -1.
     AtomicOfstream csv(dir / "error_vs_time.csv");
@@ -192,7 +198,7 @@ void write_files3(const std::string& scene, int Lref, const std::vector<Row3>& r
     root.insert("scene", scene);
     root.insert("dimension", 3);
     root.insert("reference_level", static_cast<int64_t>(Lref));
-    root.insert("reference_configuration", std::string(kReference3));
+    root.insert("reference_configuration", reference);
     root.insert("runs", jr);
     AtomicOfstream js(dir / "error_vs_time.json");
     js << toml::json_formatter{root} << "\n";
@@ -202,6 +208,17 @@ void write_files3(const std::string& scene, int Lref, const std::vector<Row3>& r
 }
 
 } // namespace
+
+bool lu_reference_fits3(const levels::ElasticProblem3& problem, int level,
+                        const levels::MemoryLimit& limit) {
+    try {
+        (void)levels::plan_contact3(levels::predict_elastic3_sizes(problem, level), Method3::lu,
+                                    limit);
+        return true;
+    } catch (const InvalidInput&) {
+        return false;
+    }
+}
 
 int study_error_vs_time3(const levels::ElasticProblem3& problem, const ErrorVsTimeOptions& opt,
                          std::ostream& os) {
@@ -218,12 +235,24 @@ int study_error_vs_time3(const levels::ElasticProblem3& problem, const ErrorVsTi
     std::filesystem::create_directories(dir);
     const int Lref = opt.max_level + opt.reference_offset;
     const auto configs = configurations3();
-    const Config3& refc = *std::find_if(configs.begin(), configs.end(),
-                                        [](const Config3& c) { return c.name == kReference3; });
+    const bool lu_ref = lu_reference_fits3(problem, Lref, levels::process_memory_limit());
+    const std::string reference = lu_ref ? kReference3 : kReferenceMg3;
     os << "work-precision study: scene '" << problem.name << "' (3D), levels 0.." << opt.max_level
-       << ", reference on level " << Lref << " (" << kReference3 << ")\n"
+       << ", reference on level " << Lref << " (" << reference
+       << (lu_ref ? "" : ": the sparse LU does not fit in memory there") << ")\n"
        << std::flush;
-    const levels::RunResult3 ref = solve_config3(problem, refc, Lref);
+    levels::RunResult3 ref;
+    if (lu_ref) {
+        ref = solve_config3(problem, *std::find_if(configs.begin(), configs.end(),
+                                                   [](const Config3& c) {
+                                                       return c.name == kReference3;
+                                                   }),
+                            Lref);
+    } else {
+        levels::ElasticProblem3 tight = problem;
+        tight.newton.rel_tol = std::min(tight.newton.rel_tol, 1e-12);
+        ref = solve_config3(tight, {"reference", true, std::nullopt}, Lref, 1e-12);
+    }
     if (!ref.converged) {
         os << "error: the reference solve failed: " << ref.failure << "\n";
         return 2;
@@ -278,7 +307,7 @@ int study_error_vs_time3(const levels::ElasticProblem3& problem, const ErrorVsTi
             os << "  " << std::left << std::setw(16) << r.config << std::right << " level "
                << r.level << "  " << std::setprecision(3) << r.seconds << " s  error "
                << r.err.energy << "\n";
-    write_files3(problem.name, Lref, rows, dir);
+    write_files3(problem.name, Lref, reference, rows, dir);
     os << "wrote " << (dir / "error_vs_time.csv").string() << ", error_vs_time.json\n";
     if (opt.plot && run_plot_script("plot_error_vs_time.py", dir, os))
         os << "wrote " << (dir / "error_vs_time.png").string() << "\n";

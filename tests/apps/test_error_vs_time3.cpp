@@ -106,6 +106,18 @@ TEST(ErrorVsTime3, ErrorsAgainstAFinerReferenceFallWithTheLevel) {
     }
 }
 
+// The reference: the sparse LU where it fits, else the multigrid. On block3d with 24 GiB the LU
+// fits on level 3 (about 3.6 GiB) and not on level 4 (about 200 GiB); 10 MiB fits neither.
+TEST(ErrorVsTime3, TheReferenceIsTheSparseLuWhereItFits) {
+    const auto block = scene::load_scene3("block3d");
+    const double gib = 1024.0 * 1024.0 * 1024.0;
+    const levels::MemoryLimit big{24 * gib, "test"}, small{10.0 * 1024 * 1024, "test"};
+    EXPECT_TRUE(apps::lu_reference_fits3(block, 2, big));
+    EXPECT_TRUE(apps::lu_reference_fits3(block, 3, big));
+    EXPECT_FALSE(apps::lu_reference_fits3(block, 4, big));
+    EXPECT_FALSE(apps::lu_reference_fits3(block, 2, small));
+}
+
 TEST(ErrorVsTime3, BadOptionsAndScenesWithoutContactAreRefused) {
     auto refused = [](const levels::ElasticProblem3& p, const apps::ErrorVsTimeOptions& o) {
         std::ostringstream log;
