@@ -39,6 +39,13 @@ const char* to_string(Method3 m) {
     return "?";
 }
 
+LinearSolverSpec gmres_spec3() {
+    LinearSolverSpec k;
+    k.method = solvers::Method::krylov;
+    k.krylov = solvers::Krylov::gmres;
+    return k;
+}
+
 double LevelStep3::agreement() const {
     if (!predicted || final_statuses.empty()) return 1.0;
     int same = 0;

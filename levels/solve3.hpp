@@ -41,6 +41,10 @@ enum class Method3 {
 /// "schur", "lu", "gmres + mg", "krylov".
 const char* to_string(Method3 m);
 
+/// The Krylov solve of Method3::krylov by default: GMRES (restart 50) with the spec's default
+/// preconditioner and limits.
+LinearSolverSpec gmres_spec3();
+
 /// Options of a 3D run that are not part of the problem.
 struct SolveOptions3 {
     /// Coarse-to-fine: every load step solves level 0, then each level from the level below's
@@ -71,12 +75,7 @@ struct SolveOptions3 {
     double krylov_rel_tol = 1e-10;
     /// Method3::krylov: the Krylov method, its preconditioner, iteration limit and restart
     /// (method krylov; its rel_tol is krylov_rel_tol's).
-    LinearSolverSpec krylov = [] {
-        LinearSolverSpec k;
-        k.method = solvers::Method::krylov;
-        k.krylov = solvers::Krylov::gmres;
-        return k;
-    }();
+    LinearSolverSpec krylov = gmres_spec3();
     /// Called after each load step of each solved level (converged or not); may be empty.
     std::function<void(int level, int step, const StepReport&)> progress;
     /// Polled before every Newton iteration; true stops the solve by throwing mlc::Interrupted
