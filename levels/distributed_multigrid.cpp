@@ -603,16 +603,6 @@ struct DistributedMultigrid3::Impl final : detail::DistributedMultigridCore<3> {
 };
 
 namespace {
-/// The Krylov parameters of a 2D spec (its tolerance the floor of solve's forcing).
-solvers::KrylovParams krylov_params(const LinearSolverSpec& spec) {
-    solvers::KrylovParams kp;
-    kp.rel_tol = spec.rel_tol;
-    kp.max_iter = spec.max_iter;
-    kp.restart = spec.restart;
-    kp.give_up_budget = spec.give_up_budget;
-    return kp;
-}
-
 /// The 3D multigrid's spec: GMRES preconditioned by mg.
 LinearSolverSpec gmres_mg_spec() {
     LinearSolverSpec s;
@@ -627,7 +617,7 @@ DistributedMultigrid::DistributedMultigrid(const std::vector<DistributedLevel>& 
                                            const std::vector<DistributedTransfer>& transfers,
                                            const Communicator& comm, LinearSolverSpec spec,
                                            solvers::MultigridParams mg)
-    : impl_(std::make_unique<Impl>(levels, transfers, comm, spec, krylov_params(spec), mg)) {}
+    : impl_(std::make_unique<Impl>(levels, transfers, comm, spec, spec.krylov_params(), mg)) {}
 DistributedMultigrid::~DistributedMultigrid() = default;
 void DistributedMultigrid::set_coarse(const Level& level_p, const std::vector<Eigen::Matrix2d>& M) {
     impl_->set_coarse(level_p, M);

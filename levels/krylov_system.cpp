@@ -32,18 +32,15 @@ std::vector<Index> level_vertex_blocks(const Level& L) {
     return solvers::vertex_block_starts(owner);
 }
 
-using CoarseSolverAsPreconditioner = detail::CoarseSolverAsPreconditioner<2>;
-
 class KrylovSystemSolver final : public NewtonSystemSolver {
 public:
     KrylovSystemSolver(const Level& level, const LinearSolverSpec& spec, const LevelBelow* below)
-        : level_(level), spec_(spec), jac_(level), method_(spec.krylov) {
-        params_.rel_tol = spec.rel_tol;
-        params_.max_iter = spec.max_iter;
-        params_.restart = spec.restart;
-        params_.give_up_budget = spec.give_up_budget;
-        params_.validate();
-        if (below != nullptr && below->available()) below_ = below;
+        : level_(level), spec_(spec), jac_(level), method_(spec.krylov),
+          params_(spec.krylov_params()) {
+        if (below != nullptr && below->available()) {
+            below_ = below;
+            coarse_ = std::make_unique<detail::CoarseJacobian<2>>(*below->coarse, *below->solver);
+        }
         const solvers::PreconditionerEntry* entry = spec.pc.entry;
         const solvers::LevelData data = level_data(entry);
         pc_ = solvers::make_preconditioner(spec.pc, &data);
@@ -84,19 +81,11 @@ public:
     }
     std::string name() const override {
         return std::string(solvers::to_string(spec_.krylov)) + "+" + pc_->name() +
-               (coarse_fallback_.empty()
-                    ? ""
-                    : " (coarse LU singular, coarse solve by the level below's " +
-                          coarse_fallback_ + ")");
+               (coarse_ ? coarse_->note() : std::string());
     }
 
     void set_coarse_statuses(const std::vector<Eigen::Matrix2d>& M) override {
-        if (below_ == nullptr) return;
-        MLC_CHECK(M.size() == below_->coarse->contacts.size(),
-                  "set_coarse_statuses: " << M.size() << " status matrices for "
-                                          << below_->coarse->contacts.size()
-                                          << " contact elements of the level below");
-        coarse_M_ = M;
+        if (coarse_) coarse_->set_statuses(M);
     }
 
     // Assembles J(M) and sets the preconditioner up, unless M is the last call's (as when the
@@ -140,34 +129,15 @@ private:
             }
             return &ebe_elements_;
         };
-        d.unknown_functions = [this]() { // 0 / 1: u_x / u_y; kMultiplierFunction: lambda
-            std::vector<int> f(static_cast<size_t>(level_.n_unknowns()),
-                               solvers::kMultiplierFunction);
-            for (int v = 0; v < level_.dofs.n_vertices(); ++v)
-                for (int c = 0; c < 2; ++c)
-                    if (const int i = level_.dofs.u_dof(v, c); i >= 0)
-                        f[static_cast<size_t>(i)] = c;
-            return f;
-        };
+        d.unknown_functions = [this]() { return detail::unknown_functions(level_); };
         d.aggregation = [this]() { return aggregation_input(level_); };
         if (below_ == nullptr || entry == nullptr || !entry->needs_level_below) return d;
         d.has_level_below = true;
         d.coarse_fine_split = [this](solvers::MultiplierScale scale) {
             return coarse_fine_split(level_, *below_->coarse, *below_->transfer, scale);
         };
-        d.coarse_lu = [this]() -> solvers::CoarseSolve {
-            if (!coarse_lu_) {
-                coarse_jac_ = std::make_unique<JacobianAssembler>(*below_->coarse);
-                coarse_lu_ = std::make_unique<solvers::SparseLUPreconditioner>();
-            }
-            return [this](const Vector& r, Vector& z) {
-                if (coarse_exact_)
-                    coarse_exact_->apply(r, z);
-                else
-                    coarse_lu_->apply(r, z);
-            };
-        };
-        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_M_);
+        d.coarse_lu = [this]() { return coarse_->lu_call(); };
+        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_->statuses_ref());
         d.top.T = &below_->transfer->T;
         d.top.R = &below_->transfer->R;
         d.top.block_starts = level_vertex_blocks(level_);
@@ -205,48 +175,25 @@ private:
     }
 
     // The coarse statuses given by the driver (set_coarse_statuses): the level below's operator
-    // in the multigrid is refreshed (its own solver's, or the coarse Jacobian assembled here and
-    // factored on level 0), and CF/SORCF's coarse LU is refactored when they changed.
+    // in the multigrid is refreshed (its own solver's, or the coarse Jacobian assembled and
+    // factored on the two-level mg's level 0), and CF/SORCF's coarse LU is refactored when they
+    // changed.
     void refresh_coarse() {
-        MLC_CHECK(coarse_M_.size() == below_->coarse->contacts.size(),
-                  spec_.pc << ": the coarse statuses hold " << coarse_M_.size()
-                           << " status matrices for " << below_->coarse->contacts.size()
-                           << " coarse contact elements; solve the level below first and pass "
-                              "its converged statuses (set_coarse_statuses)");
+        const std::string who = spec_.pc.text();
         if (mg_mode_ == MgMode::above) {
             // The level below's own multigrid level, at its converged statuses.
-            below_->solver->prepare(coarse_M_);
+            below_->solver->prepare(coarse_->statuses(who));
             return;
         }
-        if (mg_mode_ == MgMode::two_level && !coarse_jac_)
-            coarse_jac_ = std::make_unique<JacobianAssembler>(*below_->coarse);
-        if (!coarse_jac_ || coarse_fallback_set_ ||
-            (coarse_factored_ && coarse_M_ == coarse_M_used_))
+        if (mg_mode_ != MgMode::two_level) {
+            coarse_->refresh(who);
             return;
-        coarse_jac_->assemble(coarse_M_);
-        try {
-            if (mg_mode_ == MgMode::two_level)
-                mg_->set_operator(0, coarse_jac_->matrix());
-            else if (!coarse_factored_)
-                coarse_lu_->setup(coarse_jac_->matrix());
-            else
-                coarse_lu_->update_values(coarse_jac_->matrix());
-            coarse_factored_ = true;
-            coarse_M_used_ = coarse_M_;
-        } catch (const SolverBreakdown&) {
-            // The coarse Jacobian is singular at these statuses (for instance the tangential
-            // multiplier of a stuck node whose tangential displacement is prescribed: a zero
-            // row and column). The level below's own exact solver (schur) copes with it: from
-            // now on it is the coarse solve, and the name says so.
-            coarse_fallback_set_ = true;
-            coarse_fallback_ = below_->solver->name();
-            if (mg_mode_ == MgMode::two_level)
-                mg_->set_coarse_solver(
-                    std::make_unique<CoarseSolverAsPreconditioner>(*below_->solver, coarse_M_));
-            else
-                coarse_exact_ =
-                    std::make_unique<CoarseSolverAsPreconditioner>(*below_->solver, coarse_M_);
         }
+        coarse_->refresh(
+            who, [this](const SparseMatrix& J) { mg_->set_operator(0, J); },
+            [this](std::unique_ptr<Preconditioner> exact) {
+                mg_->set_coarse_solver(std::move(exact));
+            });
     }
 
     const Level& level_;
@@ -258,20 +205,11 @@ private:
     bool first_ = true;
     std::vector<Eigen::Matrix2d> last_M_; // statuses of the last assembly
     double assembly_seconds_ = 0.0;       // of the last prepare
-    // The level below (null without one), and its converged statuses (set_coarse_statuses).
+    // The level below (null without one) and its Jacobian at the converged statuses
+    // (set_coarse_statuses): CF/SORCF with coarse=lu and the two-level mg's level 0.
     const LevelBelow* below_ = nullptr;
     bool uses_coarse_statuses_ = false;
-    std::vector<Eigen::Matrix2d> coarse_M_;
-    // The coarse Jacobian, assembled here: CF/SORCF with coarse=lu (factored by coarse_lu_) and
-    // the two-level mg (factored on its level 0).
-    std::unique_ptr<JacobianAssembler> coarse_jac_;
-    std::unique_ptr<solvers::SparseLUPreconditioner> coarse_lu_;
-    bool coarse_factored_ = false;
-    std::vector<Eigen::Matrix2d> coarse_M_used_;
-    // When the coarse LU broke down: the level below's exact solver as coarse solve.
-    std::unique_ptr<Preconditioner> coarse_exact_;
-    bool coarse_fallback_set_ = false;
-    std::string coarse_fallback_;
+    std::unique_ptr<detail::CoarseJacobian<2>> coarse_;
     // mg: the multigrid (pc_) and how its coarse operators are filled.
     solvers::Multigrid* mg_ = nullptr;
     MgMode mg_mode_ = MgMode::none;

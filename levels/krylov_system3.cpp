@@ -93,17 +93,10 @@ namespace {
 
 using Matrix3 = StatusMatrix<3>;
 
-using CoarseSolver3 = detail::CoarseSolverAsPreconditioner<3>;
-
 class KrylovSystemSolver3 final : public NewtonSystemSolver3 {
 public:
     KrylovSystemSolver3(const Level3& level, const LinearSolverSpec& spec, const LevelBelow3* below)
-        : level_(level), spec_(spec), jac_(level) {
-        params_.rel_tol = spec.rel_tol;
-        params_.max_iter = spec.max_iter;
-        params_.restart = spec.restart;
-        params_.give_up_budget = spec.give_up_budget;
-        params_.validate();
+        : level_(level), spec_(spec), jac_(level), params_(spec.krylov_params()) {
         const solvers::PreconditionerEntry* entry = spec.pc.entry;
         MLC_CHECK(entry != nullptr, "a 3D Krylov solve needs a preconditioner");
         const std::string why = spec.pc.dimension_reason(3);
@@ -116,6 +109,7 @@ public:
                       spec.pc.name() << " needs the level below: use it with --levels >= 1 "
                                         "(level 0 is solved exactly)");
             below_ = below;
+            coarse_ = std::make_unique<detail::CoarseJacobian<3>>(*below->coarse, *below->solver);
         }
         const solvers::LevelData data = level_data();
         pc_ = solvers::make_preconditioner(spec.pc, &data);
@@ -141,26 +135,18 @@ public:
 
     std::string name() const override {
         return std::string(solvers::to_string(spec_.krylov)) + " + " + spec_.pc.text() +
-               (coarse_fallback_.empty()
-                    ? ""
-                    : " (coarse LU singular, coarse solve by the level below's " +
-                          coarse_fallback_ + ")");
+               (coarse_ ? coarse_->note() : std::string());
     }
 
     void set_coarse_statuses(const std::vector<Matrix3>& M) override {
-        if (below_ == nullptr) return;
-        MLC_CHECK(M.size() == below_->coarse->contacts.size(),
-                  "set_coarse_statuses: " << M.size() << " status matrices for "
-                                          << below_->coarse->contacts.size()
-                                          << " contact elements of the level below");
-        coarse_M_ = M;
+        if (coarse_) coarse_->set_statuses(M);
     }
 
     void prepare(const std::vector<Matrix3>& M) override {
         MLC_CHECK(M.size() == level_.contacts.size(),
                   "prepare: " << M.size() << " status matrices for " << level_.contacts.size()
                               << " contact elements");
-        if (below_ != nullptr) refresh_coarse();
+        if (coarse_) coarse_->refresh(spec_.pc.text());
         assembly_seconds_ = 0.0;
         if (!first_ && M == last_M_) return;
         const double t0 = wall_seconds();
@@ -180,59 +166,16 @@ private:
     solvers::LevelData level_data() {
         solvers::LevelData d;
         d.has_multipliers = !level_.contacts.empty();
-        d.unknown_functions = [this]() { // 0 / 1 / 2: u_x / u_y / u_z; else a multiplier
-            std::vector<int> f(static_cast<size_t>(level_.n_unknowns()),
-                               solvers::kMultiplierFunction);
-            for (int v = 0; v < level_.dofs.n_vertices(); ++v)
-                for (int c = 0; c < 3; ++c)
-                    if (const int i = level_.dofs.u_dof(v, c); i >= 0)
-                        f[static_cast<size_t>(i)] = c;
-            return f;
-        };
+        d.unknown_functions = [this]() { return detail::unknown_functions(level_); };
         if (below_ == nullptr) return d;
         d.has_level_below = true;
         d.coarse_fine_split = [this](solvers::MultiplierScale scale) {
             return coarse_fine_split3(level_, *below_->coarse, *below_->P_vertex, *below_->T_full,
                                       scale);
         };
-        d.coarse_lu = [this]() -> solvers::CoarseSolve {
-            if (!coarse_lu_) {
-                coarse_jac_ = std::make_unique<BasicJacobianAssembler<3>>(*below_->coarse);
-                coarse_lu_ = std::make_unique<solvers::SparseLUPreconditioner>();
-            }
-            return [this](const Vector& r, Vector& z) {
-                if (coarse_exact_)
-                    coarse_exact_->apply(r, z);
-                else
-                    coarse_lu_->apply(r, z);
-            };
-        };
-        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_M_);
+        d.coarse_lu = [this]() { return coarse_->lu_call(); };
+        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_->statuses_ref());
         return d;
-    }
-
-    // The coarse LU of CF/SORCF (coarse=lu) at the coarse statuses the driver passed,
-    // refactored when they changed; the level below's own solver when it is singular.
-    void refresh_coarse() {
-        MLC_CHECK(coarse_M_.size() == below_->coarse->contacts.size(),
-                  spec_.pc << ": the coarse statuses hold " << coarse_M_.size()
-                           << " status matrices for " << below_->coarse->contacts.size()
-                           << " coarse contact elements; solve the level below first and pass "
-                              "its converged statuses (set_coarse_statuses)");
-        if (!coarse_jac_ || coarse_exact_ || (coarse_factored_ && coarse_M_ == coarse_M_used_))
-            return;
-        coarse_jac_->assemble(coarse_M_);
-        try {
-            if (!coarse_factored_)
-                coarse_lu_->setup(coarse_jac_->matrix());
-            else
-                coarse_lu_->update_values(coarse_jac_->matrix());
-            coarse_factored_ = true;
-            coarse_M_used_ = coarse_M_;
-        } catch (const SolverBreakdown&) {
-            coarse_fallback_ = below_->solver->name();
-            coarse_exact_ = std::make_unique<CoarseSolver3>(*below_->solver, coarse_M_);
-        }
     }
 
     const Level3& level_;
@@ -244,13 +187,8 @@ private:
     std::vector<Matrix3> last_M_;
     double assembly_seconds_ = 0.0;
     const LevelBelow3* below_ = nullptr;
-    std::vector<Matrix3> coarse_M_;
-    std::unique_ptr<BasicJacobianAssembler<3>> coarse_jac_;
-    std::unique_ptr<solvers::SparseLUPreconditioner> coarse_lu_;
-    bool coarse_factored_ = false;
-    std::vector<Matrix3> coarse_M_used_;
-    std::unique_ptr<Preconditioner> coarse_exact_;
-    std::string coarse_fallback_;
+    // The level below's Jacobian for CF/SORCF (null without the level below).
+    std::unique_ptr<detail::CoarseJacobian<3>> coarse_;
 };
 
 } // namespace

@@ -499,6 +499,16 @@ void LinearSolverSpec::validate() const {
     MLC_CHECK(restart >= 1, "GMRES restart must be >= 1, found " << restart);
 }
 
+solvers::KrylovParams LinearSolverSpec::krylov_params() const {
+    solvers::KrylovParams kp;
+    kp.rel_tol = rel_tol;
+    kp.max_iter = max_iter;
+    kp.restart = restart;
+    kp.give_up_budget = give_up_budget;
+    kp.validate();
+    return kp;
+}
+
 std::ostream& operator<<(std::ostream& os, const LinearSolverSpec& s) {
     if (s.method != solvers::Method::krylov) return os << s.method;
     return os << s.krylov << " + " << s.pc << " (rel_tol " << s.rel_tol << ", max_iter "

@@ -177,6 +177,9 @@ struct LinearSolverSpec {
     /// preconditioner sweeps by lattices, else the problem's (levels::hierarchy_numbering).
     std::optional<Problem::Numbering> numbering{};
     void validate() const;
+    /// The Krylov parameters of this spec (rel_tol, max_iter, restart, give_up_budget),
+    /// validated.
+    solvers::KrylovParams krylov_params() const;
     /// Whether the preconditioner uses the level below (a Krylov method with such an entry).
     bool uses_level_below() const {
         return method == solvers::Method::krylov && pc.entry != nullptr &&
