@@ -6,9 +6,9 @@
 #include "scene/scene.hpp"
 #include "scene/scene3.hpp"
 #include "solvers/krylov.hpp"
+#include "tests/common/direct_solve.hpp"
 #include "tests/mesh/tet_test_meshes.hpp"
 
-#include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -35,12 +35,9 @@ int mg_cg_iterations(const levels::Hierarchy3& h, Vector& x, double rel_tol = 1e
     return r.iterations;
 }
 
-// The direct solution of a level's system (SimplicialLDLT).
+// The direct solution of a level's system (sparse LU).
 Vector direct_solve(const levels::Level3& L) {
-    const SparseMatrixCol K = L.elastic.K;
-    Eigen::SimplicialLDLT<SparseMatrixCol> ldlt(K);
-    EXPECT_EQ(ldlt.info(), Eigen::Success);
-    return ldlt.solve(L.elastic.f);
+    return test::lu_solve(L.elastic.K, L.elastic.f);
 }
 
 // mg-CG's iterations on levels 1..3 (returned), and the level 1 and 2 solutions against the
