@@ -4,6 +4,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake pkg-config
+  ninja-build                   # the build tool of scripts/*.sh: starts a target's files before the libraries it links are done
   libeigen3-dev libhypre-dev libopenmpi-dev openmpi-bin
   libcgal-dev libtomlplusplus-dev libcli11-dev libgtest-dev libsuitesparse-dev
   libopenblas0-serial           # the BLAS behind CHOLMOD (schur): 1.9-2.5x faster set-up than libblas3

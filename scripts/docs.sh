@@ -17,7 +17,9 @@ command -v doxygen >/dev/null || { echo "docs: doxygen missing: bash scripts/dep
 
 # The Python module (autodoc imports it).
 if [ ! -f "$build/CMakeCache.txt" ]; then
-  cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release > "$build.docs-cmake.log" 2>&1 || {
+  gen=()
+  command -v ninja > /dev/null && gen=(-G Ninja)
+  cmake -S "$root" -B "$build" "${gen[@]}" -DCMAKE_BUILD_TYPE=Release > "$build.docs-cmake.log" 2>&1 || {
     cat "$build.docs-cmake.log" >&2; exit 1; }
 fi
 cmake --build "$build" --target mlc_python -j"${MLC_DOCS_JOBS:-2}" > "$build/docs-module.log" 2>&1 || {

@@ -25,7 +25,9 @@ else
   bash scripts/deps.sh > /dev/null
   cxx=$(command -v clang++-14 || command -v clang++ || true)
   [ -n "$cxx" ] || { echo "fuzz: clang++ not found (libFuzzer needs clang; install clang-14)"; exit 1; }
-  cmake -S . -B "$dir" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
+  gen=()
+  [ ! -f "$dir/CMakeCache.txt" ] && command -v ninja > /dev/null && gen=(-G Ninja)
+  cmake -S . -B "$dir" "${gen[@]}" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
     "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g1 -D_GLIBCXX_ASSERTIONS" -DCGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE=TRUE \
     -DMLC_SANITIZE=ON -DMLC_BUILD_FUZZ=ON -DMLC_WITH_HYPRE=OFF -DMLC_BUILD_BENCH=OFF -DMLC_BUILD_PYTHON=OFF \
     -DMLC_BUILD_TESTS=OFF > "$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; exit 1; }

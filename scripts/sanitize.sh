@@ -45,7 +45,10 @@ start=$(date +%s)
 # -O1: Debug at -O0 makes the Eigen kernels several times slower under ASan. The test files and
 # the run/studies/bench libraries, which drive those kernels, are compiled at -O0 with ASan alone
 # (mlc_sanitize_lightly in CMakeLists.txt): a third of their -O1 compile time.
-cmake -S . -B "$dir" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
+# Ninja where present, as in scripts/build.sh (here it saves about a quarter of the build time).
+gen=()
+[ ! -f "$dir/CMakeCache.txt" ] && command -v ninja > /dev/null && gen=(-G Ninja)
+cmake -S . -B "$dir" "${gen[@]}" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
   "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g1 -D_GLIBCXX_ASSERTIONS" -DCGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE=TRUE \
   -DMLC_SANITIZE=ON -DMLC_WITH_HYPRE=OFF -DMLC_BUILD_BENCH=OFF -DMLC_BUILD_TESTS=ON -DMLC_BUILD_PYTHON=OFF \
   -DMLC_BUILD_FUZZ="$fuzz" > "$log" 2>&1 || { cat "$log"; exit 1; }
