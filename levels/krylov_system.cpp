@@ -137,7 +137,7 @@ private:
             return coarse_fine_split(level_, *below_->coarse, *below_->transfer, scale);
         };
         d.coarse_lu = [this]() { return coarse_->lu_call(); };
-        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_->statuses_ref());
+        d.coarse_solver = coarse_->solver_call();
         d.top.T = &below_->transfer->T;
         d.top.R = &below_->transfer->R;
         d.top.block_starts = level_vertex_blocks(level_);
@@ -179,7 +179,7 @@ private:
     // factored on the two-level mg's level 0), and CF/SORCF's coarse LU is refactored when they
     // changed.
     void refresh_coarse() {
-        const std::string who = spec_.pc.text();
+        const solvers::PcSpec& who = spec_.pc;
         if (mg_mode_ == MgMode::above) {
             // The level below's own multigrid level, at its converged statuses.
             below_->solver->prepare(coarse_->statuses(who));

@@ -146,7 +146,7 @@ public:
         MLC_CHECK(M.size() == level_.contacts.size(),
                   "prepare: " << M.size() << " status matrices for " << level_.contacts.size()
                               << " contact elements");
-        if (coarse_) coarse_->refresh(spec_.pc.text());
+        if (coarse_) coarse_->refresh(spec_.pc);
         assembly_seconds_ = 0.0;
         if (!first_ && M == last_M_) return;
         const double t0 = wall_seconds();
@@ -174,7 +174,7 @@ private:
                                       scale);
         };
         d.coarse_lu = [this]() { return coarse_->lu_call(); };
-        d.coarse_solver = detail::coarse_solver_call(*below_->solver, coarse_->statuses_ref());
+        d.coarse_solver = coarse_->solver_call();
         return d;
     }
 

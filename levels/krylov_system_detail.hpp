@@ -9,6 +9,7 @@
 #include "solvers/coarse_fine.hpp"
 #include "solvers/direct.hpp"
 #include "solvers/hypre/mgr.hpp"
+#include "solvers/pc_spec.hpp"
 
 #include <functional>
 #include <memory>
@@ -81,7 +82,7 @@ public:
         M_ = M;
     }
     /// The statuses passed last; `who` (the preconditioner) is named when none were.
-    const Statuses& statuses(const std::string& who) const {
+    const Statuses& statuses(const solvers::PcSpec& who) const {
         MLC_CHECK(M_.size() == coarse_.contacts.size(),
                   who << ": the coarse statuses hold " << M_.size() << " status matrices for "
                       << coarse_.contacts.size()
@@ -89,8 +90,9 @@ public:
                          "converged statuses (set_coarse_statuses)");
         return M_;
     }
-    /// The statuses' storage, read at each call of what is built on it (coarse_solver_call).
-    const Statuses& statuses_ref() const { return M_; }
+    /// CF/SORCF's coarse=solver: the level below's own solver at the statuses passed last
+    /// (read at each call).
+    solvers::CoarseSolve solver_call() { return coarse_solver_call(solver_, M_); }
 
     /// CF/SORCF's coarse=lu: the sparse LU of the Jacobian (after a breakdown, the exact solve).
     solvers::CoarseSolve lu_call() {
@@ -108,7 +110,7 @@ public:
     /// by the LU of lu_call, or by `factor` when given (then `take` receives the exact solve of
     /// a breakdown). Nothing to do when neither the LU nor `factor` is in use, or after a
     /// breakdown.
-    void refresh(const std::string& who, const Factor& factor = nullptr,
+    void refresh(const solvers::PcSpec& who, const Factor& factor = nullptr,
                  const TakeFallback& take = nullptr) {
         const Statuses& M = statuses(who);
         if (factor && !jac_) jac_ = std::make_unique<BasicJacobianAssembler<dim>>(coarse_);
